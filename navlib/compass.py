@@ -1,0 +1,398 @@
+"""Electronic-compass turntable simulator and the exact planar heading-error model.
+
+Physical story (paper A, Yue et al.): a three-axis magnetometer compass is mounted on a carrier whose
+ferrous structure, DC supply and electronics sit close to it. The carrier stands on a level non-magnetic
+turntable that turns it through a full revolution, read every 3 deg from north (121 readings, 0..360 deg
+inclusive). The compass computes heading from the horizontal field components it measures.
+
+Frames: NED navigation frame; body (carrier) frame x forward, y right, z down; the turntable angle is the
+true magnetic heading ``psi`` (clockwise from magnetic north).  On a level table the Earth field seen in
+the body frame is
+
+    m_b(psi) = [H cos psi, -H sin psi, Z],   H = F cos I,  Z = F sin I           (dip I, total field F)
+
+The carrier distorts it (soft iron ``S``: induced magnetisation proportional to the field; hard iron ``h``:
+permanent magnetisation, possibly drifting with temperature), the sensor is mounted with a small rotation
+``R`` (roll, pitch, yaw misalignment) and has its own per-axis scale errors ``K`` and non-orthogonality
+``N`` (lower-triangular, small angles), plus white noise ``n``:
+
+    m_meas = (I + K) N R [ (I + S) m_b + h(T) ] + n,     h(T) = h0 + dh/dT (T - T0)
+
+and the heading is ``psi_m = atan2(-m_y, m_x)`` (level compass, no tilt compensation).  The heading error
+is ``wrap(psi_m - psi)`` in (-180, 180].
+
+Exact planar model.  Because the table is level, ``Z`` is constant over a sweep, so every effect above
+(including tilt misalignment leaking ``Z`` into x and y) makes the measured horizontal field an affine
+function of the true horizontal unit vector ``r(psi) = [cos psi, -sin psi]``:  ``m_xy = A r + c``.  Heading
+sees only the direction of ``m_xy``, so the overall scale of ``A`` is unobservable and exactly five
+parameters remain.  We write them as named physical effects:
+
+    m_xy  ∝  Rot(yaw) [ (I + [[e, f], [f, -e]]) r(psi) + [hx, hy] ]
+
+``misalignment`` = ``yaw`` (a rotation: a constant heading offset), ``soft_iron`` = ``(e, f)`` (the symmetric,
+trace-free distortion: a two-cycle error), ``hard_iron`` = ``(hx, hy)`` in units of ``H`` (a one-cycle
+error).  This model is *exact* (not a truncated harmonic series); Archibald Smith's A..E deviation
+series (:mod:`navlib.smith`) is its first-order harmonic approximation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import InputError, check_param
+from .tables import Column, read_table
+
+
+def wrap_deg(a):
+    """Wrap angles in degrees to (-180, 180]."""
+    a = np.asarray(a, dtype=float)
+    w = np.mod(a + 180.0, 360.0) - 180.0
+    return np.where(w == -180.0, 180.0, w)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Simulator
+# ----------------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class EarthField:
+    """The local geomagnetic field. Defaults: Shenyang (41.8 N, 123.4 E), where paper A's authors work:
+    about 54 uT total intensity with 60 deg dip (IGRF order of magnitude)."""
+
+    total_ut: float = 54.0
+    dip_deg: float = 60.0
+
+    @property
+    def horizontal_ut(self) -> float:
+        return self.total_ut * np.cos(np.radians(self.dip_deg))
+
+    @property
+    def vertical_ut(self) -> float:
+        return self.total_ut * np.sin(np.radians(self.dip_deg))
+
+
+@dataclass(frozen=True)
+class CompassErrors:
+    """Error sources of a carrier-mounted three-axis magnetometer compass (see module docstring).
+
+    Defaults tell a plausible story: the compass sits about a decimetre from steel structure and a DC
+    supply, whose permanent magnetisation (hard iron, ~10 uT, over a third of H) dominates; the steel's induced
+    magnetisation (soft iron, up to 8 per cent) adds a two-cycle error; the sensor has 1-2 % scale mismatch,
+    a fraction of a degree non-orthogonality and a 1.6 deg mounting yaw.  With these values the
+    uncompensated heading error spans about -16..+30.7 deg, as in paper A's Fig 2.
+    """
+
+    hard_iron_ut: tuple[float, float, float] = (-6.1, 7.7, 3.0)
+    soft_iron: tuple[tuple[float, float, float], ...] = ((0.08, 0.08, 0.01),
+                                                          (-0.03, -0.08, 0.00),
+                                                          (0.01, 0.00, 0.03))
+    scale_error: tuple[float, float, float] = (0.015, -0.01, 0.005)
+    nonorthogonality_deg: tuple[float, float, float] = (0.4, 0.2, -0.3)   # xy, xz, yz
+    misalignment_deg: tuple[float, float, float] = (0.3, -0.5, 1.6)       # roll, pitch, yaw
+    hard_iron_tc_ut_per_c: tuple[float, float, float] = (0.0, 0.0, 0.0)  # hard-iron drift with temperature
+    reference_temperature_c: float = 20.0
+    noise_ut: float = 0.04                                                # white noise per axis, 1 sigma
+
+    def validate(self) -> "CompassErrors":
+        check_param("noise_ut", self.noise_ut, lo=0)
+        for name in ("hard_iron_ut", "scale_error", "nonorthogonality_deg", "misalignment_deg",
+                     "hard_iron_tc_ut_per_c"):
+            v = np.asarray(getattr(self, name), dtype=float)
+            if v.shape != (3,) or not np.all(np.isfinite(v)):
+                raise InputError(f"parameter {name}={getattr(self, name)!r}: must be three finite numbers")
+        s = np.asarray(self.soft_iron, dtype=float)
+        if s.shape != (3, 3) or not np.all(np.isfinite(s)):
+            raise InputError(f"parameter soft_iron: must be a 3x3 matrix of finite numbers")
+        if np.any(np.abs(np.asarray(self.scale_error)) >= 0.5):
+            raise InputError("parameter scale_error: each axis must be within (-0.5, 0.5)")
+        return self
+
+    def scaled(self, factor: float) -> "CompassErrors":
+        """All deterministic error sources multiplied by ``factor`` (noise unchanged)."""
+        return replace(self,
+                       hard_iron_ut=tuple(factor * np.asarray(self.hard_iron_ut)),
+                       soft_iron=tuple(map(tuple, factor * np.asarray(self.soft_iron))),
+                       scale_error=tuple(factor * np.asarray(self.scale_error)),
+                       nonorthogonality_deg=tuple(factor * np.asarray(self.nonorthogonality_deg)),
+                       misalignment_deg=tuple(factor * np.asarray(self.misalignment_deg)),
+                       hard_iron_tc_ut_per_c=tuple(factor * np.asarray(self.hard_iron_tc_ut_per_c)))
+
+
+NO_ERRORS = CompassErrors(hard_iron_ut=(0.0, 0.0, 0.0), soft_iron=((0.0,) * 3,) * 3,
+                          scale_error=(0.0, 0.0, 0.0), nonorthogonality_deg=(0.0, 0.0, 0.0),
+                          misalignment_deg=(0.0, 0.0, 0.0), noise_ut=0.0)
+
+
+@dataclass(frozen=True)
+class SweepConfig:
+    """A turntable sweep: ``n_points`` readings from ``start_deg`` every ``step_deg`` (paper A: 121 points,
+    0..360 deg every 3 deg). ``temperature_c`` is the temperature at the first reading and
+    ``temperature_rate_c_per_point`` its change per reading (a warming carrier). ``gravity_noise_ms2`` and
+    the glitch settings serve the ELM patent's data preparation: an occasional reading is hit by a field
+    spike of ``glitch_ut`` in a random direction with probability ``glitch_prob``."""
+
+    n_points: int = 121
+    start_deg: float = 0.0
+    step_deg: float = 3.0
+    temperature_c: float = 20.0
+    temperature_rate_c_per_point: float = 0.0
+    gravity_ms2: float = 9.80
+    gravity_noise_ms2: float = 0.002
+    glitch_prob: float = 0.0
+    glitch_ut: float = 15.0
+
+    def validate(self) -> "SweepConfig":
+        check_param("n_points", self.n_points, lo=2, integer=True)
+        check_param("step_deg", self.step_deg, lo=0, lo_open=True, hi=360)
+        check_param("gravity_noise_ms2", self.gravity_noise_ms2, lo=0)
+        check_param("glitch_prob", self.glitch_prob, lo=0, hi=1)
+        check_param("glitch_ut", self.glitch_ut, lo=0)
+        return self
+
+
+def _rot_x(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, s], [0, -s, c]])
+
+
+def _rot_y(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, -s], [0, 1, 0], [s, 0, c]])
+
+
+def _rot_z(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
+
+
+def mounting_matrix(misalignment_deg) -> np.ndarray:
+    """Body-to-sensor rotation for mounting errors (roll, pitch, yaw) in degrees, yaw applied first."""
+    roll, pitch, yaw = np.radians(np.asarray(misalignment_deg, dtype=float))
+    return _rot_x(roll) @ _rot_y(pitch) @ _rot_z(yaw)
+
+
+def sensor_matrix(err: CompassErrors) -> np.ndarray:
+    """``(I + K) N R``: scale errors, non-orthogonality (small angles xy, xz, yz) and mounting rotation."""
+    a_xy, a_xz, a_yz = np.radians(np.asarray(err.nonorthogonality_deg, dtype=float))
+    nonorth = np.array([[1.0, 0.0, 0.0], [a_xy, 1.0, 0.0], [a_xz, a_yz, 1.0]])
+    return np.diag(1.0 + np.asarray(err.scale_error, dtype=float)) @ nonorth @ mounting_matrix(
+        err.misalignment_deg)
+
+
+def heading_from_field(m_xyz) -> np.ndarray:
+    """Level-compass heading in [0, 360) deg from sensor-frame field components (x fwd, y right, z down)."""
+    m = np.asarray(m_xyz, dtype=float)
+    return np.mod(np.degrees(np.arctan2(-m[..., 1], m[..., 0])), 360.0)
+
+
+def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField = EarthField(),
+                   config: SweepConfig = SweepConfig(), seed: int | None = 0,
+                   sweep: int = 1) -> pd.DataFrame:
+    """One turntable sweep. Returns a frame with ``true_heading_deg``, ``measured_heading_deg`` (in [0, 360)),
+    ``heading_error_deg`` (wrapped measured - true), the raw field ``mag_x_ut, mag_y_ut, mag_z_ut``, the
+    accelerometer ``acc_x_ms2, acc_y_ms2, acc_z_ms2`` (specific force, sensor frame), ``temperature_c``,
+    ``glitch`` (1 where a spike was injected) and ``sweep``."""
+    errors.validate()
+    config.validate()
+    rng = np.random.default_rng(seed)
+    psi = config.start_deg + config.step_deg * np.arange(config.n_points)
+    true = np.where(psi == 360.0, 360.0, np.mod(psi, 360.0))   # paper A reads 0..360 inclusive
+    p = np.radians(psi)
+    H, Z = earth.horizontal_ut, earth.vertical_ut
+    m_b = np.stack([H * np.cos(p), -H * np.sin(p), np.full_like(p, Z)], axis=1)
+    temp = config.temperature_c + config.temperature_rate_c_per_point * np.arange(config.n_points)
+    h = (np.asarray(errors.hard_iron_ut, dtype=float)[None, :]
+         + np.outer(temp - errors.reference_temperature_c, np.asarray(errors.hard_iron_tc_ut_per_c)))
+    carrier = m_b @ (np.eye(3) + np.asarray(errors.soft_iron, dtype=float)).T + h
+    T = sensor_matrix(errors)
+    mag = carrier @ T.T + errors.noise_ut * rng.standard_normal(carrier.shape)
+    glitch = rng.random(config.n_points) < config.glitch_prob
+    if glitch.any():
+        d = rng.standard_normal((int(glitch.sum()), 3))
+        mag[glitch] += config.glitch_ut * d / np.linalg.norm(d, axis=1, keepdims=True)
+    f_body = np.array([0.0, 0.0, -config.gravity_ms2])      # level and static: specific force points up
+    acc = np.tile(mounting_matrix(errors.misalignment_deg) @ f_body, (config.n_points, 1))
+    acc += config.gravity_noise_ms2 * rng.standard_normal(acc.shape)
+    measured = heading_from_field(mag)
+    return pd.DataFrame({
+        "true_heading_deg": true, "measured_heading_deg": measured,
+        "heading_error_deg": wrap_deg(measured - true),
+        "mag_x_ut": mag[:, 0], "mag_y_ut": mag[:, 1], "mag_z_ut": mag[:, 2],
+        "acc_x_ms2": acc[:, 0], "acc_y_ms2": acc[:, 1], "acc_z_ms2": acc[:, 2],
+        "temperature_c": temp, "glitch": glitch.astype(int), "sweep": sweep,
+    })
+
+
+def simulate_train_test(errors: CompassErrors = CompassErrors(), earth: EarthField = EarthField(),
+                        config: SweepConfig = SweepConfig(), seed: int = 2024) -> pd.DataFrame:
+    """Paper A's experiment: the same carrier swept twice with independent noise; ``sweep`` 1 trains,
+    ``sweep`` 2 tests. Both are drawn deterministically from ``seed``."""
+    s1, s2 = np.random.SeedSequence(seed).spawn(2)
+    return pd.concat([simulate_sweep(errors, earth, config, seed=np.random.default_rng(s1), sweep=1),
+                      simulate_sweep(errors, earth, config, seed=np.random.default_rng(s2), sweep=2)],
+                     ignore_index=True)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Loading measured sweeps
+# ----------------------------------------------------------------------------------------------------------
+
+SWEEP_COLUMNS = [
+    Column("true_heading_deg", "deg", lo=0.0, hi=360.0),
+    Column("measured_heading_deg", "deg", lo=0.0, hi=360.0),
+    Column("sweep", "", required=False, lo=0, integer=True),
+    Column("temperature_c", "degC", required=False, lo=-80, hi=150),
+    Column("time_s", "s", required=False, lo=0),
+    Column("mag_x_ut", "uT", required=False), Column("mag_y_ut", "uT", required=False),
+    Column("mag_z_ut", "uT", required=False),
+    Column("acc_x_ms2", "m/s^2", required=False), Column("acc_y_ms2", "m/s^2", required=False),
+    Column("acc_z_ms2", "m/s^2", required=False),
+]
+
+
+def load_sweeps(path, *, min_points: int = 8) -> pd.DataFrame:
+    """Load a compass sweep CSV (one or several sweeps told apart by an optional ``sweep`` column) and
+    validate it.  Errors (one line, naming file, column and row): missing or misnamed columns, non-numeric
+    values, empty cells or NaN, headings outside 0..360 deg, headings that look like radians (every value
+    within 0..2*pi over a sweep spanning more than a few degrees), a true heading repeated within a sweep
+    (except 0 and 360 closing the circle), and fewer than ``min_points`` readings in a sweep."""
+    frame = read_table(path, SWEEP_COLUMNS, min_rows=min_points, kind="compass sweep")
+    name = Path(path).name
+    if "sweep" not in frame:
+        frame["sweep"] = 1
+    frame["sweep"] = frame["sweep"].astype(int)
+    for col in ("true_heading_deg", "measured_heading_deg"):
+        v = frame[col].to_numpy()
+        if v.max() <= 2 * np.pi + 1e-9 and len(v) >= 4:
+            raise InputError(f"{name}: column '{col}': every value is within 0..{2 * np.pi:.4f}; these look "
+                             f"like radians, the column must be in degrees")
+    for sweep_id, part in frame.groupby("sweep", sort=True):
+        if len(part) < min_points:
+            raise InputError(f"{name}: sweep {sweep_id} has {len(part)} readings, at least {min_points} "
+                             f"are needed")
+        t = part["true_heading_deg"].to_numpy()
+        key = np.round(np.where(t >= 360.0, t - 360.0, t), 9)
+        closing = (t >= 360.0)
+        dup = pd.Series(key[~closing]).duplicated().to_numpy()
+        if dup.any():
+            r = int(part.index[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]])
+            raise InputError(f"{name}: column 'true_heading_deg', row {r + 1} (file line {r + 2}): heading "
+                             f"{t[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]]:g} is repeated in "
+                             f"sweep {sweep_id}")
+    return frame
+
+
+def split_sweeps(frame: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(train, test) = sweep 1 and sweep 2 of a two-sweep frame, as in paper A."""
+    ids = sorted(frame["sweep"].unique())
+    if len(ids) < 2:
+        raise InputError(f"need two sweeps (train and test), found {len(ids)}")
+    return (frame[frame.sweep == ids[0]].reset_index(drop=True),
+            frame[frame.sweep == ids[1]].reset_index(drop=True))
+
+
+def unwrap_measured(true_deg, measured_deg) -> np.ndarray:
+    """The measured heading unwrapped along the sweep so that it runs continuously with the turntable
+    (paper A feeds the measured heading to a single-input network; the wrap at 0/360 would break the
+    one-to-one mapping).  The unwrapping uses only the reading order, never the true value."""
+    m = np.degrees(np.unwrap(np.radians(np.asarray(measured_deg, dtype=float))))
+    # start the branch within +-180 deg of the first true heading (the table starts at north)
+    first = np.asarray(true_deg, dtype=float)[0]
+    return m - 360.0 * np.round((m[0] - first) / 360.0)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Exact planar model (our physical reference)
+# ----------------------------------------------------------------------------------------------------------
+
+PLANAR_EFFECTS = {
+    "misalignment": ("yaw_deg",),
+    "hard_iron": ("hard_x", "hard_y"),
+    "soft_iron": ("soft_e", "soft_f"),
+}
+
+
+@dataclass
+class PlanarModel:
+    """Exact level-compass heading model ``m_xy ∝ Rot(yaw) [(I + [[e, f], [f, -e]]) r(psi) + h]`` (see module
+    docstring). ``hard_x, hard_y`` are in units of the horizontal field H. Effects not in ``effects`` are
+    held at zero."""
+
+    effects: tuple[str, ...] = ("misalignment", "hard_iron", "soft_iron")
+    params: dict = field(default_factory=dict)
+
+    def full_params(self) -> dict:
+        p = {name: 0.0 for names in PLANAR_EFFECTS.values() for name in names}
+        p.update(self.params)
+        return p
+
+    def _field(self, true_deg):
+        p = self.full_params()
+        t = np.radians(np.asarray(true_deg, dtype=float))
+        r = np.stack([np.cos(t), -np.sin(t)])
+        S = np.array([[1 + p["soft_e"], p["soft_f"]], [p["soft_f"], 1 - p["soft_e"]]])
+        m = S @ r + np.array([[p["hard_x"]], [p["hard_y"]]])
+        y = np.radians(p["yaw_deg"])
+        R = np.array([[np.cos(y), np.sin(y)], [-np.sin(y), np.cos(y)]])
+        return R @ m
+
+    def predict_measured(self, true_deg) -> np.ndarray:
+        """Measured heading (deg, [0, 360)) the model predicts for the true headings."""
+        m = self._field(true_deg)
+        return np.mod(np.degrees(np.arctan2(-m[1], m[0])), 360.0)
+
+    def predict_error(self, true_deg) -> np.ndarray:
+        return wrap_deg(self.predict_measured(true_deg) - np.asarray(true_deg, dtype=float))
+
+    def correct(self, measured_deg) -> np.ndarray:
+        """Invert the model: the true heading (deg, [0, 360)) that yields each measured heading.  Solves
+        ``|S^-1 (lambda R^-1 u - h)| = 1`` for the positive scale ``lambda`` along the measured direction
+        ``u``; the closed form needs ``|h| < 1`` in the S-metric (the compass still sees north)."""
+        p = self.full_params()
+        a = np.radians(np.asarray(measured_deg, dtype=float))
+        u = np.stack([np.cos(a), -np.sin(a)])
+        y = np.radians(p["yaw_deg"])
+        R = np.array([[np.cos(y), np.sin(y)], [-np.sin(y), np.cos(y)]])
+        S = np.array([[1 + p["soft_e"], p["soft_f"]], [p["soft_f"], 1 - p["soft_e"]]])
+        Si = np.linalg.inv(S)
+        a_vec = Si @ (R.T @ u)
+        b_vec = Si @ np.array([p["hard_x"], p["hard_y"]])
+        A = np.sum(a_vec ** 2, axis=0)
+        B = -2 * (b_vec @ a_vec)
+        C = b_vec @ b_vec - 1.0
+        disc = np.maximum(B ** 2 - 4 * A * C, 0.0)
+        lam = (-B + np.sqrt(disc)) / (2 * A)
+        r = lam * a_vec - b_vec[:, None]
+        return np.mod(np.degrees(np.arctan2(-r[1], r[0])), 360.0)
+
+
+def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron", "soft_iron"),
+                     initial: dict | None = None) -> PlanarModel:
+    """Fit the exact planar model's named effects by nonlinear least squares (scipy ``least_squares``,
+    trust-region reflective) on the wrapped heading residual ``wrap(model(true) - measured)``."""
+    from scipy.optimize import least_squares
+
+    unknown = [e for e in effects if e not in PLANAR_EFFECTS]
+    if unknown:
+        raise InputError(f"unknown compass effect '{unknown[0]}'; known: {', '.join(PLANAR_EFFECTS)}")
+    names = [n for e in effects for n in PLANAR_EFFECTS[e]]
+    true_deg = np.asarray(true_deg, dtype=float)
+    measured_deg = np.asarray(measured_deg, dtype=float)
+    if len(true_deg) < len(names) + 1:
+        raise InputError(f"{len(true_deg)} readings cannot determine {len(names)} model parameters")
+    x0 = np.array([(initial or {}).get(n, 0.0) for n in names])
+    if "yaw_deg" in names and not initial:
+        x0[names.index("yaw_deg")] = float(np.degrees(np.angle(np.mean(
+            np.exp(1j * np.radians(measured_deg - true_deg))))))
+
+    def resid(x):
+        model = PlanarModel(tuple(effects), dict(zip(names, x)))
+        return wrap_deg(model.predict_measured(true_deg) - measured_deg)
+
+    lo = np.array([-180.0 if n == "yaw_deg" else -0.95 for n in names])
+    hi = -lo
+    sol = least_squares(resid, x0, bounds=(lo, hi), x_scale="jac", method="trf")
+    return PlanarModel(tuple(effects), dict(zip(names, map(float, sol.x))))

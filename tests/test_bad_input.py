@@ -1,0 +1,147 @@
+"""Every bad input gets one line that names the file, column and row (or the parameter)."""
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from navlib.compass import load_sweeps, simulate_train_test
+from navlib.compass_study import StudyParams
+from navlib.errors import InputError
+from navlib.tables import write_new_csv
+
+
+@pytest.fixture
+def good(tmp_path):
+    d = simulate_train_test()[["true_heading_deg", "measured_heading_deg", "sweep"]]
+    return d
+
+
+def write(tmp_path, frame, name="sweep.csv"):
+    p = tmp_path / name
+    frame.to_csv(p, index=False)
+    return p
+
+
+def one_line(err):
+    msg = str(err.value)
+    assert "\n" not in msg
+    return msg
+
+
+def test_good_file_loads(tmp_path, good):
+    d = load_sweeps(write(tmp_path, good))
+    assert len(d) == 242 and set(d.sweep) == {1, 2}
+
+
+def test_missing_column(tmp_path, good):
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, good.drop(columns="measured_heading_deg")))
+    assert "sweep.csv: missing column 'measured_heading_deg'" in one_line(e)
+
+
+def test_misnamed_column_gets_a_suggestion(tmp_path, good):
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, good.rename(columns={"true_heading_deg": "true_heading"})))
+    msg = one_line(e)
+    assert "missing column 'true_heading_deg'" in msg and "'true_heading'" in msg
+
+
+def test_non_numeric_value_names_row(tmp_path, good):
+    g = good.astype(object)
+    g.loc[6, "measured_heading_deg"] = "12.3deg"
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, g))
+    assert one_line(e) == ("sweep.csv: column 'measured_heading_deg', row 7 (file line 8): "
+                           "'12.3deg' is not a number")
+
+
+@pytest.mark.parametrize("value,expect", [(np.nan, "is empty"), ("nan", "not a finite number")])
+def test_nan_names_row(tmp_path, good, value, expect):
+    g = good.astype(object)
+    g.loc[10, "true_heading_deg"] = value
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, g))
+    msg = one_line(e)
+    assert "column 'true_heading_deg', row 11" in msg and expect in msg
+
+
+def test_heading_outside_range(tmp_path, good):
+    g = good.copy()
+    g.loc[3, "measured_heading_deg"] = 365.0
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, g))
+    assert "column 'measured_heading_deg', row 4 (file line 5): 365.0 is outside 0..360 deg" in one_line(e)
+    g.loc[3, "measured_heading_deg"] = -3.0
+    with pytest.raises(InputError, match="row 4 .*outside"):
+        load_sweeps(write(tmp_path, g))
+
+
+def test_radians_are_detected(tmp_path, good):
+    g = good.copy()
+    g["true_heading_deg"] = np.radians(g["true_heading_deg"])
+    g["measured_heading_deg"] = np.radians(g["measured_heading_deg"])
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, g))
+    assert "look like radians" in one_line(e) and "'true_heading_deg'" in one_line(e)
+
+
+def test_duplicated_reading(tmp_path, good):
+    g = good.copy()
+    g.loc[5, "true_heading_deg"] = g.loc[4, "true_heading_deg"]
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, g))
+    assert "column 'true_heading_deg', row 6 (file line 7): heading 12 is repeated in sweep 1" in one_line(e)
+
+
+def test_too_few_readings(tmp_path, good):
+    with pytest.raises(InputError) as e:
+        load_sweeps(write(tmp_path, good.iloc[:5]))
+    assert "5 data rows" in one_line(e) and "at least 8" in one_line(e)
+    g = pd.concat([good[good.sweep == 1], good[good.sweep == 2].iloc[:4]])
+    with pytest.raises(InputError, match="sweep 2 has 4 readings"):
+        load_sweeps(write(tmp_path, g))
+
+
+def test_missing_file_and_not_csv(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        load_sweeps(tmp_path / "nope.csv")
+    (tmp_path / "empty.csv").write_text("")
+    with pytest.raises(InputError, match="empty.csv: file is empty"):
+        load_sweeps(tmp_path / "empty.csv")
+
+
+def test_write_never_overwrites(tmp_path, good):
+    p = write(tmp_path, good, "mine.csv")
+    before = p.read_bytes()
+    with pytest.raises(InputError, match="already exists"):
+        write_new_csv(good.iloc[:3], p)
+    assert p.read_bytes() == before
+
+
+@pytest.mark.parametrize("kw,name", [({"pop_size": 3}, "NP"), ({"de_f": 0}, "F"), ({"de_f": 2.1}, "F"),
+                                     ({"ade_f_max": 3}, "F"), ({"de_cr": -0.1}, "CR"),
+                                     ({"n_hidden": 0}, "n_hidden"), ({"network_target": "x"}, "network_target")])
+def test_bad_notebook_parameters(kw, name):
+    with pytest.raises(InputError, match=name):
+        StudyParams(**kw).validate()
+
+
+def test_negative_noise_parameter():
+    from dataclasses import replace
+
+    from navlib.compass import CompassErrors
+    with pytest.raises(InputError, match="noise_ut=-0.1"):
+        replace(CompassErrors(), noise_ut=-0.1).validate()
+
+
+def test_cli_refuses_to_overwrite_and_exits_2(tmp_path):
+    out = tmp_path / "s.csv"
+    ok = subprocess.run([sys.executable, "-m", "navlib", "simulate-compass", str(out)], capture_output=True,
+                        text=True)
+    assert ok.returncode == 0 and out.exists()
+    again = subprocess.run([sys.executable, "-m", "navlib", "simulate-compass", str(out), "--noise-ut", "-1"],
+                           capture_output=True, text=True)
+    assert again.returncode == 2
+    assert len(again.stderr.strip().splitlines()) == 1 and "Traceback" not in again.stderr

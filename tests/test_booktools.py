@@ -1,0 +1,27 @@
+import nbformat
+
+from navlib.booktools import check_html, strip_metadata
+
+
+def test_check_html_flags_remote_assets(tmp_path):
+    (tmp_path / "ok.html").write_text('<script src="_static/mathjax/tex-chtml.js"></script>')
+    assert check_html(tmp_path) == 0
+    (tmp_path / "bad.html").write_text('<script src="https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex.js"></script>')
+    assert check_html(tmp_path) == 1
+
+
+def test_check_html_flags_tracebacks(tmp_path):
+    (tmp_path / "p.html").write_text("<pre>Traceback (most recent call last):</pre>")
+    assert check_html(tmp_path) == 1
+
+
+def test_strip_metadata_removes_timings():
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["papermill"] = {"duration": 1.0}
+    cell = nbformat.v4.new_code_cell("1")
+    cell.metadata["papermill"] = {"duration": 0.1}
+    cell.metadata["execution"] = {"iopub.status.busy": "x"}
+    cell.execution_count = 3
+    nb.cells.append(cell)
+    strip_metadata(nb)
+    assert "papermill" not in nb.metadata and cell.metadata == {} and cell.execution_count is None

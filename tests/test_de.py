@@ -1,0 +1,88 @@
+import numpy as np
+import pytest
+from scipy.optimize import differential_evolution
+
+from navlib.de import DEParams, ade_cr, ade_f, distinct_triples, evolve
+from navlib.errors import InputError
+
+
+def shifted_sphere(pop):
+    return np.sum((pop - 1.5) ** 2, axis=1)
+
+
+def rastrigin(pop):
+    return 10 * pop.shape[1] + np.sum(pop ** 2 - 10 * np.cos(2 * np.pi * pop), axis=1)
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_de_finds_known_optimum(adaptive):
+    res = evolve(shifted_sphere, 5, DEParams(pop_size=40, max_generations=400, target_fitness=1e-12,
+                                             bound=5, adaptive=adaptive, seed=1))
+    assert np.allclose(res.x, 1.5, atol=1e-4)
+    assert res.fitness < 1e-8
+
+
+def test_de_on_multimodal_function_reaches_global_optimum():
+    res = evolve(rastrigin, 3, DEParams(pop_size=40, max_generations=600, target_fitness=1e-10, bound=5.12,
+                                        f=0.5, cr=0.9, seed=0))
+    assert np.allclose(res.x, 0.0, atol=1e-3)
+
+
+def test_de_stops_at_target_and_history_never_rises():
+    res = evolve(shifted_sphere, 4, DEParams(pop_size=20, max_generations=2000, target_fitness=1e-3,
+                                             bound=5, seed=2))
+    assert res.reached_target and res.fitness <= 1e-3 and res.generations < 2000
+    assert np.all(np.diff(res.history) <= 0)
+    assert res.n_evaluations == 20 * (res.generations + 1)
+
+
+def test_de_is_deterministic_with_seed_and_respects_bounds():
+    p = DEParams(pop_size=12, max_generations=50, bound=2.0, seed=5)
+    a, b = evolve(shifted_sphere, 3, p), evolve(shifted_sphere, 3, p)
+    assert np.array_equal(a.x, b.x)
+    assert np.all(np.abs(a.population) <= 2.0)
+
+
+def test_de_matches_scipy_quality_on_same_budget():
+    ours = evolve(rastrigin, 4, DEParams(pop_size=40, max_generations=300, f=0.5, cr=0.6, bound=5.12,
+                                         target_fitness=-1, seed=3))
+    ref = differential_evolution(lambda x: rastrigin(x.T), [(-5.12, 5.12)] * 4, strategy="rand1bin",
+                                 popsize=10, maxiter=300, mutation=0.5, recombination=0.6, tol=0,
+                                 polish=False, init="random", updating="deferred", vectorized=True, seed=3)
+    assert ours.fitness <= ref.fun + 1.0
+
+
+def test_ade_f_schedule():
+    g = np.arange(3000)
+    f = ade_f(g, 3000, 0.3, 0.9)
+    assert f[0] == pytest.approx(0.9) and f[-1] == pytest.approx(0.3)
+    assert np.all(np.diff(f) < 0)
+    assert f[1500] == pytest.approx(0.9 - 0.6 * 1500 / 2999)
+
+
+def test_ade_cr_from_fitness_rank():
+    fit = np.array([5.0, 1.0, 3.0, 9.0])
+    cr = ade_cr(fit, 0.1, 0.9)
+    assert cr[1] == pytest.approx(0.1)            # best -> CR_min
+    assert cr[3] == pytest.approx(0.9)            # worst -> CR_max
+    assert cr[2] == pytest.approx(0.1 + 0.8 * 2 / 8)
+    assert np.allclose(ade_cr(np.ones(4)), 0.1)   # no spread -> CR_min
+
+
+def test_distinct_triples():
+    rng = np.random.default_rng(0)
+    r = distinct_triples(rng, 6, batch=5000)
+    i = np.arange(6)[None, :]
+    assert np.all(r[..., 0] != i) and np.all(r[..., 1] != i) and np.all(r[..., 2] != i)
+    assert np.all(r[..., 0] != r[..., 1]) and np.all(r[..., 0] != r[..., 2]) and np.all(r[..., 1] != r[..., 2])
+    counts = np.bincount(r[:, 0, 0], minlength=6) / 5000   # uniform over the 5 others
+    assert counts[0] == 0 and np.allclose(counts[1:], 0.2, atol=0.03)
+
+
+@pytest.mark.parametrize("field,value,msg", [
+    ("pop_size", 3, "NP"), ("f", 0.0, "F"), ("f", 2.5, "F"), ("cr", 1.5, "CR"), ("bound", -1, "bound"),
+    ("max_generations", 0, "max_generations"),
+])
+def test_bad_de_parameters(field, value, msg):
+    with pytest.raises(InputError, match=msg):
+        evolve(shifted_sphere, 2, DEParams(**{field: value}))
