@@ -20,17 +20,23 @@ VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
 
 
 def strip_metadata(nb) -> None:
-    """Remove timing and run-specific metadata so a re-executed notebook diffs only where outputs changed."""
+    """Remove timing and run-specific metadata so a re-executed notebook diffs only where outputs changed.
+    Execution counts stay: nbval treats a cell without one as never run (they are sequential anyway)."""
     for key in VOLATILE_NB_KEYS:
         nb.metadata.pop(key, None)
     for cell in nb.cells:
         for key in VOLATILE_CELL_KEYS:
             cell.metadata.pop(key, None)
-        if cell.cell_type == "code":
-            cell.execution_count = None
-            for out in cell.get("outputs", []):
-                if "execution_count" in out:
-                    out["execution_count"] = None
+
+
+def missing_figures(nb) -> list[int]:
+    """Indices of code cells that call ``plt.show()`` but carry no image output."""
+    bad = []
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type == "code" and "plt.show()" in cell.source:
+            if not any("image/png" in out.get("data", {}) for out in cell.get("outputs", [])):
+                bad.append(i)
+    return bad
 
 
 def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
@@ -56,6 +62,11 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
                       file=sys.stderr)
                 return 1
             nb = nbformat.read(tmp_out, as_version=4)
+            missing = missing_figures(nb)
+            if missing:
+                print(f"FAILED {nb_path.name}: cell {missing[0]} calls plt.show() but produced no figure "
+                      f"(is MPLBACKEND set to a non-inline backend?)", file=sys.stderr)
+                return 1
             strip_metadata(nb)
             nbformat.write(nb, target)
         print(f"    done in {time.perf_counter() - t0:.1f} s", flush=True)

@@ -1,6 +1,6 @@
 import nbformat
 
-from navlib.booktools import check_html, strip_metadata
+from navlib.booktools import check_html, missing_figures, strip_metadata
 
 
 def test_check_html_flags_remote_assets(tmp_path):
@@ -24,4 +24,14 @@ def test_strip_metadata_removes_timings():
     cell.execution_count = 3
     nb.cells.append(cell)
     strip_metadata(nb)
-    assert "papermill" not in nb.metadata and cell.metadata == {} and cell.execution_count is None
+    assert "papermill" not in nb.metadata and cell.metadata == {}
+    assert cell.execution_count == 3          # nbval needs execution counts to compare outputs
+
+
+def test_missing_figures_detects_plot_cells_without_images():
+    nb = nbformat.v4.new_notebook()
+    cell = nbformat.v4.new_code_cell("plt.plot([1]); plt.show()")
+    nb.cells.append(cell)
+    assert missing_figures(nb) == [0]
+    cell.outputs = [nbformat.v4.new_output("display_data", data={"image/png": "iVBOR"})]
+    assert missing_figures(nb) == []

@@ -1,0 +1,485 @@
+"""Extreme learning machine (ELM) and the patent's point-incremental ELM with autonomous back-tuning.
+
+Network (patent B, Fig. 1; Huang, Zhu & Siew, "Extreme learning machine: theory and applications",
+Neurocomputing 70 (2006) 489-501): one hidden layer of L nodes, no output bias,
+
+    a1 = X                         (N x d, the normalised inputs)
+    Z  = a1 W + 1 b^T              (W: d x L input weights w_ij, b: L hidden biases b_i)
+    a2 = H = g(Z)                  (N x L hidden-layer output matrix, g = sigmoid)
+    a3 = Y = H beta                (beta: L x m output weights beta_ki; linear output, no bias)
+
+ELM stage (patent s701 / eqs (3)-(7); Huang 2006): W and b are drawn at random and not adjusted, and
+the output weights are the minimum-norm least-squares solution of H beta = T,
+
+    beta = H^+ T                   (H^+ the Moore-Penrose generalised inverse; see
+                                    :func:`solve_output_weights` for how it is computed).
+
+Back-tuning stage (patent s702 / s1001-s1104, "borrowing deep learning's backward fine-tuning"): from the
+ELM solution, the residual err = Y - T is propagated back through the 3-layer net and *all* weights
+(W, b, beta) are moved down the gradient of the training loss.  Our loss is the mean squared error over
+the N samples and m outputs (the patent's loss equation is lost in the OCR),
+
+    E = 1/(N m) sum_n sum_k (Y_nk - T_nk)^2,
+
+with the layer residuals ("deltas") and gradients
+
+    delta3 = 2/(N m) (Y - T)                       (N x m, output layer)
+    delta2 = (delta3 beta^T) * g'(Z)               (N x L, hidden layer; sigmoid: g' = a2 (1 - a2))
+    dE/dbeta = a2^T delta3,   dE/dW = a1^T delta2,   dE/db = 1^T delta2.
+
+The patent gives no learning rate.  Each gradient step uses a backtracking (Armijo) line search: the
+step is accepted only if the loss drops by at least 1e-4 * step * ||grad||^2, otherwise it is halved;
+so back-tuning can never increase the training loss (a property of the code, tested, not of a lucky
+learning rate).
+
+Point-incremental scheme (patent "fourth step" and Fig. 2): the hidden layer starts with one node and
+grows by one random node per ELM stage; ELM solve and back-tuning alternate; nodes whose output weight
+is negligible contribute little and are pruned; training stops when the loss is below the goal or the
+iteration count exceeds k.  See :func:`fit_incremental_elm` for the choices we made where the patent is
+ambiguous.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+from scipy.special import expit
+
+from navlib.errors import InputError, check_param
+
+__all__ = [
+    "ACTIVATIONS", "SCHEDULES", "ELMParams", "ELMModel", "IncrementalELMParams",
+    "random_nodes", "solve_output_weights", "fit_elm", "loss_and_gradients", "back_tune",
+    "prune_nodes", "fit_incremental_elm",
+]
+
+ACTIVATIONS = ("sigmoid", "tanh")
+SCHEDULES = ("alternate", "odd_nodes")
+
+
+def _act(name: str, z: np.ndarray) -> np.ndarray:
+    return expit(z) if name == "sigmoid" else np.tanh(z)
+
+
+def _act_prime(name: str, a: np.ndarray) -> np.ndarray:
+    """Derivative g'(z) written with the activation a = g(z)."""
+    return a * (1.0 - a) if name == "sigmoid" else 1.0 - a * a
+
+
+def _check_activation(name: str) -> None:
+    if name not in ACTIVATIONS:
+        raise InputError(f"parameter activation={name!r}: must be one of {', '.join(ACTIVATIONS)}")
+
+
+def _check_seed(seed) -> None:
+    if seed is not None:
+        check_param("seed", seed, lo=0, integer=True)
+
+
+def _as_rng(rng) -> np.random.Generator:
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is not None:
+        _check_seed(rng)
+        rng = int(rng)
+    return np.random.default_rng(rng)
+
+
+def _as_2d(name: str, values) -> np.ndarray:
+    v = np.asarray(values, dtype=float)
+    if v.ndim == 1:
+        v = v[:, None]
+    if v.ndim != 2 or v.shape[0] == 0 or v.shape[1] == 0:
+        raise InputError(f"{name}: need a non-empty 1-D or 2-D array (samples along axis 0), "
+                         f"got shape {np.shape(values)}")
+    if not np.all(np.isfinite(v)):
+        raise InputError(f"{name}: contains NaN or infinite values")
+    return v
+
+
+def _xt(x, t) -> tuple[np.ndarray, np.ndarray, bool]:
+    X, T = _as_2d("x", x), _as_2d("t", t)
+    if X.shape[0] != T.shape[0]:
+        raise InputError(f"x has {X.shape[0]} samples but t has {T.shape[0]}")
+    return X, T, np.ndim(t) == 1
+
+
+# --------------------------------------------------------------------------------------------------
+# Plain ELM
+
+@dataclass(frozen=True)
+class ELMParams:
+    """Plain ELM (Huang 2006; patent stage s701).
+
+    ``weight_range``/``bias_range``: input weights w_ij ~ U(-weight_range, weight_range) and hidden
+    biases b_i ~ U(-bias_range, bias_range) (Huang 2006 uses 1 and 1 for inputs normalised to [0, 1];
+    a wider range gives steeper, more local sigmoids and a better-conditioned H).
+    ``seed`` seeds :func:`numpy.random.default_rng` (``None``: unseeded)."""
+
+    n_hidden: int = 10
+    activation: str = "sigmoid"
+    weight_range: float = 1.0
+    bias_range: float = 1.0
+    seed: int | None = 0
+
+    def validate(self) -> "ELMParams":
+        check_param("n_hidden", self.n_hidden, lo=1, integer=True)
+        _check_activation(self.activation)
+        check_param("weight_range", self.weight_range, lo=0, lo_open=True)
+        check_param("bias_range", self.bias_range, lo=0)
+        _check_seed(self.seed)
+        return self
+
+
+@dataclass
+class ELMModel:
+    """A single-hidden-layer network without output bias: ``y = g(x W + b) beta``.
+
+    ``w`` is (d, L), ``b`` (L,), ``beta`` (L, m).  ``squeeze_output``: :meth:`predict` returns a 1-D
+    array (the model was fitted on a 1-D target)."""
+
+    w: np.ndarray
+    b: np.ndarray
+    beta: np.ndarray
+    activation: str = "sigmoid"
+    squeeze_output: bool = True
+
+    @property
+    def n_hidden(self) -> int:
+        return int(self.b.size)
+
+    @property
+    def n_inputs(self) -> int:
+        return int(self.w.shape[0])
+
+    @property
+    def n_outputs(self) -> int:
+        return int(self.beta.shape[1])
+
+    @property
+    def n_weights(self) -> int:
+        """Number of trainable numbers: d L + L + L m."""
+        return int(self.w.size + self.b.size + self.beta.size)
+
+    def hidden(self, x) -> np.ndarray:
+        """Hidden-layer output matrix H = g(x W + b), shape (N, L)."""
+        X = _as_2d("x", x)
+        if X.shape[1] != self.n_inputs:
+            raise InputError(f"x: model has {self.n_inputs} input(s), got {X.shape[1]}")
+        return _act(self.activation, X @ self.w + self.b)
+
+    def predict(self, x) -> np.ndarray:
+        """Network output H beta; 1-D when the model was fitted on a 1-D target."""
+        y = self.hidden(x) @ self.beta
+        return y[:, 0] if self.squeeze_output and y.shape[1] == 1 else y
+
+    def loss(self, x, t) -> float:
+        """Mean squared error E = mean((H beta - T)^2) over samples and outputs."""
+        X, T, _ = _xt(x, t)
+        r = self.hidden(X) @ self.beta - T
+        return float(np.mean(r * r))
+
+    def copy(self) -> "ELMModel":
+        return replace(self, w=self.w.copy(), b=self.b.copy(), beta=self.beta.copy())
+
+
+def random_nodes(n_inputs: int, n_nodes: int, rng, *, weight_range: float = 1.0,
+                 bias_range: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Random input weights W ~ U(-weight_range, weight_range), shape (n_inputs, n_nodes), and biases
+    b ~ U(-bias_range, bias_range), shape (n_nodes,) (patent s701: "randomly initialise w_ij and b_i").
+    W is drawn before b, column by column in node order."""
+    rng = _as_rng(rng)
+    w = rng.uniform(-weight_range, weight_range, size=(n_nodes, n_inputs)).T.copy()
+    b = rng.uniform(-bias_range, bias_range, size=n_nodes)
+    return w, b
+
+
+def solve_output_weights(h: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Minimum-norm least-squares output weights beta = H^+ T (patent eq. (7); Huang 2006, Sec. 2-3).
+
+    Computed with ``numpy.linalg.lstsq`` (LAPACK gelsd, SVD; singular values below eps max(N, L) times
+    the largest count as zero), which returns the minimum-norm solution H^+ T without forming H^+.
+    With random sigmoid nodes H becomes very ill-conditioned as L grows (cond(H) > 1e14 beyond about
+    15 nodes on a 1-D input) and ``pinv(H) @ T`` then lost up to two orders of magnitude in the
+    residual on a synthetic compass sweep, where ``lstsq`` did not.  Beyond cond(H) ~ 1/eps the
+    truncation makes the residual depend on rounding, so adding a node can raise the loss by a hair."""
+    beta, *_ = np.linalg.lstsq(h, t, rcond=None)
+    return beta
+
+
+def fit_elm(x, t, params: ELMParams | None = None, *, n_hidden: int | None = None,
+            rng=None) -> ELMModel:
+    """Fit a plain ELM: random W, b (not trained), then beta = H^+ T (:func:`solve_output_weights`).
+
+    ``x``: (N,) or (N, d) normalised inputs; ``t``: (N,) or (N, m) targets.  ``n_hidden`` overrides
+    ``params.n_hidden``; ``rng`` (a ``numpy.random.Generator`` or an int seed) overrides
+    ``params.seed`` — handy for loops over seeds and node counts.
+
+    With n_hidden = N distinct samples H is square and (generically) invertible, so the ELM interpolates
+    the training data exactly (Huang 2006, Theorem 2.1)."""
+    p = params or ELMParams()
+    if n_hidden is not None:
+        p = replace(p, n_hidden=n_hidden)
+    p.validate()
+    X, T, squeeze = _xt(x, t)
+    gen = _as_rng(p.seed if rng is None else rng)
+    w, b = random_nodes(X.shape[1], int(p.n_hidden), gen, weight_range=p.weight_range,
+                        bias_range=p.bias_range)
+    H = _act(p.activation, X @ w + b)
+    return ELMModel(w=w, b=b, beta=solve_output_weights(H, T), activation=p.activation,
+                    squeeze_output=squeeze)
+
+
+# --------------------------------------------------------------------------------------------------
+# Back-tuning (patent s702, s1001-s1104)
+
+def loss_and_gradients(model: ELMModel, x, t) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """Training loss E = mean((Y - T)^2) and its analytic gradients (dE/dW, dE/db, dE/dbeta).
+
+    delta3 = 2 (Y - T)/(N m); delta2 = (delta3 beta^T) * g'(Z);
+    dE/dbeta = a2^T delta3; dE/dW = a1^T delta2; dE/db = sum_n delta2."""
+    X, T, _ = _xt(x, t)
+    return _loss_grad(model.w, model.b, model.beta, X, T, model.activation)
+
+
+def _loss(w, b, beta, X, T, act) -> float:
+    r = _act(act, X @ w + b) @ beta - T
+    return float(np.mean(r * r))
+
+
+def _loss_grad(w, b, beta, X, T, act):
+    a2 = _act(act, X @ w + b)
+    r = a2 @ beta - T
+    loss = float(np.mean(r * r))
+    d3 = (2.0 / r.size) * r
+    d2 = (d3 @ beta.T) * _act_prime(act, a2)
+    return loss, X.T @ d2, d2.sum(axis=0), a2.T @ d3
+
+
+def _back_tune(model: ELMModel, X, T, steps: int, step: float, max_halvings: int = 40,
+               armijo: float = 1e-4) -> tuple[ELMModel, list[float], float]:
+    """Gradient descent with backtracking; returns the tuned copy, the loss after each accepted step
+    (the first entry is the starting loss) and the trial step for the next call."""
+    w, b, beta, act = model.w.copy(), model.b.copy(), model.beta.copy(), model.activation
+    loss, gw, gb, gbeta = _loss_grad(w, b, beta, X, T, act)
+    losses = [loss]
+    for _ in range(steps):
+        g2 = float(np.sum(gw * gw) + np.sum(gb * gb) + np.sum(gbeta * gbeta))
+        if g2 == 0.0:
+            break
+        for _ in range(max_halvings):
+            w1, b1, beta1 = w - step * gw, b - step * gb, beta - step * gbeta
+            new = _loss(w1, b1, beta1, X, T, act)
+            if new <= loss - armijo * step * g2 and new < loss:
+                break
+            step *= 0.5
+        else:  # no decrease found at any step size: (numerically) stationary, stop this stage
+            break
+        w, b, beta = w1, b1, beta1
+        loss, gw, gb, gbeta = _loss_grad(w, b, beta, X, T, act)
+        losses.append(loss)
+        step *= 2.0  # let the step grow again; the line search halves it back when needed
+    return replace(model, w=w, b=b, beta=beta), losses, step
+
+
+def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
+              max_halvings: int = 40) -> tuple[ELMModel, np.ndarray]:
+    """Back-tune all weights (W, b, beta) of ``model`` by ``steps`` gradient-descent steps on the
+    training MSE (patent s1004/s1104; gradients in :func:`loss_and_gradients`).
+
+    ``lr`` is the first trial step; each step is halved (at most ``max_halvings`` times) until the Armijo
+    condition E_new <= E - 1e-4 step ||grad||^2 holds, and doubled after an accepted step.  A step that
+    does not decrease the loss is never taken, so the returned losses are strictly decreasing.
+    Returns a new model (``model`` is not modified) and the losses: the starting loss, then one per
+    accepted step (fewer than ``steps`` + 1 if the search stalls).
+
+    Observed on the compass sweeps: tuning lowers the loss a lot for 1-3 nodes, but beyond that the
+    least-squares beta is large (|beta| ~ 1e2..1e9 as cond(H) grows), the loss surface is extremely
+    curved along W and b, and the accepted steps become tiny: back-tuning then changes little."""
+    check_param("steps", steps, lo=0, integer=True)
+    check_param("lr", lr, lo=0, lo_open=True)
+    check_param("max_halvings", max_halvings, lo=1, integer=True)
+    X, T, _ = _xt(x, t)
+    tuned, losses, _ = _back_tune(model, X, T, int(steps), float(lr), int(max_halvings))
+    return tuned, np.asarray(losses)
+
+
+# --------------------------------------------------------------------------------------------------
+# Pruning
+
+def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
+    """Remove hidden nodes whose output weights are negligible: max_k |beta_jk| <= ``tol``.
+
+    Since |g| <= 1 for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
+    (patent, Fig. 1 text: "neurons whose output weight is small have little influence on the output;
+    removing these useless neurons ...").  At least one node (the largest |beta|) is always kept.
+    Returns the pruned copy (beta not re-solved: the caller decides) and the removed node indices."""
+    check_param("tol", tol, lo=0)
+    size = np.max(np.abs(model.beta), axis=1)
+    drop = size <= tol
+    if drop.all():
+        drop[int(np.argmax(size))] = False
+    keep = ~drop
+    pruned = replace(model, w=model.w[:, keep].copy(), b=model.b[keep].copy(),
+                     beta=model.beta[keep].copy())
+    return pruned, np.flatnonzero(drop)
+
+
+# --------------------------------------------------------------------------------------------------
+# Point-incremental ELM with autonomous back-tuning
+
+@dataclass(frozen=True)
+class IncrementalELMParams:
+    """Parameters of :func:`fit_incremental_elm` (patent B, Fig. 2 and "fourth step").
+
+    - ``max_nodes``: cap on the hidden-node count (growth stops there; ELM stages then only re-solve).
+    - ``loss_goal``: stop when the training MSE (normalised units) is <= this (patent: "expected value").
+    - ``max_iter``: stop after this many iterations (patent: "iteration count exceeds k").
+    - ``lr``: first trial step of the back-tuning line search (then adapted, see :func:`back_tune`).
+    - ``tune_steps``: gradient steps per back-tuning stage.
+    - ``prune_tol``: prune nodes with max |beta_j| <= prune_tol after each ELM solve (0: only exact
+      zeros; the bound on a pruned node's contribution to the normalised output).
+    - ``schedule``: which stage runs at iteration n (the patent is ambiguous, see
+      :func:`fit_incremental_elm`): ``'alternate'`` (default) or ``'odd_nodes'``.
+    - ``activation``, ``weight_range``, ``bias_range``, ``seed``: as in :class:`ELMParams`."""
+
+    max_nodes: int = 30
+    loss_goal: float = 1e-7
+    max_iter: int = 200
+    lr: float = 0.1
+    tune_steps: int = 50
+    prune_tol: float = 1e-4
+    schedule: str = "alternate"
+    activation: str = "sigmoid"
+    weight_range: float = 1.0
+    bias_range: float = 1.0
+    seed: int | None = 0
+
+    def validate(self) -> "IncrementalELMParams":
+        check_param("max_nodes", self.max_nodes, lo=1, integer=True)
+        check_param("loss_goal", self.loss_goal, lo=0)
+        check_param("max_iter", self.max_iter, lo=1, integer=True)
+        check_param("lr", self.lr, lo=0, lo_open=True)
+        check_param("tune_steps", self.tune_steps, lo=0, integer=True)
+        check_param("prune_tol", self.prune_tol, lo=0)
+        if self.schedule not in SCHEDULES:
+            raise InputError(f"parameter schedule={self.schedule!r}: must be one of "
+                             f"{', '.join(SCHEDULES)}")
+        _check_activation(self.activation)
+        check_param("weight_range", self.weight_range, lo=0, lo_open=True)
+        check_param("bias_range", self.bias_range, lo=0)
+        _check_seed(self.seed)
+        return self
+
+
+HISTORY_COLUMNS = ["iteration", "stage", "n_nodes", "loss", "val_loss"]
+
+
+@dataclass
+class _Recorder:
+    X_val: np.ndarray | None
+    T_val: np.ndarray | None
+    rows: list = field(default_factory=list)
+
+    def add(self, it: int, stage: str, model: ELMModel, loss: float) -> None:
+        val = np.nan
+        if self.X_val is not None:
+            r = _act(model.activation, self.X_val @ model.w + model.b) @ model.beta - self.T_val
+            val = float(np.mean(r * r))
+        self.rows.append((it, stage, model.n_hidden, loss, val))
+
+    def frame(self) -> pd.DataFrame:
+        return pd.DataFrame(self.rows, columns=HISTORY_COLUMNS)
+
+
+def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng=None,
+                        x_val=None, t_val=None) -> tuple[ELMModel, pd.DataFrame]:
+    """Point-incremental ELM with autonomous back-tuning (patent B).
+
+    Iterations n = 1, 2, ... run stages on the current network:
+
+    - ``'elm'``: add one random node (unless ``max_nodes`` is reached; the existing, possibly tuned,
+      nodes are kept) and re-solve all output weights, beta = H^+ T.  Adding a column to a
+      least-squares problem cannot raise its optimum, so this stage does not raise the loss (up to
+      rounding once cond(H) nears 1/eps, see :func:`solve_output_weights`).
+    - ``'prune'`` (right after an ELM solve, only when some node has max|beta_j| <= ``prune_tol``):
+      drop those nodes and re-solve beta.  This may raise the loss slightly (by design, bounded by the
+      dropped contributions before the re-solve).
+    - ``'tune'``: ``tune_steps`` monotone gradient steps on W, b and beta (:func:`back_tune`); the
+      line-search step carries over from one tuning stage to the next.
+
+    Which stage runs when (``params.schedule``) — the patent's text disagrees with itself:
+
+    - ``'alternate'`` (default, the claims: "when n is odd run stage one (s701), when n is even run
+      stage two (s702)"): odd n -> ELM (+ prune), even n -> tune.  The claims also use n for the
+      sample count; we read this n as the iteration counter (the only reading that alternates).
+    - ``'odd_nodes'`` (the Fig. 2 description: "if the node count l is odd, back-derive and tune"):
+      every n -> ELM (+ prune), then tune if the node count is odd.
+
+    The "fourth step" of the description (ELM train, back-tune, then nodes and iterations + 1, repeat)
+    gives the same sequence of stages as ``'alternate'``, with k counting ELM+tune pairs: use
+    ``max_iter = 2 k`` for that reading.
+
+    Stop after the iteration in which the training MSE first is <= ``loss_goal``, or after
+    ``max_iter`` iterations (patent: "if smaller than the expected value, or the iteration count exceeds
+    the preset k, training ends").  The returned model is the final network (the loss never rises
+    except in prune stages, so it is also the best apart from pruning).
+
+    ``rng`` (Generator or int) overrides ``params.seed``.  ``x_val``/``t_val`` (optional) are evaluated
+    after every stage into the history's ``val_loss`` column (NaN without them) — for plots of test
+    error against node count.
+
+    Returns ``(model, history)``; history has one row per stage: ``iteration``, ``stage``
+    ('elm'/'prune'/'tune'), ``n_nodes`` and ``loss`` (training MSE) after the stage, ``val_loss``.
+    """
+    p = (params or IncrementalELMParams()).validate()
+    X, T, squeeze = _xt(x, t)
+    if (x_val is None) != (t_val is None):
+        raise InputError("give both x_val and t_val, or neither")
+    Xv = Tv = None
+    if x_val is not None:
+        Xv, Tv, _ = _xt(x_val, t_val)
+        if Xv.shape[1] != X.shape[1] or Tv.shape[1] != T.shape[1]:
+            raise InputError("x_val/t_val: column counts differ from x/t")
+    gen = _as_rng(p.seed if rng is None else rng)
+    rec = _Recorder(Xv, Tv)
+    d, m = X.shape[1], T.shape[1]
+    model = ELMModel(w=np.empty((d, 0)), b=np.empty(0), beta=np.empty((0, m)),
+                     activation=p.activation, squeeze_output=squeeze)
+    step = float(p.lr)
+
+    def elm_stage(it: int, model: ELMModel) -> tuple[ELMModel, float]:
+        if model.n_hidden < p.max_nodes:
+            w1, b1 = random_nodes(d, 1, gen, weight_range=p.weight_range, bias_range=p.bias_range)
+            model = replace(model, w=np.hstack([model.w, w1]), b=np.concatenate([model.b, b1]))
+        H = _act(p.activation, X @ model.w + model.b)
+        model = replace(model, beta=solve_output_weights(H, T))
+        loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
+        rec.add(it, "elm", model, loss)
+        pruned, removed = prune_nodes(model, p.prune_tol)
+        if removed.size:
+            H = _act(p.activation, X @ pruned.w + pruned.b)
+            model = replace(pruned, beta=solve_output_weights(H, T))
+            loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
+            rec.add(it, "prune", model, loss)
+        return model, loss
+
+    def tune_stage(it: int, model: ELMModel, step: float) -> tuple[ELMModel, float, float]:
+        model, losses, step = _back_tune(model, X, T, int(p.tune_steps), step)
+        rec.add(it, "tune", model, losses[-1])
+        return model, losses[-1], step
+
+    for it in range(1, int(p.max_iter) + 1):
+        if p.schedule == "alternate":
+            if it % 2 == 1:
+                model, loss = elm_stage(it, model)
+            else:
+                model, loss, step = tune_stage(it, model, step)
+        else:
+            model, loss = elm_stage(it, model)
+            if model.n_hidden % 2 == 1:
+                model, loss, step = tune_stage(it, model, step)
+        if loss <= p.loss_goal:
+            break
+    return model, rec.frame()

@@ -1,0 +1,170 @@
+"""Loaders for the axial-gyro-drift tables of paper C (Yu et al. 2012, Tables 2-5) and for user drift files.
+
+All tables are validated with :func:`navlib.tables.read_table` (file, column and row in every message) plus
+cross-column checks (a temperature range's minimum not above its maximum, a printed temperature change equal
+to max - min, the calibration window inside the alignment range).  Every loader adds
+``latitude_error_deg = latitude_deg - LOCAL_LATITUDE_DEG`` where a latitude is present (paper C: the
+12 h latitude *output*, local latitude 28.222 deg).  Column meanings, units and provenance:
+``data/gyro_tables.md``.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .errors import InputError
+from .paths import DATA_DIR
+from .tables import Column, read_table, where
+
+LOCAL_LATITUDE_DEG = 28.222
+
+TABLE_FILES = {
+    2: "gyro_table2_hot_train.csv",
+    3: "gyro_table3_hot_test.csv",
+    4: "gyro_table4_cold_train.csv",
+    5: "gyro_table5_cold_test.csv",
+}
+
+_LAT = Column("latitude_deg", "deg", lo=28.0, hi=28.5)       # 12 h latitude output near the site
+_DRIFT = dict(unit="deg/h", lo=-0.1, hi=0.1)
+_TEMP = dict(unit="degC", lo=-60.0, hi=120.0)
+_NMI = dict(unit="nmi/72h", lo=0.0, hi=1000.0)
+
+COLUMNS = {
+    2: [Column("sample", "", lo=1, integer=True), _LAT,
+        Column("temperature_min_c", **_TEMP), Column("temperature_max_c", **_TEMP),
+        Column("drift_deg_h", **_DRIFT)],
+    3: [Column("test", "", lo=1, integer=True), _LAT,
+        Column("temperature_min_c", **_TEMP), Column("temperature_max_c", **_TEMP),
+        Column("paper_rbf_drift_deg_h", **_DRIFT), Column("true_drift_deg_h", **_DRIFT),
+        Column("paper_error_deg_h", **_DRIFT),
+        Column("paper_pos_error_before_nmi_72h", **_NMI), Column("paper_pos_error_after_nmi_72h", **_NMI)],
+    4: [Column("sample", "", lo=1, integer=True),
+        Column("align_temp_min_c", **_TEMP), Column("align_temp_max_c", **_TEMP),
+        Column("align_temp_change_c", "degC", lo=0, hi=180),
+        Column("calib_temp_min_c", **_TEMP), Column("calib_temp_max_c", **_TEMP),
+        Column("calib_temp_change_c", "degC", lo=0, hi=180), _LAT,
+        Column("true_drift_deg_h", **_DRIFT), Column("paper_hot_rbf_drift_deg_h", **_DRIFT)],
+    5: [Column("test", "", lo=1, integer=True),
+        Column("align_temp_min_c", **_TEMP), Column("align_temp_max_c", **_TEMP),
+        Column("align_temp_change_c", "degC", lo=0, hi=180),
+        Column("calib_temp_min_c", **_TEMP), Column("calib_temp_max_c", **_TEMP),
+        Column("calib_temp_change_c", "degC", lo=0, hi=180),
+        Column("paper_pos_error_hot_net_nmi_72h", **_NMI), Column("paper_pos_error_cold_net_nmi_72h", **_NMI)],
+}
+MIN_ROWS = {2: 2, 3: 1, 4: 2, 5: 1}
+KIND = {2: "hot-state training table", 3: "hot-state test table", 4: "cold-state training table",
+        5: "cold-state test table"}
+
+
+def _check_range(path, df, lo_col, hi_col) -> None:
+    bad = np.flatnonzero(df[lo_col].to_numpy() > df[hi_col].to_numpy())
+    if bad.size:
+        r = int(bad[0])
+        raise InputError(f"{where(path, lo_col, r)}: {df[lo_col].iloc[r]:g} is above "
+                         f"{hi_col} = {df[hi_col].iloc[r]:g}")
+
+
+def _check_change(path, df, lo_col, hi_col, change_col) -> None:
+    diff = df[hi_col].to_numpy() - df[lo_col].to_numpy()
+    bad = np.flatnonzero(np.abs(df[change_col].to_numpy() - diff) > 1e-9)
+    if bad.size:
+        r = int(bad[0])
+        raise InputError(f"{where(path, change_col, r)}: {df[change_col].iloc[r]:g} is not "
+                         f"{hi_col} - {lo_col} = {diff[r]:g}")
+
+
+def _check_unique(path, df, col) -> None:
+    dup = np.flatnonzero(df[col].duplicated().to_numpy())
+    if dup.size:
+        r = int(dup[0])
+        raise InputError(f"{where(path, col, r)}: {df[col].iloc[r]:g} appears twice")
+
+
+def load_table(number: int, path: str | os.PathLike | None = None) -> pd.DataFrame:
+    """Load and validate paper C's Table ``number`` (2, 3, 4 or 5) from ``data/`` (or ``path``)."""
+    if number not in TABLE_FILES:
+        raise InputError(f"parameter table={number!r}: paper C has drift tables 2, 3, 4 and 5")
+    p = Path(path) if path is not None else DATA_DIR / TABLE_FILES[number]
+    df = read_table(p, COLUMNS[number], min_rows=MIN_ROWS[number], kind=KIND[number])
+    key = "sample" if number in (2, 4) else "test"
+    _check_unique(p, df, key)
+    if number in (2, 3):
+        _check_range(p, df, "temperature_min_c", "temperature_max_c")
+    else:
+        _check_range(p, df, "align_temp_min_c", "align_temp_max_c")
+        _check_range(p, df, "calib_temp_min_c", "calib_temp_max_c")
+        _check_change(p, df, "align_temp_min_c", "align_temp_max_c", "align_temp_change_c")
+        _check_change(p, df, "calib_temp_min_c", "calib_temp_max_c", "calib_temp_change_c")
+        _check_range(p, df, "align_temp_min_c", "calib_temp_min_c")
+        _check_range(p, df, "calib_temp_max_c", "align_temp_max_c")
+    if "latitude_deg" in df:
+        df["latitude_error_deg"] = df["latitude_deg"] - LOCAL_LATITUDE_DEG
+    df[key] = df[key].astype(int)
+    return df
+
+
+def load_hot_train(path=None) -> pd.DataFrame:
+    """Table 2: hot-state training samples (16 rows)."""
+    return load_table(2, path)
+
+
+def load_hot_test(path=None) -> pd.DataFrame:
+    """Table 3: hot-state test samples with the paper's RBF outputs and 72 h position errors (3 rows)."""
+    return load_table(3, path)
+
+
+def load_cold_train(path=None) -> pd.DataFrame:
+    """Table 4: cold-state training samples with the paper's hot-net output (6 rows)."""
+    return load_table(4, path)
+
+
+def load_cold_test(path=None) -> pd.DataFrame:
+    """Table 5: cold-state tests, temperature histories and the paper's 72 h position errors (3 rows)."""
+    return load_table(5, path)
+
+
+USER_COLUMNS = [
+    Column("latitude_error_deg", "deg", lo=-1.0, hi=1.0),
+    Column("drift_deg_h", "deg/h", lo=-1.0, hi=1.0),
+    Column("temperature_c", "degC", required=False, lo=-60.0, hi=120.0),
+    Column("temperature_change_c", "degC", required=False, lo=-180.0, hi=180.0),
+]
+
+
+def load_user_drift(path: str | os.PathLike, *, require_drift: bool = True, min_rows: int = 1) -> pd.DataFrame:
+    """A user's drift CSV: ``latitude_error_deg`` (12 h latitude error, indicated - true, deg),
+    ``drift_deg_h`` (axial drift, deg/h; optional with ``require_drift=False`` for files to identify),
+    optional ``temperature_c`` and ``temperature_change_c`` (C) for a cold-state network."""
+    cols = list(USER_COLUMNS)
+    if not require_drift:
+        cols[1] = Column("drift_deg_h", "deg/h", required=False, lo=-1.0, hi=1.0)
+    return read_table(path, cols, min_rows=min_rows, kind="drift table")
+
+
+# ------------------------------------------------------------------------------------------ network inputs
+LATITUDE_UNITS = {"deg": 1.0, "arcmin": 1 / 60.0, "arcsec": 1 / 3600.0}
+
+
+def latitude_scaler(unit: str = "arcmin"):
+    """Explicit input scaling of the hot-state network: latitude error (deg) expressed in ``unit``
+    (``deg``, ``arcmin`` = nautical miles of latitude, or ``arcsec``), so SPREAD is measured in that unit."""
+    from .rbf import InputScaler
+    if unit not in LATITUDE_UNITS:
+        raise InputError(f"parameter INPUT_UNIT={unit!r}: must be one of {', '.join(LATITUDE_UNITS)}")
+    return InputScaler.affine(0.0, LATITUDE_UNITS[unit], names=("latitude_error",), units=(unit,))
+
+
+def cold_inputs(df: pd.DataFrame, temperature_change_column: str = "calib_temp_change_c") -> np.ndarray:
+    """Cold-state network inputs (paper C 2.3: latitude error, temperature, temperature change) from a
+    Table 4-like frame: ``[latitude_error_deg, calib_temp_max_c, <temperature_change_column>]``; the
+    temperature is the one at the end of the alignment, when the drift is identified."""
+    allowed = ("calib_temp_change_c", "align_temp_change_c")
+    if temperature_change_column not in allowed:
+        raise InputError(f"parameter COLD_DT_COLUMN={temperature_change_column!r}: must be one of "
+                         f"{', '.join(allowed)}")
+    return np.c_[df["latitude_error_deg"].to_numpy(float), df["calib_temp_max_c"].to_numpy(float),
+                 df[temperature_change_column].to_numpy(float)]
