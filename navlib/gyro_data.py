@@ -168,3 +168,34 @@ def cold_inputs(df: pd.DataFrame, temperature_change_column: str = "calib_temp_c
                          f"{', '.join(allowed)}")
     return np.c_[df["latitude_error_deg"].to_numpy(float), df["calib_temp_max_c"].to_numpy(float),
                  df[temperature_change_column].to_numpy(float)]
+
+
+# ------------------------------------------------------------------------------- workbench drift files
+def drift_measurements(which: str = "all") -> pd.DataFrame:
+    """Paper C's measured tests in the drift-file schema of the workbench (``python -m navlib diagnose
+    drift``): ``latitude_error_deg``, ``drift_deg_h``, ``temperature_c``, ``temperature_change_c``, plus
+    ``state`` ('hot'/'cold'), ``table`` and ``row``.
+
+    ``which``: 'hot' (Tables 2 and 3, 19 tests), 'cold' (Table 4, 6 tests) or 'all'.
+    Temperature: the midpoint of the range over which the drift is identified (hot: the printed test
+    range; cold: the 12 h calibration window).  Temperature change: the rise during the 16 h alignment
+    (hot: the span of the printed range; cold: the printed alignment change), the quantity that defines
+    paper C's cold state."""
+    if which not in ("hot", "cold", "all"):
+        raise InputError(f"parameter which={which!r}: must be 'hot', 'cold' or 'all'")
+    parts = []
+    if which in ("hot", "all"):
+        for number, drift_col in ((2, "drift_deg_h"), (3, "true_drift_deg_h")):
+            t = load_table(number)
+            parts.append(pd.DataFrame({
+                "latitude_error_deg": t["latitude_error_deg"], "drift_deg_h": t[drift_col],
+                "temperature_c": (t["temperature_min_c"] + t["temperature_max_c"]) / 2,
+                "temperature_change_c": t["temperature_max_c"] - t["temperature_min_c"],
+                "state": "hot", "table": number, "row": t["sample" if number == 2 else "test"]}))
+    if which in ("cold", "all"):
+        t = load_table(4)
+        parts.append(pd.DataFrame({
+            "latitude_error_deg": t["latitude_error_deg"], "drift_deg_h": t["true_drift_deg_h"],
+            "temperature_c": (t["calib_temp_min_c"] + t["calib_temp_max_c"]) / 2,
+            "temperature_change_c": t["align_temp_change_c"], "state": "cold", "table": 4, "row": t["sample"]}))
+    return pd.concat(parts, ignore_index=True)

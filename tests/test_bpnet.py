@@ -72,3 +72,20 @@ def test_bad_network_inputs():
         train_gradient([1, 1, 1], [0, 1, 2], 2)
     with pytest.raises(InputError, match="method"):
         train_gradient([0, 1, 2], [0, 1, 2], 2, GradientParams(method="sgd"))
+
+
+def test_train_adam_many_matches_one_at_a_time():
+    from navlib.bpnet import train_adam_many
+
+    x = np.linspace(0, 360, 15)
+    t = x + 10 * np.sin(np.radians(x))
+    gp = GradientParams(epochs=200, lr=0.01)
+    nets = train_adam_many(x, t, 5, gp, seeds=[0, 3, 7])
+    xt = np.linspace(0, 360, 121)
+    for s, net in zip([0, 3, 7], nets):
+        ref = train_gradient(x, t, 5, GradientParams(epochs=200, lr=0.01, seed=s))
+        np.testing.assert_allclose(net.predict(xt), ref.predict(xt), atol=1e-6)
+        np.testing.assert_allclose(net.history, ref.history, rtol=1e-9)
+    assert not np.allclose(nets[0].theta, nets[1].theta)
+    with pytest.raises(InputError, match="adam"):
+        train_adam_many(x, t, 5, GradientParams(method="lm"))
