@@ -35,3 +35,17 @@ def test_missing_figures_detects_plot_cells_without_images():
     assert missing_figures(nb) == [0]
     cell.outputs = [nbformat.v4.new_output("display_data", data={"image/png": "iVBOR"})]
     assert missing_figures(nb) == []
+
+
+def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
+    from navlib.booktools import execute
+
+    nb = nbformat.v4.new_notebook()
+    nb.cells.append(nbformat.v4.new_code_cell("x = 1"))
+    nb.cells.append(nbformat.v4.new_code_cell("raise ValueError('parameter NP=3: must be >= 4')"))
+    path = tmp_path / "bad.ipynb"
+    nbformat.write(nb, path)
+    out = tmp_path / "out"
+    assert execute([path], out, in_place=False) == 1
+    assert "FAILED bad.ipynb" in capsys.readouterr().err
+    assert not (out / "bad.ipynb").exists()          # no half-executed notebook lands in the book
