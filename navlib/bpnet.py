@@ -14,7 +14,8 @@ Trainers:
 - :func:`train_gradient`: back-propagation by full-batch gradient descent in torch. The paper does not
   say which optimiser its "BP network" used; we use Adam (lr 0.01, 3000 epochs) on the normalised MSE.
   ``method="lm"`` instead uses Levenberg-Marquardt (scipy ``least_squares(method='lm')``), the trainer of
-  the paper's reference [8].
+  the paper's reference [8]; with fewer readings than weights (LM cannot run) the same least-squares
+  problem is solved by scipy's trust-region reflective method.
 - :func:`train_de` with ``DEParams(adaptive=False)`` = DE-BP, ``adaptive=True`` = ADE-BP
   (:mod:`navlib.de`); the whole population is evaluated in one vectorised call.
 """
@@ -164,10 +165,13 @@ def train_gradient(x, t, n_hidden: int = 6, params: GradientParams = GradientPar
             ds = s * (1 - s) * th[2 * m:3 * m]
             return np.hstack([ds * xn[:, None], ds, s, np.ones((len(xn), 1))])
 
+        # MINPACK's Levenberg-Marquardt needs at least as many residuals as weights; an over-sized net on
+        # few readings is solved by scipy's trust-region reflective method, same problem and Jacobian.
+        solver = "lm" if len(xn) >= n_params(n_hidden) else "trf"
         sol = least_squares(lambda th: forward_population(th[None, :], xn, n_hidden)[0] - tn, theta0,
-                            jac=jac, method="lm", max_nfev=params.epochs)
+                            jac=jac, method=solver, max_nfev=params.epochs)
         theta, history = sol.x, np.array([2 * sol.cost / len(x)])
-        name = "BP (LM)"
+        name = "BP (LM)" if solver == "lm" else "BP (TRF)"
     else:
         import torch
 

@@ -459,13 +459,16 @@ def even_indices(n_total: int, n: int) -> np.ndarray:
 
 
 def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = StudyParams(),
-                       seeds=range(20), big_hidden: int = 50) -> pd.DataFrame:
+                       seeds=range(20), big_hidden: int = 50, second_order_seeds=range(5)) -> pd.DataFrame:
     """Patent B's claim that its ELM overfits less than a large network on small samples: train on ``n``
     evenly spread readings of the training sweep (:func:`even_indices`) and score on the whole test sweep.
 
     Methods: ``ELM back-tuned`` and ``ELM`` (as in :func:`compensate`), ``BP 1-{big_hidden}-1 (Adam)``
     (an over-sized net: 3 big_hidden + 1 weights, trained by Adam with the chapter's epochs and learning
-    rate, :func:`navlib.bpnet.train_adam_many`), and ``physical model`` (five parameters; seed -1).
+    rate, :func:`navlib.bpnet.train_adam_many`), ``BP 1-{big_hidden}-1 (LM/TRF)`` (the same net trained to
+    convergence by a second-order least-squares method, :func:`navlib.bpnet.train_gradient` with
+    ``method='lm'``; slower, so over ``second_order_seeds`` only), and ``physical model`` (five parameters;
+    seed -1).
     One row per (n_train, method, seed): ``train_rms_deg`` (on the n readings), ``test_rms_deg``,
     ``n_nodes`` (hidden nodes; NaN for the physical model)."""
     params.validate()
@@ -490,6 +493,10 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
         gp = GradientParams(method="adam", epochs=params.bp_epochs, lr=params.bp_lr)
         for seed, net in zip(seeds, train_adam_many(xtr, _target(params, xtr, ttr), int(big_hidden), gp, seeds)):
             add(big, seed, net, int(big_hidden))
+        for seed in second_order_seeds:
+            net = train_gradient(xtr, _target(params, xtr, ttr), int(big_hidden),
+                                 GradientParams(method="lm", epochs=params.bp_epochs, seed=int(seed)))
+            add(f"BP 1-{int(big_hidden)}-1 (LM/TRF)", int(seed), net, int(big_hidden))
         phys = fit_planar_model(sub.t_train, sub.m_train)
         rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
                      "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),

@@ -89,3 +89,14 @@ def test_train_adam_many_matches_one_at_a_time():
     assert not np.allclose(nets[0].theta, nets[1].theta)
     with pytest.raises(InputError, match="adam"):
         train_adam_many(x, t, 5, GradientParams(method="lm"))
+
+
+def test_second_order_training_of_an_oversized_net_falls_back_to_trf_and_fits():
+    """LM needs at least as many readings as weights; with fewer, the same problem is solved by TRF."""
+    x = np.linspace(0, 360, 8)
+    t = x + 5 * np.sin(np.radians(x))
+    net = train_gradient(x, t, 20, GradientParams(method="lm", seed=0))
+    assert net.method == "BP (TRF)"
+    assert np.max(np.abs(net.predict(x) - t)) < 1e-3
+    small = train_gradient(np.linspace(0, 360, 121), np.linspace(0, 360, 121), 2, GradientParams(method="lm"))
+    assert small.method == "BP (LM)"

@@ -171,11 +171,15 @@ def test_even_indices_and_subset(sw):
 
 
 def test_small_sample_study(sw):
-    p = StudyParams(bp_epochs=30)
-    runs = small_sample_study(sw, sizes=(15,), params=p, seeds=range(2), big_hidden=10)
-    assert set(runs.method) == {"ELM back-tuned", "ELM", "BP 1-10-1 (Adam)", "physical model"}
+    p = StudyParams(bp_epochs=300)
+    runs = small_sample_study(sw, sizes=(15,), params=p, seeds=range(2), big_hidden=10,
+                              second_order_seeds=range(1))
+    assert set(runs.method) == {"ELM back-tuned", "ELM", "BP 1-10-1 (Adam)", "BP 1-10-1 (LM/TRF)",
+                                "physical model"}
     assert runs.n_train.eq(15).all()
-    assert len(runs) == 2 * 3 + 1
+    assert len(runs) == 2 * 3 + 1 + 1
+    converged = runs[runs.method == "BP 1-10-1 (LM/TRF)"].iloc[0]
+    assert converged.train_rms_deg < 0.1               # a second-order method fits the readings
     assert runs.loc[runs.method == "BP 1-10-1 (Adam)", "n_nodes"].eq(10).all()
     phys = runs[runs.method == "physical model"].iloc[0]
     assert phys.test_rms_deg < 0.3                     # five parameters from 15 readings: near the floor
