@@ -266,10 +266,6 @@ def side_by_side(summary: pd.DataFrame, paper: pd.DataFrame, single: pd.DataFram
     return pd.DataFrame(rows).set_index("method")
 
 
-def with_params(params: StudyParams, **changes) -> StudyParams:
-    return replace(params, **changes).validate()
-
-
 def _target(params: StudyParams, x, t):
     return np.asarray(t) - np.asarray(x) if params.network_target == "error" else np.asarray(t)
 

@@ -285,7 +285,7 @@ def compare(*fits: Fit) -> pd.DataFrame:
 # ------------------------------------------------------------------------------------------- loading
 def load(system: str, path) -> pd.DataFrame:
     """Load and validate a measurement file for ``system`` (see the CLI help for the columns)."""
-    from .tables import Column, read_table
+    from .tables import read_table
 
     _catalogue(system)
     if system == "compass":

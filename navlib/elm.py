@@ -108,6 +108,15 @@ def _xt(x, t) -> tuple[np.ndarray, np.ndarray, bool]:
 # --------------------------------------------------------------------------------------------------
 # Plain ELM
 
+def _check_node_draw(p) -> None:
+    """Validate the fields :class:`ELMParams` and :class:`IncrementalELMParams` share: how hidden nodes are
+    drawn (activation, weight and bias ranges, seed)."""
+    _check_activation(p.activation)
+    check_param("weight_range", p.weight_range, lo=0, lo_open=True)
+    check_param("bias_range", p.bias_range, lo=0)
+    _check_seed(p.seed)
+
+
 @dataclass(frozen=True)
 class ELMParams:
     """Plain ELM (Huang 2006; patent stage s701).
@@ -125,10 +134,7 @@ class ELMParams:
 
     def validate(self) -> "ELMParams":
         check_param("n_hidden", self.n_hidden, lo=1, integer=True)
-        _check_activation(self.activation)
-        check_param("weight_range", self.weight_range, lo=0, lo_open=True)
-        check_param("bias_range", self.bias_range, lo=0)
-        _check_seed(self.seed)
+        _check_node_draw(self)
         return self
 
 
@@ -366,10 +372,7 @@ class IncrementalELMParams:
         if self.schedule not in SCHEDULES:
             raise InputError(f"parameter schedule={self.schedule!r}: must be one of "
                              f"{', '.join(SCHEDULES)}")
-        _check_activation(self.activation)
-        check_param("weight_range", self.weight_range, lo=0, lo_open=True)
-        check_param("bias_range", self.bias_range, lo=0)
-        _check_seed(self.seed)
+        _check_node_draw(self)
         return self
 
 
