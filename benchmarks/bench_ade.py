@@ -25,10 +25,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")     # "on one core"
 import numpy as np  # noqa: E402
 from scipy.optimize import differential_evolution  # noqa: E402
 
-from navlib.bpnet import sse_objective, n_params  # noqa: E402
-from navlib.compass import load_sweeps, split_sweeps  # noqa: E402
-from navlib.compass_study import Sweeps  # noqa: E402
-from navlib.de import DEParams, evolve  # noqa: E402
+from navlib.methods.bpnet import sse_objective, n_params  # noqa: E402
+from navlib.data.compass_sweeps import load_sweeps, split_sweeps  # noqa: E402
+from navlib.studies.paper_a import Sweeps  # noqa: E402
+from navlib.methods.de import DEParams, evolve  # noqa: E402
 from navlib.paths import DATA_DIR  # noqa: E402
 
 
@@ -72,7 +72,7 @@ def main() -> None:
     ours_fit = float(exact(res.x[None, :])[0])
     scipy_fit = float(exact(ref.x[None, :])[0])
     print(f"budget: NP 95, {gens} generations, D {dim}, 121 points; best of {args.repeats} repeats")
-    print(f"ours  ADE (navlib.de.evolve):        {min(ours_t):7.3f} s   fitness J = {ours_fit:.2f} deg^2  "
+    print(f"ours  ADE (navlib.methods.de.evolve):        {min(ours_t):7.3f} s   fitness J = {ours_fit:.2f} deg^2  "
           f"({res.generations} generations, {res.n_evaluations} evaluations)")
     print(f"scipy differential_evolution DE:    {min(scipy_t):7.3f} s   fitness J = {scipy_fit:.2f} deg^2  "
           f"({ref.nit} iterations, nfev {ref.nfev} as scipy counts vectorised calls)")

@@ -1,4 +1,4 @@
-"""Speed of navlib.ins.simulate (exact matrix-exponential steps) against scipy.integrate.solve_ivp on the same
+"""Speed of navlib.sensors.ins.simulate (exact matrix-exponential steps) against scipy.integrate.solve_ivp on the same
 static-base error equations and the same piecewise-constant forcing, for one 72 h run.  Prints both times,
 their ratio and the largest difference in position error."""
 import time
@@ -6,7 +6,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from navlib import ins
+from navlib.sensors import ins
 
 imu = ins.ImuErrors(gyro_bias_x_deg_h=0.003, gyro_bias_y_deg_h=-0.002, axial_drift_deg_h=0.001,
                     accel_bias_x_ug=20.0, accel_bias_y_ug=-15.0)
@@ -40,6 +40,6 @@ t_peer = time.perf_counter() - t0
 peer = ins.NavErrors(t_h=sol.t / 3600, states=sol.y.T, earth=earth)
 diff = np.max(np.abs(peer.position_error_nmi - ours.position_error_nmi))
 print(f"72 h run, {n} steps of {step:g} s")
-print(f"navlib.ins.simulate : {t_ours * 1000:8.1f} ms")
+print(f"navlib.sensors.ins.simulate : {t_ours * 1000:8.1f} ms")
 print(f"scipy solve_ivp RK45: {t_peer * 1000:8.1f} ms   (ratio {t_peer / t_ours:.0f}x)")
 print(f"max |position error difference| {diff:.2e} nmi (final ours {ours.position_error_nmi[-1]:.4f} nmi)")

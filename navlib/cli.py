@@ -46,8 +46,8 @@ def build_parser() -> argparse.ArgumentParser:
 def _simulate_compass(args) -> int:
     from dataclasses import replace
 
-    from .compass import CompassErrors, simulate_train_test
-    from .tables import write_new_csv
+    from .data.tables import write_new_csv
+    from .sensors.compass import CompassErrors, simulate_train_test
 
     errors = CompassErrors()
     if args.noise_ut is not None:
@@ -61,8 +61,9 @@ def _simulate_compass(args) -> int:
 def _diagnose(args) -> int:
     import json
 
-    from .diagnose import diagnose
-    from .effects import check_effects, fit_model, load
+    from .workbench.diagnose import diagnose
+    from .workbench.effects import check_effects
+    from .workbench.fit import fit_model, load
 
     model = check_effects(args.system, args.model.split(","))    # unknown names fail before reading
     data = load(args.system, args.file)

@@ -6,10 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib.compass import load_sweeps, simulate_train_test
-from navlib.compass_study import StudyParams
+from navlib.data.compass_sweeps import load_sweeps
+
+from navlib.sensors.compass import simulate_train_test
+from navlib.studies.paper_a import StudyParams
 from navlib.errors import InputError
-from navlib.tables import write_new_csv
+from navlib.data.tables import write_new_csv
 
 
 @pytest.fixture
@@ -131,7 +133,7 @@ def test_bad_notebook_parameters(kw, name):
 def test_negative_noise_parameter():
     from dataclasses import replace
 
-    from navlib.compass import CompassErrors
+    from navlib.sensors.compass import CompassErrors
     with pytest.raises(InputError, match="noise_ut=-0.1"):
         replace(CompassErrors(), noise_ut=-0.1).validate()
 

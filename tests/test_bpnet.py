@@ -2,9 +2,10 @@ import numpy as np
 import pytest
 import torch
 
-from navlib.bpnet import (GradientParams, forward_population, n_params, sse_objective, train_de,
-                          train_gradient, unpack)
-from navlib.de import DEParams
+from navlib.methods.bpnet import (GradientParams, forward_population, n_params, sse_objective, train_de,
+
+    train_gradient, unpack)
+from navlib.methods.de import DEParams
 from navlib.errors import InputError
 
 
@@ -75,7 +76,7 @@ def test_bad_network_inputs():
 
 
 def test_train_adam_many_matches_one_at_a_time():
-    from navlib.bpnet import train_adam_many
+    from navlib.methods.bpnet import train_adam_many
 
     x = np.linspace(0, 360, 15)
     t = x + 10 * np.sin(np.radians(x))

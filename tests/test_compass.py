@@ -4,9 +4,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from navlib.compass import (NO_ERRORS, CompassErrors, EarthField, PlanarModel, SweepConfig,
-                            fit_planar_model, simulate_sweep, simulate_train_test, unwrap_measured,
-                            wrap_deg)
+from navlib.angles import wrap_deg
+
+from navlib.data.compass_sweeps import unwrap_measured
+
+from navlib.sensors.compass import (NO_ERRORS, CompassErrors, EarthField, SweepConfig, simulate_sweep,
+
+    simulate_train_test)
+
+from navlib.sensors.planar import PlanarModel, fit_planar_model
 
 
 def harmonics(err_deg):

@@ -8,11 +8,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib.compass import SweepConfig, simulate_train_test, split_sweeps
-from navlib.compass_study import (ALL_METHODS, GLITCH_VARIANTS, STOCHASTIC, StudyParams, Sweeps, compensate,
-                                  even_indices, glitch_run, glitch_study, node_count_curve,
-                                  prepare_patent_data, seed_study, small_sample_study, summarize,
-                                  test_errors as heading_errors)
+from navlib.data.compass_sweeps import split_sweeps
+
+from navlib.sensors.compass import SweepConfig, simulate_train_test
+from navlib.studies.paper_a import (ALL_METHODS, STOCHASTIC, StudyParams, Sweeps, compensate, seed_study,
+    summarize, test_errors as heading_errors)
+from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, glitch_study,
+    node_count_curve, prepare_patent_data, small_sample_study)
 from navlib.errors import InputError
 
 

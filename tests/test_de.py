@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.optimize import differential_evolution
 
-from navlib.de import DEParams, ade_cr, ade_f, distinct_triples, evolve
+from navlib.methods.de import DEParams, ade_cr, ade_f, distinct_triples, evolve
 from navlib.errors import InputError
 
 

@@ -7,9 +7,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib.diagnose import detection_rates, diagnose, hidden_effect_study, hidden_effect_trial
-from navlib.effects import fit_model, simulate
-from navlib.gyro_data import drift_measurements
+from navlib.workbench.diagnose import diagnose
+
+from navlib.workbench.trials import detection_rates, hidden_effect_study, hidden_effect_trial
+from navlib.workbench.fit import fit_model, simulate
+from navlib.data.gyro_tables import drift_measurements
 from navlib.paths import DATA_DIR
 
 

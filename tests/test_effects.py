@@ -3,12 +3,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib.compass import CompassErrors, SweepConfig, simulate_sweep
-from navlib.diagnose import random_params
-from navlib.effects import (CATALOGUES, catalogue_table, check_effects, compare, effect_rms, fit_model, load,
-                            simulate)
+from navlib.sensors.compass import CompassErrors, SweepConfig, simulate_sweep
+from navlib.workbench.trials import random_params
+from navlib.workbench.effects import CATALOGUES, catalogue_table, check_effects
+from navlib.workbench.fit import compare, effect_rms, fit_model, load, simulate
 from navlib.errors import InputError
-from navlib.gyro_data import drift_measurements
+from navlib.data.gyro_tables import drift_measurements
 from navlib.paths import DATA_DIR
 
 
@@ -83,7 +83,7 @@ def test_earth_rate_adds_no_constant():
 
 
 def test_earth_rate_gain_one_is_table1():
-    from navlib.ins import drift_from_latitude_error
+    from navlib.sensors.ins import drift_from_latitude_error
     frame = pd.DataFrame({"latitude_error_deg": [0.005, -0.02, 0.013]})
     frame["drift_deg_h"] = drift_from_latitude_error(frame.latitude_error_deg)
     assert fit_model("drift", frame, ["earth_rate"]).params["earth_rate_gain"] == pytest.approx(1.0)

@@ -1,11 +1,12 @@
-"""Tests for navlib.elm: plain ELM, back-tuning, pruning and the point-incremental scheme (patent B)."""
+"""Tests for navlib.methods.elm: plain ELM, back-tuning, pruning and the point-incremental scheme (patent B)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from navlib.elm import (ELMModel, ELMParams, IncrementalELMParams, back_tune, fit_elm,
-                        fit_incremental_elm, loss_and_gradients, prune_nodes)
+from navlib.methods.elm import (ELMModel, ELMParams, IncrementalELMParams, back_tune, fit_elm,
+
+    fit_incremental_elm, loss_and_gradients, prune_nodes)
 from navlib.errors import InputError
 
 

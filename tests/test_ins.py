@@ -1,4 +1,4 @@
-"""navlib.ins: static-base error model of the single-axis rotation INS and Table 1 of paper C."""
+"""navlib.sensors.ins: static-base error model of the single-axis rotation INS and Table 1 of paper C."""
 import math
 import time
 
@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from navlib.errors import InputError
-from navlib.ins import (ARCSEC, DEG, ColdStart, Earth, ImuErrors, InitialErrors, Procedure, Rotation,
-                        drift_from_latitude_error, latitude_error_per_drift, run_procedure, simulate,
-                        system_matrices, table1_latitude_error)
+from navlib.angles import ARCSEC, DEG
+from navlib.sensors.ins import (ColdStart, Earth, ImuErrors, InitialErrors, Procedure, Rotation,
+    drift_from_latitude_error, latitude_error_per_drift, run_procedure, simulate, system_matrices,
+    table1_latitude_error)
 
 NO_ROT = Rotation(kind="none")
 

@@ -1,13 +1,13 @@
-"""Tests for navlib.preprocess (patent B data preparation) and navlib.scaling (min-max normalisation)."""
+"""Tests for navlib.methods.preprocess (patent B data preparation) and navlib.methods.scaling (min-max normalisation)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from navlib.errors import InputError
-from navlib.preprocess import (dot_product_screen, field_gravity_dot, median_filter,
-                               reject_dot_product_outliers, train_test_split)
-from navlib.scaling import MinMax
+from navlib.methods.preprocess import (dot_product_screen, field_gravity_dot, median_filter,
+    reject_dot_product_outliers, train_test_split)
+from navlib.methods.scaling import MinMax
 
 
 def sweep_readings(n: int = 121, seed: int = 0):

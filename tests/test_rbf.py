@@ -1,11 +1,11 @@
-"""navlib.rbf: MATLAB newrb / newrbe semantics."""
+"""navlib.methods.rbf: MATLAB newrb / newrbe semantics."""
 import math
 
 import numpy as np
 import pytest
 
 from navlib.errors import InputError
-from navlib.rbf import InputScaler, newrb, newrbe, radbas, width_from_spread
+from navlib.methods.rbf import InputScaler, newrb, newrbe, radbas, width_from_spread
 
 
 def test_spread_to_width_relation():

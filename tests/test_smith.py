@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from navlib.compass import wrap_deg
+from navlib.angles import wrap_deg
 from navlib.errors import InputError
-from navlib.smith import design, eight_position_indices, fit_smith
+from navlib.methods.smith import design, eight_position_indices, fit_smith
 
 
 def smith_curve(h, coef):

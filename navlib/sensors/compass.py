@@ -36,26 +36,13 @@ series (:mod:`navlib.smith`) is its first-order harmonic approximation.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from pathlib import Path
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
 
-from .errors import InputError, check_param
-from .tables import Column, read_table
-
-
-def wrap_deg(a):
-    """Wrap angles in degrees to (-180, 180]."""
-    a = np.asarray(a, dtype=float)
-    w = np.mod(a + 180.0, 360.0) - 180.0
-    return np.where(w == -180.0, 180.0, w)
-
-
-# ----------------------------------------------------------------------------------------------------------
-# Simulator
-# ----------------------------------------------------------------------------------------------------------
+from ..angles import heading_deg, wrap_deg
+from ..errors import InputError, check_param
 
 @dataclass(frozen=True)
 class EarthField:
@@ -185,7 +172,7 @@ def sensor_matrix(err: CompassErrors) -> np.ndarray:
 def heading_from_field(m_xyz) -> np.ndarray:
     """Level-compass heading in [0, 360) deg from sensor-frame field components (x fwd, y right, z down)."""
     m = np.asarray(m_xyz, dtype=float)
-    return np.mod(np.degrees(np.arctan2(-m[..., 1], m[..., 0])), 360.0)
+    return heading_deg(m[..., 0], m[..., 1])
 
 
 def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField = EarthField(),
@@ -236,194 +223,3 @@ def simulate_train_test(errors: CompassErrors = CompassErrors(), earth: EarthFie
                      ignore_index=True)
 
 
-# ----------------------------------------------------------------------------------------------------------
-# Loading measured sweeps
-# ----------------------------------------------------------------------------------------------------------
-
-SWEEP_COLUMNS = [
-    Column("true_heading_deg", "deg", lo=0.0, hi=360.0),
-    Column("measured_heading_deg", "deg", lo=0.0, hi=360.0),
-    Column("sweep", "", required=False, lo=0, integer=True),
-    Column("temperature_c", "degC", required=False, lo=-80, hi=150),
-    Column("time_s", "s", required=False, lo=0),
-    Column("mag_x_ut", "uT", required=False), Column("mag_y_ut", "uT", required=False),
-    Column("mag_z_ut", "uT", required=False),
-    Column("acc_x_ms2", "m/s^2", required=False), Column("acc_y_ms2", "m/s^2", required=False),
-    Column("acc_z_ms2", "m/s^2", required=False),
-]
-
-
-def load_sweeps(path, *, min_points: int = 8) -> pd.DataFrame:
-    """Load a compass sweep CSV (one or several sweeps told apart by an optional ``sweep`` column) and
-    validate it.  Errors (one line, naming file, column and row): missing or misnamed columns, non-numeric
-    values, empty cells or NaN, headings outside 0..360 deg, headings that look like radians (every value
-    within 0..2*pi over a sweep spanning more than a few degrees), a true heading repeated within a sweep
-    (except 0 and 360 closing the circle), and fewer than ``min_points`` readings in a sweep."""
-    frame = read_table(path, SWEEP_COLUMNS, min_rows=min_points, kind="compass sweep")
-    name = Path(path).name
-    if "sweep" not in frame:
-        frame["sweep"] = 1
-    frame["sweep"] = frame["sweep"].astype(int)
-    for col in ("true_heading_deg", "measured_heading_deg"):
-        v = frame[col].to_numpy()
-        if v.max() <= 2 * np.pi + 1e-9 and len(v) >= 4:
-            raise InputError(f"{name}: column '{col}': every value is within 0..{2 * np.pi:.4f}; these look "
-                             f"like radians, the column must be in degrees")
-    for sweep_id, part in frame.groupby("sweep", sort=True):
-        if len(part) < min_points:
-            raise InputError(f"{name}: sweep {sweep_id} has {len(part)} readings, at least {min_points} "
-                             f"are needed")
-        t = part["true_heading_deg"].to_numpy()
-        key = np.round(np.where(t >= 360.0, t - 360.0, t), 9)
-        closing = (t >= 360.0)
-        dup = pd.Series(key[~closing]).duplicated().to_numpy()
-        if dup.any():
-            r = int(part.index[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]])
-            raise InputError(f"{name}: column 'true_heading_deg', row {r + 1} (file line {r + 2}): heading "
-                             f"{t[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]]:g} is repeated in "
-                             f"sweep {sweep_id}")
-    return frame
-
-
-def split_sweeps(frame: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(train, test) = sweep 1 and sweep 2 of a two-sweep frame, as in paper A."""
-    ids = sorted(frame["sweep"].unique())
-    if len(ids) < 2:
-        raise InputError(f"need two sweeps (train and test), found {len(ids)}")
-    return (frame[frame.sweep == ids[0]].reset_index(drop=True),
-            frame[frame.sweep == ids[1]].reset_index(drop=True))
-
-
-def unwrap_measured(true_deg, measured_deg) -> np.ndarray:
-    """The measured heading unwrapped along the sweep so that it runs continuously with the turntable
-    (paper A feeds the measured heading to a single-input network; the wrap at 0/360 would break the
-    one-to-one mapping).  The unwrapping uses only the reading order, never the true value."""
-    m = np.degrees(np.unwrap(np.radians(np.asarray(measured_deg, dtype=float))))
-    # start the branch within +-180 deg of the first true heading (the table starts at north)
-    first = np.asarray(true_deg, dtype=float)[0]
-    return m - 360.0 * np.round((m[0] - first) / 360.0)
-
-
-# ----------------------------------------------------------------------------------------------------------
-# Exact planar model (our physical reference)
-# ----------------------------------------------------------------------------------------------------------
-
-PLANAR_EFFECTS = {
-    "misalignment": ("yaw_deg",),
-    "hard_iron": ("hard_x", "hard_y"),
-    "soft_iron": ("soft_e", "soft_f"),
-    "temperature": ("temp_x_per_c", "temp_y_per_c"),
-}
-
-
-def _rotation(yaw_deg):
-    y = np.radians(yaw_deg)
-    return np.array([[np.cos(y), np.sin(y)], [-np.sin(y), np.cos(y)]])
-
-
-@dataclass
-class PlanarModel:
-    """Exact level-compass heading model (see module docstring)
-
-        m_xy ∝ Rot(yaw) [ (I + [[e, f], [f, -e]]) r(psi) + h + k (T - T_ref) ]
-
-    ``hard_x, hard_y`` (h) are in units of the horizontal field H; ``temp_x_per_c, temp_y_per_c`` (k) are
-    the hard iron's drift with temperature, in H per degC, about ``reference_temperature_c``. Effects not in
-    ``effects`` are held at zero; the temperature effect needs the temperature of every reading."""
-
-    effects: tuple[str, ...] = ("misalignment", "hard_iron", "soft_iron")
-    params: dict = field(default_factory=dict)
-    reference_temperature_c: float = 20.0
-
-    def full_params(self) -> dict:
-        p = {name: 0.0 for names in PLANAR_EFFECTS.values() for name in names}
-        p.update(self.params)
-        return p
-
-    def _offset(self, p, n, temperature_c):
-        h = np.repeat(np.array([[p["hard_x"]], [p["hard_y"]]]), n, axis=1)
-        if p["temp_x_per_c"] or p["temp_y_per_c"]:
-            if temperature_c is None:
-                raise InputError("the temperature effect needs the temperature of every reading "
-                                 "(column 'temperature_c')")
-            dt = np.asarray(temperature_c, dtype=float) - self.reference_temperature_c
-            h = h + np.array([[p["temp_x_per_c"]], [p["temp_y_per_c"]]]) * dt[None, :]
-        return h
-
-    def _field(self, true_deg, temperature_c=None):
-        p = self.full_params()
-        t = np.radians(np.atleast_1d(np.asarray(true_deg, dtype=float)))
-        r = np.stack([np.cos(t), -np.sin(t)])
-        S = np.array([[1 + p["soft_e"], p["soft_f"]], [p["soft_f"], 1 - p["soft_e"]]])
-        return _rotation(p["yaw_deg"]) @ (S @ r + self._offset(p, len(t), temperature_c))
-
-    def predict_measured(self, true_deg, temperature_c=None) -> np.ndarray:
-        """Measured heading (deg, [0, 360)) the model predicts for the true headings."""
-        m = self._field(true_deg, temperature_c)
-        return np.mod(np.degrees(np.arctan2(-m[1], m[0])), 360.0)
-
-    def predict_error(self, true_deg, temperature_c=None) -> np.ndarray:
-        return wrap_deg(self.predict_measured(true_deg, temperature_c) - np.asarray(true_deg, dtype=float))
-
-    def correct(self, measured_deg, temperature_c=None) -> np.ndarray:
-        """Invert the model: the true heading (deg, [0, 360)) that yields each measured heading.  Solves
-        ``|S^-1 (lambda R^-1 u - h)| = 1`` for the positive scale ``lambda`` along the measured direction
-        ``u``; the closed form needs ``|h| < 1`` in the S-metric (the compass still sees north)."""
-        p = self.full_params()
-        a = np.radians(np.atleast_1d(np.asarray(measured_deg, dtype=float)))
-        u = np.stack([np.cos(a), -np.sin(a)])
-        S = np.array([[1 + p["soft_e"], p["soft_f"]], [p["soft_f"], 1 - p["soft_e"]]])
-        Si = np.linalg.inv(S)
-        a_vec = Si @ (_rotation(p["yaw_deg"]).T @ u)
-        b_vec = Si @ self._offset(p, len(a), temperature_c)
-        A = np.sum(a_vec ** 2, axis=0)
-        B = -2 * np.sum(b_vec * a_vec, axis=0)
-        C = np.sum(b_vec ** 2, axis=0) - 1.0
-        disc = np.maximum(B ** 2 - 4 * A * C, 0.0)
-        lam = (-B + np.sqrt(disc)) / (2 * A)
-        r = lam * a_vec - b_vec
-        return np.mod(np.degrees(np.arctan2(-r[1], r[0])), 360.0)
-
-
-def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron", "soft_iron"),
-                     initial: dict | None = None, temperature_c=None, full_output: bool = False):
-    """Fit the exact planar model's named effects by nonlinear least squares (scipy ``least_squares``,
-    trust-region reflective) on the wrapped heading residual ``wrap(model(true) - measured)``.
-
-    The temperature effect is referred to the mean temperature of the data (so it adds no constant hard
-    iron). ``full_output=True`` also returns scipy's result (residuals and Jacobian)."""
-    from scipy.optimize import least_squares
-
-    effects = tuple(effects)
-    unknown = [e for e in effects if e not in PLANAR_EFFECTS]
-    if unknown:
-        raise InputError(f"unknown compass effect '{unknown[0]}'; known: {', '.join(PLANAR_EFFECTS)}")
-    names = [n for e in effects for n in PLANAR_EFFECTS[e]]
-    true_deg = np.asarray(true_deg, dtype=float)
-    measured_deg = np.asarray(measured_deg, dtype=float)
-    if len(true_deg) < len(names) + 1:
-        raise InputError(f"{len(true_deg)} readings cannot determine {len(names)} model parameters")
-    t_ref = 20.0
-    if "temperature" in effects:
-        if temperature_c is None:
-            raise InputError("the temperature effect needs the column 'temperature_c'")
-        temperature_c = np.asarray(temperature_c, dtype=float)
-        t_ref = float(np.mean(temperature_c))
-    x0 = np.array([(initial or {}).get(n, 0.0) for n in names])
-    if "yaw_deg" in names and not initial:
-        x0[names.index("yaw_deg")] = float(np.degrees(np.angle(np.mean(
-            np.exp(1j * np.radians(measured_deg - true_deg))))))
-
-    def resid(x):
-        model = PlanarModel(effects, dict(zip(names, x)), t_ref)
-        return wrap_deg(model.predict_measured(true_deg, temperature_c) - measured_deg)
-
-    lo = np.array([-180.0 if n == "yaw_deg" else -0.95 for n in names])
-    hi = -lo
-    if not names:
-        model = PlanarModel(effects, {}, t_ref)
-        return (model, None) if full_output else model
-    sol = least_squares(resid, np.clip(x0, lo + 1e-9, hi - 1e-9), bounds=(lo, hi), x_scale="jac",
-                        method="trf")
-    model = PlanarModel(effects, dict(zip(names, map(float, sol.x))), t_ref)
-    return (model, sol) if full_output else model

@@ -1,6 +1,6 @@
 """Loaders for the axial-gyro-drift tables of paper C (Yu et al. 2012, Tables 2-5) and for user drift files.
 
-All tables are validated with :func:`navlib.tables.read_table` (file, column and row in every message) plus
+All tables are validated with :func:`navlib.data.tables.read_table` (file, column and row in every message) plus
 cross-column checks (a temperature range's minimum not above its maximum, a printed temperature change equal
 to max - min, the calibration window inside the alignment range).  Every loader adds
 ``latitude_error_deg = latitude_deg - LOCAL_LATITUDE_DEG`` where a latitude is present (paper C: the
@@ -15,11 +15,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import InputError
-from .paths import DATA_DIR
+from ..errors import InputError
+from ..paths import DATA_DIR
+from ..sensors.ins import LOCAL_LATITUDE_DEG
 from .tables import Column, read_table, where
-
-LOCAL_LATITUDE_DEG = 28.222
 
 TABLE_FILES = {
     2: "gyro_table2_hot_train.csv",
@@ -143,31 +142,6 @@ def load_user_drift(path: str | os.PathLike, *, require_drift: bool = True, min_
     if not require_drift:
         cols[1] = Column("drift_deg_h", "deg/h", required=False, lo=-1.0, hi=1.0)
     return read_table(path, cols, min_rows=min_rows, kind="drift table")
-
-
-# ------------------------------------------------------------------------------------------ network inputs
-LATITUDE_UNITS = {"deg": 1.0, "arcmin": 1 / 60.0, "arcsec": 1 / 3600.0}
-
-
-def latitude_scaler(unit: str = "arcmin"):
-    """Explicit input scaling of the hot-state network: latitude error (deg) expressed in ``unit``
-    (``deg``, ``arcmin`` = nautical miles of latitude, or ``arcsec``), so SPREAD is measured in that unit."""
-    from .rbf import InputScaler
-    if unit not in LATITUDE_UNITS:
-        raise InputError(f"parameter INPUT_UNIT={unit!r}: must be one of {', '.join(LATITUDE_UNITS)}")
-    return InputScaler.affine(0.0, LATITUDE_UNITS[unit], names=("latitude_error",), units=(unit,))
-
-
-def cold_inputs(df: pd.DataFrame, temperature_change_column: str = "calib_temp_change_c") -> np.ndarray:
-    """Cold-state network inputs (paper C 2.3: latitude error, temperature, temperature change) from a
-    Table 4-like frame: ``[latitude_error_deg, calib_temp_max_c, <temperature_change_column>]``; the
-    temperature is the one at the end of the alignment, when the drift is identified."""
-    allowed = ("calib_temp_change_c", "align_temp_change_c")
-    if temperature_change_column not in allowed:
-        raise InputError(f"parameter COLD_DT_COLUMN={temperature_change_column!r}: must be one of "
-                         f"{', '.join(allowed)}")
-    return np.c_[df["latitude_error_deg"].to_numpy(float), df["calib_temp_max_c"].to_numpy(float),
-                 df[temperature_change_column].to_numpy(float)]
 
 
 # ------------------------------------------------------------------------------- workbench drift files

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
 LN2_SQRT = math.sqrt(-math.log(0.5))  # 0.8326
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from navlib.errors import InputError
+from ..errors import InputError
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import InputError, check_param
+from ..errors import InputError, check_param
 
 
 @dataclass(frozen=True)

@@ -25,9 +25,11 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import torch
+from scipy.optimize import least_squares
 
 from .de import DEParams, DEResult, evolve
-from .errors import InputError, check_param
+from ..errors import InputError, check_param
 from .scaling import MinMax
 
 
@@ -156,8 +158,6 @@ def train_gradient(x, t, n_hidden: int = 6, params: GradientParams = GradientPar
     theta0 = rng.uniform(-params.init_bound, params.init_bound, n_params(n_hidden))
     t0 = time.perf_counter()
     if params.method == "lm":
-        from scipy.optimize import least_squares
-
         m = n_hidden
 
         def jac(th):                     # d o'/d[w, b, v, c] with sigma' = sigma (1 - sigma)
@@ -173,8 +173,6 @@ def train_gradient(x, t, n_hidden: int = 6, params: GradientParams = GradientPar
         theta, history = sol.x, np.array([2 * sol.cost / len(x)])
         name = "BP (LM)" if solver == "lm" else "BP (TRF)"
     else:
-        import torch
-
         with torch.random.fork_rng():
             torch.manual_seed(params.seed)
             th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
@@ -210,8 +208,6 @@ def train_adam_many(x, t, n_hidden: int, params: GradientParams = GradientParams
     seeds = [int(s) for s in seeds]
     if not seeds:
         raise InputError("seeds: need at least one seed")
-    import torch
-
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
     xn, tn = xs.transform(x), ts.transform(t)
     theta0 = np.stack([np.random.default_rng(s).uniform(-params.init_bound, params.init_bound,

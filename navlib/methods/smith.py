@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
+from ..angles import wrap_deg
+from ..errors import InputError
 
 COEFFICIENTS = ("A", "B", "C", "D", "E")
 
@@ -47,8 +48,6 @@ class SmithModel:
 
 def fit_smith(measured_deg, true_deg) -> SmithModel:
     """Least-squares A..E from readings; deviation = wrap(measured - true). Needs >= 5 distinct readings."""
-    from .compass import wrap_deg
-
     m = np.asarray(measured_deg, dtype=float)
     t = np.asarray(true_deg, dtype=float)
     if m.shape != t.shape or m.ndim != 1:

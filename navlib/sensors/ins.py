@@ -45,10 +45,9 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import minimize_scalar
 
-from .errors import InputError, check_param
+from ..angles import ARCSEC, DEG
+from ..errors import InputError, check_param
 
-DEG = math.pi / 180.0
-ARCSEC = DEG / 3600.0
 DEG_H = DEG / 3600.0            # 1 deg/h in rad/s
 UG = 9.80665e-6                 # 1 micro-g in m/s^2
 NMI = 1852.0

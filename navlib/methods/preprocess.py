@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from navlib.errors import InputError, check_param
+from ..errors import InputError, check_param
 
 __all__ = ["MEDIAN_MODES", "median_filter", "field_gravity_dot", "DotScreen", "dot_product_screen",
            "reject_dot_product_outliers", "train_test_split", "MAD_TO_SIGMA"]

@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import expit
 
-from navlib.errors import InputError, check_param
+from ..errors import InputError, check_param
 
 __all__ = [
     "ACTIVATIONS", "SCHEDULES", "ELMParams", "ELMModel", "IncrementalELMParams",

@@ -1,0 +1,7 @@
+"""Physical simulators and exact error models: what the sensors measure and why.
+
+- :mod:`navlib.sensors.compass` -- three-axis magnetometer compass on a level turntable (papers A, B);
+- :mod:`navlib.sensors.planar` -- the exact five-parameter heading-error model of a level compass;
+- :mod:`navlib.sensors.ins` -- static-base error propagation of a single-axis rotation INS and paper C's
+  Table 1 closed forms.
+"""

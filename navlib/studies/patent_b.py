@@ -1,0 +1,240 @@
+"""Document B, the ELM compass patent: ELM against node count, the patent's data preparation (median
+filter, field-gravity screen, min-max, random 90/10 split) on sweeps with glitches, and the small-sample
+claim.  The ELM rows of paper A's comparison are in :mod:`navlib.studies.paper_a`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+
+from ..angles import wrap_deg
+from ..data.compass_sweeps import unwrap_measured
+from ..errors import InputError, check_param
+from ..methods.bpnet import GradientParams, train_adam_many, train_gradient
+from ..methods.elm import fit_elm, fit_incremental_elm
+from ..methods.preprocess import DotScreen, dot_product_screen, median_filter, train_test_split
+from ..methods.scaling import MinMax
+from ..sensors.compass import heading_from_field
+from ..sensors.planar import fit_planar_model
+from .paper_a import ELM_METHODS, StudyParams, Sweeps, _output, _target, fit_elm_method, rms_deg
+
+# ----------------------------------------------------------------------------------------------------------
+# Patent B: test error against hidden-node count
+
+def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
+                     max_nodes: int = 40) -> pd.DataFrame:
+    """Test-sweep RMS error (deg) against the hidden-node count, one row per (method, seed, n_nodes):
+
+    - ``ELM``: a plain ELM fitted afresh with n = 1..max_nodes random nodes (seed ``seed``);
+    - ``ELM back-tuned``: one run of the patent's incremental scheme per seed, grown to ``max_nodes``
+      without the loss goal (so it does not stop early), scored after the back-tuning stage that follows
+      each ELM stage (the history's ``val_loss``, evaluated on the test sweep).
+
+    The error is the de-normalised network output minus the true heading without wrapping (the same as
+    the wrapped error wherever it is below 180 deg), in both cases computed the same way."""
+    params.validate()
+    check_param("max_nodes", max_nodes, lo=1, integer=True)
+    target, t_val = _target(params, sw.x_train, sw.t_train), _target(params, sw.x_test, sw.t_test)
+    xs, ts = MinMax.fit(sw.x_train, name="network input"), MinMax.fit(target, name="network target")
+    xn, tn = xs.transform(sw.x_train), ts.transform(target)
+    xv, tv = xs.transform(sw.x_test), ts.transform(t_val)
+    span = float(ts.span[0])
+    rows = []
+    for seed in seeds:
+        for n in range(1, int(max_nodes) + 1):
+            model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=seed)
+            rows.append(("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)),
+                         span * np.sqrt(model.loss(xv, tv))))
+        ip = replace(params.incremental_params(span), loss_goal=0.0, max_nodes=int(max_nodes),
+                     max_iter=2 * int(max_nodes))
+        _, hist = fit_incremental_elm(xn, tn, ip, rng=seed, x_val=xv, t_val=tv)
+        tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
+        for n, row in tuned.iterrows():
+            rows.append(("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss)))
+    return pd.DataFrame(rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg"])
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Patent B: data preparation and glitches
+
+MAG_COLUMNS = ("mag_x_ut", "mag_y_ut", "mag_z_ut")
+ACC_COLUMNS = ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2")
+
+
+@dataclass
+class PatentData:
+    """A sweep prepared as patent B's second to fifth steps describe (:func:`prepare_patent_data`).
+
+    ``keep``: mask over the input rows (False = discarded by the dot-product screen); ``screen``: the
+    :class:`navlib.preprocess.DotScreen` (None when not screened); ``true_deg``/``measured_deg``: the kept
+    readings (measured heading recomputed from the filtered field); ``x``: the measured heading unwrapped
+    along the kept readings; ``x_scale``/``t_scale``: min-max scalers of ``x`` and ``true_deg``;
+    ``train_idx``/``test_idx``: the random split (indices into the kept readings)."""
+
+    keep: np.ndarray
+    screen: DotScreen | None
+    true_deg: np.ndarray
+    measured_deg: np.ndarray
+    x: np.ndarray
+    x_scale: MinMax
+    t_scale: MinMax
+    train_idx: np.ndarray
+    test_idx: np.ndarray
+
+    @property
+    def n_rejected(self) -> int:
+        return int(self.keep.size - np.count_nonzero(self.keep))
+
+
+def prepare_patent_data(frame: pd.DataFrame, *, window: int = 3, threshold: float = 4.0,
+                        frac: float = 0.9, rng=None, median: bool = True, screen: bool = True,
+                        mode: str = "closed") -> PatentData:
+    """Patent B's data preparation of one sweep (``frame`` with true and measured heading, the field
+    ``mag_*_ut`` and the accelerometer ``acc_*_ms2`` columns):
+
+    1. sliding median filter of ``window`` readings over each field and accelerometer component
+       (:func:`navlib.preprocess.median_filter`; ``mode='closed'`` for a 0..360 deg inclusive sweep), the
+       measured heading recomputed from the filtered field (skipped if ``median`` is False);
+    2. discard readings whose field-gravity inner product is abnormal (robust z-score > ``threshold``,
+       :func:`navlib.preprocess.dot_product_screen`; skipped if ``screen`` is False);
+    3. min-max normalisation of input and target (:class:`navlib.scaling.MinMax`);
+    4. random split, ``frac`` for training and the rest for the patent's check
+       (:func:`navlib.preprocess.train_test_split`, ``rng`` a seed or Generator).
+
+    The patent prescribes the order (filter, then screen) but no window, threshold or split seed."""
+    missing = [c for c in ("true_heading_deg", "measured_heading_deg", *MAG_COLUMNS, *ACC_COLUMNS)
+               if c not in frame]
+    if missing:
+        raise InputError(f"patent data preparation needs column '{missing[0]}' (field and accelerometer "
+                         f"columns: {', '.join(MAG_COLUMNS + ACC_COLUMNS)})")
+    mag = frame[list(MAG_COLUMNS)].to_numpy(float)
+    acc = frame[list(ACC_COLUMNS)].to_numpy(float)
+    true = frame["true_heading_deg"].to_numpy(float)
+    measured = frame["measured_heading_deg"].to_numpy(float)
+    if median:
+        mag, acc = median_filter(mag, window, mode=mode), median_filter(acc, window, mode=mode)
+        measured = heading_from_field(mag)
+    scr = dot_product_screen(mag, acc, threshold=threshold) if screen else None
+    keep = scr.keep.copy() if scr is not None else np.ones(len(frame), dtype=bool)
+    if keep.sum() < 4:
+        raise InputError(f"patent data preparation: only {int(keep.sum())} readings left after the "
+                         f"dot-product screen; need at least 4")
+    t, m = true[keep], measured[keep]
+    x = unwrap_measured(t, m)
+    train_idx, test_idx = train_test_split(int(keep.sum()), frac, rng)
+    return PatentData(keep=keep, screen=scr, true_deg=t, measured_deg=m, x=x,
+                      x_scale=MinMax.fit(x, name="network input"),
+                      t_scale=MinMax.fit(t, name="network target"), train_idx=train_idx, test_idx=test_idx)
+
+
+GLITCH_VARIANTS = {
+    "no preparation": dict(median=False, screen=False),
+    "dot-product screen": dict(median=False, screen=True),
+    "median filter": dict(median=True, screen=False),
+    "median filter + screen (patent)": dict(median=True, screen=True),
+}
+
+
+def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: StudyParams = StudyParams(),
+               seed: int = 0, *, method: str = "ELM back-tuned", window: int = 3, threshold: float = 4.0,
+               frac: float = 0.9):
+    """One run of :func:`glitch_study`: prepare ``train`` as ``variant`` (a key of :data:`GLITCH_VARIANTS`;
+    split seed = ``seed``), train ``method`` (an ELM method, seed ``seed``) on the training part, and
+    compensate every reading of ``test``.  Returns ``(test_errors_deg, clean, data, info)``: the wrapped
+    test-sweep errors, the mask of glitch-free test readings (``glitch`` column; all True without it), the
+    :class:`PatentData` and the training info (``n_nodes``, ``check_rms_deg`` on the patent's held-out
+    part)."""
+    if variant not in GLITCH_VARIANTS:
+        raise InputError(f"unknown preparation {variant!r}; known: {', '.join(GLITCH_VARIANTS)}")
+    d = prepare_patent_data(train, window=window, threshold=threshold, frac=frac, rng=seed,
+                            **GLITCH_VARIANTS[variant])
+    tr, ck = d.train_idx, d.test_idx
+    net, info = fit_elm_method(method, d.x[tr], _target(params, d.x[tr], d.true_deg[tr]), params, seed)
+    t_test = test["true_heading_deg"].to_numpy(float)
+    x_test = unwrap_measured(t_test, test["measured_heading_deg"].to_numpy(float))
+    err = wrap_deg(_output(params, x_test, net.predict(x_test)) - t_test)
+    clean = ~test["glitch"].to_numpy(bool) if "glitch" in test else np.ones(len(test), bool)
+    info["check_rms_deg"] = rms_deg(_output(params, d.x[ck], net.predict(d.x[ck])), d.true_deg[ck])
+    return err, clean, d, info
+
+
+def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = StudyParams(),
+                 seeds=range(20), *, method: str = "ELM back-tuned", window: int = 3,
+                 threshold: float = 4.0, frac: float = 0.9) -> pd.DataFrame:
+    """What patent B's data preparation buys on a training sweep with glitches: for each variant of
+    :data:`GLITCH_VARIANTS` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
+    sweep (a compensation cannot repair a reading hit by a spike).
+
+    One row per (variant, seed): ``test_rms_deg`` (test sweep), ``check_rms_deg`` (the patent's own
+    held-out part of the training sweep), ``n_rejected``, ``glitches_rejected`` (rejected readings that
+    were glitches, from the training sweep's ``glitch`` column), ``n_nodes``."""
+    params.validate()
+    glitch = train["glitch"].to_numpy(bool) if "glitch" in train else np.zeros(len(train), bool)
+    rows = []
+    for variant in GLITCH_VARIANTS:
+        for seed in seeds:
+            err, clean, d, info = glitch_run(train, test, variant, params, seed, method=method,
+                                             window=window, threshold=threshold, frac=frac)
+            rows.append({"variant": variant, "seed": seed,
+                         "test_rms_deg": float(np.sqrt(np.mean(err[clean] ** 2))),
+                         "check_rms_deg": info["check_rms_deg"], "n_rejected": d.n_rejected,
+                         "glitches_rejected": int(np.sum(glitch & ~d.keep)), "n_nodes": info["n_nodes"]})
+    return pd.DataFrame(rows)
+
+
+# ----------------------------------------------------------------------------------------------------------
+# Patent B: small samples
+
+def even_indices(n_total: int, n: int) -> np.ndarray:
+    """``n`` readings spread evenly over a sweep of ``n_total`` (first and last included): a turntable
+    calibration with fewer stops."""
+    check_param("n", n, lo=2, hi=n_total, integer=True)
+    return np.unique(np.round(np.linspace(0, n_total - 1, int(n))).astype(int))
+
+
+def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = StudyParams(),
+                       seeds=range(20), big_hidden: int = 50, second_order_seeds=range(5)) -> pd.DataFrame:
+    """Patent B's claim that its ELM overfits less than a large network on small samples: train on ``n``
+    evenly spread readings of the training sweep (:func:`even_indices`) and score on the whole test sweep.
+
+    Methods: ``ELM back-tuned`` and ``ELM`` (as in :func:`compensate`), ``BP 1-{big_hidden}-1 (Adam)``
+    (an over-sized net: 3 big_hidden + 1 weights, trained by Adam with the chapter's epochs and learning
+    rate, :func:`navlib.bpnet.train_adam_many`), ``BP 1-{big_hidden}-1 (LM/TRF)`` (the same net trained to
+    convergence by a second-order least-squares method, :func:`navlib.bpnet.train_gradient` with
+    ``method='lm'``; slower, so over ``second_order_seeds`` only), and ``physical model`` (five parameters;
+    seed -1).
+    One row per (n_train, method, seed): ``train_rms_deg`` (on the n readings), ``test_rms_deg``,
+    ``n_nodes`` (hidden nodes; NaN for the physical model)."""
+    params.validate()
+    check_param("big_hidden", big_hidden, lo=1, integer=True)
+    seeds = list(seeds)
+    big = f"BP 1-{int(big_hidden)}-1 (Adam)"
+    rows = []
+    for n in sizes:
+        sub = sw.subset(even_indices(sw.t_train.size, n))
+        xtr, ttr, xte = sub.x_train, sub.t_train, sub.x_test
+
+        def add(method, seed, net, n_nodes):
+            rows.append({"n_train": int(n), "method": method, "seed": seed,
+                         "train_rms_deg": rms_deg(_output(params, xtr, net.predict(xtr)), ttr),
+                         "test_rms_deg": rms_deg(_output(params, xte, net.predict(xte)), sub.t_test),
+                         "n_nodes": n_nodes})
+
+        for method in ELM_METHODS[::-1]:
+            for seed in seeds:
+                net, info = fit_elm_method(method, xtr, _target(params, xtr, ttr), params, seed)
+                add(method, seed, net, info["n_nodes"])
+        gp = GradientParams(method="adam", epochs=params.bp_epochs, lr=params.bp_lr)
+        for seed, net in zip(seeds, train_adam_many(xtr, _target(params, xtr, ttr), int(big_hidden), gp, seeds)):
+            add(big, seed, net, int(big_hidden))
+        for seed in second_order_seeds:
+            net = train_gradient(xtr, _target(params, xtr, ttr), int(big_hidden),
+                                 GradientParams(method="lm", epochs=params.bp_epochs, seed=int(seed)))
+            add(f"BP 1-{int(big_hidden)}-1 (LM/TRF)", int(seed), net, int(big_hidden))
+        phys = fit_planar_model(sub.t_train, sub.m_train)
+        rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
+                     "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
+                     "test_rms_deg": rms_deg(phys.correct(sub.m_test), sub.t_test), "n_nodes": np.nan})
+    return pd.DataFrame(rows)
