@@ -22,13 +22,14 @@
    probability at least ``1 - alpha``.
 
 The effect to add (``missing``) is the significant candidate with the strongest evidence (smallest p) that
-also improves the held-out RMS *and* explains what it claims: if the residual shows significant structure,
-a candidate is named only if, once added, at least one of those structures is gone (no longer significant,
-or its amplitude at most halved) or it is still significant when the detected structure is allowed for
-in both models (a conditional F test).  A candidate that removes some variance only because it soaks up a
-little of an unexplained structure (e.g. a temperature term and a three-cycle error) is not named; the report then says which structure remains and that no
-catalogued effect explains it.  If no candidate is named and no structure is found, the residuals are
-consistent with noise.
+also improves the held-out RMS *and* explains what it claims.  If the residual shows significant structure,
+the candidate is added and the structure re-tested: a structure no longer significant is *gone* (the
+candidate explains it); for what *remains*, a conditional F test asks whether the candidate still lowers
+the residual once the remaining structure is allowed for in both models.  A candidate that only soaks up a
+little of an unexplained structure (a temperature term and a three-cycle error; a one-cycle term and the
+heading-correlated part of a drift in time) fails that test and is not named; the report then says which
+structure remains and that no catalogued effect explains it.  If no candidate is named and no structure is
+found, the residuals are consistent with noise.
 """
 from __future__ import annotations
 
@@ -52,10 +53,6 @@ DEFAULT_ALPHA = 0.025
 # A structure shape is "already in the model" when less than this share of its norm is left after
 # projecting it off the model's Jacobian.
 SPANNED = 0.1
-# A structure counts as explained by a candidate when, once the candidate is added, it is no longer
-# significant or its amplitude has fallen to at most this share (on thousands of correlated 3-D samples a
-# structure can stay "significant" at a fraction of its size).
-GONE = 0.5
 
 
 @dataclass
@@ -297,16 +294,13 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
             break
         f1 = fits[c.effect]
         after = {s.what: s for s in _structure(f1)}
-        gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level
-                or after[s.what].amplitude <= GONE * s.amplitude]
-        if gone:
+        gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level]
+        remaining = [s for s in found if s.what not in gone]
+        # named only if it still matters once the structure it leaves in place is allowed for
+        if not remaining or _conditional_p(fit, f1, remaining) < level:
             c.explains = "; ".join(gone)
             missing = c.effect
-            found = [s for s in found if s.what not in gone]
-            break
-        # it explains none of the structure: name it only if it still matters once that structure is allowed for
-        if _conditional_p(fit, f1, found) < level:
-            missing = c.effect
+            found = remaining
             break
         blocked.append(c.effect)
     unit = fit.unit

@@ -143,14 +143,23 @@ def loop_figure(result: LoopResult):
     return fig
 
 
-def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Path]:
-    """Write ``loop.png`` (:func:`loop_figure`) and ``loop.md`` (steps and outcome) into ``folder``;
-    never over an existing file (InputError)."""
+def check_report_folder(folder) -> tuple[Path, Path]:
+    """The report's two files in ``folder``; InputError if either exists (nothing is ever overwritten)."""
     folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder}: is a file, expected a folder for the report")
     png, md = folder / "loop.png", folder / "loop.md"
     for p in (png, md):
         if p.exists():
             raise InputError(f"{p}: already exists; not overwritten (choose another --report folder)")
+    return png, md
+
+
+def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Path]:
+    """Write ``loop.png`` (:func:`loop_figure`) and ``loop.md`` (steps and outcome) into ``folder``;
+    never over an existing file (InputError)."""
+    folder = Path(folder)
+    png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
     fig = loop_figure(result)
     fig.savefig(png, dpi=110)
