@@ -93,7 +93,7 @@ def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
     bad = np.flatnonzero(np.abs(norm - 1.0) > QUAT_TOL)
     if bad.size:
         r = int(bad[0])
-        raise InputError(f"{where(path, 'q_w', r).replace(chr(39) + 'q_w' + chr(39), 'q_w..q_z')}: quaternion norm "
+        raise InputError(f"{where(path, 'q_w..q_z', r)}: quaternion norm "
                          f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})")
     check_orientations(frame, Path(path).name)
     return frame
@@ -291,3 +291,19 @@ def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
 SYSTEM = register_system(System(
     "magnetometer", "uT", MAGNETOMETER_EFFECTS, load_magnetometer, _fit_magnetometer, magnetometer_structure,
     "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT"))
+
+
+def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, seed=0) -> pd.DataFrame:
+    """3-D samples from the model (eq. in the module docstring) at ``n`` random attitudes (uniform over
+    rotations), a body rate of up to 60 deg/s per axis, 0.1 s apart; ``params`` as in the catalogue plus
+    the local field ``field_*_ut`` (default: BROAD's room, (15.2, -0.3, 40.8) uT); white noise ``noise_ut``."""
+    rng = np.random.default_rng(seed)
+    p = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8, **params}
+    rot = Rotation.random(n, random_state=rng)               # body -> NED
+    q = rot.as_quat()[:, [3, 0, 1, 2]]
+    frame = pd.DataFrame(q, columns=list(QUAT))
+    frame[list(GYR)] = rng.uniform(-60, 60, (n, 3))
+    frame["time_s"] = 0.1 * np.arange(n)
+    m = predict_field(p, frame) + noise_ut * rng.standard_normal((n, 3))
+    frame[list(MAG)] = m
+    return frame
