@@ -35,7 +35,7 @@ from .paths import ROOT
 
 #: Where each chapter's headline results are written during a build (git-ignored).
 RESULTS_DIR = ROOT / "book" / "_generated" / "results"
-#: Plain-text rendering width (characters): a stored output line longer than this would be cut on the page.
+#: Plain-text rendering width in characters; a stored output line longer than this would be cut on the page.
 PLAIN_WIDTH = 92
 METHOD_KEYS = ("median_rms", "p10_rms", "p90_rms", "median_min", "median_max")
 

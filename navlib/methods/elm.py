@@ -124,7 +124,7 @@ class ELMParams:
     ``weight_range``/``bias_range``: input weights w_ij ~ U(-weight_range, weight_range) and hidden
     biases b_i ~ U(-bias_range, bias_range) (Huang 2006 uses 1 and 1 for inputs normalised to [0, 1];
     a wider range gives steeper, more local sigmoids and a better-conditioned H).
-    ``seed`` seeds :func:`numpy.random.default_rng` (``None``: unseeded)."""
+    ``seed`` seeds ``numpy.random.default_rng`` (``None``: unseeded)."""
 
     n_hidden: int = 10
     activation: str = "sigmoid"
@@ -165,7 +165,7 @@ class ELMModel:
 
     @property
     def n_weights(self) -> int:
-        """Number of trainable numbers: d L + L + L m."""
+        """Number of trainable numbers, d L + L + L m."""
         return int(self.w.size + self.b.size + self.beta.size)
 
     def hidden(self, x) -> np.ndarray:

@@ -6,7 +6,7 @@ Patent text (our translation):
   median filter to pre-process the measured data; discard data whose geomagnetic-vector / gravity-vector
   inner product is abnormal, reducing magnetometer and accelerometer noise and random-error
   interference" -> :func:`median_filter`, :func:`dot_product_screen` / :func:`reject_dot_product_outliers`;
-- third step: "normalise the raw data by the max-min method" -> :class:`navlib.scaling.MinMax`;
+- third step: "normalise the raw data by the max-min method" -> :class:`navlib.methods.scaling.MinMax`;
 - fourth/fifth step: "randomly draw 90 % of the training set ... the remaining 10 % are the test set"
   -> :func:`train_test_split`.
 

@@ -1,15 +1,17 @@
 """Which physical effect is missing from a model? Evidence from the residuals, with honest statistics.
 
-:func:`diagnose` takes a fitted model (:class:`navlib.effects.Fit`) and
+:func:`diagnose` takes a fitted model (:class:`navlib.workbench.fit.Fit`) and
 
 1. refits it with each catalogued effect that is not yet in the model and that the data can test, and
    scores each candidate by
+
    - variance explained: the share of the residual sum of squares the effect removes,
    - significance: the nested-model F test ``F = (dRSS / q) / (RSS_1 / (n - p_1))`` (q parameters added);
      for small linear problems (n <= 12, the drift tables) an exact or Monte-Carlo permutation test of the
      candidate's covariate instead, which does not lean on normal errors,
    - held-out improvement: leave-one-out RMS with and without the effect (exact for linear models, the
      leverage approximation for the compass);
+
 2. looks for structure that no catalogued effect explains, in the residuals of the *fullest* model (every
    testable effect added): heading harmonics 1..6 and serial correlation along a compass sweep, a trend in
    a covariate the catalogue does not use (``time_s``), curvature in each drift covariate;

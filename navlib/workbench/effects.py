@@ -1,18 +1,18 @@
 """Physical models built from named effects: fit them to measurements, look at the residuals, add an effect.
 
-Two systems, each with a catalogue of effects (:data:`CATALOGUES`):
+Two systems, each with a catalogue of effects (``CATALOGUES``):
 
 ``compass`` (papers A and B) — measurement: the compass heading; residual = measured - model heading,
-wrapped to (-180, 180] deg.  The model is the *exact* planar heading model of :mod:`navlib.compass`
+wrapped to (-180, 180] deg.  The model is the *exact* planar heading model of :mod:`navlib.sensors.compass`
 (heading computed through the distorted field), not a truncated harmonic series; Smith's A..E series
-(:mod:`navlib.smith`) is its first-order harmonic approximation and is offered separately.
+(:mod:`navlib.methods.smith`) is its first-order harmonic approximation and is offered separately.
 
 ``drift`` (paper C) — measurement: the axial gyro drift (deg/h) of a single-axis rotation INS, with the
 12 h latitude error as the physical observable.  The model is linear in its parameters:
 
     drift = g * dL12 / K  +  b  +  c_T (T - mean T)  +  c_dT (dT - mean dT)
 
-with ``K = (cos L / W)(1 - cos 12 h W)`` the Table 1 gain (:func:`navlib.ins.latitude_error_per_drift`).
+with ``K = (cos L / W)(1 - cos 12 h W)`` the Table 1 gain (:func:`navlib.sensors.ins.latitude_error_per_drift`).
 ``earth_rate`` adds only ``g`` (no constant: that is ``bias``); the temperature terms are centred, so they
 add no constant either.  Effects in one model are identifiable together.
 
