@@ -252,13 +252,16 @@ class _PageScan(HTMLParser):
                 return      # one message per block
 
 
-def check_page(text: str) -> list[str]:
-    """Problems of one built page (HTML text): network assets, execution errors, output blocks wider than
-    the content column, figures without captions, visible nbval markers."""
+def check_page(text: str, content: bool = True) -> list[str]:
+    """Problems of one built page (HTML text): network assets and, if ``content`` (every page but the
+    highlighted source listings under ``_modules/``), execution errors, output blocks wider than the
+    content column, figures without captions, visible nbval markers."""
     problems = []
     for m in re.finditer(r"<(script|link|img)\b[^>]*>", text, re.I):
         if REMOTE.search(m.group(0)):
             problems.append(f"loads from the network: {m.group(0)[:120]}")
+    if not content:
+        return problems
     if "Traceback (most recent call last)" in text or 'class="output traceback' in text:
         problems.append("shows an execution error")
     scan = _PageScan()
@@ -273,7 +276,8 @@ def check_html(html_dir: Path, limit: int = 60) -> int:
     pages = sorted(Path(html_dir).rglob("*.html"))
     for page in pages:
         text = page.read_text(encoding="utf-8", errors="replace")
-        problems += [f"{page.relative_to(html_dir)}: {p}" for p in check_page(text)]
+        rel = page.relative_to(html_dir)
+        problems += [f"{rel}: {p}" for p in check_page(text, content=rel.parts[0] != "_modules")]
     for p in problems[:limit]:
         print(p, file=sys.stderr)
     if len(problems) > limit:
@@ -665,8 +669,9 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         return 2
     html_dir, out_dir = Path(html_dir).resolve(), Path(out_dir)
     pages = [p for p in sorted(html_dir.rglob("*.html"))
-             if not p.relative_to(html_dir).parts[0].startswith("_") and p.name not in ("search.html",
-                                                                                     "genindex.html")]
+             if p.relative_to(html_dir).parts[0] not in ("_modules", "_sources", "_static", "_images")
+             and p.name not in ("search.html", "genindex.html", "py-modindex.html")
+             and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000]]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
     heights, overflow = [], {}

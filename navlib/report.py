@@ -248,7 +248,9 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
 
     ``methods`` maps a display label to :func:`method_stats`-style keys (without unit suffix); the unit
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
-    significant digits.  Returns the path written (this is a build output; it is rewritten each run)."""
+    significant digits.  Returns the path written (this is a build output; it is rewritten each run); it
+    displays as ``results written: <chapter>.json``, the same in every run, so a notebook cell that ends
+    with this call shows no run-specific folder."""
     if not chapter.isidentifier():
         raise InputError(f"chapter name {chapter!r}: use letters, digits and underscores")
     out: dict[str, Any] = {"chapter": chapter}
@@ -274,7 +276,14 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     d.mkdir(parents=True, exist_ok=True)
     path = d / f"{chapter}.json"
     path.write_text(json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n", encoding="utf-8")
-    return path
+    return _WrittenPath(path)
+
+
+class _WrittenPath(type(Path())):
+    """A :class:`pathlib.Path` whose display names only the file (stable across runs and machines)."""
+
+    def __repr__(self) -> str:
+        return f"results written: {self.name}"
 
 
 def read_results(folder: str | os.PathLike | None = None) -> dict[str, dict]:

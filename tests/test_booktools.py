@@ -202,3 +202,12 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path):
     assert stored["claims"][0]["reproduced"] is True
     from navlib.report import RESULTS_DIR
     assert not (RESULTS_DIR / "demo_chapter.json").exists()   # the book's folder is not touched
+
+
+def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
+    listing = tmp_path / "_modules" / "navlib"
+    listing.mkdir(parents=True)
+    (listing / "booktools.html").write_text('<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>')
+    assert check_html(tmp_path) == 0
+    (listing / "cli.html").write_text('<script src="https://cdn.example/x.js"></script>')
+    assert check_html(tmp_path) == 1
