@@ -616,6 +616,22 @@ class _Chrome:
                     return self.events.pop(k)
             self.events.append(self._read())
 
+    def wait_loaded(self, session: str, url: str) -> None:
+        """Poll until the page at ``url`` has finished loading (events of the blank page that preceded it
+        must not be mistaken for its load event)."""
+        deadline = time.monotonic() + self.timeout_s
+        probe = {"expression": "document.readyState + ' ' + location.href", "returnByValue": True}
+        while time.monotonic() < deadline:
+            try:
+                state = self.send("Runtime.evaluate", probe, session=session)["result"].get("value", "")
+            except RuntimeError:            # the context was replaced by the navigation: ask again
+                state = ""
+            if state == f"complete {url}":
+                self.events.clear()
+                return
+            time.sleep(0.1)
+        raise TimeoutError(f"chromium: {url} did not load within {self.timeout_s:.0f} s")
+
     def _read(self) -> dict:
         deadline = time.monotonic() + self.timeout_s
         while b"\0" not in self._buf:
@@ -671,7 +687,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
     pages = [p for p in sorted(html_dir.rglob("*.html"))
              if p.relative_to(html_dir).parts[0] not in ("_modules", "_sources", "_static", "_images")
              and p.name not in ("search.html", "genindex.html", "py-modindex.html")
-             and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000]]
+             and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
     heights, overflow = [], {}
@@ -684,7 +700,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
             metrics = {"width": width, "height": 900, "deviceScaleFactor": 1, "mobile": False}
             chrome.send("Emulation.setDeviceMetricsOverride", metrics, session=session)
             chrome.send("Page.navigate", {"url": page.as_uri()}, session=session)
-            chrome.wait_event("Page.loadEventFired", session)
+            chrome.wait_loaded(session, page.as_uri())
             wait = (f"new Promise(r => setTimeout(r, {int(settle_s * 1000)}))"
                     ".then(() => (window.MathJax && MathJax.startup) ? MathJax.startup.promise : null)"
                     ".then(() => document.fonts.ready).then(() => 1)")
@@ -696,6 +712,9 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
                             session=session)["result"]["value"]
             h = int(h)
             chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": h}, session=session)
+            # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
+            chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
+                        "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
             found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
                                 session=session)["result"].get("value") or []
             shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
