@@ -13,7 +13,8 @@ Subcommands of ``python -m navlib.booktools``:
 ``check-html DIR``
     Fail if a built page loads anything from the network, shows an execution error, has an output block
     wider than the content column (a preformatted line over :data:`MAX_PRE_CHARS` characters), a figure
-    without a caption or a visible nbval marker.
+    without a caption or a visible nbval marker, or is a chapter (``_generated/``) that does not open with
+    its *Results at a glance* admonition.
 ``status RESULTS_DIR --notebooks DIR --out FILE``
     Write the landing page's status table (claims reproduced per chapter and reading) from the results.
 ``api-modules --out FILE``
@@ -270,6 +271,22 @@ def check_page(text: str, content: bool = True) -> list[str]:
     return problems + scan.problems
 
 
+GLANCE = "Results at a glance"
+
+
+def check_chapter_opening(text: str) -> list[str]:
+    """A chapter page (executed notebook) must open with the *Results at a glance* admonition: present,
+    and before the first code cell."""
+    m = re.search(r'<p class="admonition-title">\s*' + GLANCE, text)
+    if not m:
+        return [f"chapter without a '{GLANCE}' admonition: open the chapter with report.glance(claims) "
+                f"glued into a ':::{{admonition}} {GLANCE}' block"]
+    first_cell = text.find('<div class="cell docutils container')
+    if 0 <= first_cell < m.start():
+        return [f"the '{GLANCE}' admonition comes after a code cell: move it right after the title and intro"]
+    return []
+
+
 def check_html(html_dir: Path, limit: int = 60) -> int:
     """Run :func:`check_page` on every built page; print each problem as ``page: problem``; 1 if any."""
     problems = []
@@ -278,6 +295,8 @@ def check_html(html_dir: Path, limit: int = 60) -> int:
         text = page.read_text(encoding="utf-8", errors="replace")
         rel = page.relative_to(html_dir)
         problems += [f"{rel}: {p}" for p in check_page(text, content=rel.parts[0] != "_modules")]
+        if rel.parts[0] == "_generated":              # the chapters (executed notebooks)
+            problems += [f"{rel}: {p}" for p in check_chapter_opening(text)]
     for p in problems[:limit]:
         print(p, file=sys.stderr)
     if len(problems) > limit:
@@ -286,7 +305,8 @@ def check_html(html_dir: Path, limit: int = 60) -> int:
         print(f"check-html: {len(problems)} problem(s) in {len(pages)} pages", file=sys.stderr)
         return 1
     print(f"check-html: {len(pages)} pages: nothing loaded from the network, no errors, no output wider than "
-          f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers")
+          f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers, every chapter opens with "
+          f"its results at a glance")
     return 0
 
 

@@ -211,3 +211,20 @@ def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
     assert check_html(tmp_path) == 0
     (listing / "cli.html").write_text('<script src="https://cdn.example/x.js"></script>')
     assert check_html(tmp_path) == 1
+
+
+def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
+    from navlib.booktools import check_chapter_opening
+
+    glance = '<div class="admonition"><p class="admonition-title">Results at a glance</p><table></table></div>'
+    cell = '<div class="cell docutils container"><pre>n_seeds = 20</pre></div>'
+    assert check_chapter_opening(page(glance + cell)) == []
+    assert "after a code cell" in check_chapter_opening(page(cell + glance))[0]
+    assert "without a 'Results at a glance'" in check_chapter_opening(page(cell))[0]
+    chapters = tmp_path / "_generated"
+    chapters.mkdir()
+    (chapters / "gyro.html").write_text(page(cell))
+    (tmp_path / "intro.html").write_text(page("<p>no glance needed</p>"))
+    assert check_html(tmp_path) == 1
+    err = capsys.readouterr().err
+    assert "_generated/gyro.html: chapter without" in err and "intro.html" not in err
