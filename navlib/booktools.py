@@ -50,8 +50,10 @@ from .report import claims_summary, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
-#: A preformatted output line longer than this is cut (or scrolls) in the content column at 1400 px.
-MAX_PRE_CHARS = 95
+#: A preformatted output line longer than this does not fit the content column at 1400 px: measured in
+#: headless Chromium on the built book (sphinx-book-theme 1.3): an output ``<pre>`` is 784 px wide with
+#: 32 px of padding, and its 14 px monospace font is 8.43 px per character, so 89 characters fit.
+MAX_PRE_CHARS = 89
 #: Tolerances of ``check-results``: a number passes if ``|fresh - ref| <= ATOL + RTOL * |ref|``.
 RTOL = 1e-3
 ATOL = 1e-9
@@ -578,7 +580,7 @@ _OVERFLOW_JS = r"""(() => {
     document.querySelectorAll('h1, h2, h3').forEach(x => {
       if (x.compareDocumentPosition(el) & Node.DOCUMENT_POSITION_FOLLOWING) h = x; });
     return h ? h.textContent.replace(/[#\s]+$/, '').trim() : ''; };
-  art.querySelectorAll('.cell_output .output, .cell_output table, .admonition table, table').forEach(el => {
+  art.querySelectorAll('.cell_output pre, .cell_output .output, .cell_output img, table').forEach(el => {
     const r = el.getBoundingClientRect();
     const over = Math.max(el.scrollWidth - el.clientWidth, r.right - right);
     if (r.width > 0 && over > 2) out.push({heading: heading(el), overflow_px: Math.round(over),
