@@ -11,12 +11,13 @@ NOTEBOOKS := $(sort $(wildcard notebooks/*.ipynb))
 export PYTHONHASHSEED := 0
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
 
-.PHONY: help venv book test test-lib test-notebooks notebooks bench lock clean
+.PHONY: help venv book screenshots test test-lib test-notebooks test-results notebooks bench lock clean
 
 help:
 	@echo "make book      - execute every notebook (papermill) and build the HTML book in book/_build/html"
-	@echo "make test      - library tests (pytest) + stored notebook outputs checked by nbval"
-	@echo "make notebooks - re-execute notebooks/*.ipynb in place (regenerate the stored outputs nbval checks)"
+	@echo "make screenshots - render every built page with headless Chromium (1400 px) into book/_build/screenshots"
+	@echo "make test      - library tests (pytest) + nbval on the stored notebooks + their results vs notebooks/results"
+	@echo "make notebooks - re-execute notebooks/*.ipynb in place (regenerate the stored outputs and notebooks/results)"
 	@echo "make bench     - run the speed benchmarks in benchmarks/"
 	@echo "make lock      - regenerate environment.lock from requirements/requirements.in"
 
@@ -31,20 +32,36 @@ $(STAMP): environment.lock pyproject.toml
 	@touch $(STAMP)
 
 book: $(STAMP)
+	@rm -rf $(GENERATED)
 	@$(PY) -m navlib.booktools execute --out $(GENERATED) $(NOTEBOOKS)
+	@$(PY) -m navlib.booktools status $(GENERATED)/results --notebooks $(GENERATED) --out $(GENERATED)/status.md
+	@$(PY) -m navlib.booktools api-modules --out $(GENERATED)/api_modules.md
 	@echo "== building the HTML book"
 	@$(VENV)/bin/jupyter-book build book -W -n --keep-going --quiet
 	@$(PY) -m navlib.booktools check-html book/_build/html
 	@echo "== book built: book/_build/html/index.html"
 
-test: test-lib test-notebooks
+# Screenshots of every built page (run `make book` first). Needs the Debian package chromium.
+screenshots: $(STAMP)
+	@test -f book/_build/html/index.html || { echo "no built book: run 'make book' first" >&2; exit 1; }
+	@command -v chromium > /dev/null || { echo "chromium is missing: install it with 'apt-get install -y chromium' (Debian package chromium)" >&2; exit 2; }
+	@$(PY) -m navlib.booktools screenshots book/_build/html book/_build/screenshots --width 1400
+
+test: test-lib test-notebooks test-results
 
 test-lib: $(STAMP)
 	@$(PY) -m pytest -q tests -p no:cacheprovider
 
+# nbval re-executes every notebook; each chapter's last cell rewrites $(GENERATED)/results/<chapter>.json.
+# The folder is cleared first so a stale file cannot pass test-results.
 test-notebooks: $(STAMP)
-	@$(PY) -m pytest -q -p no:cacheprovider --nbval --nbval-current-env \
-	    --nbval-sanitize-with notebooks/sanitize.cfg notebooks
+	@rm -rf $(GENERATED)/results
+	@NAVBOOK_RESULTS_DIR=$(CURDIR)/$(GENERATED)/results $(PY) -m pytest -q -p no:cacheprovider --nbval \
+	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks
+
+# The fresh results files against the committed references notebooks/results/<chapter>.json (make notebooks).
+test-results: $(STAMP)
+	@$(PY) -m navlib.booktools check-results --fresh $(GENERATED)/results --reference notebooks/results $(NOTEBOOKS)
 
 notebooks: $(STAMP)
 	@$(PY) -m navlib.booktools execute --in-place $(NOTEBOOKS)

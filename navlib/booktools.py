@@ -1,26 +1,67 @@
-"""Build helpers for the book: execute notebooks with papermill, strip volatile metadata, check the HTML.
+"""Build helpers for the book (used by the Makefile): execute notebooks, check the built HTML, write the
+landing page's status table and the API page's module list, check the chapters' results files, and take
+screenshots of every page.
 
-``python -m navlib.booktools execute --out book/_generated notebooks/*.ipynb`` executes each notebook into
-the book's generated folder (one progress line per notebook) and stops with a non-zero exit at the first
-failing notebook; ``--in-place`` re-executes the stored notebooks instead (how the outputs that nbval checks
-are regenerated).  ``check-html DIR`` fails if a built page loads anything from the network or shows an
-execution error.
+Subcommands of ``python -m navlib.booktools``:
+
+``execute --out book/_generated notebooks/*.ipynb``
+    Execute each notebook with papermill into the book's generated folder (one progress line per notebook);
+    stop with a non-zero exit at the first failing notebook.  ``--in-place`` re-executes the stored
+    notebooks instead (how the outputs that nbval checks are regenerated) and also stores each chapter's
+    results file as ``notebooks/results/<chapter>.json`` (the committed reference ``make test`` compares
+    with).  With ``--out DIR`` the results files go to ``DIR/results/``.
+``check-html DIR``
+    Fail if a built page loads anything from the network, shows an execution error, has an output block
+    wider than the content column (a preformatted line over :data:`MAX_PRE_CHARS` characters), a figure
+    without a caption or a visible nbval marker, or is a chapter (``_generated/``) that does not open with
+    its *Results at a glance* admonition.
+``status RESULTS_DIR --notebooks DIR --out FILE``
+    Write the landing page's status table (claims reproduced per chapter and reading) from the results.
+``api-modules --out FILE``
+    Write one ``automodule`` section per module of ``navlib`` (the API reference page includes it).
+``check-results --fresh DIR --reference DIR NOTEBOOK...``
+    Compare the results files a fresh run wrote with the committed references, within tolerance.
+``screenshots HTML_DIR OUT_DIR``
+    Render every page with headless Chromium (1400 px wide, full page height), record the page heights and
+    list output blocks that overflow the content column.
 """
 from __future__ import annotations
 
 import argparse
+import base64
+import csv
+import fcntl
+import html
+import json
+import math
+import os
+import pkgutil
 import re
+import select
+import shutil
+import subprocess
 import sys
 import tempfile
 import time
+from html.parser import HTMLParser
 from pathlib import Path
+
+from .report import claims_summary, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
+#: A preformatted output line longer than this does not fit the content column at 1400 px: measured in
+#: headless Chromium on the built book (sphinx-book-theme 1.3): an output ``<pre>`` is 784 px wide with
+#: 32 px of padding, and its 14 px monospace font is 8.43 px per character, so 89 characters fit.
+MAX_PRE_CHARS = 89
+#: Tolerances of ``check-results``: a number passes if ``|fresh - ref| <= ATOL + RTOL * |ref|``.
+RTOL = 1e-3
+ATOL = 1e-9
 
 
 def strip_metadata(nb) -> None:
     """Remove timing and run-specific metadata so a re-executed notebook diffs only where outputs changed.
+
     Execution counts stay: nbval treats a cell without one as never run (they are sequential anyway)."""
     for key in VOLATILE_NB_KEYS:
         nb.metadata.pop(key, None)
@@ -39,19 +80,43 @@ def missing_figures(nb) -> list[int]:
     return bad
 
 
+_WRITE_RESULTS = re.compile(r"""write_results\(\s*(?:chapter\s*=\s*)?["']([A-Za-z_]\w*)["']""")
+
+
+def results_chapter(nb_path: Path) -> str | None:
+    """The chapter name a notebook passes to ``report.write_results`` (None if it never calls it)."""
+    import nbformat
+
+    nb = nbformat.read(nb_path, as_version=4)
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            m = _WRITE_RESULTS.search(cell.source)
+            if m:
+                return m.group(1)
+    return None
+
+
 def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
             parameters: dict | None = None) -> int:
+    """Execute notebooks with papermill (see the module docstring); 0 on success, 1 at the first failure.
+
+    Each notebook runs with ``NAVBOOK_RESULTS_DIR`` pointing at a fresh temporary folder; the results
+    files it writes are then copied to ``notebooks/results/`` (``in_place``) or ``out_dir/results/``."""
     import nbformat
     import papermill as pm
 
     for i, nb_path in enumerate(notebooks, 1):
         nb_path = Path(nb_path).resolve()
         target = nb_path if in_place else (out_dir / nb_path.name)
+        results_target = (nb_path.parent if in_place else Path(out_dir)) / "results"
         target.parent.mkdir(parents=True, exist_ok=True)
         print(f"[{i}/{len(notebooks)}] executing {nb_path.name} -> {target}", flush=True)
         t0 = time.perf_counter()
+        old_env = os.environ.get("NAVBOOK_RESULTS_DIR")
         with tempfile.TemporaryDirectory() as tmp:
             tmp_out = Path(tmp) / nb_path.name
+            tmp_results = Path(tmp) / "results"
+            os.environ["NAVBOOK_RESULTS_DIR"] = str(tmp_results)   # the kernel inherits the environment
             try:
                 pm.execute_notebook(str(nb_path), str(tmp_out), cwd=str(nb_path.parent),
                                     parameters=parameters or {}, kernel_name="python3",
@@ -61,6 +126,11 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
                 print(f"FAILED {nb_path.name}: cell {err.exec_count}: {lines[-1] if lines else err.ename}",
                       file=sys.stderr)
                 return 1
+            finally:
+                if old_env is None:
+                    os.environ.pop("NAVBOOK_RESULTS_DIR", None)
+                else:
+                    os.environ["NAVBOOK_RESULTS_DIR"] = old_env
             nb = nbformat.read(tmp_out, as_version=4)
             missing = missing_figures(nb)
             if missing:
@@ -69,46 +139,674 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
                 return 1
             strip_metadata(nb)
             nbformat.write(nb, target)
-        print(f"    done in {time.perf_counter() - t0:.1f} s", flush=True)
+            written = sorted(tmp_results.glob("*.json")) if tmp_results.is_dir() else []
+            if written:
+                results_target.mkdir(parents=True, exist_ok=True)
+            for f in written:
+                shutil.copyfile(f, results_target / f.name)
+        names = ", ".join(f.name for f in written) or "none (the chapter does not call report.write_results)"
+        print(f"    done in {time.perf_counter() - t0:.1f} s; results: {names}", flush=True)
     return 0
 
 
+# ------------------------------------------------------------------------------------------ HTML checks
 REMOTE = re.compile(r"""(?:src|href)\s*=\s*["'](?:https?:)?//(?!localhost)""", re.I)
+_VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "param", "source",
+         "track", "wbr"}
 
 
-def check_html(html_dir: Path) -> int:
-    """Fail if any built page references a remote script/style/image, or shows a notebook traceback."""
+class _PageScan(HTMLParser):
+    """One pass over a built page: collects the problems :func:`check_page` reports."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.stack: list[tuple[str, set[str]]] = []
+        self.heading = ""          # the last section heading seen (to say where a problem is)
+        self._in_heading = False
+        self._heading_buf: list[str] = []
+        self.pre_stack: list[list[str]] = []   # text of output <pre> blocks being read
+        self.figures: list[dict] = []          # open <figure> elements
+        self.problems: list[str] = []
+        self._skip = 0                         # inside <script>/<style>
+
+    # -- helpers
+    def _classes(self, attrs) -> set[str]:
+        return set((dict(attrs).get("class") or "").split())
+
+    def _inside(self, cls: str) -> bool:
+        return any(cls in c for _, c in self.stack)
+
+    def _in_output(self) -> bool:
+        return self._inside("cell_output") or self._inside("output")
+
+    def _where(self) -> str:
+        return f"under heading '{self.heading}'" if self.heading else "before the first heading"
+
+    # -- parser callbacks
+    def handle_starttag(self, tag, attrs):
+        classes = self._classes(attrs)
+        a = dict(attrs)
+        if tag in ("script", "style"):
+            self._skip += 1
+        if tag in ("h1", "h2", "h3", "h4"):
+            self._in_heading, self._heading_buf = True, []
+        if tag == "img":
+            if self._in_output() and not self.figures:
+                alt = (a.get("alt") or "")[:60]
+                self.problems.append(f"figure without a caption {self._where()} (image '{alt}'): glue it "
+                                     f"with report.glue_figure and show it with a glue:figure directive "
+                                     f"that has a caption")
+            for fig in self.figures:
+                fig["img"] = True
+        if tag == "figure":
+            self.figures.append({"id": a.get("id", ""), "caption": False, "img": False})
+        if tag == "figcaption" and self.figures:
+            self.figures[-1]["caption"] = True
+        if tag == "pre" and self._in_output():
+            self.pre_stack.append([])
+        if tag not in _VOID:
+            self.stack.append((tag, classes))
+
+    def handle_startendtag(self, tag, attrs):
+        self.handle_starttag(tag, attrs)
+        if tag not in _VOID and self.stack and self.stack[-1][0] == tag:
+            self.handle_endtag(tag)
+
+    def handle_endtag(self, tag):
+        if tag in _VOID:
+            return
+        if tag in ("script", "style") and self._skip:
+            self._skip -= 1
+        if tag in ("h1", "h2", "h3", "h4") and self._in_heading:
+            self._in_heading = False
+            self.heading = re.sub(r"\s+", " ", "".join(self._heading_buf)).strip().rstrip("#").strip()
+        if tag == "pre" and self.pre_stack and self._in_output():
+            self._check_pre("".join(self.pre_stack.pop()))
+        if tag == "figure" and self.figures:
+            fig = self.figures.pop()
+            if not fig["caption"]:
+                name = f" '{fig['id']}'" if fig["id"] else ""
+                self.problems.append(f"figure{name} without a caption {self._where()}: give the "
+                                     f"glue:figure/figure directive a caption paragraph")
+        # pop up to and including the matching open tag (tolerates unclosed <p> and the like)
+        for k in range(len(self.stack) - 1, -1, -1):
+            if self.stack[k][0] == tag:
+                del self.stack[k:]
+                break
+
+    def handle_data(self, data):
+        if self._skip:
+            return
+        if self._in_heading:
+            self._heading_buf.append(data)
+        if self.pre_stack:
+            self.pre_stack[-1].append(data)
+        if "NBVAL_" in data:
+            m = re.search(r"#?\s*NBVAL_\w*", data)
+            self.problems.append(f"visible nbval marker '{m.group(0).strip()}' {self._where()}: use the cell "
+                                 f"tag nbval-ignore-output (or nbval-skip) instead of the comment")
+
+    def _check_pre(self, text: str):
+        for line in text.splitlines():
+            if len(line.rstrip()) > MAX_PRE_CHARS:
+                self.problems.append(
+                    f"output line of {len(line.rstrip())} characters (max {MAX_PRE_CHARS}) {self._where()}: "
+                    f"'{line.strip()[:70]}...': show a report.table(...) or shorten the printed text")
+                return      # one message per block
+
+
+def check_page(text: str, content: bool = True) -> list[str]:
+    """Problems of one built page (HTML text): network assets and, if ``content`` (every page but the
+    highlighted source listings under ``_modules/``), execution errors, output blocks wider than the
+    content column, figures without captions, visible nbval markers."""
     problems = []
-    for page in sorted(html_dir.rglob("*.html")):
+    for m in re.finditer(r"<(script|link|img)\b[^>]*>", text, re.I):
+        if REMOTE.search(m.group(0)):
+            problems.append(f"loads from the network: {m.group(0)[:120]}")
+    if not content:
+        return problems
+    if "Traceback (most recent call last)" in text or 'class="output traceback' in text:
+        problems.append("shows an execution error")
+    scan = _PageScan()
+    scan.feed(text)
+    scan.close()
+    return problems + scan.problems
+
+
+GLANCE = "Results at a glance"
+
+
+def check_chapter_opening(text: str) -> list[str]:
+    """A chapter page (executed notebook) must open with the *Results at a glance* admonition: present,
+    and before the first code cell."""
+    m = re.search(r'<p class="admonition-title">\s*' + GLANCE, text)
+    if not m:
+        return [f"chapter without a '{GLANCE}' admonition: open the chapter with report.glance(claims) "
+                f"glued into a ':::{{admonition}} {GLANCE}' block"]
+    first_cell = text.find('<div class="cell docutils container')
+    if 0 <= first_cell < m.start():
+        return [f"the '{GLANCE}' admonition comes after a code cell: move it right after the title and intro"]
+    return []
+
+
+def check_html(html_dir: Path, limit: int = 60) -> int:
+    """Run :func:`check_page` on every built page; print each problem as ``page: problem``; 1 if any."""
+    problems = []
+    pages = sorted(Path(html_dir).rglob("*.html"))
+    for page in pages:
         text = page.read_text(encoding="utf-8", errors="replace")
-        for m in re.finditer(r"<(script|link|img)\b[^>]*>", text, re.I):
-            if REMOTE.search(m.group(0)):
-                problems.append(f"{page.relative_to(html_dir)}: loads from the network: {m.group(0)[:120]}")
-        if "Traceback (most recent call last)" in text or 'class="output traceback' in text:
-            problems.append(f"{page.relative_to(html_dir)}: shows an execution error")
-    for p in problems[:20]:
+        rel = page.relative_to(html_dir)
+        problems += [f"{rel}: {p}" for p in check_page(text, content=rel.parts[0] != "_modules")]
+        if rel.parts[0] == "_generated":              # the chapters (executed notebooks)
+            problems += [f"{rel}: {p}" for p in check_chapter_opening(text)]
+    for p in problems[:limit]:
+        print(p, file=sys.stderr)
+    if len(problems) > limit:
+        print(f"... and {len(problems) - limit} more", file=sys.stderr)
+    if problems:
+        print(f"check-html: {len(problems)} problem(s) in {len(pages)} pages", file=sys.stderr)
+        return 1
+    print(f"check-html: {len(pages)} pages: nothing loaded from the network, no errors, no output wider than "
+          f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers, every chapter opens with "
+          f"its results at a glance")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ landing page
+def notebook_title(nb_path: Path) -> str:
+    """The first markdown heading of a notebook (its chapter title), else the file stem."""
+    import nbformat
+
+    nb = nbformat.read(nb_path, as_version=4)
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            m = re.search(r"^#\s+(.+)$", cell.source, re.M)
+            if m:
+                return m.group(1).strip()
+    return nb_path.stem
+
+
+def _md_cell(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def status_markdown(results: dict[str, dict], notebooks: list[Path]) -> str:
+    """The landing page's status table (MyST markdown): per chapter and reading, how many of the paper's
+    claims are reproduced, not reproduced, or cannot be judged, each chapter linked; then the chapters that
+    wrote no results file."""
+    chapter_doc, titles = {}, {}
+    for nb in notebooks:
+        chapter = results_chapter(nb) or nb.stem
+        chapter_doc[chapter] = f"/_generated/{nb.stem}"
+        titles[chapter] = notebook_title(nb)
+    lines = []
+    summary = claims_summary(results)
+    if len(summary):
+        lines += ["| chapter | reading of the paper | reproduced | not reproduced | cannot be judged |",
+                  "|---|---|---|---|---|"]
+        last = None
+        for row in summary.to_dict("records"):
+            chap = row["chapter"]
+            if chap != last:
+                doc = chapter_doc.get(chap)
+                name = _md_cell(titles.get(chap, chap))
+                label = f"{{doc}}`{name} <{doc}>`" if doc else name
+            else:
+                label = ""
+            last = chap
+            lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of {row['claims']} | "
+                         f"{row['not reproduced']} | {row['cannot be judged']} |")
+        lines.append("")
+        lines.append("Counts are computed by each chapter's code from its claims (the table "
+                     "*Results at a glance* at the top of the chapter) when the book is built.")
+    else:
+        lines.append("No chapter has written its results yet.")
+    missing = [c for c in chapter_doc if c not in results]
+    if missing:
+        names = ", ".join(f"{{doc}}`{_md_cell(titles[c])} <{chapter_doc[c]}>`" for c in missing)
+        lines += ["", f"Not yet summarised (no results file): {names}."]
+    return "\n".join(lines) + "\n"
+
+
+def write_status(results_dir: Path, notebooks_dir: Path, out: Path) -> int:
+    """Write :func:`status_markdown` for the results in ``results_dir`` and the executed notebooks in
+    ``notebooks_dir`` to ``out``."""
+    results = read_results(results_dir) if Path(results_dir).is_dir() else {}
+    notebooks = sorted(Path(notebooks_dir).glob("*.ipynb"))
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(status_markdown(results, notebooks), encoding="utf-8")
+    n_claims = sum(len(r.get("claims", [])) for r in results.values())
+    print(f"status: {len(results)} chapter(s) with results, {n_claims} claims -> {out}")
+    no_results = [nb.name for nb in notebooks if (results_chapter(nb) or nb.stem) not in results]
+    if no_results:
+        print(f"status: no results file from {', '.join(no_results)} (the chapter's last cell must call "
+              f"report.write_results)", file=sys.stderr)
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ API page
+def navlib_modules() -> list[str]:
+    """Every module of the ``navlib`` package (``__main__`` excluded), top-level modules first."""
+    import navlib
+
+    names = [m.name for m in pkgutil.walk_packages(navlib.__path__, "navlib.")
+             if not m.name.endswith("__main__")]
+    return sorted(names, key=lambda n: (n.count("."), n))
+
+
+def api_markdown(modules: list[str]) -> str:
+    """One section per module (MyST markdown): a heading and an ``automodule`` directive, in an
+    ``eval-rst`` block because autodoc emits reStructuredText."""
+    parts = []
+    for name in modules:
+        parts += [f"## `{name}`", "", "```{eval-rst}", f".. automodule:: {name}", "   :members:", "```", ""]
+    return "\n".join(parts)
+
+
+def write_api(out: Path) -> int:
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    mods = navlib_modules()
+    out.write_text(api_markdown(mods), encoding="utf-8")
+    print(f"api-modules: {len(mods)} modules -> {out}")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ results check
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def validate_results(res: dict, name: str) -> list[str]:
+    """Schema problems of one results file (see ``navlib.report.write_results``)."""
+    p = []
+    if not isinstance(res, dict):
+        return [f"{name}: not a JSON object"]
+    if res.get("chapter") != Path(name).stem:
+        p.append(f"{name}: 'chapter' is {res.get('chapter')!r}, expected {Path(name).stem!r}")
+    claims = res.get("claims")
+    if not isinstance(claims, list) or not claims:
+        p.append(f"{name}: 'claims' must be a non-empty list")
+        claims = []
+    for i, c in enumerate(claims):
+        if not isinstance(c, dict):
+            p.append(f"{name}: claims[{i}] is not an object")
+            continue
+        for k in ("claim", "paper", "ours", "reading"):
+            if not isinstance(c.get(k), str) or not c.get(k).strip():
+                p.append(f"{name}: claims[{i}].{k} missing or empty")
+        if "reproduced" not in c or c["reproduced"] not in (True, False, None):
+            p.append(f"{name}: claims[{i}].reproduced must be true, false or null")
+    methods = res.get("methods")
+    if methods is not None:
+        unit = res.get("unit")
+        if not isinstance(unit, str) or not unit:
+            p.append(f"{name}: 'methods' given without a 'unit'")
+            unit = "?"
+        if not isinstance(methods, dict) or not methods:
+            p.append(f"{name}: 'methods' must be a non-empty object")
+            methods = {}
+        required = [f"{k}_{unit}" for k in ("median_rms", "p10_rms", "p90_rms")] + ["n_seeds"]
+        optional = {f"median_min_{unit}", f"median_max_{unit}"}
+        for label, stats in methods.items():
+            if not isinstance(stats, dict):
+                p.append(f"{name}: methods[{label!r}] is not an object")
+                continue
+            for k in required:
+                if k not in stats:
+                    p.append(f"{name}: methods[{label!r}] lacks {k!r}")
+            for k, v in stats.items():
+                if k not in required and k not in optional:
+                    p.append(f"{name}: methods[{label!r}] has an unknown key {k!r}")
+                elif k == "n_seeds" and not (isinstance(v, int) and not isinstance(v, bool) and v > 0):
+                    p.append(f"{name}: methods[{label!r}].n_seeds must be a positive integer")
+                elif k != "n_seeds" and not (v is None or _is_num(v)):
+                    p.append(f"{name}: methods[{label!r}].{k} must be a number or null")
+    return p
+
+
+def _close(a, b, rtol: float, atol: float) -> bool:
+    if a is None or b is None:
+        return a is b
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return a == b
+    return abs(a - b) <= atol + rtol * abs(b)
+
+
+def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol: float = ATOL) -> list[str]:
+    """Differences between a fresh results file and its committed reference: the same methods and
+    statistics (numbers within ``atol + rtol * |reference|``, seed counts equal), the same claims (text,
+    reading, the paper's side) with the same verdicts, the same extra values within tolerance."""
+    p = []
+    fm, rm = fresh.get("methods") or {}, ref.get("methods") or {}
+    if fresh.get("unit") != ref.get("unit"):
+        p.append(f"{name}: unit {fresh.get('unit')!r}, reference {ref.get('unit')!r}")
+    if set(fm) != set(rm):
+        p.append(f"{name}: methods {sorted(fm)} differ from the reference's {sorted(rm)}")
+    for label in sorted(set(fm) & set(rm)):
+        for k in sorted(set(fm[label]) | set(rm[label])):
+            a, b = fm[label].get(k, "missing"), rm[label].get(k, "missing")
+            if k == "n_seeds" or not (_is_num(a) or a is None) or not (_is_num(b) or b is None):
+                ok = a == b
+            else:
+                ok = _close(a, b, rtol, atol)
+            if not ok:
+                p.append(f"{name}: methods[{label!r}].{k} = {a}, reference {b} "
+                         f"(tolerance {rtol:g} relative + {atol:g})")
+    fc, rc = fresh.get("claims") or [], ref.get("claims") or []
+    if len(fc) != len(rc):
+        p.append(f"{name}: {len(fc)} claims, reference {len(rc)}")
+    for i, (a, b) in enumerate(zip(fc, rc)):
+        for k in ("claim", "reading", "paper"):
+            if a.get(k) != b.get(k):
+                p.append(f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}")
+        if a.get("reproduced") != b.get("reproduced"):
+            p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
+                     f"{a.get('reproduced')}, reference {b.get('reproduced')}")
+    fe, re_ = fresh.get("extra") or {}, ref.get("extra") or {}
+    if set(fe) != set(re_):
+        p.append(f"{name}: extra keys {sorted(fe)} differ from the reference's {sorted(re_)}")
+    for k in sorted(set(fe) & set(re_)):
+        a, b = fe[k], re_[k]
+        pairs = list(zip(a, b)) if isinstance(a, list) and isinstance(b, list) and len(a) == len(b) else [(a, b)]
+        ok = all(_close(x, y, rtol, atol) if (_is_num(x) and _is_num(y)) else x == y for x, y in pairs)
+        if not ok:
+            p.append(f"{name}: extra[{k!r}] = {a}, reference {b}")
+    return p
+
+
+def check_results(fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: float = RTOL,
+                  atol: float = ATOL) -> int:
+    """Check every chapter notebook's fresh results file (written by the nbval run) against its committed
+    reference in ``ref_dir``; print each problem; 1 if any."""
+    fresh_dir, ref_dir = Path(fresh_dir), Path(ref_dir)
+    problems, checked = [], []
+    chapters = {}
+    for nb in notebooks:
+        nb = Path(nb)
+        chapter = results_chapter(nb)
+        if chapter is None:
+            problems.append(f"{nb}: writes no results file: its last code cell must call "
+                            f"report.write_results('<chapter>', claims=...)")
+            continue
+        chapters[chapter] = nb
+        ref_path, fresh_path = ref_dir / f"{chapter}.json", fresh_dir / f"{chapter}.json"
+        if not ref_path.exists():
+            problems.append(f"{ref_path}: missing reference for {nb}: regenerate it with "
+                            f"'.venv/bin/python -m navlib.booktools execute --in-place {nb}' (or make "
+                            f"notebooks) and commit it")
+            continue
+        if not fresh_path.exists():
+            problems.append(f"{fresh_path}: {nb} wrote no fresh results: run the notebooks first "
+                            f"(make test-notebooks)")
+            continue
+        try:
+            ref = json.loads(ref_path.read_text(encoding="utf-8"))
+            fresh = json.loads(fresh_path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as err:
+            problems.append(f"{chapter}.json: not valid JSON ({err.msg}, line {err.lineno})")
+            continue
+        problems += [f"reference {q}" for q in validate_results(ref, f"{chapter}.json")]
+        problems += [f"fresh {q}" for q in validate_results(fresh, f"{chapter}.json")]
+        problems += compare_results(fresh, ref, f"{chapter}.json", rtol, atol)
+        checked.append(chapter)
+    for stray in sorted(ref_dir.glob("*.json")) if ref_dir.is_dir() else []:
+        if stray.stem not in chapters:
+            problems.append(f"{stray}: no notebook writes chapter {stray.stem!r}: delete the file or fix the "
+                            f"chapter name")
+    for p in problems:
         print(p, file=sys.stderr)
     if problems:
-        print(f"check-html: {len(problems)} problem(s)", file=sys.stderr)
+        print(f"check-results: {len(problems)} problem(s)", file=sys.stderr)
         return 1
-    print(f"check-html: {len(list(html_dir.rglob('*.html')))} pages, nothing loaded from the network")
+    print(f"check-results: {len(checked)} chapter(s) reproduce their stored results "
+          f"({', '.join(checked)}; numbers within {rtol:g} relative + {atol:g} absolute, verdicts equal)")
     return 0
 
 
+# ------------------------------------------------------------------------------------------ screenshots
+CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--no-first-run")
+CHROMIUM_MISSING = ("chromium not found: install it with 'apt-get install -y chromium' (Debian package "
+                    "chromium) or pass --chromium /path/to/chromium")
+
+#: JavaScript run on each page: output blocks and tables wider than the article (cut or scrolling).
+_OVERFLOW_JS = r"""(() => {
+  const art = document.querySelector('article') || document.body;
+  const right = art.getBoundingClientRect().right;
+  const out = [];
+  const heading = el => { let h = null;
+    document.querySelectorAll('h1, h2, h3').forEach(x => {
+      if (x.compareDocumentPosition(el) & Node.DOCUMENT_POSITION_FOLLOWING) h = x; });
+    return h ? h.textContent.replace(/[#\s]+$/, '').trim() : ''; };
+  art.querySelectorAll('.cell_output pre, .cell_output .output, .cell_output img, table').forEach(el => {
+    const r = el.getBoundingClientRect();
+    const over = Math.max(el.scrollWidth - el.clientWidth, r.right - right);
+    if (r.width > 0 && over > 2) out.push({heading: heading(el), overflow_px: Math.round(over),
+      what: el.tagName.toLowerCase() + '.' + (el.className || '').toString().split(' ').slice(0, 2).join('.'),
+      text: (el.innerText || '').trim().slice(0, 60)});
+  });
+  return out; })()"""
+
+
+class _Chrome:
+    """Headless Chromium driven over the DevTools protocol on a pipe (``--remote-debugging-pipe``: the
+    browser reads JSON messages from fd 3 and writes to fd 4, each ending with a NUL byte)."""
+
+    def __init__(self, binary: str, timeout_s: float = 60.0):
+        self.timeout_s = timeout_s
+        self.profile = tempfile.mkdtemp(prefix="navbook-chromium-")
+        to_chrome_r, self._to_chrome_w = os.pipe()
+        self._from_chrome_r, from_chrome_w = os.pipe()
+
+        def child_fds():            # runs in the child before exec: put the pipe ends on fds 3 and 4
+            a = fcntl.fcntl(to_chrome_r, fcntl.F_DUPFD, 10)
+            b = fcntl.fcntl(from_chrome_w, fcntl.F_DUPFD, 10)
+            os.dup2(a, 3)
+            os.dup2(b, 4)
+
+        self.proc = subprocess.Popen(
+            [binary, *CHROMIUM_FLAGS, f"--user-data-dir={self.profile}", "--remote-debugging-pipe",
+             "--hide-scrollbars", "about:blank"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            preexec_fn=child_fds, close_fds=False)
+        os.close(to_chrome_r)
+        os.close(from_chrome_w)
+        self._buf = b""
+        self._id = 0
+        self.events: list[dict] = []
+
+    def send(self, method: str, params: dict | None = None, session: str | None = None) -> dict:
+        self._id += 1
+        msg = {"id": self._id, "method": method, "params": params or {}}
+        if session:
+            msg["sessionId"] = session
+        os.write(self._to_chrome_w, json.dumps(msg).encode() + b"\0")
+        while True:
+            m = self._read()
+            if m.get("id") == self._id:
+                if "error" in m:
+                    raise RuntimeError(f"chromium: {method}: {m['error'].get('message')}")
+                return m.get("result", {})
+            self.events.append(m)
+
+    def wait_event(self, method: str, session: str | None = None) -> dict:
+        while True:
+            for k, e in enumerate(self.events):
+                if e.get("method") == method and (session is None or e.get("sessionId") == session):
+                    return self.events.pop(k)
+            self.events.append(self._read())
+
+    def wait_loaded(self, session: str, url: str) -> None:
+        """Poll until the page at ``url`` has finished loading (events of the blank page that preceded it
+        must not be mistaken for its load event)."""
+        deadline = time.monotonic() + self.timeout_s
+        probe = {"expression": "document.readyState + ' ' + location.href", "returnByValue": True}
+        while time.monotonic() < deadline:
+            try:
+                state = self.send("Runtime.evaluate", probe, session=session)["result"].get("value", "")
+            except RuntimeError:            # the context was replaced by the navigation: ask again
+                state = ""
+            if state == f"complete {url}":
+                self.events.clear()
+                return
+            time.sleep(0.1)
+        raise TimeoutError(f"chromium: {url} did not load within {self.timeout_s:.0f} s")
+
+    def _read(self) -> dict:
+        deadline = time.monotonic() + self.timeout_s
+        while b"\0" not in self._buf:
+            left = deadline - time.monotonic()
+            ready, _, _ = select.select([self._from_chrome_r], [], [], max(left, 0))
+            if not ready:
+                raise TimeoutError(f"chromium did not answer within {self.timeout_s:.0f} s")
+            chunk = os.read(self._from_chrome_r, 1 << 20)
+            if not chunk:
+                raise RuntimeError("chromium exited")
+            self._buf += chunk
+        msg, self._buf = self._buf.split(b"\0", 1)
+        return json.loads(msg)
+
+    def close(self):
+        try:
+            self.send("Browser.close")
+        except (RuntimeError, TimeoutError, OSError):
+            pass
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+        for fd in (self._to_chrome_w, self._from_chrome_r):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+        shutil.rmtree(self.profile, ignore_errors=True)
+
+
+def find_chromium(explicit: str | None = None) -> str | None:
+    """The Chromium binary: ``explicit``, else ``chromium`` / ``chromium-browser`` / ``google-chrome``."""
+    if explicit:
+        return explicit if Path(explicit).exists() or shutil.which(explicit) else None
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        if shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str | None = None,
+                settle_s: float = 0.5) -> int:
+    """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
+    relative names, ``.png``); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
+    or tables wider than the content column, by page).  Returns 2 if Chromium is missing."""
+    binary = find_chromium(chromium)
+    if binary is None:
+        print(CHROMIUM_MISSING, file=sys.stderr)
+        return 2
+    html_dir, out_dir = Path(html_dir).resolve(), Path(out_dir)
+    pages = [p for p in sorted(html_dir.rglob("*.html"))
+             if p.relative_to(html_dir).parts[0] not in ("_modules", "_sources", "_static", "_images")
+             and p.name not in ("search.html", "genindex.html", "py-modindex.html")
+             and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
+    out_dir.mkdir(parents=True, exist_ok=True)
+    chrome = _Chrome(binary)
+    heights, overflow = [], {}
+    try:
+        for page in pages:
+            rel = page.relative_to(html_dir)
+            target = chrome.send("Target.createTarget", {"url": "about:blank"})["targetId"]
+            session = chrome.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+            chrome.send("Page.enable", session=session)
+            metrics = {"width": width, "height": 900, "deviceScaleFactor": 1, "mobile": False}
+            chrome.send("Emulation.setDeviceMetricsOverride", metrics, session=session)
+            chrome.send("Page.navigate", {"url": page.as_uri()}, session=session)
+            chrome.wait_loaded(session, page.as_uri())
+            wait = (f"new Promise(r => setTimeout(r, {int(settle_s * 1000)}))"
+                    ".then(() => (window.MathJax && MathJax.startup) ? MathJax.startup.promise : null)"
+                    ".then(() => document.fonts.ready).then(() => 1)")
+            chrome.send("Runtime.evaluate", {"expression": wait, "awaitPromise": True}, session=session)
+            js_height = ("Math.max(document.documentElement.scrollHeight, document.body.scrollHeight, "
+                         "...[...document.querySelectorAll('.bd-main, .bd-container, .bd-page-width')]"
+                         ".map(e => e.scrollHeight))")
+            h = chrome.send("Runtime.evaluate", {"expression": js_height, "returnByValue": True},
+                            session=session)["result"]["value"]
+            h = int(h)
+            chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": h}, session=session)
+            # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
+            chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
+                        "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
+            found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
+                                session=session)["result"].get("value") or []
+            shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
+                               session=session)
+            png = out_dir / rel.with_suffix(".png")
+            png.parent.mkdir(parents=True, exist_ok=True)
+            png.write_bytes(base64.b64decode(shot["data"]))
+            chrome.send("Target.closeTarget", {"targetId": target})
+            heights.append((str(rel), h))
+            if found:
+                overflow[str(rel)] = found
+            note = f"; {len(found)} block(s) wider than the content column" if found else ""
+            print(f"{rel}: {width} x {h} px -> {png}{note}", flush=True)
+    finally:
+        chrome.close()
+    with open(out_dir / "heights.csv", "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["page", "height_px"])
+        w.writerows(heights)
+    (out_dir / "overflow.json").write_text(json.dumps(overflow, indent=1, ensure_ascii=False) + "\n",
+                                           encoding="utf-8")
+    for page, items in overflow.items():
+        for it in items:
+            print(f"  wider than the column: {page}: {it['what']} by {it['overflow_px']} px under "
+                  f"'{it['heading']}': {html.unescape(it['text'])[:50]!r}", file=sys.stderr)
+    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json)")
+    return 0
+
+
+# ------------------------------------------------------------------------------------------ CLI
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m navlib.booktools")
     sub = ap.add_subparsers(dest="cmd", required=True)
     ex = sub.add_parser("execute", help="execute notebooks with papermill")
     ex.add_argument("notebooks", nargs="+", type=Path)
     g = ex.add_mutually_exclusive_group(required=True)
-    g.add_argument("--out", type=Path, help="folder for the executed copies")
-    g.add_argument("--in-place", action="store_true", help="re-execute the stored notebooks")
-    ch = sub.add_parser("check-html", help="check built pages load nothing remote")
+    g.add_argument("--out", type=Path, help="folder for the executed copies (results go to OUT/results)")
+    g.add_argument("--in-place", action="store_true",
+                   help="re-execute the stored notebooks; store results in notebooks/results")
+    ch = sub.add_parser("check-html", help="check the built pages")
     ch.add_argument("html_dir", type=Path)
+    st = sub.add_parser("status", help="write the landing page's status table from the results files")
+    st.add_argument("results_dir", type=Path)
+    st.add_argument("--notebooks", type=Path, required=True, help="folder of the executed notebooks")
+    st.add_argument("--out", type=Path, required=True)
+    api = sub.add_parser("api-modules", help="write the API page's automodule list")
+    api.add_argument("--out", type=Path, required=True)
+    cr = sub.add_parser("check-results", help="compare fresh results files with the committed references")
+    cr.add_argument("notebooks", nargs="+", type=Path)
+    cr.add_argument("--fresh", type=Path, required=True)
+    cr.add_argument("--reference", type=Path, required=True)
+    cr.add_argument("--rtol", type=float, default=RTOL)
+    cr.add_argument("--atol", type=float, default=ATOL)
+    sc = sub.add_parser("screenshots", help="render every page with headless Chromium")
+    sc.add_argument("html_dir", type=Path)
+    sc.add_argument("out_dir", type=Path)
+    sc.add_argument("--width", type=int, default=1400)
+    sc.add_argument("--chromium", default=None)
     args = ap.parse_args(argv)
     if args.cmd == "execute":
         return execute(args.notebooks, args.out, args.in_place)
-    return check_html(args.html_dir)
+    if args.cmd == "check-html":
+        return check_html(args.html_dir)
+    if args.cmd == "status":
+        return write_status(args.results_dir, args.notebooks, args.out)
+    if args.cmd == "api-modules":
+        return write_api(args.out)
+    if args.cmd == "check-results":
+        return check_results(args.fresh, args.reference, args.notebooks, args.rtol, args.atol)
+    return screenshots(args.html_dir, args.out_dir, args.width, args.chromium)
 
 
 if __name__ == "__main__":

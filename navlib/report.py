@@ -10,14 +10,16 @@ A chapter notebook uses it like this::
     report.glue_figure("fig-compass-errors", fig)         # markdown: ```{glue:figure} fig-compass-errors
     claims = [report.Claim("ADE-BP beats DE-BP", "-0.22..0.20 vs -0.31..0.25", "4.2 vs 10.4 deg RMS",
                            True, reading="pure DE")]
-    report.glue_table("glance", report.glance(claims))    # Results at a glance (top of the chapter)
-    report.write_results("compass", methods=summary_frame, claims=claims)
+    report.glue_table("compass_glance", report.glance(claims))   # Results at a glance (chapter top)
+    report.write_results("compass", claims=claims, unit="deg",
+                         methods={"ADE-BP": report.method_stats(rms, mins, maxs)})
 
 Every number shown comes from the code that ran; nothing is typed in.  Rounding happens here, so stored
 notebook outputs compare within tolerance (nbval).
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -33,13 +35,13 @@ from .paths import ROOT
 
 #: Where each chapter's headline results are written during a build (git-ignored).
 RESULTS_DIR = ROOT / "book" / "_generated" / "results"
-#: Plain-text rendering width (characters): a stored output line longer than this would be cut on the page.
+#: Plain-text rendering width in characters; a stored output line longer than this would be cut on the page.
 PLAIN_WIDTH = 92
 METHOD_KEYS = ("median_rms", "p10_rms", "p90_rms", "median_min", "median_max")
 
 _CSS = ("table-layout:auto;width:100%;max-width:100%;border-collapse:collapse;font-size:0.85em;"
         "margin-bottom:0.5em")
-_CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflow-wrap:anywhere;"
+_CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflow-wrap:break-word;"
 
 
 def results_dir() -> Path:
@@ -116,7 +118,8 @@ class Table:
     def _repr_html_(self) -> str:
         f = self.formatted()
         styler = f.style if self.index else f.style.hide(axis="index")
-        styler = styler.set_uuid(f"t{abs(hash(tuple(f.columns))) % 10**8}")
+        digest = hashlib.sha1((f.to_csv() + str(self.caption)).encode("utf-8")).hexdigest()[:10]
+        styler = styler.set_uuid(f"t{digest}")      # stable across runs, distinct per table
         styler = styler.set_table_attributes(f'class="navbook-table" style="{_CSS}"')
         styler = styler.set_table_styles([{"selector": "th", "props": _CELL + "text-align:left;"},
                                           {"selector": "td", "props": _CELL}])
@@ -148,25 +151,26 @@ def _glue(name: str, obj: Any) -> None:
 
 
 def glue_number(name: str, value: Any, spec: str = "{:.3g}") -> str:
-    """Glue a number (formatted by ``spec``) for ``{glue:text}`name``` in the prose; returns the text."""
+    """Glue a number (formatted by ``spec``) for the prose, where the MyST role ``{glue:text}`` with the
+    same ``name`` shows it; returns the text."""
     text = fmt(value, spec)
     _glue(name, text)
     return text
 
 
 def glue_text(name: str, text: str) -> str:
-    """Glue a short text (a verdict, a method name) for ``{glue:text}`name```."""
+    """Glue a short text (a verdict, a method name) for the MyST role ``{glue:text}`` in the prose."""
     _glue(name, str(text))
     return str(text)
 
 
 def glue_table(name: str, tab: Table | pd.DataFrame) -> None:
-    """Glue a table for ```{glue:} name``` (e.g. inside the Results-at-a-glance admonition)."""
+    """Glue a table for a MyST ``{glue:}`` directive (e.g. inside the Results-at-a-glance admonition)."""
     _glue(name, tab if isinstance(tab, Table) else Table(tab))
 
 
 def glue_figure(name: str, fig) -> None:
-    """Glue a matplotlib figure for ```{glue:figure} name``` (numbered, captioned, with alt text in the
+    """Glue a matplotlib figure for a MyST ``{glue:figure}`` directive (numbered, captioned, with alt text in the
     directive), then close it so it is not shown a second time."""
     import matplotlib.pyplot as plt
 
@@ -244,7 +248,9 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
 
     ``methods`` maps a display label to :func:`method_stats`-style keys (without unit suffix); the unit
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
-    significant digits.  Returns the path written (this is a build output; it is rewritten each run)."""
+    significant digits.  Returns the path written (this is a build output; it is rewritten each run); it
+    displays as ``results written: <chapter>.json``, the same in every run, so a notebook cell that ends
+    with this call shows no run-specific folder."""
     if not chapter.isidentifier():
         raise InputError(f"chapter name {chapter!r}: use letters, digits and underscores")
     out: dict[str, Any] = {"chapter": chapter}
@@ -270,7 +276,14 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     d.mkdir(parents=True, exist_ok=True)
     path = d / f"{chapter}.json"
     path.write_text(json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n", encoding="utf-8")
-    return path
+    return _WrittenPath(path)
+
+
+class _WrittenPath(type(Path())):
+    """A :class:`pathlib.Path` whose display names only the file (stable across runs and machines)."""
+
+    def __repr__(self) -> str:
+        return f"results written: {self.name}"
 
 
 def read_results(folder: str | os.PathLike | None = None) -> dict[str, dict]:

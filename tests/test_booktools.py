@@ -1,3 +1,5 @@
+import json
+
 import nbformat
 
 from navlib.booktools import check_html, missing_figures, strip_metadata
@@ -49,3 +51,180 @@ def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
     assert execute([path], out, in_place=False) == 1
     assert "FAILED bad.ipynb" in capsys.readouterr().err
     assert not (out / "bad.ipynb").exists()          # no half-executed notebook lands in the book
+
+
+# ------------------------------------------------------------------ the presentation checks of check-html
+from navlib.booktools import (MAX_PRE_CHARS, api_markdown, check_page, check_results, compare_results,  # noqa: E402
+                              navlib_modules, status_markdown, validate_results)
+
+OUT = '<div class="cell_output docutils container">{}</div>'
+PRE = '<div class="output stream highlight-myst-ansi notranslate"><div class="highlight"><pre>{}</pre></div></div>'
+
+
+def page(body, heading="Results"):
+    return f"<html><body><article><section><h2>{heading}<a class='headerlink'>#</a></h2>{body}</section></article></body></html>"
+
+
+def test_check_page_accepts_a_clean_page():
+    body = (OUT.format(PRE.format("x" * MAX_PRE_CHARS)) +
+            '<figure id="fig-a"><div class="cell_output docutils container"><img alt="errors" src="a.png"/></div>'
+            '<figcaption><p>Caption.</p></figcaption></figure>'
+            '<div class="cell tag_nbval-ignore-output">3.2 s</div>')
+    assert check_page(page(body)) == []
+
+
+def test_check_page_flags_a_wide_output_line_and_says_where():
+    problems = check_page(page(OUT.format(PRE.format("short\n" + "y" * (MAX_PRE_CHARS + 1))), "Table 3"))
+    assert len(problems) == 1
+    assert f"{MAX_PRE_CHARS + 1} characters" in problems[0] and "Table 3" in problems[0]
+
+
+def test_check_page_ignores_wide_code_input_but_not_wide_output():
+    code = '<div class="cell_input"><div class="highlight"><pre>' + "z" * 150 + "</pre></div></div>"
+    assert check_page(page(code)) == []
+    assert len(check_page(page(code + OUT.format(PRE.format("&lt;" * 120))))) == 1
+
+
+def test_check_page_flags_uncaptioned_figures():
+    bare_output_image = OUT.format('<img alt="../_images/x.png" src="../_images/x.png"/>')
+    assert any("without a caption" in p for p in check_page(page(bare_output_image)))
+    figure_no_caption = '<figure id="fig-b"><img src="b.png"/></figure>'
+    problems = check_page(page(figure_no_caption))
+    assert len(problems) == 1 and "fig-b" in problems[0]
+
+
+def test_check_page_flags_visible_nbval_markers_not_tags():
+    code = '<div class="cell_input"><pre><span class="c1"># NBVAL_IGNORE_OUTPUT</span>\nt = 1</pre></div>'
+    problems = check_page(page(code))
+    assert len(problems) == 1 and "NBVAL_IGNORE_OUTPUT" in problems[0]
+    assert check_page(page('<script>var s = "NBVAL_x";</script>')) == []
+
+
+def test_check_html_reports_page_and_problem(tmp_path, capsys):
+    (tmp_path / "chapter.html").write_text(page(OUT.format(PRE.format("w" * 200))))
+    assert check_html(tmp_path) == 1
+    assert "chapter.html: output line of 200 characters" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ landing page and API list
+def _nb(path, write_call, title="Electronic compass"):
+    nb = nbformat.v4.new_notebook()
+    nb.cells.append(nbformat.v4.new_markdown_cell(f"# {title}\n\nIntro."))
+    nb.cells.append(nbformat.v4.new_code_cell(write_call))
+    nbformat.write(nb, path)
+    return path
+
+
+def _claim(text, reproduced, reading="as printed"):
+    return {"claim": text, "paper": "-0.22..0.20 deg", "ours": "4.2 deg", "reproduced": reproduced,
+            "reading": reading, "why": ""}
+
+
+def test_status_markdown_counts_claims_per_chapter_and_reading(tmp_path):
+    nb = _nb(tmp_path / "compass.ipynb", 'report.write_results("compass", claims=claims)')
+    other = _nb(tmp_path / "gyro.ipynb", "x = 1", title="Gyro drift")
+    results = {"compass": {"chapter": "compass", "claims": [
+        _claim("a", True), _claim("b", False), _claim("c", None), _claim("a", True, "MATLAB defaults")]}}
+    md = status_markdown(results, [nb, other])
+    assert "| {doc}`Electronic compass </_generated/compass>` | as printed | 1 of 3 | 1 | 1 |" in md
+    assert "|  | MATLAB defaults | 1 of 1 | 0 | 0 |" in md
+    assert "no results file" in md and "</_generated/gyro>" in md
+
+
+def test_api_markdown_lists_every_navlib_module():
+    mods = navlib_modules()
+    assert {"navlib.angles", "navlib.report", "navlib.booktools", "navlib.studies.paper_a"} <= set(mods)
+    assert "navlib.__main__" not in mods
+    md = api_markdown(mods)
+    assert md.count(".. automodule:: navlib.") == len(mods)
+
+
+# ------------------------------------------------------------------ results check
+def _results(rms=4.2, verdict=False):
+    return {"chapter": "compass", "unit": "deg",
+            "methods": {"ADE-BP": {"median_rms_deg": rms, "p10_rms_deg": 3.0, "p90_rms_deg": 5.0,
+                                   "median_min_deg": -9.0, "median_max_deg": 8.0, "n_seeds": 20}},
+            "claims": [_claim("ADE-BP beats DE-BP", verdict)]}
+
+
+def test_validate_results_checks_the_schema():
+    assert validate_results(_results(), "compass.json") == []
+    bad = _results()
+    del bad["methods"]["ADE-BP"]["p90_rms_deg"]
+    bad["claims"][0]["reproduced"] = "yes"
+    bad["unit"] = "mg"
+    problems = " ".join(validate_results(bad, "compass.json"))
+    assert "reproduced must be" in problems and "lacks 'p90_rms_mg'" in problems
+    assert validate_results({"chapter": "compass", "claims": []}, "compass.json")
+
+
+def test_compare_results_tolerance_and_verdicts():
+    ref = _results(4.2)
+    assert compare_results(_results(4.2 * (1 + 1e-4)), ref, "c") == []
+    assert any("median_rms_deg" in p for p in compare_results(_results(4.3), ref, "c"))
+    assert any("verdict" in p for p in compare_results(_results(4.2, verdict=True), ref, "c"))
+    fewer_seeds = _results()
+    fewer_seeds["methods"]["ADE-BP"]["n_seeds"] = 5
+    assert any("n_seeds" in p for p in compare_results(fewer_seeds, ref, "c"))
+
+
+def test_check_results_fails_without_reference_and_passes_with_it(tmp_path, capsys):
+    nb = _nb(tmp_path / "compass.ipynb", 'report.write_results("compass", claims=claims)')
+    fresh, ref = tmp_path / "fresh", tmp_path / "ref"
+    fresh.mkdir()
+    ref.mkdir()
+    (fresh / "compass.json").write_text(json.dumps(_results()))
+    assert check_results(fresh, ref, [nb]) == 1
+    assert "missing reference" in capsys.readouterr().err
+    (ref / "compass.json").write_text(json.dumps(_results()))
+    assert check_results(fresh, ref, [nb]) == 0
+    (fresh / "compass.json").unlink()                      # a stale fresh folder cannot pass
+    assert check_results(fresh, ref, [nb]) == 1
+
+
+def test_check_results_fails_for_a_notebook_that_writes_no_results(tmp_path, capsys):
+    nb = _nb(tmp_path / "gyro.ipynb", "x = 1")
+    assert check_results(tmp_path, tmp_path, [nb]) == 1
+    assert "writes no results file" in capsys.readouterr().err
+
+
+def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path):
+    from navlib.booktools import execute
+
+    nb = nbformat.v4.new_notebook()
+    nb.cells.append(nbformat.v4.new_code_cell(
+        "from navlib import report\n"
+        "report.write_results('demo_chapter', claims=[report.Claim('c', 'p', 'o', True)])"))
+    path = tmp_path / "demo.ipynb"
+    nbformat.write(nb, path)
+    assert execute([path], None, in_place=True) == 0
+    stored = json.loads((tmp_path / "results" / "demo_chapter.json").read_text())
+    assert stored["claims"][0]["reproduced"] is True
+    from navlib.report import RESULTS_DIR
+    assert not (RESULTS_DIR / "demo_chapter.json").exists()   # the book's folder is not touched
+
+
+def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
+    listing = tmp_path / "_modules" / "navlib"
+    listing.mkdir(parents=True)
+    (listing / "booktools.html").write_text('<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>')
+    assert check_html(tmp_path) == 0
+    (listing / "cli.html").write_text('<script src="https://cdn.example/x.js"></script>')
+    assert check_html(tmp_path) == 1
+
+
+def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
+    from navlib.booktools import check_chapter_opening
+
+    glance = '<div class="admonition"><p class="admonition-title">Results at a glance</p><table></table></div>'
+    cell = '<div class="cell docutils container"><pre>n_seeds = 20</pre></div>'
+    assert check_chapter_opening(page(glance + cell)) == []
+    assert "after a code cell" in check_chapter_opening(page(cell + glance))[0]
+    assert "without a 'Results at a glance'" in check_chapter_opening(page(cell))[0]
+    chapters = tmp_path / "_generated"
+    chapters.mkdir()
+    (chapters / "gyro.html").write_text(page(cell))
+    (tmp_path / "intro.html").write_text(page("<p>no glance needed</p>"))
+    assert check_html(tmp_path) == 1
+    err = capsys.readouterr().err
+    assert "_generated/gyro.html: chapter without" in err and "intro.html" not in err

@@ -1,8 +1,8 @@
 """Data loading with validation: CSV tables whose every fault is reported with file, column and row.
 
-- :mod:`navlib.data.tables` -- generic validated CSV reading (:func:`read_table`) and safe writing
-  (:func:`write_new_csv`, never over an existing file);
+- :mod:`navlib.data.tables` -- generic validated CSV reading (:func:`.tables.read_table`) and safe writing
+  (:func:`.tables.write_new_csv`, never over an existing file);
 - :mod:`navlib.data.compass_sweeps` -- turntable sweeps (papers A and B, the workbench's compass files);
 - :mod:`navlib.data.gyro_tables` -- paper C's measured Tables 2-5 and user drift files;
-- :mod:`navlib.data.paper_results` -- the numbers the papers print (transcribed facts in ``data/``).
+- ``navlib.data.paper_results`` -- the numbers the papers print (transcribed facts in ``data/``).
 """

@@ -1,7 +1,7 @@
 """Paper A's single-input single-output BP network (1-M-1) and its three trainers.
 
 Network (Yue et al., eqs 1-4): input = measured heading x, output = true heading; both min-max normalised
-(:class:`navlib.scaling.MinMax`), ``M`` sigmoid hidden neurons, linear (purelin) output:
+(:class:`navlib.methods.scaling.MinMax`), ``M`` sigmoid hidden neurons, linear (purelin) output:
 
     x' = (x - x_min)/(x_max - x_min),   y_j = sigmoid(w_j x' + b_j),   o' = sum_j v_j y_j + c,
     o = d_min + o' (d_max - d_min)
@@ -11,13 +11,14 @@ Fitness (paper eq 5-6, equation image lost in the OCR): ``J = sum_k (d_k - o_k)^
 points, in deg^2, on the de-normalised output.
 
 Trainers:
+
 - :func:`train_gradient`: back-propagation by full-batch gradient descent in torch. The paper does not
   say which optimiser its "BP network" used; we use Adam (lr 0.01, 3000 epochs) on the normalised MSE.
   ``method="lm"`` instead uses Levenberg-Marquardt (scipy ``least_squares(method='lm')``), the trainer of
   the paper's reference [8]; with fewer readings than weights (LM cannot run) the same least-squares
   problem is solved by scipy's trust-region reflective method.
 - :func:`train_de` with ``DEParams(adaptive=False)`` = DE-BP, ``adaptive=True`` = ADE-BP
-  (:mod:`navlib.de`); the whole population is evaluated in one vectorised call.
+  (:mod:`navlib.methods.de`); the whole population is evaluated in one vectorised call.
 """
 from __future__ import annotations
 

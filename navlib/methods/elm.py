@@ -124,7 +124,7 @@ class ELMParams:
     ``weight_range``/``bias_range``: input weights w_ij ~ U(-weight_range, weight_range) and hidden
     biases b_i ~ U(-bias_range, bias_range) (Huang 2006 uses 1 and 1 for inputs normalised to [0, 1];
     a wider range gives steeper, more local sigmoids and a better-conditioned H).
-    ``seed`` seeds :func:`numpy.random.default_rng` (``None``: unseeded)."""
+    ``seed`` seeds ``numpy.random.default_rng`` (``None``: unseeded)."""
 
     n_hidden: int = 10
     activation: str = "sigmoid"
@@ -165,7 +165,7 @@ class ELMModel:
 
     @property
     def n_weights(self) -> int:
-        """Number of trainable numbers: d L + L + L m."""
+        """Number of trainable numbers, d L + L + L m."""
         return int(self.w.size + self.b.size + self.beta.size)
 
     def hidden(self, x) -> np.ndarray:
@@ -301,7 +301,7 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
     accepted step (fewer than ``steps`` + 1 if the search stalls).
 
     Observed on the compass sweeps: tuning lowers the loss a lot for 1-3 nodes, but beyond that the
-    least-squares beta is large (|beta| ~ 1e2..1e9 as cond(H) grows), the loss surface is extremely
+    least-squares beta is large (``|beta| ~ 1e2..1e9`` as cond(H) grows), the loss surface is extremely
     curved along W and b, and the accepted steps become tiny: back-tuning then changes little."""
     check_param("steps", steps, lo=0, integer=True)
     check_param("lr", lr, lo=0, lo_open=True)
@@ -315,11 +315,11 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
 # Pruning
 
 def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
-    """Remove hidden nodes whose output weights are negligible: max_k |beta_jk| <= ``tol``.
+    """Remove hidden nodes whose output weights are negligible: ``max_k |beta_jk| <= tol``.
 
-    Since |g| <= 1 for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
+    Since ``|g| <= 1`` for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
     (patent, Fig. 1 text: "neurons whose output weight is small have little influence on the output;
-    removing these useless neurons ...").  At least one node (the largest |beta|) is always kept.
+    removing these useless neurons ...").  At least one node (the largest ``|beta|``) is always kept.
     Returns the pruned copy (beta not re-solved: the caller decides) and the removed node indices."""
     check_param("tol", tol, lo=0)
     size = np.max(np.abs(model.beta), axis=1)
@@ -344,7 +344,7 @@ class IncrementalELMParams:
     - ``max_iter``: stop after this many iterations (patent: "iteration count exceeds k").
     - ``lr``: first trial step of the back-tuning line search (then adapted, see :func:`back_tune`).
     - ``tune_steps``: gradient steps per back-tuning stage.
-    - ``prune_tol``: prune nodes with max |beta_j| <= prune_tol after each ELM solve (0: only exact
+    - ``prune_tol``: prune nodes with ``max |beta_j| <= prune_tol`` after each ELM solve (0: only exact
       zeros; the bound on a pruned node's contribution to the normalised output).
     - ``schedule``: which stage runs at iteration n (the patent is ambiguous, see
       :func:`fit_incremental_elm`): ``'alternate'`` (default) or ``'odd_nodes'``.
@@ -406,7 +406,7 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
       nodes are kept) and re-solve all output weights, beta = H^+ T.  Adding a column to a
       least-squares problem cannot raise its optimum, so this stage does not raise the loss (up to
       rounding once cond(H) nears 1/eps, see :func:`solve_output_weights`).
-    - ``'prune'`` (right after an ELM solve, only when some node has max|beta_j| <= ``prune_tol``):
+    - ``'prune'`` (right after an ELM solve, only when some node has ``max |beta_j| <= prune_tol``):
       drop those nodes and re-solve beta.  This may raise the loss slightly (by design, bounded by the
       dropped contributions before the re-solve).
     - ``'tune'``: ``tune_steps`` monotone gradient steps on W, b and beta (:func:`back_tune`); the

@@ -6,7 +6,7 @@ Patent text (our translation):
   median filter to pre-process the measured data; discard data whose geomagnetic-vector / gravity-vector
   inner product is abnormal, reducing magnetometer and accelerometer noise and random-error
   interference" -> :func:`median_filter`, :func:`dot_product_screen` / :func:`reject_dot_product_outliers`;
-- third step: "normalise the raw data by the max-min method" -> :class:`navlib.scaling.MinMax`;
+- third step: "normalise the raw data by the max-min method" -> :class:`navlib.methods.scaling.MinMax`;
 - fourth/fifth step: "randomly draw 90 % of the training set ... the remaining 10 % are the test set"
   -> :func:`train_test_split`.
 
@@ -71,7 +71,7 @@ def median_filter(values, window: int, *, mode: str = "nearest") -> np.ndarray:
 def field_gravity_dot(mag_xyz, grav_xyz, *, normalize: bool = False) -> np.ndarray:
     """Per-sample inner product m . g of the measured field (N x 3) and gravity (N x 3), both in the
     sensor frame.  At one site the angle between the geomagnetic and gravity vectors (90 deg + magnetic
-    dip) is fixed, so m . g = |m| |g| sin(dip) is invariant under any rotation of the sensor (patent,
+    dip) is fixed, so ``m . g = |m| |g| sin(dip)`` is invariant under any rotation of the sensor (patent,
     second step; the "dot-product invariance" constraint).  ``normalize=True`` returns the cosine of
     the angle between them instead (insensitive to magnitude errors of either sensor)."""
     m = np.asarray(mag_xyz, dtype=float)
@@ -113,7 +113,7 @@ def dot_product_screen(mag_xyz, grav_xyz, *, threshold: float = 4.0, normalize: 
     whose geomagnetic/gravity inner product is abnormal").
 
     "Abnormal" is our rule (the patent gives none): robust z-score with the median and the median
-    absolute deviation, which a few glitches cannot drag,
+    absolute deviation, which a few glitches cannot drag::
 
         s_n = m_n . g_n,   c = median(s),   scale = max(1.4826 median|s - c|, min_scale),
         keep_n  <=>  |s_n - c| <= threshold * scale   (and s_n finite).

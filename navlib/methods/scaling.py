@@ -33,7 +33,7 @@ class MinMax:
     def fit(cls, values, *, name: str = "values") -> "MinMax":
         """Scaler mapping the column minima to 0 and maxima to 1.
 
-        Raises :class:`InputError` for an empty array, non-finite values, or a constant column (the
+        Raises :class:`~navlib.errors.InputError` for an empty array, non-finite values, or a constant column (the
         transform would divide by zero); ``name`` is used in the message."""
         v = np.asarray(values, dtype=float)
         if v.ndim not in (1, 2) or v.shape[0] == 0:

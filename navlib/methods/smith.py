@@ -6,7 +6,7 @@ Deviation as a function of the *compass* (measured) heading ``h``:
 
 A: constant (misalignment, antisymmetric soft iron); B, C: one-cycle (hard iron, with a small soft-iron
 part); D, E: two-cycle (symmetric soft iron).  It is the first-order harmonic approximation of the exact
-planar model in :mod:`navlib.compass` (Bowditch, ch. on compass adjustment).  The compensated heading is
+planar model in :mod:`navlib.sensors.compass` (Bowditch, ch. on compass adjustment).  The compensated heading is
 ``h - delta(h)``.  Paper A fits it by least squares to 8 readings, from 0 deg every 45 deg; the paper does
 not print its model, Smith's is the classical choice.
 """

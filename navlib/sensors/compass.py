@@ -32,7 +32,7 @@ parameters remain.  We write them as named physical effects:
 ``misalignment`` = ``yaw`` (a rotation: a constant heading offset), ``soft_iron`` = ``(e, f)`` (the symmetric,
 trace-free distortion: a two-cycle error), ``hard_iron`` = ``(hx, hy)`` in units of ``H`` (a one-cycle
 error).  This model is *exact* (not a truncated harmonic series); Archibald Smith's A..E deviation
-series (:mod:`navlib.smith`) is its first-order harmonic approximation.
+series (:mod:`navlib.methods.smith`) is its first-order harmonic approximation.
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 paper C (Yu et al. 2012, J. NUDT 34(3)) with their inverse (12 h latitude error -> axial gyro drift).
 
 Sign conventions (used everywhere in this module and in the gyro chapter)
-------------------------------------------------------------------------
+-------------------------------------------------------------------------
 * Errors are *indicated minus true*: latitude error ``dL = L_ins - L_true``, likewise longitude, velocity.
 * A gyro drift ``eps`` is the gyro's output minus the true rate (what has to be *subtracted* to correct it).
 * Attitude error ``phi`` (phi-angle, local-level East-North-Up frame n) obeys Titterton & Weston's

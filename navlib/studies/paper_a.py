@@ -2,25 +2,26 @@
 sweep 2, repeated over seeds for the stochastic ones.
 
 Methods (names as in the tables):
+
 - ``uncompensated``: the measured heading.
-- ``LS 8-position``: Smith's A..E fitted to the readings at 0, 45, ..., 315 deg (:mod:`navlib.smith`).
-- ``BP (Adam)``: the 1-6-1 net trained by back-propagation with Adam (:func:`navlib.bpnet.train_gradient`).
+- ``LS 8-position``: Smith's A..E fitted to the readings at 0, 45, ..., 315 deg (:mod:`navlib.methods.smith`).
+- ``BP (Adam)``: the 1-6-1 net trained by back-propagation with Adam (:func:`navlib.methods.bpnet.train_gradient`).
 - ``BP (LM)``: the same net trained by Levenberg-Marquardt (paper A's reference [8]); not in paper A's
   table, shown because it is the strongest gradient trainer for a net this small.
-- ``DE-BP`` / ``ADE-BP``: :func:`navlib.bpnet.train_de`.
-- ``physical model``: the exact planar model fitted to all of sweep 1 (:func:`navlib.compass.fit_planar_model`),
+- ``DE-BP`` / ``ADE-BP``: :func:`navlib.methods.bpnet.train_de`.
+- ``physical model``: the exact planar model fitted to all of sweep 1 (:func:`navlib.sensors.planar.fit_planar_model`),
   our reference for the noise floor.
 - ``ELM``: patent B's network without its training scheme: a plain extreme learning machine (Huang 2006,
-  :func:`navlib.elm.fit_elm`) with ``StudyParams.elm_nodes`` random sigmoid nodes, beta = H^+ T.
+  :func:`navlib.methods.elm.fit_elm`) with ``StudyParams.elm_nodes`` random sigmoid nodes, beta = H^+ T.
 - ``ELM back-tuned``: patent B's scheme, the point-incremental ELM with autonomous back-tuning and pruning
-  (:func:`navlib.elm.fit_incremental_elm`); ``info['n_nodes']`` is the hidden-node count it settles on.
+  (:func:`navlib.methods.elm.fit_incremental_elm`); ``info['n_nodes']`` is the hidden-node count it settles on.
 
 Both ELMs use the BP nets' convention: input = unwrapped measured heading, output = true heading (or the
 heading error, ``StudyParams.network_target``), both min-max normalised on the training sweep.
 
 Patent B's data preparation (median filter, dot-product screen, min-max, random 90/10 split) is
-:func:`prepare_patent_data`; :func:`glitch_study` measures what it buys on sweeps with glitches and
-:func:`small_sample_study` tests the patent's claim of less overfitting on small samples.
+:func:`.prepare_patent_data`; :func:`.glitch_study` measures what it buys on sweeps with glitches and
+:func:`.small_sample_study` tests the patent's claim of less overfitting on small samples.
 
 Error = compensated - true heading, wrapped to (-180, 180], on the test sweep.
 """
@@ -154,7 +155,7 @@ class ELMPredictor:
 def fit_elm_method(method: str, x, target, params: StudyParams = StudyParams(), seed: int = 0):
     """Train ``'ELM'`` or ``'ELM back-tuned'`` on raw inputs ``x`` and targets (deg), min-max normalised
     here.  Returns ``(predictor, info)``; info has ``n_nodes`` and, for the back-tuned ELM, the stage
-    ``history`` of :func:`navlib.elm.fit_incremental_elm`."""
+    ``history`` of :func:`navlib.methods.elm.fit_incremental_elm`."""
     if method not in ELM_METHODS:
         raise InputError(f"unknown ELM method {method!r}; known: {', '.join(ELM_METHODS)}")
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(target, name="network target")
