@@ -143,7 +143,7 @@ def test_fig1_simulated_tests():
 def test_hot_network_is_newrb_on_table2():
     h = pc.hot_network(P)
     x2, y2 = _t2()
-    assert h.net.n_neurons == 2 and h.quantities.loc["stop reason", "value"] == "goal met"
+    assert h.net.n_neurons == 2 == h.quantities.loc["neurons", "value"] and h.net.stop_reason == "goal met"
     # centres are training inputs, in arcmin
     np.testing.assert_allclose(h.neurons["centre (arcmin)"], x2[h.neurons["training sample"] - 1] * 60)
     rms = np.sqrt(np.mean((y2 - h.net.predict(x2)) ** 2))
@@ -315,7 +315,7 @@ def test_claims_one_per_reading():
     assert t3["input in arcmin, goal as MSE"] is True and t3["input in deg, goal as MSE"] is False
     outputs = {c.reading: c.reproduced for c in cl if c.claim.startswith("Table 3's RBF outputs")}
     assert outputs == {"input in arcmin, goal as MSE": True, "input in deg, goal as MSE": False}
-    loo = [c for c in cl if "leave-one-out" in c.claim and "arcmin" in c.reading][0]
+    loo = [c for c in cl if "leave-one-out (Table 2)" in c.claim and "arcmin" in c.reading][0]
     assert loo.reproduced is False                      # two Table 2 rows miss by more than 0.0003
     assert any(c.reproduced is None and c.why for c in cl)
 
