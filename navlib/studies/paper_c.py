@@ -504,6 +504,13 @@ def design_hot_net(x_deg, drift_deg_h, hot: HotNetSettings) -> RBFNet:
                  scaler=latitude_scaler(hot.input_unit))
 
 
+@lru_cache(maxsize=16)
+def _table2_net(hot: HotNetSettings) -> RBFNet:
+    """The hot net designed on all of Table 2 (cached per settings; read-only)."""
+    x2, y2, _, _ = _hot_xy()
+    return design_hot_net(x2, y2, hot)
+
+
 @dataclass(frozen=True)
 class HotNet:
     """``net``: the designed network; ``neurons``: centre (in the input unit) and weight of each neuron;
@@ -525,8 +532,7 @@ def hot_network(params: StudyParams = StudyParams()) -> HotNet:
     -------
     HotNet
     """
-    x2, y2, _, _ = _hot_xy()
-    net = design_hot_net(x2, y2, params.hot)
+    net = _table2_net(params.hot)
     unit = params.hot.input_unit
     neurons = pd.DataFrame({"neuron": np.arange(1, net.n_neurons + 1), "training sample": net.center_index + 1,
                             f"centre ({unit})": net.centers[:, 0], "weight (deg/h)": net.weights[:, 0]})
@@ -566,7 +572,7 @@ def table3_identification(params: StudyParams = StudyParams()) -> Table3:
     """
     t3 = load_hot_test()
     x2, y2, x3, y3 = _hot_xy()
-    net = design_hot_net(x2, y2, params.hot)
+    net = _table2_net(params.hot)
     line = np.polyfit(x2, y2, 1)
     out = pd.DataFrame({"test": t3["test"], "dL (arcmin)": to_arcmin(x3), "true (deg/h)": y3,
                         "paper RBF": t3["paper_rbf_drift_deg_h"].to_numpy(float), "our RBF": net.predict(x3),
@@ -659,7 +665,7 @@ def fig2_training_path(params: StudyParams = StudyParams()) -> Fig2:
     h = params.hot
     full = design_hot_net(x2, y2, HotNetSettings(spread=h.spread, goal=0.0, goal_kind="mse",
                                                  input_unit=h.input_unit))
-    ours = design_hot_net(x2, y2, h)
+    ours = _table2_net(h)
     path = pd.DataFrame({"neurons": np.arange(full.perf_mse.size), "MSE ((deg/h)^2)": full.perf_mse,
                          "SSE ((deg/h)^2)": full.perf_sse})
     return Fig2(path, full.n_neurons, full.stop_reason, ours.n_neurons)
@@ -793,7 +799,7 @@ def drift_against_latitude(params: StudyParams = StudyParams(), n_grid: int = 30
         pd.DataFrame({"table": "Table 4 (cold start)", "dL_arcmin": to_arcmin(t4["latitude_error_deg"]),
                       "drift_deg_h": t4["true_drift_deg_h"].to_numpy(float)})], ignore_index=True)
     xs = np.linspace(-0.03, 0.03, int(n_grid))
-    net = design_hot_net(x2, y2, params.hot)
+    net = _table2_net(params.hot)
     models = {f"our RBF ({net.n_neurons} neurons)": net.predict(xs),
               "Table 1 inverse": ins.drift_from_latitude_error(xs, fact("identify_h"), params.earth),
               "straight line fit to Table 2": np.polyval(np.polyfit(x2, y2, 1), xs)}
@@ -859,8 +865,7 @@ def table4_hot_net(params: StudyParams = StudyParams()) -> pd.DataFrame:
         and the two errors (deg/h).
     """
     t4 = load_cold_train()
-    x2, y2, _, _ = _hot_xy()
-    net = design_hot_net(x2, y2, params.hot)
+    net = _table2_net(params.hot)
     x4, y4 = t4["latitude_error_deg"].to_numpy(float), t4["true_drift_deg_h"].to_numpy(float)
     ours = net.predict(x4)
     paper = t4["paper_hot_rbf_drift_deg_h"].to_numpy(float)
@@ -948,8 +953,7 @@ def cold_leave_one_out(params: StudyParams = StudyParams()) -> ColdLoo:
     ColdLoo
     """
     t4 = load_cold_train()
-    x2, y2, _, _ = _hot_xy()
-    hot = design_hot_net(x2, y2, params.hot)
+    hot = _table2_net(params.hot)
     x4, y4 = t4["latitude_error_deg"].to_numpy(float), t4["true_drift_deg_h"].to_numpy(float)
     hot4 = hot.predict(x4)
     rate4 = t4["calib_temp_change_c"].to_numpy(float) / fact("identify_h")
@@ -1000,6 +1004,15 @@ def _cold_history(row, k_rate: float, proc: ins.Procedure) -> ins.ColdStart:
 
 
 @lru_cache(maxsize=4)
+def _simulated_hot_tests(params: StudyParams) -> list:
+    """16 simulated hot tests with Table 2's drifts (seeds :func:`experiment_seeds` ``"hot_reference"``)."""
+    _, y2, _, _ = _hot_xy()
+    s = params.sim
+    return ins.simulated_tests(y2, seed=experiment_seeds(s.seed, "hot_reference", 1)[0], earth=params.earth,
+                               procedure=s.procedure(), **s.error_sd())
+
+
+@lru_cache(maxsize=4)
 def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
     """Table 5 and Fig 4 analogues: the cold-start study repeated in a simulated world.
 
@@ -1022,11 +1035,10 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
     """
     s, proc, earth = params.sim, params.sim.procedure(), params.earth
     t4, t5 = load_cold_train(), load_cold_test()
-    x2, y2, _, _ = _hot_xy()
+    _, y2, _, _ = _hot_xy()
     y4 = t4["true_drift_deg_h"].to_numpy(float)
     k_rate = float(cold_leave_one_out(params).quantities.loc["k_R from Table 4", "value"])
-    sim_hot = ins.simulated_tests(y2, seed=experiment_seeds(s.seed, "hot_reference", 1)[0], earth=earth,
-                                  procedure=proc, **s.error_sd())
+    sim_hot = _simulated_hot_tests(params)
     sim_hot_net = design_hot_net([r.latitude_error_12h_deg for r in sim_hot], y2, params.hot)
     sim_cold = ins.simulated_tests(y4, seed=experiment_seeds(s.seed, "cold_training", 1)[0],
                                    cold=[_cold_history(r, k_rate, proc) for r in t4.itertuples()],
@@ -1071,7 +1083,6 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
 
 
 # ------------------------------------------------------------------------------------------ verdict
-@lru_cache(maxsize=4)
 def reference_gap(params: StudyParams = StudyParams()) -> pd.DataFrame:
     """How well the paper's "true" drift (the compensation minimising the worst 72 h position error) knows
     the actual drift: 16 simulated hot tests with Table 2's drifts (seeds :func:`experiment_seeds`
@@ -1086,10 +1097,7 @@ def reference_gap(params: StudyParams = StudyParams()) -> pd.DataFrame:
     pandas.DataFrame
         test, actual drift, 72 h-optimal drift, gap = optimal - actual (deg/h).
     """
-    s = params.sim
-    _, y2, _, _ = _hot_xy()
-    sim_hot = ins.simulated_tests(y2, seed=experiment_seeds(s.seed, "hot_reference", 1)[0], earth=params.earth,
-                                  procedure=s.procedure(), **s.error_sd())
+    sim_hot = _simulated_hot_tests(params)
     return pd.DataFrame({"test": np.arange(1, len(sim_hot) + 1),
                          "actual drift (deg/h)": [r.final_drift_deg_h for r in sim_hot],
                          "72 h-optimal drift (deg/h)": [r.best_drift_deg_h for r in sim_hot],
