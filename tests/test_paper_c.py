@@ -105,6 +105,13 @@ def test_measured_tables():
     m = pc.measured_tables()
     assert [len(t) for t in (m.table2, m.table3, m.table4, m.table5)] == [16, 3, 6, 3]
     assert m.table2["latitude_error_deg"].iloc[6] == pytest.approx(28.2474 - 28.222)
+    for n in (2, 3, 4, 5):
+        short = m.short_headers(n, derived=True)
+        assert short.shape == getattr(m, f"table{n}").shape and short.columns.is_unique
+        assert "dL (deg)" not in m.short_headers(n).columns
+        assert not [c for c in short.columns if "_" in c]                 # every column has a short header
+    with pytest.raises(InputError, match="number"):
+        m.short_headers(1)
 
 
 def test_table1_vs_simulator():

@@ -325,6 +325,20 @@ def _quantities(rows) -> pd.DataFrame:
 
 
 # ------------------------------------------------------------------------------------------ measured tables
+#: Short column headers (with units) for showing the measured tables in the book.
+SHORT_HEADERS = {
+    "sample": "sample", "test": "test", "latitude_deg": "latitude (deg)", "latitude_error_deg": "dL (deg)",
+    "temperature_min_c": "T min (C)", "temperature_max_c": "T max (C)", "drift_deg_h": "drift (deg/h)",
+    "paper_rbf_drift_deg_h": "paper RBF (deg/h)", "true_drift_deg_h": "true drift (deg/h)",
+    "paper_error_deg_h": "paper error (deg/h)", "paper_pos_error_before_nmi_72h": "paper before (nmi)",
+    "paper_pos_error_after_nmi_72h": "paper after (nmi)", "align_temp_min_c": "align T min (C)",
+    "align_temp_max_c": "align T max (C)", "align_temp_change_c": "align dT (C)",
+    "calib_temp_min_c": "calib T min (C)", "calib_temp_max_c": "calib T max (C)",
+    "calib_temp_change_c": "calib dT (C)", "paper_hot_rbf_drift_deg_h": "paper hot RBF (deg/h)",
+    "paper_pos_error_hot_net_nmi_72h": "paper, hot net (nmi)",
+    "paper_pos_error_cold_net_nmi_72h": "paper, cold net (nmi)"}
+
+
 @dataclass(frozen=True)
 class MeasuredTables:
     """Paper C's Tables 2-5 as loaded (``table2`` ... ``table5``, see ``data/gyro_tables.md``)."""
@@ -333,6 +347,16 @@ class MeasuredTables:
     table3: pd.DataFrame
     table4: pd.DataFrame
     table5: pd.DataFrame
+
+    def short_headers(self, number: int, derived: bool = False) -> pd.DataFrame:
+        """Table ``number`` (2-5) with the short headers of :data:`SHORT_HEADERS` (for display); the
+        loader's derived ``latitude_error_deg`` only if ``derived``."""
+        if number not in (2, 3, 4, 5):
+            raise InputError(f"parameter number={number!r}: paper C's measured tables are 2, 3, 4 and 5")
+        t = getattr(self, f"table{number}")
+        if not derived:
+            t = t.drop(columns=["latitude_error_deg"], errors="ignore")
+        return t.rename(columns=SHORT_HEADERS)
 
 
 def measured_tables() -> MeasuredTables:
