@@ -248,3 +248,14 @@ def test_bad_study_parameters_stop_with_one_line(kwargs, name):
 def test_bad_component_parameters(make, name):
     with pytest.raises(InputError, match=name):
         make()
+
+
+def test_notebook_stops_at_validation_with_one_line(tmp_path):
+    pm = pytest.importorskip("papermill")
+    from navlib.paths import NOTEBOOK_DIR
+
+    with pytest.raises(pm.PapermillExecutionError) as err:
+        pm.execute_notebook(str(NOTEBOOK_DIR / "celestial.ipynb"), str(tmp_path / "out.ipynb"),
+                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0}, progress_bar=False)
+    assert err.value.ename == "InputError"
+    assert "star_rate_hz" in err.value.evalue and "\n" not in err.value.evalue
