@@ -24,7 +24,6 @@ increments back with :func:`navlib.sensors.strapdown.strapdown` reproduces the t
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Literal
 

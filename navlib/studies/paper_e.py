@@ -202,7 +202,7 @@ def simulate(spec: StudySpec = StudySpec()) -> StudyData:
             if rep == 0:
                 _trace(trace_rows, t, kind, "KF", f_test.att_err_arcsec[0])
             if kind == "s_turns":
-                aug = km.run_filter(test, km.FilterSpec(**{**spec.filter.__dict__, "scale_states": True}))
+                aug = km.run_filter(test, replace(spec.filter, scale_states=True))
                 _score_rows(score_rows, rep, kind, "held-out", "augmented KF", aug.att_err_arcsec, mask)
                 _score_rows(score_rows, rep, kind, "same run", "augmented KF", aug.att_err_arcsec[:1], mask)
                 if rep == 0:
