@@ -6,5 +6,7 @@
 - :mod:`navlib.methods.elm` -- extreme learning machine and the patent's incremental back-tuned ELM (B);
 - :mod:`navlib.methods.preprocess` -- the patent's median filter and field-gravity screen (B);
 - :mod:`navlib.methods.rbf` -- MATLAB-compatible ``newrb``/``newrbe`` RBF networks (C);
-- :mod:`navlib.methods.scaling` -- explicit min-max scaling.
+- :mod:`navlib.methods.scaling` -- explicit min-max scaling;
+- :mod:`navlib.methods.kalman` -- the INS/star-sensor Kalman filter, QR gain features, innovation GLR test (E);
+- :mod:`navlib.methods.mlp` -- generic n_in-n_hidden-n_out BP network in torch (E).
 """

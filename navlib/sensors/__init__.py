@@ -4,4 +4,7 @@
 - :mod:`navlib.sensors.planar` -- the exact five-parameter heading-error model of a level compass;
 - :mod:`navlib.sensors.ins` -- static-base error propagation of a single-axis rotation INS and paper C's
   Table 1 closed forms.
+- :mod:`navlib.sensors.trajectory` -- level flight and yaw S-manoeuvres with consistent ideal IMU increments (E);
+- :mod:`navlib.sensors.strapdown` -- strapdown INS with IMU errors and a star sensor (E);
+- :mod:`navlib.sensors.ins15` -- the 15-state ENU phi-angle error model (+ gyro scale-factor states) (E).
 """
