@@ -24,10 +24,12 @@ recorded temperature of each reading differs from the set point by the residual 
 degree with the defaults, the paper's "0.1..0.5 degC").  The internal temperature sensor that the model uses
 is this lagged temperature.  White noise ``noise_ug`` (1 sigma per averaged reading) is added.
 
-Defaults and their story: bias drift about 1.7 mg and scale-factor drift up to about 6e-3 relative against
-55 degC over -40..70 degC, output drift about 5 mg (paper D Figs 2-4); noise 3 ug per reading (a 10 s
-average of a 10 ug/sqrt(Hz) sensor); second unit of the same batch: every drift coefficient scaled by
-``1 + spread N(0, 1)`` with ``batch_spread_rel`` = 0.25.
+Defaults and their story: against 55 degC over -40..70 degC the 0/180 deg bias test drifts 1.68 mg, the
+scale factor up to 5.6 mg/g (input-dependent), the output up to 5.8 mg (paper D: 1.7 mg, 6 mV/g, 5 mV; the
+three cannot all hold at once under this model, because at +-1 g the bias and scale-factor drifts add in one
+direction); noise 3 ug per reading (a 10 s average of a 10 ug/sqrt(Hz) sensor); second unit of the same
+batch: every coefficient scaled by ``1 + spread N(0, 1)`` with ``batch_spread_rel`` = 0.25 (seed 2: its
+maximum output drift, 6.75 mg, is the nearest to the paper's 7.21 mg among seeds 1-11).
 
 The Fourier coefficients of one tumble (``q`` over 24 equally spaced positions) give, with ``K1 = 1 + kappa``
 (see :func:`tumble_fourier` and :func:`coefficients_from_fourier`)::
@@ -55,16 +57,16 @@ class AccelCoefficients:
     Units are in the names: ``mg``, ``per_c`` (relative per degC), ``mg_g2`` (mg per g^2)."""
 
     k0c_mg: float = 0.8                 # bias at 55 degC
-    bias_lin_mg_c: float = 0.0155       # b1
+    bias_lin_mg_c: float = 0.0175       # b1
     bias_quad_mg_c2: float = 2.0e-5     # b2
     bias_cub_mg_c3: float = 2.0e-7      # b3
     bias_step_mg: float = 0.12          # height s of the tanh step
     bias_step_c: float = 10.0           # its centre T_s
     bias_step_width_c: float = 8.0      # its width w
-    sf_lin_per_c: float = -4.6e-5       # k1 (relative scale-factor change per degC)
+    sf_lin_per_c: float = -4.2e-5       # k1 (relative scale-factor change per degC)
     sf_quad_per_c2: float = 1.5e-8      # k2
     k2c_mg_g2: float = 0.02             # K2 at 55 degC (20 ug/g^2)
-    k2_temp_mg_g2_c: float = -0.016     # k2t (K2 change per degC)
+    k2_temp_mg_g2_c: float = -0.002     # k2t (K2 change per degC)
     kip_mg_g2: float = 0.03             # cross-coupling Kip (30 ug/g^2)
     delta_o_mg: float = 0.2             # misalignment delta_o (0.2 mrad = 0.2 mg per g of a_p)
 
@@ -194,15 +196,15 @@ def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int, u
 
 
 def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int) -> pd.DataFrame:
-    """The 0/180 deg bias test at each set point: ``K0 ~ (U(0) + U(180))/2`` (the K2 term, ``K1 K2/2 * 2``,
+    """The 0/180 deg bias test at each set point: ``(U(0) + U(180))/2 = K0 + K1 K2`` (the second-order term
     stays in: this is what the paper's bias test measures).  Columns ``set_point_c``, ``temperature_c``,
-    ``bias_mg``, ``true_bias_mg`` (the model's K0)."""
+    ``bias_mg`` (measured), ``true_bias_mg`` (the same test without noise)."""
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     temps = sensor_temperatures_c(exp)[:, 0]
     u = coef.output_mg(temps[:, None], np.array([0.0, 180.0])[None, :])
-    u = u + 1e-3 * exp.noise_ug * rng.standard_normal(u.shape)
+    noisy = u + 1e-3 * exp.noise_ug * rng.standard_normal(u.shape)
     return pd.DataFrame({"set_point_c": exp.set_points_c, "temperature_c": temps,
-                         "bias_mg": u.mean(axis=1), "true_bias_mg": coef.bias_mg(temps)})
+                         "bias_mg": noisy.mean(axis=1), "true_bias_mg": u.mean(axis=1)})
 
 
 # ------------------------------------------------------------------------------------- Fourier analysis
@@ -241,7 +243,7 @@ def tumble_coefficients(df: pd.DataFrame, by: str = "set_point_c") -> pd.DataFra
 DEFAULT_COEFFICIENTS = AccelCoefficients()
 DEFAULT_EXPERIMENT = TumbleExperiment()
 #: Seeds of the stored data set: unit A's noise, unit B's coefficients and noise.
-DATA_SEEDS = {"noise_a": 12, "batch_b": 6, "noise_b": 13}
+DATA_SEEDS = {"noise_a": 12, "batch_b": 2, "noise_b": 13}
 BATCH_SPREAD_REL = 0.25
 
 

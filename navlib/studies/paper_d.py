@@ -473,3 +473,23 @@ def method_summary(err: pd.DataFrame, s: str = "test") -> dict:
         g = err[(err["method"] == m) & (err["set"] == s)]
         out[m] = report.method_stats(1000 * g["RMSE_mg"], None, 1000 * g["ME_mg"])
     return out
+
+
+def swarm_choices(runs: list[Run]) -> pd.DataFrame:
+    """Per seed: the swarm's clustering radius ``ra``, squash ``rb/ra``, the resulting rule count, and the
+    best checking RMSE of genfis2's FIS (ug) it found."""
+    return pd.DataFrame([{"seed": r.seed, "ra": r.ra, "rb/ra": r.squash, "rules": r.n_rules["IAFSA-SCM-ANFIS"],
+                          "FIS rules (r = fis_radius)": r.n_rules["FIS"],
+                          "fitness (ug)": 1000 * float(r.swarm_history[-1])} for r in runs])
+
+
+def unit_b_table(err: pd.DataFrame, paper: pd.DataFrame) -> pd.DataFrame:
+    """Unit B compensated with unit A's models: median over seeds of the maximum and RMS residual (ug),
+    with the paper's 7.21 mg before and 9.3 ug after."""
+    e = err[(err["set"] == "unit B") & err["method"].isin(("uncompensated", *METHODS, "oracle"))]
+    g = e.groupby("method", sort=False)
+    out = pd.DataFrame({"max |e| (ug)": 1000 * g["ME_mg"].median(), "RMSE (ug)": 1000 * g["RMSE_mg"].median()})
+    out["paper max (ug)"] = np.nan
+    out.loc["uncompensated", "paper max (ug)"] = 1000 * _paper_value(paper, "unit_b_before")
+    out.loc["IAFSA-SCM-ANFIS", "paper max (ug)"] = 1000 * _paper_value(paper, "unit_b_after")
+    return out.rename(index={"oracle": "unit A's exact model"}).reset_index()
