@@ -3,5 +3,7 @@
 - :mod:`navlib.sensors.compass` -- three-axis magnetometer compass on a level turntable (papers A, B);
 - :mod:`navlib.sensors.planar` -- the exact five-parameter heading-error model of a level compass;
 - :mod:`navlib.sensors.ins` -- static-base error propagation of a single-axis rotation INS and paper C's
-  Table 1 closed forms.
+  Table 1 closed forms;
+- :mod:`navlib.sensors.accelerometer` -- IEEE Std 1293 tumble test of a quartz-flexure accelerometer in a
+  temperature chamber (paper D).
 """
