@@ -435,26 +435,29 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
     floor = np.sqrt(2) * params.experiment.noise_ug
     best_test = ours[3]
     best_train = med("IAFSA-SCM-ANFIS", "train") * 1000
-    out.append(report.Claim("IAFSA-SCM-ANFIS RMSE 4 ug", f"{paper_r[3]:.0f} ug",
+    out.append(report.Claim("IAFSA-SCM-ANFIS RMSE 4 ug (ours within 1.5x)", f"{paper_r[3]:.0f} ug",
                             f"{best_train:.1f} ug (training)", bool(best_train <= 1.5 * paper_r[3]),
                             reading="training readings",
                             why=f"noise floor sqrt(2) x {params.experiment.noise_ug:g} = {floor:.1f} ug"))
-    out.append(report.Claim("IAFSA-SCM-ANFIS RMSE 4 ug", f"{paper_r[3]:.0f} ug",
+    out.append(report.Claim("IAFSA-SCM-ANFIS RMSE 4 ug (ours within 1.5x)", f"{paper_r[3]:.0f} ug",
                             f"{best_test:.1f} ug (held-out)", bool(best_test <= 1.5 * paper_r[3]),
                             reading="held-out temperatures",
                             why=f"noise floor sqrt(2) x {params.experiment.noise_ug:g} = {floor:.1f} ug"))
     improvement = ours[0] / ours[3]
-    out.append(report.Claim("accuracy improved by about two orders of magnitude over ANN",
+    out.append(report.Claim("accuracy improved 1-2 orders of magnitude over ANN (ours >= 10x)",
                             f"{paper_r[0] / paper_r[3]:.0f}x", f"{improvement:.0f}x (held-out)",
                             bool(improvement >= 10), reading="held-out temperatures"))
     phys = med("physical (poly K0, K1, K2)", "test") * 1000
+    winner = "IAFSA-SCM-ANFIS" if best_test < phys else "the polynomial calibration"
     out.append(report.Claim("IAFSA-SCM-ANFIS beats a polynomial K0, K1, K2 calibration",
                             "not compared", f"{best_test:.1f} vs {phys:.1f} ug (held-out)",
-                            bool(best_test < phys), reading="held-out temperatures"))
+                            None, reading="held-out temperatures",
+                            why=f"the paper has no physical baseline; here {winner} wins, and which wins depends "
+                                "on the non-polynomial part of the simulated bias (bias_step_mg)"))
     ub_after = med("IAFSA-SCM-ANFIS", "unit B", "ME_mg") * 1000
     ub_before = float(drift.loc[drift["quantity"] == "max |output drift|, unit B", "ours"].iloc[0])
     p_after = _paper_value(paper, "unit_b_after") * 1000
-    out.append(report.Claim("second unit of the batch compensated to 9.3 ug max",
+    out.append(report.Claim("second unit compensated to 9.3 ug max (ours within 2x)",
                             f"{_paper_value(paper, 'unit_b_before'):.2f} mg -> {p_after:.1f} ug",
                             f"{ub_before:.2f} mg -> {ub_after:.0f} ug",
                             bool(ub_after <= 2 * p_after), reading=f"batch spread {params.batch_spread_rel:g}"))
