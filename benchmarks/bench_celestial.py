@@ -10,7 +10,8 @@ import torch
 from filterpy.kalman import KalmanFilter
 
 from navlib.methods import kalman as km
-from navlib.methods.mlp import MLPSpec, train_mlp
+from navlib.methods.mlp import train_mlp
+from navlib.studies.paper_e import bp_params
 from navlib.sensors import ins15
 from navlib.sensors.strapdown import ImuSpec, strapdown
 from navlib.sensors.trajectory import FlightProfile, generate
@@ -18,7 +19,7 @@ from navlib.sensors.trajectory import FlightProfile, generate
 torch.set_num_threads(1)
 run = strapdown(generate(FlightProfile(kind="s_turns")), [1], ImuSpec(gyro_scale_ppm=100))
 res = km.run_filter(run)
-net = train_mlp(km.gain_features(res, "qr6_rate"), res.att_err_arcsec, MLPSpec(n_in=9, epochs=50))
+net = train_mlp(km.gain_features(res, "qr6_rate"), res.att_err_arcsec, bp_params(9, epochs=50))
 
 t0 = time.perf_counter()
 res = km.run_filter(run)
@@ -41,7 +42,7 @@ print(f"150 s run, 1500 epochs: numpy KF + QR + 9-10-3 net {t_ours:.3f} s; filte
       f"ratio peer/ours {t_peer / t_ours:.2f}")
 
 x45, x6 = km.gain_features(res, "raw45"), km.gain_features(res, "qr6")
-n45 = train_mlp(x45, res.att_err_arcsec, MLPSpec(n_in=45, epochs=300))
-n6 = train_mlp(x6, res.att_err_arcsec, MLPSpec(n_in=6, epochs=300))
+n45 = train_mlp(x45, res.att_err_arcsec, bp_params(45, epochs=300))
+n6 = train_mlp(x6, res.att_err_arcsec, bp_params(6, epochs=300))
 print(f"training pass: 45-10-3 {1e3 * n45.seconds_per_pass:.2f} ms, 6-10-3 {1e3 * n6.seconds_per_pass:.2f} ms, "
       f"ratio {n45.seconds_per_pass / n6.seconds_per_pass:.2f} (paper 0.3038 s / 0.0418 s = 7.27)")

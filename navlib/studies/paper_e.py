@@ -25,7 +25,7 @@ from .. import report
 from ..data.tables import Column, read_table
 from ..errors import InputError, check_param
 from ..methods import kalman as km
-from ..methods.mlp import MLPSpec, train_mlp
+from ..methods.mlp import MLPParams, train_mlp
 from ..paths import DATA_DIR
 from ..sensors.strapdown import ImuSpec, InitialError, StarSensorSpec, strapdown
 from ..sensors.trajectory import FlightProfile, generate
@@ -40,6 +40,13 @@ CASE_LABEL = {"level_raw45": "level, 45 raw gains (Fig 3, Table 2)", "level_qr6"
               "sturn_qr6": "S-turns, 6 QR (Figs 6-7, Table 4)",
               "sturn_qr6_rate": "S-turns, 6 QR + 3 rates (Figs 8-9, Table 5)",
               "sturn_raw45": "S-turns, 45 raw gains (ours)"}
+
+
+def bp_params(n_in: int, n_hidden: int = 10, epochs: int = 300, learning_rate: float = 0.01) -> MLPParams:
+    """Paper E's BP network ``n_in - n_hidden - 3`` (logsig hidden, purelin output), as we train it:
+    standardised inputs and targets, torch's default initialisation, full-batch Adam."""
+    return MLPParams(n_in=n_in, n_hidden=n_hidden, n_out=3, hidden="logsig", trainer="adam", epochs=epochs,
+                     learning_rate=learning_rate, scaling="standardize", init="torch")
 
 
 @dataclass(frozen=True)
@@ -223,7 +230,7 @@ def simulate(spec: StudySpec = StudySpec()) -> StudyData:
                 if ck != kind:
                     continue
                 x_tr, x_te = km.gain_features(f_train, feats), km.gain_features(f_test, feats)
-                mspec = MLPSpec(n_in=km.N_INPUTS[feats], n_hidden=spec.n_hidden, n_out=3, epochs=spec.epochs)
+                mspec = bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs)
                 net = train_mlp(x_tr, f_train.att_err_arcsec, mspec, seed=spec.seed * 1000 + rep)
                 bp = f_test.att_err_arcsec - net.predict(x_te)
                 _score_rows(score_rows, rep, case, "held-out", "BPKF", bp, mask)
