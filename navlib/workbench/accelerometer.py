@@ -29,7 +29,7 @@ import pandas as pd
 from ..data.tumble import read_tumble, require_levels
 from ..errors import InputError
 from .effects import Effect, System, register_system
-from .fit import Fit, best_least_squares, fit_model, lstsq, user_columns, user_design
+from .fit import Fit, fit_linear, fit_model, user_columns
 from .diagnose import diagnose
 from .trials import wilson
 
@@ -102,22 +102,9 @@ def _fit_accelerometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) -
             require_levels(data, temperatures=need, what=f"effect '{name}'", name="tumble data")
     t_c = float(data["temperature_c"].mean())
     X = design(data, cat, t_c)
-    names = [p for e in cat for p in ACCELEROMETER_EFFECTS[e].params] + [p for e in users for p in e.params]
-    if len(names) >= len(y):
-        raise InputError(f"{len(y)} readings cannot determine {len(names)} parameters of the model "
-                         f"{' + '.join(e.name for e in effects)}")
-    shape = (len(y),)
-    XU = np.column_stack([X, user_design(users, data, shape)])
-    beta = lstsq(XU, y)
-    jac = XU
+    beta, jac, names = fit_linear(y, X, [p for e in cat for p in ACCELEROMETER_EFFECTS[e].params], users, data,
+                                  start, what="readings", model=" + ".join(e.name for e in effects))
     nc = X.shape[1]
-    if users:
-        def resid(x):
-            return X @ x[:nc] + user_columns(users, dict(zip(names, x)), data, shape) - y
-
-        inf = np.full(len(names), np.inf)
-        sol = best_least_squares(resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf)
-        beta, jac = sol.x, np.asarray(sol.jac)
     params = dict(zip(names, map(float, beta)))
 
     def predict(frame):

@@ -311,15 +311,43 @@ def drift_design(data: pd.DataFrame, effects, centres: dict | None = None) -> tu
     return (np.column_stack(cols) if cols else np.zeros((len(data), 0))), centres
 
 
-def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
-    y = data["drift_deg_h"].to_numpy(float)
-    cat = tuple(e.name for e in effects if e.contribution is None)
-    users = tuple(e for e in effects if e.contribution is not None)
-    X, centres = drift_design(data, cat)
-    names = [DRIFT_EFFECTS[e].params[0] for e in cat] + [p for e in users for p in e.params]
+def fit_linear(y: np.ndarray, X: np.ndarray, cat_names, users, data: pd.DataFrame, start,
+               *, what: str = "rows", model: str = "") -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Least squares for a model linear in its catalogued parameters, ``y ~ X beta_cat + sum of user
+    effects``.  The linear problem (user effects linearised by :func:`user_design`) is solved first; with
+    user effects, which may be nonlinear, the solution is refined by nonlinear least squares from it and
+    from ``start`` (:func:`best_least_squares`).
+
+    Parameters
+    ----------
+    y : ndarray
+        The measurements (n,).
+    X : ndarray
+        Design matrix of the catalogued effects (n, p).
+    cat_names : sequence of str
+        The catalogued parameters, one per column of ``X``.
+    users : sequence of Effect
+        User effects (with a ``contribution``).
+    data : DataFrame
+        The measurements' table (the user effects read their columns from it).
+    start : dict or None
+        Starting values by parameter name.
+    what, model : str
+        Words for the error message when there are too few measurements.
+
+    Returns
+    -------
+    beta : ndarray
+        All parameters, catalogued first.
+    jacobian : ndarray
+        d(model)/d(beta) at the solution.
+    names : list of str
+        The parameter names, in the order of ``beta``.
+    """
+    names = list(cat_names) + [p for e in users for p in e.params]
     if len(names) >= len(y):
-        raise InputError(f"{len(y)} rows cannot determine {len(names)} parameters of the model "
-                         f"{' + '.join(e.name for e in effects)}; at least {len(names) + 1} rows are needed")
+        raise InputError(f"{len(y)} {what} cannot determine {len(names)} parameters of the model {model}; "
+                         f"at least {len(names) + 1} {what} are needed")
     shape = (len(y),)
     XU = np.column_stack([X, user_design(users, data, shape)])
     beta = lstsq(XU, y)
@@ -333,6 +361,16 @@ def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         inf = np.full(len(names), np.inf)
         sol = best_least_squares(resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf)
         beta, jac = sol.x, np.asarray(sol.jac)
+    return beta, jac, names
+
+
+def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
+    y = data["drift_deg_h"].to_numpy(float)
+    cat = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    X, centres = drift_design(data, cat)
+    beta, jac, names = fit_linear(y, X, [DRIFT_EFFECTS[e].params[0] for e in cat], users, data, start,
+                                  model=" + ".join(e.name for e in effects))
     params = dict(zip(names, map(float, beta)))
     nc = X.shape[1]
 
