@@ -50,11 +50,11 @@ from .report import claims_summary, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
-#: A preformatted output line longer than this does not fit the content column at 1400 px: measured in
-#: headless Chromium on the built book (sphinx-book-theme 1.3): an output ``<pre>`` is 784 px wide with
-#: 32 px of padding, and its 14 px monospace font is 8.43 px per character, so 89 characters fit.
+#: A preformatted output line longer than this does not fit the content column at 1400 px (measured in
+#: headless Chromium on the built book with sphinx-book-theme 1.3; an output ``<pre>`` is 784 px wide with
+#: 32 px of padding, and its 14 px monospace font is 8.43 px per character, so 89 characters fit).
 MAX_PRE_CHARS = 89
-#: Tolerances of ``check-results``: a number passes if ``|fresh - ref| <= ATOL + RTOL * |ref|``.
+#: Tolerances of ``check-results`` (a number passes if ``|fresh - ref| <= ATOL + RTOL * |ref|``).
 RTOL = 1e-3
 ATOL = 1e-9
 
