@@ -1,8 +1,27 @@
 """The workbench: compare a model of named physical effects with measurements, see where it fails, find
 the missing effect, add it, and watch the error fall.
 
-- :mod:`navlib.workbench.effects` -- the effect catalogues of each system;
-- :mod:`navlib.workbench.fit` -- fitting a model of effects, residuals, held-out error, simulated data;
+- :mod:`navlib.workbench.effects` -- the two types everything is built from: :class:`Effect` (name,
+  parameters with units, needed columns, meaning, and for a user effect its contribution to the model) and
+  :class:`System` (unit, catalogue, ``load``, ``fit``, ``structure``); the registry :data:`SYSTEMS`;
+  user effects from a file (:func:`load_effects`);
+- :mod:`navlib.workbench.fit` -- :class:`Fit` (residuals, held-out error, ``add``), the compass and drift
+  systems, simulated data;
+- :mod:`navlib.workbench.magnetometer` -- the 3-D magnetometer system (hard and soft iron, misalignment,
+  time lag; the local field estimated);
 - :mod:`navlib.workbench.diagnose` -- which effect is missing, with family-wise false-alarm control;
-- :mod:`navlib.workbench.trials` -- detection and false-alarm rates on data with hidden effects.
+- :mod:`navlib.workbench.loop` -- the whole loop (diagnose, add, repeat) as one function, its JSON and report;
+- :mod:`navlib.workbench.trials` -- detection and false-alarm rates on data with hidden effects, in and
+  outside the catalogue.
+
+Adding a system (e.g. an accelerometer): write ``navlib/workbench/accelerometer.py`` that defines its
+catalogue (a dict of :class:`Effect`), a loader ``load(path) -> DataFrame`` (one-line InputError naming file,
+column, row), ``fit(data, effects, start) -> Fit`` (use :func:`navlib.workbench.fit.best_least_squares`
+from the previous parameters and a linearised start; add user effects with
+:func:`navlib.workbench.fit.user_columns`), and ``structure(fit) -> [(what, X, scale)]``; then call
+``register_system(System(name, unit, catalogue, load, fit, structure, meaning))`` at the end of the module
+and import the module below.  ``fit_model``, ``Fit.add``, ``diagnose``, ``loop`` and the CLI
+(``python -m navlib loop accelerometer FILE``) then work unchanged.
 """
+from . import fit, magnetometer  # noqa: F401  (importing registers the compass, drift and magnetometer systems)
+from .effects import SYSTEMS, Effect, System, get_system, load_effects, register_system  # noqa: F401

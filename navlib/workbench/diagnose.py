@@ -1,27 +1,35 @@
 """Which physical effect is missing from a model? Evidence from the residuals, with honest statistics.
 
-:func:`diagnose` takes a fitted model (:class:`navlib.workbench.fit.Fit`) and
+:func:`diagnose` takes a fitted model (:class:`navlib.effects.Fit`) and
 
 1. refits it with each catalogued effect that is not yet in the model and that the data can test, and
    scores each candidate by
-
    - variance explained: the share of the residual sum of squares the effect removes,
    - significance: the nested-model F test ``F = (dRSS / q) / (RSS_1 / (n - p_1))`` (q parameters added);
      for small linear problems (n <= 12, the drift tables) an exact or Monte-Carlo permutation test of the
      candidate's covariate instead, which does not lean on normal errors,
    - held-out improvement: leave-one-out RMS with and without the effect (exact for linear models, the
      leverage approximation for the compass);
-
-2. looks for structure that no catalogued effect explains, in the residuals of the *fullest* model (every
-   testable effect added): heading harmonics 1..6 and serial correlation along a compass sweep, a trend in
-   a covariate the catalogue does not use (``time_s``), curvature in each drift covariate;
+2. looks for structure in the residuals of the current model, with the shapes its system lists
+   (:attr:`navlib.workbench.effects.System.structure`; compass: a constant offset, heading harmonics 1..6,
+   offsets and one-cycle errors differing between sweeps, a trend in time; drift: curvature in each
+   covariate; magnetometer: trends with time, angular rate and position).  Each shape ``X`` is first
+   projected off the model's Jacobian (what the model can already absorb is not structure); what remains
+   is F-tested against the residual.  The *amplitude* reported is computed on the residual itself (least
+   squares of the residual on ``X``), so it can never exceed what the residual allows;
 3. controls false alarms over the whole family of tests with Bonferroni: each test is run at
    ``alpha / m`` (m = number of tests), so data with nothing missing are called "consistent with noise" with
    probability at least ``1 - alpha``.
 
 The effect to add (``missing``) is the significant candidate with the strongest evidence (smallest p) that
-also improves the held-out RMS.  If none is, and no structure is found, the residuals are consistent with
-noise.
+also improves the held-out RMS *and* explains what it claims.  If the residual shows significant structure,
+the candidate is added and the structure re-tested: a structure no longer significant is *gone* (the
+candidate explains it); for what *remains*, a conditional F test asks whether the candidate still lowers
+the residual once the remaining structure is allowed for in both models.  A candidate that only soaks up a
+little of an unexplained structure (a temperature term and a three-cycle error; a one-cycle term and the
+heading-correlated part of a drift in time) fails that test and is not named; the report then says which
+structure remains and that no catalogued effect explains it.  If no candidate is named and no structure is
+found, the residuals are consistent with noise.
 """
 from __future__ import annotations
 
@@ -34,14 +42,17 @@ import pandas as pd
 from scipy import stats
 
 from ..errors import check_param
+from ..errors import InputError
 from .effects import testable
-from .fit import Fit, drift_design
+from .fit import Fit, drift_design, lstsq, orth_basis
 
 SMALL_SAMPLE = 12
 # Family-wise false-alarm level. Bonferroni keeps the false-alarm rate at or below alpha; the users' target
 # is at most 5 %, so the default runs at half of it to stay under the target with margin.
 DEFAULT_ALPHA = 0.025
-HARMONICS = tuple(range(1, 7))
+# A structure shape is "already in the model" when less than this share of its norm is left after
+# projecting it off the model's Jacobian.
+SPANNED = 0.1
 
 
 @dataclass
@@ -54,6 +65,7 @@ class Candidate:
     test: str                   # 'F' or 'permutation'
     significant: bool = False
     log_p: float = field(default=0.0, repr=False)
+    explains: str = ""          # the structure it removes ("" if no structure was found)
 
 
 @dataclass
@@ -86,6 +98,7 @@ class Diagnosis:
         d = asdict(self)
         for c in d["candidates"]:
             c.pop("log_p")
+            c.pop("explains")
         for s in d["structure"]:
             s.pop("log_p")
         return d
@@ -171,61 +184,75 @@ def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n
     return float(hits / len(perms)) if exact else float((1 + hits) / (1 + len(perms)))
 
 
-def _regress_extra(resid: np.ndarray, base_jac: np.ndarray, extra: np.ndarray) -> tuple[float, float, float]:
-    """Add columns ``extra`` to the model's (linearised) design and F-test them on the residuals:
-    returns (p, log p, RMS of the fitted extra component)."""
-    n = len(resid)
-    X = np.column_stack([base_jac, extra]) if base_jac.shape[1] else extra
-    beta = np.linalg.lstsq(X, resid, rcond=None)[0]
-    fitted = X @ beta
-    rss1 = float(np.sum((resid - fitted) ** 2))
-    rss0 = float(np.sum(resid ** 2))
-    p, logp = _f_test(rss0, rss1, extra.shape[1], n - X.shape[1])
-    comp = extra @ beta[-extra.shape[1]:]
-    return p, logp, float(np.sqrt(np.mean(comp ** 2)))
+def _projector(J: np.ndarray) -> np.ndarray:
+    """Orthonormal basis of the model Jacobian's column space (rank-revealing SVD)."""
+    return orth_basis(J)
 
 
-def _structure(full: Fit) -> list[Finding]:
-    """Structure tests on the residuals of the fullest model."""
-    r, J, data = full.residuals, full.jacobian, full.data
+def _structure(fit: Fit) -> list[Finding]:
+    """The system's structure tests on the residuals of ``fit`` (module docstring, point 2)."""
+    r = fit.residuals
+    Q = _projector(fit.jacobian)
     out = []
-    if full.system == "compass":
-        h = np.radians(data["true_heading_deg"].to_numpy(float))
-        for k in HARMONICS:
-            if len(r) - J.shape[1] - 2 < 3:
-                break
-            p, logp, amp = _regress_extra(r, J, np.column_stack([np.sin(k * h), np.cos(k * h)]))
-            out.append(Finding(f"heading harmonic {k} (period {360 // k} deg)", amp * math.sqrt(2), p, log_p=logp))
-        order = np.lexsort((data["true_heading_deg"].to_numpy(float),
-                            data["sweep"].to_numpy(float) if "sweep" in data else np.zeros(len(r))))
-        rs = r[order] - r.mean()
-        if len(rs) > 10 and np.sum(rs ** 2) > 0:
-            r1 = float(np.sum(rs[1:] * rs[:-1]) / np.sum(rs ** 2))
-            z = r1 * math.sqrt(len(rs))
-            logp = float(stats.norm.logsf(z))
-            out.append(Finding(f"serial correlation along the sweep (lag-1 r = {r1:.2f})", float(np.std(r)),
-                               math.exp(logp), log_p=logp))
-        for col in ("time_s",):
-            if col in data and np.ptp(data[col].to_numpy(float)) > 0:
-                x = data[col].to_numpy(float)
-                p, logp, amp = _regress_extra(r, J, (x - x.mean())[:, None])
-                out.append(Finding(f"trend with {col}", amp, p, log_p=logp))
-    else:
-        for col in ("latitude_error_deg", "temperature_c", "temperature_change_c"):
-            if col in data and np.ptp(data[col].to_numpy(float)) > 0 and len(r) - J.shape[1] - 1 >= 2:
-                x = data[col].to_numpy(float)
-                x = (x - x.mean()) / (np.std(x) or 1.0)
-                p, logp, amp = _regress_extra(r, J, (x ** 2 - np.mean(x ** 2))[:, None])
-                out.append(Finding(f"curvature in {col}", amp, p, log_p=logp))
+    for what, X, scale in fit.spec.structure(fit):
+        X = np.asarray(X, float)
+        X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
+        Xp = X - Q @ (Q.T @ X)
+        # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns)
+        w, V = np.linalg.eigh(Xp.T @ Xp)
+        keep = w > SPANNED ** 2
+        q = int(np.sum(keep))
+        df2 = len(r) - Q.shape[1] - q
+        if q == 0 or df2 < 3:
+            continue                                   # the model already spans this shape, or too few rows
+        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
+        drop = float(np.sum((u.T @ r) ** 2))
+        p, logp = _f_test(float(np.sum(r ** 2)), float(np.sum(r ** 2)) - drop, q, df2)
+        beta = lstsq(X, r)                              # amplitude: on the residual itself
+        amp = scale * float(np.sqrt(np.mean((X @ beta) ** 2)))
+        out.append(Finding(what, amp, p, log_p=logp))
     return out
 
 
+def _conditional_p(fit: Fit, f1: Fit, found: list[Finding]) -> float:
+    """p of the candidate's improvement when the structure ``found`` is allowed for in both models: the
+    residuals of ``fit`` and of ``f1`` (= fit + candidate) are each regressed on their model's Jacobian and
+    the structure shapes, and the two remaining sums of squares are F-tested."""
+    shapes = {what: X for what, X, _ in fit.spec.structure(fit)}
+    S = np.column_stack([shapes[s.what] for s in found if s.what in shapes])
+
+    def rss_p(f):
+        u = orth_basis(np.column_stack([f.jacobian, S]))
+        r = f.residuals
+        return float(r @ r - np.sum((u.T @ r) ** 2)), u.shape[1]
+
+    rss0, _ = rss_p(fit)
+    rss1, p1 = rss_p(f1)
+    return _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
+
+
 def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
-    """Rank the catalogue's effects not yet in ``fit`` by the evidence that adding each explains the
-    residuals; name the one to add, or say the residuals are consistent with noise (module docstring)."""
+    """Rank the effects not yet in ``fit`` by the evidence that adding each explains the residuals; name the
+    one to add, or say the residuals are consistent with noise, or name the structure no effect explains.
+
+    Parameters
+    ----------
+    fit : Fit
+        The current model (:func:`navlib.workbench.fit.fit_model`); its ``available`` effects (catalogue and
+        user effects) are the candidates.
+    alpha : float
+        Family-wise false-alarm level (default :data:`DEFAULT_ALPHA`), Bonferroni over every test.
+    seed : int
+        Seed of the Monte-Carlo permutation test (drift tables with more than 7 rows).
+
+    Returns
+    -------
+    Diagnosis
+        ``missing`` (the effect to add or None), candidates, structure findings, the message.
+    """
     alpha = DEFAULT_ALPHA if alpha is None else alpha
     check_param("alpha", alpha, lo=0, lo_open=True, hi=1, hi_open=True)
-    ok, why = testable(fit.system, fit.data)
+    ok, why = testable(fit.available, fit.data)
     untestable = {k: v for k, v in why.items() if k not in fit.effects}
     cands = []
     fits = {}
@@ -234,53 +261,69 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
             continue
         try:
             f1 = fit.add(effect)
-        except Exception as err:                       # e.g. too few rows for one more parameter
-            untestable[effect] = str(err).split(";")[0]
+        except InputError as err:                      # e.g. too few rows for one more parameter
+            untestable[effect] = str(err)
             continue
         fits[effect] = f1
         q, df2 = f1.n_params - fit.n_params, f1.n - f1.n_params
-        drop = fit.rss - f1.rss
+        drop = max(fit.rss - f1.rss, 0.0)
         p, logp = _f_test(fit.rss, f1.rss, q, df2)
         test = "F"
-        if fit.system == "drift" and fit.n <= SMALL_SAMPLE:
+        if (fit.system == "drift" and fit.n <= SMALL_SAMPLE
+                and all(e in fit.spec.catalogue for e in fit.effects + (effect,))):
             pp = _permutation_p(fit, effect, drop, seed)
             if pp is not None:
                 p, logp, test = pp, math.log(max(pp, 1e-300)), "permutation"
         cands.append(Candidate(effect, f1.rms, f1.loo_rms, drop / fit.rss if fit.rss > 0 else 0.0, p, test,
                                log_p=logp))
-    full = fit
-    for effect in fits:
-        try:
-            full = full.add(effect)
-        except Exception:
-            pass
-    structure = _structure(full)
+    structure = _structure(fit)
     m = len(cands) + len(structure)
     level = alpha / max(m, 1)
-    for c in cands:
-        c.significant = bool(c.p_value < level and c.loo_rms < fit.loo_rms)
     for s in structure:
         s.significant = bool(s.p_value < level)
-    cands.sort(key=lambda c: (not c.significant, c.log_p, -c.variance_explained))
-    missing = cands[0].effect if cands and cands[0].significant else None
     found = [s for s in structure if s.significant]
+    for c in cands:
+        c.significant = bool(c.p_value < level and c.loo_rms < fit.loo_rms)
+    cands.sort(key=lambda c: (not c.significant, c.log_p, -c.variance_explained))
+    missing, blocked = None, []
+    for c in cands:
+        if not c.significant:
+            break
+        if not found:
+            missing = c.effect
+            break
+        f1 = fits[c.effect]
+        after = {s.what: s for s in _structure(f1)}
+        gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level]
+        remaining = [s for s in found if s.what not in gone]
+        # named only if it still matters once the structure it leaves in place is allowed for
+        if not remaining or _conditional_p(fit, f1, remaining) < level:
+            c.explains = "; ".join(gone)
+            missing = c.effect
+            found = remaining
+            break
+        blocked.append(c.effect)
     unit = fit.unit
     if missing:
-        c = cands[0]
+        c = next(c for c in cands if c.effect == missing)
         msg = (f"add '{missing}': it removes {100 * c.variance_explained:.1f} % of the residual variance "
                f"(p = {c.p_value:.2g}, {c.test} test) and lowers the held-out rms from {_fmt(fit.loo_rms)} to "
                f"{_fmt(c.loo_rms)} {unit}")
+        if c.explains:
+            msg += f"; it explains the {c.explains}"
     elif found:
         msg = ("no catalogued effect explains the residuals, but they are not noise: "
-               + "; ".join(s.what for s in found) + " -- look for an effect the catalogue lacks")
+               + "; ".join(f"{s.what} (amplitude {_fmt(s.amplitude)} {unit})" for s in found)
+               + " -- look for an effect the catalogue lacks")
+        if blocked:
+            msg += (f" ({', '.join(blocked)} would remove some variance but leave this structure in place, "
+                    f"so it is not named)")
     else:
         msg = (f"the residuals are consistent with noise: no candidate effect and no structure is significant "
                f"at the family-wise level alpha = {alpha:g} over {m} tests")
         if fit.n <= SMALL_SAMPLE:
             msg += f" (only {fit.n} rows: small effects cannot be excluded)"
     if missing and found:
-        msg += "; also found structure no catalogued effect explains: " + "; ".join(s.what for s in found)
+        msg += "; structure it does not explain remains: " + "; ".join(s.what for s in found)
     return Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
                      missing is None and not found, cands, structure, untestable, alpha, m, msg)
-
-

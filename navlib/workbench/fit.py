@@ -1,15 +1,20 @@
 """A model of named effects fitted to measurements: residuals, held-out error, adding an effect in one call;
-loading a system's measurement file, and simulated data from the catalogue model.
+the compass and drift systems (loading, fitting, structure tests, simulated data).
 
-See :mod:`navlib.workbench.effects` for the catalogues and the model equations.
+See :mod:`navlib.workbench.effects` for the Effect/System types and the model equations.  Every refit starts
+from several points and keeps the best: the previous model's parameters (new ones at zero) and the
+system's *linearised* solution (for the compass the first-order harmonic model, in which hard iron is a
+one-cycle and soft iron a two-cycle error; for a linear model the exact solution), so a refit never ends
+worse than the linearised model that motivated it.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 import pandas as pd
+from scipy.optimize import least_squares
 
 from ..angles import heading_deg, wrap_deg
 from ..data.compass_sweeps import load_sweeps
@@ -17,18 +22,23 @@ from ..data.gyro_tables import USER_COLUMNS
 from ..data.tables import read_table
 from ..errors import InputError
 from ..sensors.ins import latitude_error_per_drift
-from ..sensors.planar import PlanarModel, fit_planar_model
-from .effects import COMPASS_EFFECTS, DRIFT_EFFECTS, UNITS, _catalogue, check_effects
+from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
+from .effects import COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, get_system, register_system, resolve
+
+RAD = 180.0 / np.pi
+
 
 @dataclass
 class Fit:
     """A model (a set of named effects) fitted to measurements.
 
-    ``residuals`` = measured - model (wrapped for the compass), in the system's unit; ``loo_residuals`` the
-    leave-one-out prediction errors (exact for the linear drift model; the leverage approximation
-    ``e_i / (1 - h_ii)`` from the fit's Jacobian for the compass)."""
+    ``residuals`` = measured - model (wrapped for the compass), one value per scalar observation (3 per row
+    for a 3-D field), in the system's unit; ``jacobian`` d(model)/d(parameters) at the solution;
+    ``loo_residuals`` the leave-one-out prediction errors (exact for a linear model, the leverage
+    approximation ``e_i / (1 - h_ii)`` otherwise).  ``available`` holds every effect that may be added
+    (catalogue and user effects)."""
 
-    system: str
+    spec: System
     effects: tuple[str, ...]
     params: dict
     data: pd.DataFrame
@@ -36,10 +46,15 @@ class Fit:
     jacobian: np.ndarray
     predict: Callable[[pd.DataFrame], np.ndarray] = field(repr=False)
     model: object = field(default=None, repr=False)
+    available: Mapping[str, Effect] = field(default_factory=dict, repr=False)
+
+    @property
+    def system(self) -> str:
+        return self.spec.name
 
     @property
     def unit(self) -> str:
-        return UNITS[self.system]
+        return self.spec.unit
 
     @property
     def n(self) -> int:
@@ -62,7 +77,7 @@ class Fit:
         J = self.jacobian
         if J.shape[1] == 0:
             return self.residuals.copy()
-        q, _ = np.linalg.qr(J)
+        q = orth_basis(J)
         h = np.clip(np.sum(q ** 2, axis=1), 0.0, 1.0 - 1e-9)
         return self.residuals / (1.0 - h)
 
@@ -70,16 +85,22 @@ class Fit:
     def loo_rms(self) -> float:
         return float(np.sqrt(np.mean(self.loo_residuals ** 2)))
 
+    @property
+    def user_effects(self) -> tuple[Effect, ...]:
+        return tuple(e for k, e in self.available.items() if k not in self.spec.catalogue)
+
     def add(self, effect: str) -> "Fit":
-        """The same data fitted with one more effect (one call)."""
+        """The same data fitted with one more effect (one call), starting from this fit's parameters."""
         if effect in self.effects:
             raise InputError(f"effect '{effect}' is already in the model")
-        return fit_model(self.system, self.data, self.effects + (effect,), start=self.params)
+        return fit_model(self.spec, self.data, self.effects + (effect,), start=self.params,
+                         user_effects=self.user_effects)
 
     def remove(self, effect: str) -> "Fit":
         if effect not in self.effects:
             raise InputError(f"effect '{effect}' is not in the model")
-        return fit_model(self.system, self.data, tuple(e for e in self.effects if e != effect))
+        return fit_model(self.spec, self.data, tuple(e for e in self.effects if e != effect),
+                         user_effects=self.user_effects)
 
     def summary(self) -> dict:
         return {"model": " + ".join(self.effects) or "(none)", "parameters": self.n_params,
@@ -87,36 +108,183 @@ class Fit:
                 f"max ({self.unit})": float(self.residuals.max()), f"held-out rms ({self.unit})": self.loo_rms}
 
 
-def observed(system: str, data: pd.DataFrame) -> np.ndarray:
-    col = "measured_heading_deg" if system == "compass" else "drift_deg_h"
-    return data[col].to_numpy(float)
+def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
+              user_effects: tuple[Effect, ...] = ()) -> Fit:
+    """Fit the named effects of ``system`` (a name or a :class:`System`) to ``data`` (a validated frame,
+    see :func:`load`); ``user_effects`` are extra effects (with a contribution) the names may refer to."""
+    spec = get_system(system) if isinstance(system, str) else system
+    available = {**spec.catalogue, **{e.name: e for e in user_effects}}
+    chosen = resolve(available, effects, data, spec.name)
+    fit = spec.fit(data, chosen, start)
+    fit.available = available
+    return fit
 
 
-def fit_model(system: str, data: pd.DataFrame, effects, start: dict | None = None) -> Fit:
-    """Fit the named effects of ``system`` to ``data`` (a validated frame, see :func:`load`)."""
-    effects = check_effects(system, effects, data)
-    if system == "compass":
-        return _fit_compass(data, effects, start)
-    return _fit_drift(data, effects)
+def compare(*fits: Fit) -> pd.DataFrame:
+    """Before/after table: one row per fit with RMS, residual range and held-out RMS."""
+    return pd.DataFrame([f.summary() for f in fits]).set_index("model")
 
 
-def _fit_compass(data, effects, start):
+# ------------------------------------------------------------------------------ shared fitting helpers
+# Tall matrices (thousands of rows, tens of columns) are handled through their small Gram matrix: on a
+# shared machine a threaded LAPACK factorisation of the tall matrix can be a hundred times slower, and the
+# columns are scaled to unit norm first so squaring the condition number costs nothing we need.
+def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
+    """An orthonormal basis of the column space of ``X`` (columns below ``rtol`` of the largest singular
+    value dropped)."""
+    if X.shape[1] == 0:
+        return np.zeros((X.shape[0], 0))
+    norms = np.linalg.norm(X, axis=0)
+    keep = norms > 0
+    Xs = X[:, keep] / norms[keep]
+    if Xs.shape[1] == 0:
+        return np.zeros((X.shape[0], 0))
+    w, V = np.linalg.eigh(Xs.T @ Xs)
+    ok = w > max(w.max(), 1e-300) * rtol ** 2
+    return (Xs @ V[:, ok]) / np.sqrt(w[ok])
+
+
+def lstsq(X: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Minimum-norm least-squares solution of ``X b = y`` via the (column-scaled) normal equations."""
+    if X.shape[1] == 0:
+        return np.zeros(0)
+    norms = np.linalg.norm(X, axis=0)
+    norms[norms == 0] = 1.0
+    Xs = X / norms
+    return (np.linalg.pinv(Xs.T @ Xs, rcond=1e-12, hermitian=True) @ (Xs.T @ y)) / norms
+
+
+def user_columns(effects, params: dict, data: pd.DataFrame, shape) -> np.ndarray:
+    """Sum of the user effects' contributions, flattened to the residual vector."""
+    total = np.zeros(int(np.prod(shape)))
+    for e in effects:
+        c = np.asarray(e.contribution({k: params[k] for k in e.params}, data), dtype=float)
+        if c.shape != tuple(shape):
+            raise InputError(f"effect '{e.name}': contribution has shape {c.shape}, the measurement {tuple(shape)}")
+        total += c.ravel()
+    return total
+
+
+def user_design(effects, data: pd.DataFrame, shape) -> np.ndarray:
+    """Columns d(contribution)/d(parameter) of the user effects at zero (central differences, step 1 in
+    the parameter's unit: exact for an effect linear in its parameters)."""
+    cols = []
+    for e in effects:
+        for name in e.params:
+            up = user_columns([e], {k: (1.0 if k == name else 0.0) for k in e.params}, data, shape)
+            dn = user_columns([e], {k: (-1.0 if k == name else 0.0) for k in e.params}, data, shape)
+            cols.append((up - dn) / 2.0)
+    return np.column_stack(cols) if cols else np.zeros((int(np.prod(shape)), 0))
+
+
+def best_least_squares(model_minus_obs, starts, lo, hi):
+    """``scipy.optimize.least_squares`` (trust-region reflective) from each start; the lowest cost wins."""
+    best = None
+    finite = np.isfinite(lo) & np.isfinite(hi)
+    margin = np.where(finite, 1e-9 * (np.abs(np.where(finite, hi - lo, 0.0)) + 1), 0.0)
+    for x0 in starts:
+        x0 = np.clip(np.asarray(x0, float), lo + margin, hi - margin)
+        sol = least_squares(model_minus_obs, x0, bounds=(lo, hi), x_scale="jac", method="trf",
+                            tr_solver="lsmr" if len(x0) > 6 else "exact")
+        if best is None or sol.cost < best.cost:
+            best = sol
+    return best
+
+
+# --------------------------------------------------------------------------------------------- compass
+def compass_linear_design(data: pd.DataFrame, names, t_ref: float) -> np.ndarray:
+    """First-order (harmonic) model of the planar parameters, deg per unit parameter, about zero:
+    ``err = yaw - (h_x + k_x dT) sin psi - (h_y + k_y dT) cos psi - e sin 2 psi - f cos 2 psi`` (rad)."""
+    psi = np.radians(data["true_heading_deg"].to_numpy(float))
+    dt = (data["temperature_c"].to_numpy(float) - t_ref) if "temperature_c" in data else np.zeros(len(psi))
+    col = {"yaw_deg": np.ones_like(psi), "hard_x": -RAD * np.sin(psi), "hard_y": -RAD * np.cos(psi),
+           "soft_e": -RAD * np.sin(2 * psi), "soft_f": -RAD * np.cos(2 * psi),
+           "temp_x_per_c": -RAD * dt * np.sin(psi), "temp_y_per_c": -RAD * dt * np.cos(psi)}
+    return np.column_stack([col[n] for n in names]) if names else np.zeros((len(psi), 0))
+
+
+def _fit_compass(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     true = data["true_heading_deg"].to_numpy(float)
     meas = data["measured_heading_deg"].to_numpy(float)
     temp = data["temperature_c"].to_numpy(float) if "temperature_c" in data else None
-    initial = {k: v for k, v in (start or {}).items()} or None
-    model, sol = fit_planar_model(true, meas, effects, initial=initial, temperature_c=temp, full_output=True)
-    # residual = measured - model, in degrees
-    resid = wrap_deg(meas - model.predict_measured(true, temp))
-    jac = -np.asarray(sol.jac) if sol is not None else np.zeros((len(true), 0))
+    planar = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    pnames = [p for e in planar for p in PLANAR_EFFECTS[e]]
+    unames = [p for e in users for p in e.params]
+    names = pnames + unames
+    if len(true) < len(names) + 1:
+        raise InputError(f"{len(true)} readings cannot determine {len(names)} model parameters")
+    t_ref = float(np.mean(temp)) if "temperature" in planar else 20.0
+    shape = (len(true),)
+
+    def model(x):
+        p = dict(zip(names, x))
+        pm = PlanarModel(planar, {k: p[k] for k in pnames}, t_ref)
+        return pm.predict_measured(true, temp) + user_columns(users, p, data, shape)
+
+    def resid(x):                                   # model - measured, wrapped
+        return wrap_deg(model(x) - meas)
+
+    if not names:
+        r = wrap_deg(meas - model(np.zeros(0)))
+        pm = PlanarModel(planar, {}, t_ref)
+        return Fit(SYSTEMS_BASE["compass"], planar, {}, data, r, np.zeros((len(r), 0)),
+                   lambda f: PlanarModel(planar, {}, t_ref).predict_measured(f["true_heading_deg"].to_numpy(float)),
+                   pm)
+    lo = np.array([-180.0 if n == "yaw_deg" else -0.95 for n in pnames] + [-np.inf] * len(unames))
+    hi = np.array([180.0 if n == "yaw_deg" else 0.95 for n in pnames] + [np.inf] * len(unames))
+    # start 1: the previous model's parameters, new ones at zero (yaw from the mean error if new)
+    x1 = np.array([(start or {}).get(n, 0.0) for n in names])
+    if "yaw_deg" in pnames and "yaw_deg" not in (start or {}):
+        x1[pnames.index("yaw_deg")] = float(np.degrees(np.angle(np.mean(np.exp(1j * np.radians(meas - true))))))
+    # start 2: the linearised (harmonic) model fitted by linear least squares
+    X = np.column_stack([compass_linear_design(data, pnames, t_ref), user_design(users, data, shape)])
+    x2 = lstsq(X, wrap_deg(meas - true))
+    sol = best_least_squares(resid, [x1, x2], lo, hi)
+    params = dict(zip(names, map(float, sol.x)))
+    pm = PlanarModel(planar, {k: params[k] for k in pnames}, t_ref)
+    r = wrap_deg(meas - model(sol.x))
 
     def predict(frame):
         t = frame["temperature_c"].to_numpy(float) if "temperature_c" in frame else None
-        return model.predict_measured(frame["true_heading_deg"].to_numpy(float), t)
+        return (pm.predict_measured(frame["true_heading_deg"].to_numpy(float), t)
+                + user_columns(users, params, frame, (len(frame),)))
 
-    return Fit("compass", effects, dict(model.params), data, resid, jac, predict, model)
+    return Fit(SYSTEMS_BASE["compass"], tuple(e.name for e in effects), params, data, r, np.asarray(sol.jac),
+               predict, pm)
 
 
+def harmonic_columns(data: pd.DataFrame, k: int) -> np.ndarray:
+    h = np.radians(data["true_heading_deg"].to_numpy(float))
+    return np.column_stack([np.sin(k * h), np.cos(k * h)]) if k else np.ones((len(h), 1))
+
+
+def compass_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
+    """Shapes no catalogued compass effect produces on its own: a constant offset, heading harmonics 1..6,
+    an offset and a one-cycle error that differ between sweeps, and a trend in time."""
+    data = fit.data
+    out = [("constant offset", harmonic_columns(data, 0), 1.0)]
+    out += [(f"heading harmonic {k} (period {360 // k} deg)", harmonic_columns(data, k), np.sqrt(2.0))
+            for k in range(1, 7)]
+    if "sweep" in data and data["sweep"].nunique() > 1:
+        ids = sorted(data["sweep"].unique())
+        d = np.column_stack([(data["sweep"] == i).to_numpy(float) for i in ids[1:]])
+        d = d - d.mean(axis=0)
+        out.append(("offset differing between sweeps", d, 2.0))
+        h1 = harmonic_columns(data, 1)
+        out.append(("one-cycle error differing between sweeps",
+                    np.column_stack([d * h1[:, [0]], d * h1[:, [1]]]), 2.0))
+    if "time_s" in data and np.ptp(data["time_s"].to_numpy(float)) > 0:
+        t = data["time_s"].to_numpy(float)
+        out.append(("trend in time", (t - t.mean())[:, None], np.sqrt(3.0)))
+    return out
+
+
+def load_compass(path) -> pd.DataFrame:
+    return load_sweeps(path)
+
+
+# ----------------------------------------------------------------------------------------------- drift
 def drift_design(data: pd.DataFrame, effects, centres: dict | None = None) -> tuple[np.ndarray, dict]:
     """Design matrix of the linear drift model; ``centres`` holds the means the temperature terms are
     centred on (taken from ``data`` when not given)."""
@@ -135,46 +303,73 @@ def drift_design(data: pd.DataFrame, effects, centres: dict | None = None) -> tu
     return (np.column_stack(cols) if cols else np.zeros((len(data), 0))), centres
 
 
-def _fit_drift(data, effects):
+def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     y = data["drift_deg_h"].to_numpy(float)
-    X, centres = drift_design(data, effects)
-    if X.shape[1] >= len(y):
-        raise InputError(f"{len(y)} rows cannot determine {X.shape[1]} parameters of the model "
-                         f"{' + '.join(effects)}; at least {X.shape[1] + 1} rows are needed")
-    beta = np.linalg.lstsq(X, y, rcond=None)[0] if X.shape[1] else np.zeros(0)
-    names = [DRIFT_EFFECTS[e].params[0] for e in effects]
+    cat = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    X, centres = drift_design(data, cat)
+    names = [DRIFT_EFFECTS[e].params[0] for e in cat] + [p for e in users for p in e.params]
+    if len(names) >= len(y):
+        raise InputError(f"{len(y)} rows cannot determine {len(names)} parameters of the model "
+                         f"{' + '.join(e.name for e in effects)}; at least {len(names) + 1} rows are needed")
+    shape = (len(y),)
+    XU = np.column_stack([X, user_design(users, data, shape)])
+    beta = lstsq(XU, y)
+    jac = XU
+    if users:                                       # a user effect may be nonlinear: refine
+        nc = X.shape[1]
+
+        def resid(x):
+            return X @ x[:nc] + user_columns(users, dict(zip(names, x)), data, shape) - y
+
+        inf = np.full(len(names), np.inf)
+        sol = best_least_squares(resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf)
+        beta, jac = sol.x, np.asarray(sol.jac)
     params = dict(zip(names, map(float, beta)))
+    nc = X.shape[1]
 
     def predict(frame):
-        Xf, _ = drift_design(frame, effects, centres)
-        return Xf @ beta
+        Xf, _ = drift_design(frame, cat, centres)
+        return Xf @ beta[:nc] + user_columns(users, params, frame, (len(frame),))
 
-    return Fit("drift", effects, params, data, y - X @ beta, X, predict, centres)
-
-
-def compare(*fits: Fit) -> pd.DataFrame:
-    """Before/after table: one row per fit with RMS, residual range and held-out RMS."""
-    return pd.DataFrame([f.summary() for f in fits]).set_index("model")
+    return Fit(SYSTEMS_BASE["drift"], tuple(e.name for e in effects), params, data, y - predict(data), jac,
+               predict, centres)
 
 
-# ------------------------------------------------------------------------------------------- loading
-def load(system: str, path) -> pd.DataFrame:
-    """Load and validate a measurement file for ``system`` (see the CLI help for the columns)."""
-    _catalogue(system)
-    if system == "compass":
-        return load_sweeps(path)
+def drift_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
+    """Curvature in each drift covariate (a quadratic term no catalogued effect has)."""
+    out = []
+    for col in ("latitude_error_deg", "temperature_c", "temperature_change_c"):
+        if col in fit.data and np.ptp(fit.data[col].to_numpy(float)) > 0:
+            x = fit.data[col].to_numpy(float)
+            x = (x - x.mean()) / (np.std(x) or 1.0)
+            out.append((f"curvature in {col}", (x ** 2 - np.mean(x ** 2))[:, None], 1.0))
+    return out
+
+
+def load_drift(path) -> pd.DataFrame:
     return read_table(path, USER_COLUMNS, min_rows=2, kind="drift table")
+
+
+SYSTEMS_BASE = {
+    "compass": System("compass", "deg", COMPASS_EFFECTS, load_compass, _fit_compass, compass_structure,
+                      "level compass heading; residual = measured - model heading, wrapped, deg"),
+    "drift": System("drift", "deg/h", DRIFT_EFFECTS, load_drift, _fit_drift, drift_structure,
+                    "axial gyro drift of a rotating INS; residual = measured - model drift, deg/h"),
+}
+for _s in SYSTEMS_BASE.values():
+    register_system(_s)
 
 
 # ------------------------------------------------------------------------------------- simulated data
 def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 0.0, seed=0) -> pd.DataFrame:
     """Data from the catalogue model with the given parameters (effects absent = 0) plus white noise.
 
-    compass: two sweeps of 121 readings (0..360 every 3 deg) while the carrier warms from 15 to 35 degC;
-    ``noise`` is the heading noise in deg, added as field noise (so it is larger where the distorted
-    horizontal field is weaker, as on a real compass).  drift: ``n`` tests (default 16) with covariates
-    spread like paper C's tables (12 h latitude error within +-0.05 deg, mean temperature 10..65 degC,
-    temperature change 0..30 degC); ``noise`` in deg/h."""
+    compass: two sweeps of 121 readings (0..360 every 3 deg, one reading every 5 s) while the carrier warms
+    from 15 to 35 degC; ``noise`` is the heading noise in deg, added as field noise (so it is larger where
+    the distorted horizontal field is weaker, as on a real compass).  drift: ``n`` tests (default 16) with
+    covariates spread like paper C's tables (12 h latitude error within +-0.05 deg, mean temperature
+    10..65 degC, temperature change 0..30 degC); ``noise`` in deg/h."""
     rng = np.random.default_rng(seed)
     if system == "compass":
         true = np.tile(np.arange(0.0, 361.0, 3.0), 2)
@@ -184,8 +379,9 @@ def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 
         m = m + np.radians(noise) * rng.standard_normal(m.shape)
         meas = heading_deg(m[0], m[1])
         return pd.DataFrame({"true_heading_deg": true, "measured_heading_deg": meas, "temperature_c": temp,
-                             "sweep": np.repeat([1, 2], 121)})
-    _catalogue(system)
+                             "sweep": np.repeat([1, 2], 121), "time_s": 5.0 * np.arange(len(true))})
+    if system != "drift":
+        raise InputError(f"simulate: unknown system {system!r}; known: compass, drift")
     n = 16 if n is None else n
     frame = pd.DataFrame({"latitude_error_deg": rng.uniform(-0.05, 0.05, n),
                           "temperature_c": rng.uniform(10.0, 65.0, n),
@@ -198,7 +394,7 @@ def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 
 
 def effect_rms(system: str, data: pd.DataFrame, params: dict, effect: str) -> float:
     """RMS (in the system's unit) of what ``effect`` contributes to the noiseless model on ``data``."""
-    cat = _catalogue(system)
+    cat = get_system(system).catalogue
     without = {k: v for k, v in params.items() if k not in cat[effect].params}
     if system == "compass":
         temp = data["temperature_c"].to_numpy(float)
@@ -209,3 +405,8 @@ def effect_rms(system: str, data: pd.DataFrame, params: dict, effect: str) -> fl
         return float(np.sqrt(np.mean(wrap_deg(a - b) ** 2)))
     X, _ = drift_design(data, (effect,))
     return float(np.sqrt(np.mean((X[:, 0] * params.get(cat[effect].params[0], 0.0)) ** 2)))
+
+
+def load(system: str, path) -> pd.DataFrame:
+    """Load and validate a measurement file for ``system`` (its ``load``; see the CLI help for columns)."""
+    return get_system(system).load(path)

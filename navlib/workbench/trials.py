@@ -1,5 +1,7 @@
 """Does the loop name the right effect? Simulated data with a hidden effect, and the detection and
-false-alarm rates of :func:`navlib.workbench.diagnose.diagnose` over many trials."""
+false-alarm rates of :func:`navlib.workbench.diagnose.diagnose` over many trials; and data with an effect
+*outside* the catalogue (three- and four-cycle heading errors, a step between sweeps, a drift in time),
+where the right answer names no catalogued effect and says the residuals are not noise."""
 from __future__ import annotations
 
 import math
@@ -7,6 +9,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ..errors import InputError
 from .diagnose import diagnose
 from .effects import CATALOGUES
 from .fit import effect_rms, fit_model, simulate
@@ -97,18 +100,78 @@ def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=ra
     return pd.DataFrame(rows)
 
 
+#: Compass errors outside the catalogue: name -> shape (unit RMS before scaling) from (data, rng).
+OUT_OF_CATALOGUE = {
+    "three-cycle error": lambda d, rng: np.sin(3 * np.radians(d.true_heading_deg.to_numpy()) + rng.uniform(0, 2 * np.pi)),
+    "four-cycle error": lambda d, rng: np.sin(4 * np.radians(d.true_heading_deg.to_numpy()) + rng.uniform(0, 2 * np.pi)),
+    "step between sweeps": lambda d, rng: (d.sweep.to_numpy() == 2).astype(float) * rng.choice([-1.0, 1.0]),
+    "drift in time": lambda d, rng: d.time_s.to_numpy() / d.time_s.max() * rng.choice([-1.0, 1.0]),
+}
+
+
+def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int) -> dict:
+    """One trial: compass sweeps from a random subset of the catalogue plus an error of kind ``kind``
+    (:data:`OUT_OF_CATALOGUE`) whose RMS about its mean is ``ratio * noise``; the model is exactly the
+    catalogued effects present, plus misalignment (every model has a heading offset, which also takes the
+    added error's mean).  ``quiet`` = no catalogued effect named; ``detected`` = reported as not noise."""
+    if kind not in OUT_OF_CATALOGUE:
+        raise InputError(f"unknown out-of-catalogue error {kind!r}; known: {', '.join(OUT_OF_CATALOGUE)}")
+    cat = tuple(CATALOGUES["compass"])
+    rng = np.random.default_rng(seed)
+    k = int(rng.integers(1, len(cat)))
+    present = tuple(cat[i] for i in sorted(rng.choice(len(cat), size=k, replace=False)))
+    params = random_params("compass", rng, present)
+    data = simulate("compass", params, noise=noise, seed=rng)
+    shape = OUT_OF_CATALOGUE[kind](data, rng)
+    shape = shape - shape.mean()
+    extra = ratio * noise * shape / np.sqrt(np.mean(shape ** 2))
+    data["measured_heading_deg"] = np.mod(data["measured_heading_deg"] + extra, 360.0)
+    model = tuple(e for e in cat if e in present or e == "misalignment")
+    d = diagnose(fit_model("compass", data, model))
+    return {"kind": kind, "ratio": ratio, "noise": noise, "seed": seed, "model": " + ".join(model),
+            "named": d.missing or "(none)", "quiet": d.missing is None,
+            "detected": not d.consistent_with_noise}
+
+
+def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10)) -> pd.DataFrame:
+    """:func:`out_of_catalogue_trial` over every kind, size, noise level and seed (independent draws)."""
+    rows = []
+    for j, noise in enumerate(noises):
+        for i, kind in enumerate(OUT_OF_CATALOGUE):
+            for ratio in ratios:
+                for seed in seeds:
+                    rows.append(out_of_catalogue_trial(kind, ratio, noise, 1_000_000 * (i + 1) + 100_000 * j
+                                                       + 1000 * int(ratio) + seed))
+    return pd.DataFrame(rows)
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95 % Wilson score interval of a rate k/n."""
+    if n == 0:
+        return (np.nan, np.nan)
+    p = k / n
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (c - h, c + h)
+
+
+def out_of_catalogue_rates(study: pd.DataFrame) -> pd.DataFrame:
+    """Per kind: trials, the share where no catalogued effect was named (quiet), and the share reported as
+    not noise (detected), with 95 % Wilson intervals; the last row pools every kind."""
+    rows = []
+    for kind, g in list(study.groupby("kind", sort=False)) + [("all kinds", study)]:
+        q, det = int(g.quiet.sum()), int(g.detected.sum())
+        (ql, qh), (dl, dh) = wilson(q, len(g)), wilson(det, len(g))
+        rows.append({"error outside the catalogue": kind, "trials": len(g), "no catalogued effect named": q / len(g),
+                     "95% low": ql, "95% high": qh, "reported as not noise": det / len(g),
+                     "95% low ": dl, "95% high ": dh})
+    return pd.DataFrame(rows).set_index("error outside the catalogue")
+
+
 def detection_rates(study: pd.DataFrame) -> pd.DataFrame:
     """Per hidden effect: trials and the share named correctly; for data with nothing hidden: trials and the
     share of false alarms (anything reported other than "consistent with noise"), with a 95 % Wilson
     interval for every rate."""
-    def wilson(k, n, z=1.96):
-        if n == 0:
-            return (np.nan, np.nan)
-        p = k / n
-        c = (p + z * z / (2 * n)) / (1 + z * z / n)
-        h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-        return (c - h, c + h)
-
     rows = []
     for h, g in study[study.hidden != "(none)"].groupby("hidden", sort=False):
         k = int(g.correct.sum())

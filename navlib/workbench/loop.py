@@ -1,0 +1,176 @@
+"""The whole workbench loop as one function: diagnose, add the named effect, repeat until the residuals are
+consistent with noise or nothing more can be named.  The CLI command ``loop`` and the notebooks call
+:func:`loop`; :meth:`LoopResult.to_dict` is the ``--json`` schema and :func:`write_report` the
+``--report DIR`` output.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from ..angles import wrap_deg
+from ..errors import InputError, check_param
+from .diagnose import Diagnosis, diagnose
+from .effects import Effect
+from .fit import Fit, fit_model
+
+
+@dataclass
+class LoopResult:
+    """The loop's steps: ``fits[i]`` was diagnosed as ``diagnoses[i]``; the last one ends the loop."""
+
+    fits: list
+    diagnoses: list
+
+    @property
+    def final(self) -> Fit:
+        return self.fits[-1]
+
+    @property
+    def final_diagnosis(self) -> Diagnosis:
+        return self.diagnoses[-1]
+
+    @property
+    def unexplained(self) -> list[dict]:
+        """Significant structure left at the end that no effect explains."""
+        return [{"structure": s.what, "amplitude": float(s.amplitude), "p_value": float(s.p_value)}
+                for s in self.final_diagnosis.structure if s.significant]
+
+    @property
+    def consistent_with_noise(self) -> bool:
+        return bool(self.final_diagnosis.consistent_with_noise)
+
+    def steps_table(self) -> pd.DataFrame:
+        unit = self.final.unit
+        return pd.DataFrame([{"step": i, "model": " + ".join(f.effects) or "(none)", f"rms ({unit})": f.rms,
+                              f"held-out rms ({unit})": f.loo_rms, "named": d.missing or "-"}
+                             for i, (f, d) in enumerate(zip(self.fits, self.diagnoses))]).set_index("step")
+
+    def outcome(self) -> str:
+        if self.consistent_with_noise:
+            return "consistent with noise"
+        return "unexplained structure: " + "; ".join(u["structure"] for u in self.unexplained)
+
+    def to_dict(self) -> dict:
+        """The ``--json`` schema: ``{"steps": [{"model", "rms", "loo_rms", "missing"}], "final": {"model",
+        "rms", "loo_rms", "consistent_with_noise", "unexplained"}}`` (rms in the system's unit)."""
+        f = self.final
+        return {"system": f.system, "unit": f.unit,
+                "steps": [{"model": list(fi.effects), "rms": fi.rms, "loo_rms": fi.loo_rms, "missing": d.missing}
+                          for fi, d in zip(self.fits, self.diagnoses)],
+                "final": {"model": list(f.effects), "rms": f.rms, "loo_rms": f.loo_rms,
+                          "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
+                          "message": self.final_diagnosis.message}}
+
+
+def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effect, ...] = (),
+         alpha: float | None = None, max_steps: int = 8) -> LoopResult:
+    """Run the workbench loop on ``data``.
+
+    Starting from ``start_model`` (effect names), fit, :func:`~navlib.workbench.diagnose.diagnose`, add the
+    named effect, refit (from the previous parameters and the linearised start), and repeat until the
+    diagnosis names nothing (consistent with noise, or structure no effect explains) or ``max_steps``.
+
+    Parameters
+    ----------
+    system : str or System
+        ``"compass"``, ``"drift"``, ``"magnetometer"`` or any registered system.
+    data : DataFrame
+        A validated measurement frame (the system's ``load``).
+    start_model : sequence of str
+        Effects in the first model.
+    user_effects : tuple of Effect
+        Extra effects (:func:`~navlib.workbench.effects.load_effects`) the loop may add.
+    alpha : float
+        Family-wise false-alarm level of each diagnosis.
+    max_steps : int
+        At most this many effects are added.
+
+    Returns
+    -------
+    LoopResult
+    """
+    check_param("max_steps", max_steps, lo=0, integer=True)
+    fits = [fit_model(system, data, list(start_model), user_effects=tuple(user_effects))]
+    diagnoses = [diagnose(fits[0], alpha=alpha)]
+    while diagnoses[-1].missing is not None and len(fits) <= max_steps:
+        fits.append(fits[-1].add(diagnoses[-1].missing))
+        diagnoses.append(diagnose(fits[-1], alpha=alpha))
+    return LoopResult(fits, diagnoses)
+
+
+def loop_figure(result: LoopResult):
+    """Three panels: measurement against the start and final models, residuals at each step, the error
+    falling (rms and held-out rms per step)."""
+    fits, unit = result.fits, result.final.unit
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    ax = axes[0]
+    data = fits[0].data
+    if fits[0].system == "compass":
+        h = data["true_heading_deg"].to_numpy(float)
+        ax.plot(h, wrap_deg(data["measured_heading_deg"].to_numpy(float) - h), "k.", ms=3, label="measured")
+        for f, style in ((fits[0], "r."), (result.final, "b.")):
+            ax.plot(h, wrap_deg(f.predict(data) - h), style, ms=2,
+                    label=f"model: {' + '.join(f.effects) or '(none)'}")
+        ax.set(xlabel="true heading (deg)", ylabel="heading error (deg)")
+    else:
+        obs = fits[0].residuals + np.ravel(fits[0].predict(data))
+        for f, style in ((fits[0], "r."), (result.final, "b.")):
+            ax.plot(np.ravel(f.predict(data)), obs, style, ms=2, label=f"model: {' + '.join(f.effects) or '(none)'}")
+        lim = [float(np.min(obs)), float(np.max(obs))]
+        ax.plot(lim, lim, "k-", lw=0.8, label="measured = model")
+        ax.set(xlabel=f"model ({unit})", ylabel=f"measured ({unit})")
+    ax.set_title("measurement against model")
+    ax.legend(fontsize=9)
+    for f in fits:
+        axes[1].plot(f.residuals, ".", ms=2, label=f"{' + '.join(f.effects) or '(none)'}")
+    axes[1].set(xlabel="observation (file order)", ylabel=f"residual ({unit})", title="residuals at each step")
+    axes[1].legend(fontsize=9)
+    k = np.arange(len(fits))
+    axes[2].semilogy(k, [f.rms for f in fits], "ko-", label="rms")
+    axes[2].semilogy(k, [f.loo_rms for f in fits], "bs--", label="held-out rms")
+    axes[2].set_xticks(k, ["\n+ ".join(["start"] + list(f.effects[len(fits[0].effects):]))[:40] if i == 0 else
+                           "+ " + f.effects[-1] for i, f in enumerate(fits)], fontsize=9)
+    axes[2].set(ylabel=f"error ({unit})", title="the error falling")
+    axes[2].legend(fontsize=9)
+    for a in axes:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def check_report_folder(folder) -> tuple[Path, Path]:
+    """The report's two files in ``folder``; InputError if either exists (nothing is ever overwritten)."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder}: is a file, expected a folder for the report")
+    png, md = folder / "loop.png", folder / "loop.md"
+    for p in (png, md):
+        if p.exists():
+            raise InputError(f"{p}: already exists; not overwritten (choose another --report folder)")
+    return png, md
+
+
+def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Path]:
+    """Write ``loop.png`` (:func:`loop_figure`) and ``loop.md`` (steps and outcome) into ``folder``;
+    never over an existing file (InputError)."""
+    folder = Path(folder)
+    png, md = check_report_folder(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    fig = loop_figure(result)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    unit = result.final.unit
+    lines = [f"# Workbench loop: {result.final.system}" + (f" on `{source}`" if source else ""), "",
+             f"| step | model | rms ({unit}) | held-out rms ({unit}) | named |", "|---|---|---|---|---|"]
+    for i, (f, d) in enumerate(zip(result.fits, result.diagnoses)):
+        lines.append(f"| {i} | {' + '.join(f.effects) or '(none)'} | {f.rms:.4g} | {f.loo_rms:.4g} | "
+                     f"{d.missing or '-'} |")
+    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message, "",
+              f"![the loop]({png.name})", ""]
+    md.write_text("\n".join(lines))
+    return png, md

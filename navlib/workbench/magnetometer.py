@@ -1,0 +1,309 @@
+"""The ``magnetometer`` system: a 3-D magnetometer with a reference attitude.
+
+Measurement model (body frame FRD, navigation frame NED, field in uT)::
+
+    m_i = A C_n^b(t_i + dt) m_n + b + noise,    A = R(theta) (I + S)
+
+- ``m_n`` the local Earth field in NED, always estimated (its dip ``atan(m_d / |m_h|)`` and intensity
+  ``|m_n|`` are reported by :func:`field_summary`);
+- ``hard_iron`` = ``b`` (uT): a field fixed to the body (a magnet on the board, sensor offsets);
+- ``soft_iron`` = ``S``, symmetric and trace-free (5 parameters): induced magnetisation and scale mismatch
+  (the mean scale is not observable: it trades against ``|m_n|``);
+- ``misalignment`` = ``theta`` (deg, a rotation vector): the sensor's axes turned against the body frame of
+  the reference attitude;
+- ``time_lag`` = ``dt`` (s): the magnetometer and the reference clock disagree; to first order
+  ``C_n^b(t + dt) m_n = C_n^b m_n - dt omega x (C_n^b m_n)`` with the body rate ``omega`` (gyro columns).
+  This is what the residuals of the undisturbed BROAD trials called for: against angular rate they grow
+  linearly, against time and position they do not.
+
+The residual is ``m - model`` (3 values per row, uT).  Structure tests (shapes no body-fixed effect
+produces): a per-axis trend in time (a drifting offset), a per-axis linear dependence on position (a
+field that changes across the room, as near a stationary magnet), and a per-axis dependence on |omega|.
+
+Files: ``mag_x_ut, mag_y_ut, mag_z_ut`` and the reference attitude quaternion ``q_w, q_x, q_y, q_z``
+(scalar first, rotating body FRD into NED); optional ``time_s``, ``gyr_*_dps``, ``pos_*_m`` and others
+(``../shared/realdata/broad/3d``).  :func:`load_magnetometer` reports bad input in one line naming file,
+column and row.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+from ..angles import wrap_deg
+from ..data.tables import Column, read_table, where
+from ..errors import InputError
+from .effects import Effect, System, register_system
+from .fit import Fit, best_least_squares, lstsq, user_columns, user_design
+
+MAG = ("mag_x_ut", "mag_y_ut", "mag_z_ut")
+QUAT = ("q_w", "q_x", "q_y", "q_z")
+GYR = ("gyr_x_dps", "gyr_y_dps", "gyr_z_dps")
+POS = ("pos_n_m", "pos_e_m", "pos_d_m")
+FIELD = ("field_n_ut", "field_e_ut", "field_d_ut")
+QUAT_TOL = 0.01          # |q| must be within 1 +- this
+MIN_ORIENTATIONS = 12    # distinct 30-deg attitude cells needed to separate the effects
+MIN_TILT_DEG = 10.0      # the down axis must leave the body z axis by at least this much somewhere
+
+MAGNETOMETER_EFFECTS = {
+    "hard_iron": Effect(
+        "hard_iron", ("hard_x_ut", "hard_y_ut", "hard_z_ut"), ("uT", "uT", "uT"),
+        "A field fixed to the body (a magnet or magnetised steel on the board, sensor offsets) adds the same "
+        "vector in every attitude. Missing, the residual is a constant vector in the body frame."),
+    "soft_iron": Effect(
+        "soft_iron", ("soft_xx", "soft_yy", "soft_xy", "soft_xz", "soft_yz"), ("-",) * 5,
+        "Soft iron magnetised by the Earth field and per-axis scale mismatch scale the field differently "
+        "along different body axes (symmetric, trace-free). Missing, the residual is quadratic in the "
+        "attitude: the measured field traces an ellipsoid, not a sphere."),
+    "misalignment": Effect(
+        "misalignment", ("mis_x_deg", "mis_y_deg", "mis_z_deg"), ("deg", "deg", "deg"),
+        "The magnetometer's axes are turned against the body frame the reference attitude describes. "
+        "Missing, the residual is the field rotated by a small fixed angle: perpendicular to the field."),
+    "time_lag": Effect(
+        "time_lag", ("time_lag_s",), ("s",),
+        "The magnetometer and the attitude reference are sampled with a time offset. Missing, the residual "
+        "grows with the angular rate (omega x field).", GYR),
+}
+
+_PARAMS = [p for e in MAGNETOMETER_EFFECTS.values() for p in e.params]
+
+
+def quaternion_columns() -> list[Column]:
+    return ([Column(c, "uT") for c in MAG] + [Column(c, "", lo=-1.5, hi=1.5) for c in QUAT]
+            + [Column(c, "deg/s", required=False) for c in GYR] + [Column(c, "m", required=False) for c in POS]
+            + [Column("time_s", "s", required=False), Column("moving", "", required=False),
+               Column("magnet_attached", "", required=False), Column("att_blur", "", required=False)]
+            + [Column(c, "", required=False) for c in ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2", "ref_roll_deg",
+                                                        "ref_pitch_deg", "ref_heading_deg")])
+
+
+def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
+    """Load and validate a 3-D magnetometer file with reference attitude.
+
+    One-line errors naming file, column and row: missing field or attitude columns; empty cells, text or
+    NaN; a quaternion whose norm is farther than 0.01 from 1; fewer than ``min_rows`` rows; too few
+    distinct orientations (fewer than 12 attitude cells of 30 deg, or no tilt of 10 deg) to separate the
+    hard iron from the local field."""
+    frame = read_table(path, quaternion_columns(), min_rows=min_rows, kind="magnetometer file")
+    q = frame[list(QUAT)].to_numpy(float)
+    norm = np.linalg.norm(q, axis=1)
+    bad = np.flatnonzero(np.abs(norm - 1.0) > QUAT_TOL)
+    if bad.size:
+        r = int(bad[0])
+        raise InputError(f"{where(path, 'q_w..q_z', r)}: quaternion norm "
+                         f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})")
+    check_orientations(frame, Path(path).name)
+    return frame
+
+
+def body_from_nav(frame: pd.DataFrame) -> np.ndarray:
+    """``C_n^b`` for every row, shape (n, 3, 3), from the scalar-first quaternion rotating body into NED."""
+    q = frame[list(QUAT)].to_numpy(float)
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix().transpose(0, 2, 1)
+
+
+def check_orientations(frame: pd.DataFrame, name: str = "data") -> None:
+    """Enough distinct orientations to separate the effects (see :func:`load_magnetometer`)."""
+    C = body_from_nav(frame)
+    down = C[:, :, 2]                                  # NED down in body axes
+    north = C[:, :, 0]
+    cells = {tuple(v) for v in np.round(np.column_stack([down, north]) * 2).astype(int)}
+    tilt = np.degrees(np.arccos(np.clip(down[:, 2], -1, 1)))
+    if len(cells) < MIN_ORIENTATIONS or np.max(np.abs(tilt - np.median(tilt))) < MIN_TILT_DEG:
+        raise InputError(f"{name}: columns q_w..q_z, rows 1..{len(frame)}: only {len(cells)} distinct "
+                         f"orientations (30-deg cells) and a tilt range of {np.ptp(tilt):.1f} deg; at least "
+                         f"{MIN_ORIENTATIONS} and a tilt of {MIN_TILT_DEG:g} deg are needed to separate hard "
+                         f"iron from the local field")
+
+
+def _rotation(theta_deg) -> np.ndarray:
+    return Rotation.from_rotvec(np.radians(theta_deg)).as_matrix()
+
+
+def _matrix(p: dict) -> np.ndarray:
+    """A = R(theta) (I + S)."""
+    S = np.array([[p["soft_xx"], p["soft_xy"], p["soft_xz"]],
+                  [p["soft_xy"], p["soft_yy"], p["soft_yz"]],
+                  [p["soft_xz"], p["soft_yz"], -p["soft_xx"] - p["soft_yy"]]])
+    return _rotation([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]]) @ (np.eye(3) + S)
+
+
+def full_params(params: dict) -> dict:
+    p = {k: 0.0 for k in _PARAMS}
+    p.update(params)
+    return p
+
+
+def predict_field(params: dict, frame: pd.DataFrame, C: np.ndarray | None = None) -> np.ndarray:
+    """Model field (n, 3) in body axes for catalogued parameters ``params`` (absent = 0)."""
+    p = full_params(params)
+    C = body_from_nav(frame) if C is None else C
+    v = C @ np.array([p[k] for k in FIELD])
+    if p["time_lag_s"]:
+        w = np.radians(frame[list(GYR)].to_numpy(float))
+        v = v - p["time_lag_s"] * np.cross(w, v)
+    return v @ _matrix(p).T + np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
+
+
+def correct_field(params: dict, frame: pd.DataFrame) -> np.ndarray:
+    """Invert the body-fixed part: ``A^-1 (m - b)``, (n, 3) uT."""
+    p = full_params(params)
+    m = frame[list(MAG)].to_numpy(float) - np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
+    return m @ np.linalg.inv(_matrix(p)).T
+
+
+def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
+    cat = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    names = list(FIELD) + [p for e in cat for p in MAGNETOMETER_EFFECTS[e].params] + [p for e in users for p in e.params]
+    m = data[list(MAG)].to_numpy(float)
+    C = body_from_nav(data)
+    shape = m.shape
+    if m.size < len(names) + 1:
+        raise InputError(f"{len(m)} rows cannot determine {len(names)} model parameters")
+
+    def model(x):
+        p = dict(zip(names, x))
+        return predict_field(p, data, C).ravel() + user_columns(users, p, data, shape)
+
+    # start 2 (linearised): m = C m_n + b (+ linear user terms), all else zero -- linear least squares
+    lin = [C[:, :, j].reshape(-1) for j in range(3)]          # d m / d m_n
+    hard = "hard_iron" in cat
+    if hard:
+        lin += [np.tile(np.eye(3)[j], len(m)) for j in range(3)]
+    X = np.column_stack(lin + ([user_design(users, data, shape)] if users else []))
+    beta = lstsq(X, m.ravel())
+    x2 = np.zeros(len(names))
+    x2[:3] = beta[:3]
+    if hard:
+        x2[names.index("hard_x_ut"):names.index("hard_x_ut") + 3] = beta[3:6]
+    if users:
+        k = len([p for e in users for p in e.params])
+        x2[-k:] = beta[-k:]
+    # start 1: the previous model's parameters, new ones at zero (field from start 2 if new)
+    x1 = np.array([(start or {}).get(n, x2[i] if i < 3 else 0.0) for i, n in enumerate(names)])
+    inf = np.full(len(names), np.inf)
+    sol = best_least_squares(lambda x: model(x) - m.ravel(), [x1, x2], -inf, inf)
+    params = dict(zip(names, map(float, sol.x)))
+
+    def predict(frame):
+        return predict_field(params, frame) + user_columns(users, params, frame, (len(frame), 3)).reshape(-1, 3)
+
+    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, m.ravel() - model(sol.x),
+               np.asarray(sol.jac), predict)
+
+
+def _per_axis(x: np.ndarray) -> np.ndarray:
+    """A row covariate as three columns, one per axis of the flattened (n, 3) residual."""
+    n = len(x)
+    out = np.zeros((3 * n, 3))
+    for j in range(3):
+        out[j::3, j] = x
+    return out
+
+
+def _cells(x: np.ndarray, bins: int) -> np.ndarray:
+    """Quantile cell index (0..bins-1) of each value."""
+    edges = np.quantile(x, np.linspace(0, 1, bins + 1)[1:-1])
+    return np.searchsorted(edges, x, side="right")
+
+
+def _cell_offsets(cell: np.ndarray) -> np.ndarray:
+    """Per-axis offset of every cell but the first, centred: columns for a piecewise-constant field."""
+    ids = np.unique(cell)
+    cols = [_per_axis((cell == i).astype(float) - np.mean(cell == i)) for i in ids[1:]]
+    return np.column_stack(cols) if cols else np.zeros((3 * len(cell), 0))
+
+
+def magnetometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
+    """Shapes no body-fixed effect produces (module docstring): a field that changes in time (an offset
+    per 10 % of the recording and axis), with position (an offset per position cell -- 3 quantile cells
+    along each room axis -- and axis), and with the angular rate |omega| (per axis)."""
+    d = fit.data
+    out = []
+    if "time_s" in d and np.ptp(d["time_s"].to_numpy(float)) > 0:
+        out.append(("field changing in time (per axis)", _cell_offsets(_cells(d["time_s"].to_numpy(float), 10)),
+                    2.0))
+    if all(c in d for c in POS):
+        P = d[list(POS)].to_numpy(float)
+        cell = _cells(P[:, 0], 3) * 9 + _cells(P[:, 1], 3) * 3 + _cells(P[:, 2], 3)
+        out.append(("field changing with position (per axis)", _cell_offsets(cell), 2.0))
+    if all(c in d for c in GYR):
+        w = np.linalg.norm(d[list(GYR)].to_numpy(float), axis=1)
+        out.append(("dependence on angular rate |omega| (per axis)", _per_axis(w - w.mean()), np.sqrt(3.0)))
+    return out
+
+
+def apply_calibration(fit: Fit, frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with its field corrected by the body-fixed part of a fitted model, ``A^-1 (m - b)``: the
+    data as a calibrated sensor would see them (a new disturbance then shows as a missing effect)."""
+    out = frame.copy()
+    out[list(MAG)] = correct_field(fit.params, frame)
+    return out
+
+
+def field_summary(fit: Fit) -> dict:
+    """The estimated local field: north, east, down (uT), horizontal, intensity (uT), dip (deg)."""
+    n, e, dn = (fit.params[k] for k in FIELD)
+    h = float(np.hypot(n, e))
+    return {"north (uT)": n, "east (uT)": e, "down (uT)": dn, "horizontal (uT)": h,
+            "intensity (uT)": float(np.sqrt(h * h + dn * dn)), "dip (deg)": float(np.degrees(np.arctan2(dn, h)))}
+
+
+def heading_error_deg(body_field: np.ndarray, frame: pd.DataFrame, north_deg: float | None = None) -> np.ndarray:
+    """Heading error (deg) of a calibrated body-frame field, levelled with the reference attitude: the
+    field's declination in NED minus ``north_deg`` (default: its circular mean), with the sign of a heading
+    error (a field seen turned anticlockwise reads as a heading too high)."""
+    f = np.einsum("nji,nj->ni", body_from_nav(frame), body_field)      # C_b^n m = (C_n^b)^T m
+    dec = np.degrees(np.arctan2(f[:, 1], f[:, 0]))
+    if north_deg is None:
+        north_deg = float(np.degrees(np.angle(np.mean(np.exp(1j * np.radians(dec))))))
+    return -wrap_deg(dec - north_deg)
+
+
+def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """The calibration users pick without a reference attitude: a least-squares ellipsoid through the
+    measured field, ``(m - c)^T M (m - c) = 1``, fitted algebraically (linear least squares on the quadric
+    ``a x^2 + b y^2 + c z^2 + 2d xy + 2e xz + 2f yz + 2g x + 2h y + 2i z = 1``); the calibration is
+    ``m_cal = W (m - c)`` with ``W = r M^(1/2)`` (symmetric) and ``r`` the mean field radius.
+
+    Returns
+    -------
+    (W, c) : the 3x3 matrix and the centre (uT)."""
+    m = frame[list(MAG)].to_numpy(float)
+    x, y, z = m.T
+    D = np.column_stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z, 2 * x, 2 * y, 2 * z])
+    v = np.linalg.lstsq(D, np.ones(len(m)), rcond=None)[0]
+    M = np.array([[v[0], v[3], v[4]], [v[3], v[1], v[5]], [v[4], v[5], v[2]]])
+    c = -np.linalg.solve(M, v[6:9])
+    M = M / (1.0 + c @ M @ c)
+    w, U = np.linalg.eigh(M)
+    if np.any(w <= 0):
+        raise InputError("the ellipsoid fit is not an ellipsoid (too few orientations)")
+    radius = float(np.mean(np.linalg.norm(m - c, axis=1)))
+    return radius * (U @ np.diag(np.sqrt(w)) @ U.T), c
+
+
+SYSTEM = register_system(System(
+    "magnetometer", "uT", MAGNETOMETER_EFFECTS, load_magnetometer, _fit_magnetometer, magnetometer_structure,
+    "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT"))
+
+
+def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, seed=0) -> pd.DataFrame:
+    """3-D samples from the model (eq. in the module docstring) at ``n`` random attitudes (uniform over
+    rotations), a body rate of up to 60 deg/s per axis, 0.1 s apart; ``params`` as in the catalogue plus
+    the local field ``field_*_ut`` (default: BROAD's room, (15.2, -0.3, 40.8) uT); white noise ``noise_ut``."""
+    rng = np.random.default_rng(seed)
+    p = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8, **params}
+    rot = Rotation.random(n, random_state=rng)               # body -> NED
+    q = rot.as_quat()[:, [3, 0, 1, 2]]
+    frame = pd.DataFrame(q, columns=list(QUAT))
+    frame[list(GYR)] = rng.uniform(-60, 60, (n, 3))
+    frame["time_s"] = 0.1 * np.arange(n)
+    m = predict_field(p, frame) + noise_ut * rng.standard_normal((n, 3))
+    frame[list(MAG)] = m
+    return frame
