@@ -16,6 +16,7 @@ SYSTEM is compass, drift or magnetometer:
   drift columns: latitude_error_deg, drift_deg_h; optional temperature_c, temperature_change_c.
   magnetometer columns: mag_x_ut, mag_y_ut, mag_z_ut, q_w, q_x, q_y, q_z (reference attitude, body FRD to
   NED); optional time_s, gyr_*_dps, pos_*_m.  Extra columns are ignored.
+
 --effects FILE.py adds your own effects (every navlib.workbench.effects.Effect defined in the file whose
 system matches), usable in --model and named by diagnose like catalogued ones.
 
