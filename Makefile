@@ -10,6 +10,9 @@ GENERATED := book/_generated
 NOTEBOOKS := $(sort $(wildcard notebooks/*.ipynb))
 export PYTHONHASHSEED := 0
 export PYDEVD_DISABLE_FILE_VALIDATION := 1
+# One BLAS thread per process: on 2 shared cores threaded LAPACK stalls (50-400 ms on small solves) and
+# single-threaded reductions keep stored notebook numbers identical from run to run.
+export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: help venv book screenshots test test-lib test-notebooks test-results notebooks bench lock clean
 

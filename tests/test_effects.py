@@ -13,19 +13,33 @@ from navlib.paths import DATA_DIR
 
 
 @pytest.mark.parametrize("system", ["compass", "drift"])
-def test_catalogue_entries_are_complete(system):
+def test_each_effect_alone_is_recovered_by_its_own_parameters(system):
+    """Every catalogued effect's declared parameters are the ones its model uses: data made with that effect
+    alone are fitted exactly by it, and the table lists each parameter with its unit."""
     table = catalogue_table(system)
-    assert len(table) == len(CATALOGUES[system]) >= 4
-    for e in CATALOGUES[system].values():
-        assert len(e.params) == len(e.units) >= 1
-        assert len(e.meaning) > 60 and "residual" in e.meaning.lower()
+    for name, effect in CATALOGUES[system].items():
+        p = random_params(system, np.random.default_rng(1), [name])
+        assert set(p) == set(effect.params)
+        data = simulate(system, p, n=30, noise=0.0, seed=2)
+        fit = fit_model(system, data, [name])
+        assert fit.rms < 1e-6, name
+        for k in effect.params:
+            assert fit.params[k] == pytest.approx(p[k], rel=1e-4, abs=1e-9)
+            assert f"{k} [" in table.loc[name, "parameters"]
 
 
-def test_minimum_catalogue():
-    assert {"misalignment", "hard_iron", "soft_iron", "temperature"} <= set(CATALOGUES["compass"])
-    assert {"earth_rate", "bias", "temperature", "temperature_change"} <= set(CATALOGUES["drift"])
-    assert CATALOGUES["compass"]["temperature"].columns == ("temperature_c",)
-    assert CATALOGUES["drift"]["temperature_change"].columns == ("temperature_change_c",)
+def test_needed_columns_are_enforced():
+    """An effect that needs a column is untestable without it and cannot be put in a model."""
+    from navlib.workbench.effects import testable
+    data = simulate("compass", {"yaw_deg": 1.0}, noise=0.1).drop(columns=["temperature_c"])
+    ok, why = testable(CATALOGUES["compass"], data)
+    assert "temperature" not in ok and why["temperature"] == "no column 'temperature_c'"
+    with pytest.raises(InputError, match="needs the column 'temperature_c'"):
+        fit_model("compass", data, ["temperature"])
+    d = simulate("drift", {}, n=10)
+    d["temperature_change_c"] = 5.0
+    with pytest.raises(InputError, match="'temperature_change_c' to vary"):
+        fit_model("drift", d, ["temperature_change"])
 
 
 @pytest.mark.parametrize("system", ["compass", "drift"])

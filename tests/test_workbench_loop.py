@@ -180,3 +180,26 @@ def test_real_level_files_end_honestly():
         assert res.consistent_with_noise or res.unexplained, name
         assert max([u["amplitude"] for u in res.unexplained] + [0]) <= 3 * res.final.rms, name
         assert res.final.rms < 0.8 * res.fits[0].rms, name
+
+
+def test_a_user_effect_works_for_the_drift_system_too():
+    data = simulate("drift", {"earth_rate_gain": 1.0}, n=30, noise=1e-4, seed=1)
+    x = data.latitude_error_deg.to_numpy()
+    data["drift_deg_h"] += 2.0 * (x ** 2 - np.mean(x ** 2))
+    curv = Effect("curvature", ("c_deg_h_per_deg2",), ("deg/h/deg^2",), "quadratic in the latitude error",
+                  system="drift",
+                  contribution=lambda p, d: p["c_deg_h_per_deg2"] * (d.latitude_error_deg.to_numpy() ** 2
+                                                                     - np.mean(d.latitude_error_deg.to_numpy() ** 2)))
+    res = loop("drift", data, ["earth_rate"], user_effects=(curv,))
+    assert "curvature" in res.final.effects and res.consistent_with_noise
+    assert res.final.params["c_deg_h_per_deg2"] == pytest.approx(2.0, rel=0.1)
+
+
+def test_claims_without_real_data_say_so():
+    from navlib.workbench.trials import detection_rates, hidden_effect_study, out_of_catalogue_rates
+    st = hidden_effect_study("drift", ratios=(10.0,), noises=(1e-4,), seeds=range(2), n=16, none_seeds=range(4))
+    rates = detection_rates(st).reset_index()
+    ooc = out_of_catalogue_rates(pd.concat([pd.DataFrame([{"kind": "k", "quiet": True, "detected": True}])]))
+    claims = wb.glance_claims(rates, ooc, None, None)
+    assert claims[-1].reproduced is None and "absent" in claims[-1].ours
+    assert [c.reproduced for c in claims[:3]] == [True, True, True]

@@ -164,7 +164,8 @@ def magnet_study(row_step: int = 3, alpha: float | None = None) -> MagnetStudy |
     with that calibration, and run the loop again from the field alone: on the attached-magnet trials the
     loop should name ``hard_iron`` first; on the stationary-magnet trials the field changes with position,
     which no body-fixed effect explains.  Beside it, the least-squares ellipsoid fit (no reference
-    attitude) on the same data, and both heading errors.  None if the data are absent."""
+    attitude) on the same data, and both heading errors.  ``row_step`` thins the calibration and
+    attached-magnet trials (every n-th block, for speed).  None if the data are absent."""
     if not MAG_DIR.is_dir():
         return None
     cal_data = load_trial(CALIBRATION_TRIAL, row_step)
@@ -173,7 +174,8 @@ def magnet_study(row_step: int = 3, alpha: float | None = None) -> MagnetStudy |
     rows, loops, heads = [], {}, []
     heads.append(_headings("05 undisturbed", cal_data, cal.final.params, cal.final))
     for name in list(ATTACHED) + list(STATIONARY):
-        raw = load_trial(name, row_step, attached_only=name in ATTACHED)
+        # the stationary-magnet trials keep few moving blocks: all of them are used
+        raw = load_trial(name, row_step if name in ATTACHED else 1, attached_only=name in ATTACHED)
         data = apply_calibration(cal.final, raw)
         res = loop("magnetometer", data, [], alpha=alpha)
         loops[name] = res

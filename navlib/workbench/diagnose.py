@@ -46,7 +46,7 @@ from scipy import stats
 from ..errors import check_param
 from ..errors import InputError
 from .effects import testable
-from .fit import Fit, drift_design, lstsq, orth_basis
+from .fit import Fit, drift_design, orth_basis
 
 SMALL_SAMPLE = 12
 # Family-wise false-alarm level. Bonferroni keeps the false-alarm rate at or below alpha; the users' target
@@ -200,18 +200,19 @@ def _structure(fit: Fit) -> list[Finding]:
         X = np.asarray(X, float)
         X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
         Xp = X - Q @ (Q.T @ X)
-        # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns)
+        # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns;
+        # the Gram matrix is small: a structure shape has at most a few tens of columns)
         w, V = np.linalg.eigh(Xp.T @ Xp)
         keep = w > SPANNED ** 2
         q = int(np.sum(keep))
+        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
         df2 = len(r) - Q.shape[1] - q
         if q == 0 or df2 < 3:
             continue                                   # the model already spans this shape, or too few rows
-        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
         drop = float(np.sum((u.T @ r) ** 2))
         p, logp = _f_test(float(np.sum(r ** 2)), float(np.sum(r ** 2)) - drop, q, df2)
-        beta = lstsq(X, r)                              # amplitude: on the residual itself
-        amp = scale * float(np.sqrt(np.mean((X @ beta) ** 2)))
+        qx = orth_basis(X)                              # amplitude: the shape fitted to the residual itself
+        amp = scale * float(np.sqrt(np.mean((qx @ (qx.T @ r)) ** 2)))
         out.append(Finding(what, amp, p, log_p=logp))
     return out
 

@@ -107,7 +107,7 @@ def loop_figure(result: LoopResult):
     """Three panels: measurement against the start and final models, residuals at each step, the error
     falling (rms and held-out rms per step)."""
     fits, unit = result.fits, result.final.unit
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
     ax = axes[0]
     data = fits[0].data
     if fits[0].system == "compass":
@@ -126,8 +126,8 @@ def loop_figure(result: LoopResult):
         ax.set(xlabel=f"model ({unit})", ylabel=f"measured ({unit})")
     ax.set_title("measurement against model")
     ax.legend(fontsize=9)
-    for f in fits:
-        axes[1].plot(f.residuals, ".", ms=2, label=f"{' + '.join(f.effects) or '(none)'}")
+    for i, f in enumerate(fits):
+        axes[1].plot(f.residuals, ".", ms=2, label=f"step {i}")
     axes[1].set(xlabel="observation (file order)", ylabel=f"residual ({unit})", title="residuals at each step")
     axes[1].legend(fontsize=9)
     k = np.arange(len(fits))

@@ -187,7 +187,12 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
     # start 1: the previous model's parameters, new ones at zero (field from start 2 if new)
     x1 = np.array([(start or {}).get(n, x2[i] if i < 3 else 0.0) for i, n in enumerate(names)])
     inf = np.full(len(names), np.inf)
-    sol = best_least_squares(lambda x: model(x) - m.ravel(), [x1, x2], -inf, inf)
+    w = np.radians(data[list(GYR)].to_numpy(float)) if "time_lag" in cat else None
+
+    def jacobian(x):
+        return _jacobian(dict(zip(names, x)), names, C, w, users, data)
+
+    sol = best_least_squares(lambda x: model(x) - m.ravel(), [x1, x2], -inf, inf, jac=jacobian)
     params = dict(zip(names, map(float, sol.x)))
 
     def predict(frame):
@@ -195,6 +200,55 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
 
     return Fit(SYSTEM, tuple(e.name for e in effects), params, data, m.ravel() - model(sol.x),
                np.asarray(sol.jac), predict)
+
+
+_SOFT_BASIS = {"soft_xx": np.diag([1.0, 0.0, -1.0]), "soft_yy": np.diag([0.0, 1.0, -1.0]),
+               "soft_xy": np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 0]]),
+               "soft_xz": np.array([[0, 0, 1.0], [0, 0, 0], [1.0, 0, 0]]),
+               "soft_yz": np.array([[0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])}
+
+
+def _jacobian(params: dict, names, C, w, users, data) -> np.ndarray:
+    """d(model)/d(parameters) of :func:`predict_field` (analytic; the rotation's derivative by central
+    differences of the 3x3 matrix; user effects by central differences)."""
+    p = full_params(params)
+    theta = np.array([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])
+    R = _rotation(theta)
+    W = _matrix({**p, "mis_x_deg": 0.0, "mis_y_deg": 0.0, "mis_z_deg": 0.0})
+    A = R @ W
+    dt = p["time_lag_s"]
+
+    def lag(u):
+        return u - dt * np.cross(w, u) if (dt and w is not None) else u
+
+    v = C @ np.array([p[k] for k in FIELD])
+    vl = lag(v)
+    cols = {}
+    for k, name in enumerate(FIELD):
+        cols[name] = lag(C[:, :, k]) @ A.T
+    for j, name in enumerate(("hard_x_ut", "hard_y_ut", "hard_z_ut")):
+        e = np.zeros((len(v), 3))
+        e[:, j] = 1.0
+        cols[name] = e
+    for name, D in _SOFT_BASIS.items():
+        cols[name] = vl @ (R @ D).T
+    h = 1e-4
+    for k, name in enumerate(("mis_x_deg", "mis_y_deg", "mis_z_deg")):
+        step = np.zeros(3)
+        step[k] = h
+        dR = (_rotation(theta + step) - _rotation(theta - step)) / (2 * h)
+        cols[name] = vl @ (dR @ W).T
+    if w is not None:
+        cols["time_lag_s"] = -np.cross(w, v) @ A.T
+    for e in users:
+        for name in e.params:
+            q = dict(params)
+            d = 1e-6 * (1.0 + abs(q[name]))
+            q[name] = params[name] + d
+            up = user_columns([e], q, data, v.shape)
+            q[name] = params[name] - d
+            cols[name] = ((up - user_columns([e], q, data, v.shape)) / (2 * d)).reshape(-1, 3)
+    return np.column_stack([cols[n].reshape(-1) for n in names])
 
 
 def _per_axis(x: np.ndarray) -> np.ndarray:
@@ -221,8 +275,8 @@ def _cell_offsets(cell: np.ndarray) -> np.ndarray:
 
 def magnetometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     """Shapes no body-fixed effect produces (module docstring): a field that changes in time (an offset
-    per 10 % of the recording and axis), with position (an offset per position cell -- 3 quantile cells
-    along each room axis -- and axis), and with the angular rate ``|omega|`` (per axis)."""
+    per 10 % of the recording and axis), with position (an offset per position cell -- the room split at
+    the median along each axis, 8 cells -- and axis), and with the angular rate ``|omega|`` (per axis)."""
     d = fit.data
     out = []
     if "time_s" in d and np.ptp(d["time_s"].to_numpy(float)) > 0:
@@ -230,7 +284,7 @@ def magnetometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
                     2.0))
     if all(c in d for c in POS):
         P = d[list(POS)].to_numpy(float)
-        cell = _cells(P[:, 0], 3) * 9 + _cells(P[:, 1], 3) * 3 + _cells(P[:, 2], 3)
+        cell = _cells(P[:, 0], 2) * 4 + _cells(P[:, 1], 2) * 2 + _cells(P[:, 2], 2)
         out.append(("field changing with position (per axis)", _cell_offsets(cell), 2.0))
     if all(c in d for c in GYR):
         w = np.linalg.norm(d[list(GYR)].to_numpy(float), axis=1)
