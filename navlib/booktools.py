@@ -344,18 +344,19 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path]) -> str:
     if len(summary):
         lines += ["| chapter | reading of the paper | reproduced | not reproduced | cannot be judged |",
                   "|---|---|---|---|---|"]
-        last = None
-        for row in summary.to_dict("records"):
-            chap = row["chapter"]
-            if chap != last:
-                doc = chapter_doc.get(chap)
-                name = _md_cell(titles.get(chap, chap))
-                label = f"{{doc}}`{name} <{doc}>`" if doc else name
-            else:
+        for chap, rows in summary.groupby("chapter", sort=False):
+            doc = chapter_doc.get(chap)
+            name = _md_cell(titles.get(chap, chap))
+            label = f"{{doc}}`{name} <{doc}>`" if doc else name
+            if len(rows) > 1:                   # the chapter's total first, then one row per reading
+                lines.append(f"| {label} | **all readings** | **{rows['reproduced'].sum()} of "
+                             f"{rows['claims'].sum()}** | {rows['not reproduced'].sum()} | "
+                             f"{rows['cannot be judged'].sum()} |")
                 label = ""
-            last = chap
-            lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of {row['claims']} | "
-                         f"{row['not reproduced']} | {row['cannot be judged']} |")
+            for row in rows.to_dict("records"):
+                lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of "
+                             f"{row['claims']} | {row['not reproduced']} | {row['cannot be judged']} |")
+                label = ""
         lines.append("")
         lines.append("Counts are computed by each chapter's code from its claims (the table "
                      "*Results at a glance* at the top of the chapter) when the book is built.")
