@@ -11,11 +11,13 @@ Commands:
       or nothing more can be named.  --json prints {"steps": [...], "final": {...}}; --report DIR writes
       loop.png and loop.md (never over existing files).
 
-SYSTEM is compass, drift or magnetometer:
+SYSTEM is compass, drift, magnetometer or accelerometer:
   compass columns: true_heading_deg, measured_heading_deg; optional temperature_c, time_s, sweep.
   drift columns: latitude_error_deg, drift_deg_h; optional temperature_c, temperature_change_c.
   magnetometer columns: mag_x_ut, mag_y_ut, mag_z_ut, q_w, q_x, q_y, q_z (reference attitude, body FRD to
-  NED); optional time_s, gyr_*_dps, pos_*_m.  Extra columns are ignored.
+  NED); optional time_s, gyr_*_dps, pos_*_m.
+  accelerometer columns (one unit's tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
+  output_mg (output / nominal scale factor), unit; optional set_point_c.  Extra columns are ignored.
 
 --effects FILE.py adds your own effects (every navlib.workbench.effects.Effect defined in the file whose
 system matches), usable in --model and named by diagnose like catalogued ones.

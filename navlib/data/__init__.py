@@ -4,5 +4,5 @@
   (:func:`.tables.write_new_csv`, never over an existing file);
 - :mod:`navlib.data.compass_sweeps` -- turntable sweeps (papers A and B, the workbench's compass files);
 - :mod:`navlib.data.gyro_tables` -- paper C's measured Tables 2-5 and user drift files;
-- ``navlib.data.paper_results`` -- the numbers the papers print (transcribed facts in ``data/``).
+- :mod:`navlib.data.tumble` -- accelerometer tumble files (paper D).
 """

@@ -6,5 +6,11 @@
 - :mod:`navlib.methods.elm` -- extreme learning machine and the patent's incremental back-tuned ELM (B);
 - :mod:`navlib.methods.preprocess` -- the patent's median filter and field-gravity screen (B);
 - :mod:`navlib.methods.rbf` -- MATLAB-compatible ``newrb``/``newrbe`` RBF networks (C);
-- :mod:`navlib.methods.scaling` -- explicit min-max scaling.
+- :mod:`navlib.methods.scaling` -- explicit min-max scaling;
+- :mod:`navlib.methods.kalman` -- the INS/star-sensor Kalman filter, QR gain features, innovation GLR test (E);
+- :mod:`navlib.methods.subclust` -- MATLAB ``subclust``/``genfis2`` and first-order Sugeno inference (D);
+- :mod:`navlib.methods.anfis` -- ANFIS with Jang's hybrid learning as MATLAB ``anfis`` (D);
+- :mod:`navlib.methods.fish_swarm` -- artificial fish swarm and its improved variant, batched (D);
+- :mod:`navlib.methods.mlp` -- a generic n_in-n_hidden-n_out tansig/logsig-purelin network in torch, trained
+  full-batch, with its time per pass (D, E).
 """

@@ -23,5 +23,6 @@ from the previous parameters and a linearised start; add user effects with
 and import the module below.  ``fit_model``, ``Fit.add``, ``diagnose``, ``loop`` and the CLI
 (``python -m navlib loop accelerometer FILE``) then work unchanged.
 """
-from . import fit, magnetometer  # noqa: F401  (importing registers the compass, drift and magnetometer systems)
+from . import accelerometer, fit, magnetometer  # noqa: F401  (importing registers the compass, drift, magnetometer
+#                                                and accelerometer systems)
 from .effects import SYSTEMS, Effect, System, get_system, load_effects, register_system  # noqa: F401

@@ -1,0 +1,306 @@
+"""Kalman filtering of the INS/star-sensor system (paper E eq. 1-7), its gain features for the BP network
+(section 2.1), and the innovation test that names a missing error state.
+
+- :func:`star_measurement` -- paper E eq. 5-6: the platform misalignment ``Z = -M (att_INS - att_star)``
+  with ``M`` of :func:`navlib.sensors.trajectory.euler_rate_matrix` (attitude order pitch, roll, yaw);
+- :func:`kalman_filter` -- the standard discrete KF (eq. 7), batched over runs in numpy, covariance
+  update in Joseph form (as filterpy 2.0.0's ``KalmanFilter.update``; tested against it to 1e-12);
+- :func:`run_filter` -- the open-loop 15-state filter (or 18-state with gyro scale factors) on an
+  :class:`navlib.sensors.strapdown.InsRun`, returning the corrected attitude's Euler errors;
+- :func:`qr_features` / :func:`gain_features` -- the 6 non-zero entries of ``R`` in ``K = Q R`` (diagonal
+  made non-negative), the 45 raw entries, and the 6 + 3 angular-rate variant;
+- :func:`innovation_glr` -- a generalised-likelihood-ratio test (Willsky and Jones 1976) of the filter's
+  innovations against the signature of each candidate unmodelled effect.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ..angles import ARCSEC, DEG
+from ..errors import InputError, check_param
+from ..sensors.ins15 import N_BASE, discretise, process_noise, system_matrix
+from ..sensors.strapdown import InsRun, misalignment, rotvec_to_dcm
+from ..sensors.trajectory import dcm_to_euler, euler_rate_matrix
+
+UG = 9.80665e-6
+
+
+def wrap_rad(a):
+    """Wrap angles (rad) to [-pi, pi)."""
+    return np.mod(np.asarray(a, float) + np.pi, 2 * np.pi) - np.pi
+
+
+def star_measurement(att_ins, att_star):
+    """Paper E's measurement: ``Z = phi = -M(att_INS) (att_INS - att_star)`` (rad), attitudes ordered
+    (pitch, roll, yaw), yaw difference wrapped.  First-order equal to the direction-cosine route
+    :func:`navlib.sensors.strapdown.misalignment` (tested below 1e-3 arcsec for 10-arcsec errors)."""
+    d = np.asarray(att_ins, float) - np.asarray(att_star, float)
+    d[..., 2] = wrap_rad(d[..., 2])
+    return -np.einsum("...ij,...j->...i", euler_rate_matrix(att_ins), d)
+
+
+@dataclass(frozen=True)
+class FilterSpec:
+    """Initial 1-sigma uncertainties of the filter (they also set ``P_0``) and whether to carry the three
+    gyro scale-factor states (the augmented filter)."""
+
+    phi_level_arcsec: float = 20.0
+    phi_azimuth_arcsec: float = 60.0
+    vel_m_s: float = 0.1
+    pos_m: float = 10.0
+    drift_deg_h: float = 0.02
+    bias_ug: float = 100.0
+    scale_ppm: float = 300.0
+    scale_states: bool = False
+
+    def __post_init__(self):
+        for f in ("phi_level_arcsec", "phi_azimuth_arcsec", "vel_m_s", "pos_m", "drift_deg_h", "bias_ug",
+                  "scale_ppm"):
+            check_param(f, getattr(self, f), lo=0.0, lo_open=True)
+
+    @property
+    def n_states(self) -> int:
+        return N_BASE + (3 if self.scale_states else 0)
+
+    def p0(self, lat_rad: float) -> np.ndarray:
+        r = 6.371e6
+        sd = [self.phi_level_arcsec * ARCSEC] * 2 + [self.phi_azimuth_arcsec * ARCSEC] + [self.vel_m_s] * 3
+        sd += [self.pos_m / r, self.pos_m / (r * np.cos(lat_rad)), self.pos_m]
+        sd += [self.drift_deg_h * DEG / 3600] * 3 + [self.bias_ug * UG] * 3
+        if self.scale_states:
+            sd += [self.scale_ppm * 1e-6] * 3
+        return np.diag(np.square(sd))
+
+
+def kalman_filter(phi, q, h, z, r, x0, p0):
+    """Discrete Kalman filter (paper E eq. 7), batched over runs, predict then update at each epoch::
+
+        x- = Phi x,  P- = Phi P Phi^T + Q,  S = H P- H^T + R,  K = P- H^T S^-1,
+        x = x- + K (z - H x-),  P = (I - K H) P- (I - K H)^T + K R K^T   (Joseph form).
+
+    Parameters
+    ----------
+    phi : (n_runs, n_steps, d, d) transition matrices
+    q : (d, d) or (n_runs, n_steps, d, d) process noise
+    h : (m, d) measurement matrix
+    z : (n_runs, n_steps, m) measurements
+    r : (n_runs, n_steps, m, m) measurement noise
+    x0, p0 : (d,), (d, d) initial state and covariance (same for every run)
+
+    Returns
+    -------
+    dict of arrays (n_runs, n_steps, ...): ``x`` posterior, ``P`` posterior, ``K`` gain (d, m),
+    ``x_prior``, ``innov`` (z - H x-), ``S`` innovation covariance.
+    """
+    phi, z, r = np.asarray(phi, float), np.asarray(z, float), np.asarray(r, float)
+    n, steps, d = phi.shape[0], phi.shape[1], phi.shape[-1]
+    m = h.shape[0]
+    q = np.asarray(q, float)
+    x = np.broadcast_to(np.asarray(x0, float), (n, d)).copy()
+    p = np.broadcast_to(np.asarray(p0, float), (n, d, d)).copy()
+    out = {"x": np.empty((n, steps, d)), "P": np.empty((n, steps, d, d)), "K": np.empty((n, steps, d, m)),
+           "x_prior": np.empty((n, steps, d)), "innov": np.empty((n, steps, m)), "S": np.empty((n, steps, m, m))}
+    eye = np.eye(d)
+    ht = h.T
+    for k in range(steps):
+        f = phi[:, k]
+        qk = q if q.ndim == 2 else q[:, k]
+        x = np.einsum("rij,rj->ri", f, x)
+        p = f @ p @ np.swapaxes(f, 1, 2) + qk
+        s = h @ p @ ht + r[:, k]
+        kg = np.swapaxes(np.linalg.solve(s, (p @ ht).swapaxes(1, 2)), 1, 2)
+        nu = z[:, k] - x @ ht
+        out["x_prior"][:, k] = x
+        x = x + np.einsum("rij,rj->ri", kg, nu)
+        ikh = eye - kg @ h
+        p = ikh @ p @ np.swapaxes(ikh, 1, 2) + kg @ r[:, k] @ np.swapaxes(kg, 1, 2)
+        out["x"][:, k], out["P"][:, k], out["K"][:, k] = x, p, kg
+        out["innov"][:, k], out["S"][:, k] = nu, s
+    return out
+
+
+@dataclass(frozen=True)
+class FilterResult:
+    """Output of :func:`run_filter` over epochs 1..N (epoch 0 is the initial state).
+
+    ``att_err_arcsec``: Euler-angle errors (pitch, roll, yaw) of the filter-corrected attitude,
+    ``ins_err_arcsec`` those of the uncorrected INS; ``phi_err`` the misalignment estimation error
+    ``phi_true - phi_hat`` (rad); the raw filter output in ``kf``; ``phi`` the transition matrices."""
+
+    t_s: np.ndarray
+    att_err_arcsec: np.ndarray
+    ins_err_arcsec: np.ndarray
+    phi_err: np.ndarray
+    rate_deg_s: np.ndarray
+    kf: dict
+    phi: np.ndarray
+    spec: FilterSpec
+
+
+def attitude_error_arcsec(cbn_est, att_true):
+    """Euler-angle errors (pitch, roll, yaw) of an attitude estimate, arcsec (yaw wrapped)."""
+    d = dcm_to_euler(cbn_est) - att_true
+    d[..., 2] = wrap_rad(d[..., 2])
+    return d / ARCSEC
+
+
+def run_filter(run: InsRun, spec: FilterSpec = FilterSpec()) -> FilterResult:
+    """Run the open-loop Kalman filter on every run of ``run``: transition from the INS outputs at each
+    epoch (:func:`navlib.sensors.ins15.system_matrix`, second-order discretisation), measurement noise
+    ``R = C_b^n diag(s_c^2, s_c^2, s_b^2) C_n^b`` (the star sensor's body-frame noise in n), measurement
+    :func:`star_measurement`.  The corrected attitude is ``exp([phi_hat x]) C_ins``."""
+    t = run.t_s
+    period = float(t[1] - t[0])
+    sl = slice(1, None)
+    cw = run.cw_b[:, sl] if spec.scale_states else None
+    F = system_matrix(run.pos[:, sl], run.vn[:, sl], run.fn[:, sl], run.cbn[:, sl], cw)
+    phi = discretise(F, period)
+    q = process_noise(run.imu, period, spec.n_states)
+    h = np.zeros((3, spec.n_states))
+    h[:, :3] = np.eye(3)
+    z = star_measurement(run.att[:, sl], run.star_att[:, sl])
+    rb = np.diag(run.star.noise_rad**2)
+    c = run.cbn[:, sl]
+    r = c @ rb @ np.swapaxes(c, -1, -2)
+    p0 = spec.p0(float(run.pos[0, 0, 0]))
+    kf = kalman_filter(phi, q, h, z, r, np.zeros(spec.n_states), p0)
+    phi_hat = kf["x"][..., :3]
+    c_est = rotvec_to_dcm(phi_hat) @ c
+    att_true = run.att_true[:, sl]
+    return FilterResult(t_s=t[sl], att_err_arcsec=attitude_error_arcsec(c_est, att_true),
+                        ins_err_arcsec=attitude_error_arcsec(c, att_true),
+                        phi_err=misalignment(c, run.cbn_true[:, sl]) - phi_hat,
+                        rate_deg_s=run.rate_b[:, sl] / DEG, kf=kf, phi=phi, spec=spec)
+
+
+# ------------------------------------------------------------------------------------------- gain features
+def qr_features(K):
+    """The 6 non-zero entries of ``R`` in the QR decomposition ``K = Q R`` of the (15 x 3) gain (paper E
+    eq. 8), signs fixed so that ``R``'s diagonal is non-negative: ``[R11, R12, R13, R22, R23, R33]``.
+    Batched over leading axes.  ``R^T R = K^T K`` holds whatever the signs."""
+    K = np.asarray(K, float)
+    if K.shape[-2:] != (K.shape[-2], 3) or K.shape[-2] < 3:
+        raise InputError(f"qr_features: gain of shape {K.shape}, expected (..., d >= 3, 3)")
+    r = np.linalg.qr(K, mode="r")
+    sign = np.where(np.diagonal(r, axis1=-2, axis2=-1) < 0, -1.0, 1.0)
+    r = r * sign[..., :, None]
+    iu = np.triu_indices(3)
+    return r[..., iu[0], iu[1]]
+
+
+def r_from_features(feat):
+    """The upper-triangular 3x3 ``R`` from the 6 features of :func:`qr_features`."""
+    feat = np.asarray(feat, float)
+    r = np.zeros(feat.shape[:-1] + (3, 3))
+    iu = np.triu_indices(3)
+    r[..., iu[0], iu[1]] = feat
+    return r
+
+
+FeatureSet = Literal["raw45", "qr6", "qr6_rate"]
+N_INPUTS = {"raw45": 45, "qr6": 6, "qr6_rate": 9}
+
+
+def gain_features(result: FilterResult, kind: FeatureSet) -> np.ndarray:
+    """Network inputs per epoch, shape (n_runs, n_epochs, n_in): ``raw45`` the 45 entries of the 15x3 gain
+    (base states only), ``qr6`` its QR features, ``qr6_rate`` those plus the INS angular rates (deg/s)."""
+    if kind not in N_INPUTS:
+        raise InputError(f"parameter features={kind!r}: must be one of {', '.join(N_INPUTS)}")
+    K = result.kf["K"][..., :N_BASE, :]
+    if kind == "raw45":
+        return K.reshape(K.shape[:-2] + (45,))
+    f = qr_features(K)
+    if kind == "qr6_rate":
+        f = np.concatenate([f, result.rate_deg_s], -1)
+    return f
+
+
+# ------------------------------------------------------------------------------------------- innovation test
+CANDIDATES = {
+    "gyro scale factor x": ("cw_b", 0, -1.0, 0), "gyro scale factor y": ("cw_b", 1, -1.0, 0),
+    "gyro scale factor z": ("cw_b", 2, -1.0, 0),
+    "accelerometer scale factor x": ("cf_b", 0, 1.0, 3), "accelerometer scale factor y": ("cf_b", 1, 1.0, 3),
+    "accelerometer scale factor z": ("cf_b", 2, 1.0, 3),
+}
+
+
+def innovation_signatures(run: InsRun, result: FilterResult) -> dict[str, np.ndarray]:
+    """For each candidate effect (a constant ``theta`` entering the state derivative through the column
+    ``b_k``: gyro scale factor ``-C_b^n diag(w_ib^b)``, accelerometer scale factor ``+C_b^n diag(f^b)``),
+    the innovations' response to ``theta = 1`` through the filter:
+    ``e_k- = Phi_k (I - K_{k-1} H) e_{k-1}- + b_k T``, signature ``g_k = H e_k-`` (n_runs, n_steps, 3)."""
+    kf = result.kf
+    K = kf["K"]
+    n, steps, d, m = K.shape
+    period = float(result.t_s[1] - result.t_s[0])
+    out = {}
+    for name, (field, col, sgn, row) in CANDIDATES.items():
+        src = getattr(run, field)[:, 1:, :, col] * (sgn * period)       # (n, steps, 3)
+        e = np.zeros((n, d))
+        g = np.empty((n, steps, m))
+        for k in range(steps):
+            e = np.einsum("rij,rj->ri", result.phi[:, k], e)
+            e[:, row:row + 3] += src[:, k]
+            g[:, k] = e[:, :3]
+            e = e - np.einsum("rij,rj->ri", K[:, k], g[:, k])
+        out[name] = g
+    return out
+
+
+@dataclass(frozen=True)
+class GlrResult:
+    """GLR statistics per candidate (chi-square with 1 dof under 'no missing effect'), their p-values, the
+    Bonferroni-corrected verdict and the named effect (None if nothing is significant)."""
+
+    table: pd.DataFrame
+    named: str | None
+    alpha: float
+
+
+def innovation_glr(run: InsRun, result: FilterResult, alpha: float = 0.01) -> GlrResult:
+    """Generalised likelihood ratio test of the filter's innovations ``nu_k`` (covariance ``S_k`` when the
+    model is right) for each candidate's signature ``g_k`` (:func:`innovation_signatures`), pooled over
+    runs::
+
+        theta_hat = sum g^T S^-1 nu / sum g^T S^-1 g,    chi2 = (sum g^T S^-1 nu)^2 / sum g^T S^-1 g
+
+    ``chi2 ~ chi2(1)`` if the effect is absent; p-values Bonferroni-corrected over the testable candidates
+    (those whose signature is not numerically zero).  The named effect is the most significant one."""
+    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
+    nu, s = result.kf["innov"], result.kf["S"]
+    sinv_nu = np.linalg.solve(s, nu[..., None])[..., 0]
+    sig = innovation_signatures(run, result)
+    rows = []
+    for name, g in sig.items():
+        sinv_g = np.linalg.solve(s, g[..., None])[..., 0]
+        info = float(np.sum(g * sinv_g))
+        num = float(np.sum(g * sinv_nu))
+        testable = info > 1e-6
+        chi2 = num**2 / info if testable else np.nan
+        rows.append({"candidate": name, "testable": testable, "chi2": chi2,
+                     "estimate": num / info if testable else np.nan,
+                     "p_value": float(stats.chi2.sf(chi2, 1)) if testable else np.nan})
+    df = pd.DataFrame(rows)
+    n_test = max(int(df["testable"].sum()), 1)
+    df["p_bonferroni"] = np.minimum(df["p_value"] * n_test, 1.0)
+    df["significant"] = df["p_bonferroni"] < alpha
+    sig_rows = df[df["significant"]]
+    named = None if sig_rows.empty else str(sig_rows.sort_values("chi2", ascending=False)["candidate"].iloc[0])
+    return GlrResult(table=df, named=named, alpha=alpha)
+
+
+def rate_correlation(result: FilterResult, axis: int = 2) -> tuple[float, float]:
+    """Pearson correlation of the normalised innovation of one channel (default Up, the yaw channel) with
+    the INS angular rate about the same body axis, pooled over runs, and its two-sided p-value (the
+    innovations of a right model are white, so the usual t-test applies)."""
+    nu = result.kf["innov"][..., axis] / np.sqrt(result.kf["S"][..., axis, axis])
+    w = result.rate_deg_s[..., axis]
+    if np.std(w) < 1e-9:
+        return float("nan"), float("nan")
+    r, p = stats.pearsonr(nu.ravel(), w.ravel())
+    return float(r), float(p)

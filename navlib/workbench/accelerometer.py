@@ -1,0 +1,231 @@
+"""The accelerometer as a workbench system (paper D's tumble tests): IEEE Std 1293 effects, linear in their
+parameters, fitted to tumble files (:mod:`navlib.data.tumble`).
+
+Measurement: ``output_mg`` (output divided by the nominal scale factor) of one accelerometer on a dividing
+head, ``a = cos q`` along the input axis and ``a_p = sin q`` across it (g), ``dT = T - T_c`` with ``T_c`` the
+mean temperature of the data.  The model is the nominal ``1000 a`` plus the effects::
+
+    bias                         k0                                  mg
+    scale_factor                 k1 a                                mg/g
+    bias_temperature             b1 dT + b2 dT^2                     mg/degC, mg/degC^2
+    scale_factor_temperature     (s1 dT + s2 dT^2) a                 mg/g/degC, mg/g/degC^2
+    second_order                 k2 a^2                              mg/g^2
+    second_order_temperature     k2t dT a^2                          mg/g^2/degC
+    cross_coupling               kip a a_p                           mg/g^2
+    misalignment                 delta_o a_p                         mg/g (= mrad)
+
+residual = measured - model, mg.  Products of small terms (scale-factor error times K2 ...) are below a
+microgravity for the sensors of paper D and are left out, so every fit is one linear least-squares solve.
+Structure tests: a third harmonic in position (a ``K3 a^3`` term or a dividing-head error), a cubic in
+temperature, and a position-dependent temperature step (thermal lag during the tumble).
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pandas as pd
+
+from ..data.tumble import read_tumble, require_levels
+from ..errors import InputError
+from .effects import Effect, System, register_system
+from .fit import Fit, best_least_squares, fit_model, lstsq, user_columns, user_design
+from .diagnose import diagnose
+from .trials import wilson
+
+ACCELEROMETER_EFFECTS = {
+    "bias": Effect("bias", ("k0_mg",), ("mg",),
+                   "Output at zero input (pick-off null, servo offset): a constant offset in every position."),
+    "scale_factor": Effect("scale_factor", ("k1_mg_g",), ("mg/g",),
+                           "Scale-factor error (magnet, coil, readout resistor): an error proportional to "
+                           "the input a = cos q, i.e. a one-cycle cosine in position."),
+    "bias_temperature": Effect("bias_temperature", ("bias_t1_mg_c", "bias_t2_mg_c2"), ("mg/degC", "mg/degC^2"),
+                               "Bias drift with temperature (head deformation, pick-off and capacitance "
+                               "gain, gap change): an offset that follows T (needs 3 temperatures).",
+                               columns=("temperature_c",)),
+    "scale_factor_temperature": Effect("scale_factor_temperature", ("sf_t1_mg_g_c", "sf_t2_mg_g_c2"),
+                                       ("mg/g/degC", "mg/g/degC^2"),
+                                       "Scale-factor drift with temperature (magnet and coil temperature "
+                                       "coefficients): a cos q error whose size follows T (needs 3 "
+                                       "temperatures).", columns=("temperature_c",)),
+    "second_order": Effect("second_order", ("k2_mg_g2",), ("mg/g^2",),
+                           "Second-order nonlinearity K2 a^2: a two-cycle cosine in position plus an offset."),
+    "second_order_temperature": Effect("second_order_temperature", ("k2_t_mg_g2_c",), ("mg/g^2/degC",),
+                                       "K2 changing with temperature: the two-cycle error grows with T; makes "
+                                       "the apparent scale factor depend on the input (paper D, Fig 4).",
+                                       columns=("temperature_c",)),
+    "cross_coupling": Effect("cross_coupling", ("kip_mg_g2",), ("mg/g^2",),
+                             "Cross-coupling Kip a a_p between input and pendulum axes: a two-cycle sine."),
+    "misalignment": Effect("misalignment", ("delta_o_mg",), ("mg/g",),
+                           "Input-axis misalignment about the output axis (mrad): a one-cycle sine, the "
+                           "pendulum-axis acceleration leaking in."),
+}
+
+
+def load_accelerometer(path: str | os.PathLike) -> pd.DataFrame:
+    """A tumble file of ONE accelerometer (:func:`navlib.data.tumble.read_tumble`; at least 5 positions)."""
+    df = read_tumble(path)
+    units = list(dict.fromkeys(df["unit"]))
+    if len(units) != 1:
+        raise InputError(f"{os.path.basename(str(path))}: column 'unit' names {len(units)} accelerometers "
+                         f"({', '.join(units)}); the workbench fits one: give a file with one unit")
+    require_levels(df, positions=5, what="the accelerometer model", name=os.path.basename(str(path)))
+    return df
+
+
+def _columns(data: pd.DataFrame, name: str, t_c: float) -> list[np.ndarray]:
+    q = np.deg2rad(data["position_deg"].to_numpy(float))
+    a, ap = np.cos(q), np.sin(q)
+    dt = (data["temperature_c"].to_numpy(float) - t_c) if "temperature_c" in data else np.zeros_like(a)
+    return {"bias": [np.ones_like(a)], "scale_factor": [a], "bias_temperature": [dt, dt ** 2],
+            "scale_factor_temperature": [a * dt, a * dt ** 2], "second_order": [a ** 2],
+            "second_order_temperature": [a ** 2 * dt], "cross_coupling": [a * ap], "misalignment": [ap]}[name]
+
+
+def design(data: pd.DataFrame, effects, t_c: float) -> np.ndarray:
+    """Design matrix of the catalogued effects (columns in the order of their parameters)."""
+    cols = [c for e in effects for c in _columns(data, e, t_c)]
+    return np.column_stack(cols) if cols else np.zeros((len(data), 0))
+
+
+def nominal_mg(data: pd.DataFrame) -> np.ndarray:
+    return 1000.0 * np.cos(np.deg2rad(data["position_deg"].to_numpy(float)))
+
+
+def _fit_accelerometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
+    y = data["output_mg"].to_numpy(float) - nominal_mg(data)
+    cat = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    for name in cat:
+        if "temperature_c" in ACCELEROMETER_EFFECTS[name].columns:
+            need = 3 if len(ACCELEROMETER_EFFECTS[name].params) == 2 else 2
+            require_levels(data, temperatures=need, what=f"effect '{name}'", name="tumble data")
+    t_c = float(data["temperature_c"].mean())
+    X = design(data, cat, t_c)
+    names = [p for e in cat for p in ACCELEROMETER_EFFECTS[e].params] + [p for e in users for p in e.params]
+    if len(names) >= len(y):
+        raise InputError(f"{len(y)} readings cannot determine {len(names)} parameters of the model "
+                         f"{' + '.join(e.name for e in effects)}")
+    shape = (len(y),)
+    XU = np.column_stack([X, user_design(users, data, shape)])
+    beta = lstsq(XU, y)
+    jac = XU
+    nc = X.shape[1]
+    if users:
+        def resid(x):
+            return X @ x[:nc] + user_columns(users, dict(zip(names, x)), data, shape) - y
+
+        inf = np.full(len(names), np.inf)
+        sol = best_least_squares(resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf)
+        beta, jac = sol.x, np.asarray(sol.jac)
+    params = dict(zip(names, map(float, beta)))
+
+    def predict(frame):
+        return nominal_mg(frame) + design(frame, cat, t_c) @ beta[:nc] + user_columns(users, params, frame,
+                                                                                        (len(frame),))
+
+    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, data["output_mg"].to_numpy(float) - predict(data),
+               jac, predict, {"temperature_centre_c": t_c})
+
+
+def accelerometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
+    """Third harmonic in position; cubic in temperature; a temperature offset that changes along each
+    tumble (first vs second half of the positions, times the input)."""
+    d = fit.data
+    q = np.deg2rad(d["position_deg"].to_numpy(float))
+    out = [("third harmonic in position", np.c_[np.cos(3 * q), np.sin(3 * q)], np.sqrt(2.0))]
+    if d["set_point_c"].nunique() >= 4:
+        x = d["temperature_c"].to_numpy(float)
+        x = (x - x.mean()) / (np.std(x) or 1.0)
+        out.append(("cubic in temperature", (x ** 3 - 3 * x)[:, None], 1.0))
+    return out
+
+
+SYSTEM = register_system(System(
+    "accelerometer", "mg", ACCELEROMETER_EFFECTS, load_accelerometer, _fit_accelerometer, accelerometer_structure,
+    "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg"))
+
+
+# ------------------------------------------------------------------------------------------ trials
+def simulate_catalogue(params: dict, *, temperatures_c=None, positions: int = 24, noise_ug: float = 3.0,
+                       seed=0) -> pd.DataFrame:
+    """Tumble data from the catalogue model (effects absent = 0) on the paper's grid (-40..70 degC every
+    5 degC, 24 positions) plus white noise ``noise_ug``."""
+    t = np.arange(-40.0, 70.1, 5.0) if temperatures_c is None else np.asarray(temperatures_c, float)
+    q = np.arange(positions) * 360.0 / positions
+    T, Q = np.meshgrid(t, q, indexing="ij")
+    frame = pd.DataFrame({"set_point_c": T.ravel(), "temperature_c": T.ravel(), "position_deg": Q.ravel(),
+                          "unit": "sim"})
+    X = design(frame, tuple(ACCELEROMETER_EFFECTS), float(frame["temperature_c"].mean()))
+    beta = np.array([params.get(p, 0.0) for e in ACCELEROMETER_EFFECTS.values() for p in e.params])
+    rng = np.random.default_rng(seed)
+    frame["output_mg"] = nominal_mg(frame) + X @ beta + 1e-3 * noise_ug * rng.standard_normal(len(frame))
+    return frame
+
+
+#: Typical sizes of each parameter for random draws (paper D's sensor: bias ~1 mg, 1.7 mg bias drift ...).
+PARAM_SCALE = {"k0_mg": 1.0, "k1_mg_g": 1.0, "bias_t1_mg_c": 0.015, "bias_t2_mg_c2": 1e-4,
+               "sf_t1_mg_g_c": 0.04, "sf_t2_mg_g_c2": 2e-4, "k2_mg_g2": 0.02, "k2_t_mg_g2_c": 0.002,
+               "kip_mg_g2": 0.03, "delta_o_mg": 0.2}
+
+
+def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float, seed: int) -> dict:
+    """One trial: with ``hidden`` set, data contain every effect (random, ``hidden`` rescaled so that its
+    RMS is ``ratio`` x noise) and the model is the catalogue without ``hidden``; with ``None`` the data
+    contain a random subset and the model is exactly that subset (a correct answer is "consistent with
+    noise")."""
+    cat = tuple(ACCELEROMETER_EFFECTS)
+    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    if hidden is None:
+        k = int(rng.integers(1, len(cat)))
+        present = tuple(cat[i] for i in sorted(rng.choice(len(cat), size=k, replace=False)))
+    else:
+        if hidden not in cat:
+            raise InputError(f"unknown accelerometer effect '{hidden}'; known: {', '.join(cat)}")
+        present = cat
+    params = {p: PARAM_SCALE[p] * rng.uniform(-1, 1) for e in present for p in ACCELEROMETER_EFFECTS[e].params}
+    if hidden is not None:
+        probe = simulate_catalogue(params, noise_ug=0.0)
+        x = design(probe, (hidden,), float(probe["temperature_c"].mean())) @ np.array(
+            [params[p] for p in ACCELEROMETER_EFFECTS[hidden].params])
+        s = ratio * 1e-3 * noise_ug / np.sqrt(np.mean(x ** 2))
+        for p in ACCELEROMETER_EFFECTS[hidden].params:
+            params[p] *= s
+        model = tuple(e for e in cat if e != hidden)
+    else:
+        model = present
+    data = simulate_catalogue(params, noise_ug=noise_ug, seed=rng)
+    d = diagnose(fit_model("accelerometer", data, model))
+    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise_ug": noise_ug, "seed": seed,
+            "named": d.missing or "(none)",
+            "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
+            "consistent_with_noise": d.consistent_with_noise}
+
+
+def hidden_effect_study(ratios=(3.0, 10.0), noise_ug: float = 3.0, seeds=range(10), none_seeds=None) -> pd.DataFrame:
+    """Detection trials for every hidden effect, size and seed, plus nothing-hidden trials (false alarms;
+    default twice as many seeds)."""
+    seeds = list(seeds)
+    none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
+    rows = [hidden_effect_trial(h, r, noise_ug, 1000 * i + 100 * int(r) + s)
+            for i, h in enumerate(ACCELEROMETER_EFFECTS) for r in ratios for s in seeds]
+    rows += [hidden_effect_trial(None, 0.0, noise_ug, 90_000 + s) for s in none_seeds]
+    return pd.DataFrame(rows)
+
+
+def detection_table(study: pd.DataFrame) -> pd.DataFrame:
+    """Per hidden effect and size: trials and share named correctly; nothing hidden: the false-alarm share;
+    95 % Wilson intervals."""
+    rows = []
+    for (h, r), g in study[study["hidden"] != "(none)"].groupby(["hidden", "ratio"], sort=False):
+        k = int(g["correct"].sum())
+        lo, hi = wilson(k, len(g))
+        rows.append({"hidden effect": h, "size (x noise)": r, "rate": "correctly named", "trials": len(g),
+                     "value": k / len(g), "95% low": lo, "95% high": hi})
+    none = study[study["hidden"] == "(none)"]
+    if len(none):
+        k = int((~none["correct"].astype(bool)).sum())
+        lo, hi = wilson(k, len(none))
+        rows.append({"hidden effect": "(none)", "size (x noise)": 0.0, "rate": "false alarms",
+                     "trials": len(none), "value": k / len(none), "95% low": lo, "95% high": hi})
+    return pd.DataFrame(rows)

@@ -1,0 +1,261 @@
+"""Paper E (INS/celestial): trajectory kinematics, strapdown, 15-state error model against closed forms,
+measurement through M against the direction-cosine route, KF against filterpy, QR gain features, GLR
+innovation test, MLP, bad input."""
+import math
+
+import numpy as np
+import pytest
+from filterpy.kalman import KalmanFilter
+
+from navlib.angles import ARCSEC, DEG
+from navlib.errors import InputError
+from navlib.methods import kalman as km
+from navlib.methods.mlp import MLPParams, train_mlp
+from navlib.sensors import ins15
+from navlib.sensors.strapdown import (ImuSpec, InitialError, StarSensorSpec, misalignment, rotvec_to_dcm,
+                                      strapdown)
+from navlib.sensors.trajectory import (EARTH_RATE_RAD_S, FlightProfile, dcm_to_euler, euler_rate_matrix,
+                                       euler_to_dcm, generate, gravity, radii)
+from navlib.studies.paper_e import StudySpec
+
+QUIET = ImuSpec(gyro_drift_deg_h=0, gyro_arw_deg_rt_h=0, accel_bias_ug=0, accel_noise_ug_rt_hz=0)
+
+
+@pytest.fixture(scope="module")
+def sturn():
+    return generate(FlightProfile(kind="s_turns", duration_s=60.0, turn_period_s=8.0, manoeuvre_seed=3))
+
+
+# ------------------------------------------------------------------------------------------- kinematics
+@pytest.mark.parametrize("kind", ["level", "s_turns"])
+def test_ideal_imu_integrates_back_to_the_truth(kind):
+    tr = generate(FlightProfile(kind=kind, duration_s=60.0, turn_period_s=8.0))
+    run = strapdown(tr, [0], ideal=True)
+    idx = np.arange(len(run.t_s)) * 10
+    assert np.abs(run.phi_true).max() < 0.02 * ARCSEC
+    assert np.abs(run.vn[0] - tr.vn[idx]).max() < 1e-3
+    rmh, _ = radii(tr.pos[0, 0], tr.pos[0, 2])
+    assert np.abs(run.pos[0, :, 0] - tr.pos[idx, 0]).max() * rmh < 0.05
+    assert np.abs(run.pos[0, :, 2] - tr.pos[idx, 2]).max() < 0.05
+    if kind == "s_turns":
+        assert np.ptp(tr.att[:, 2]) > 20 * DEG          # the manoeuvre is there
+
+
+def test_euler_round_trip_and_rate_matrix(sturn):
+    rng = np.random.default_rng(1)
+    att = np.c_[rng.uniform(-1.2, 1.2, 50), rng.uniform(-3, 3, 50), rng.uniform(-3, 3, 50)]
+    np.testing.assert_allclose(dcm_to_euler(euler_to_dcm(att)), att, atol=1e-12)
+    c = euler_to_dcm(att)
+    np.testing.assert_allclose(c @ np.swapaxes(c, 1, 2), np.broadcast_to(np.eye(3), c.shape), atol=1e-14)
+    # w_nb^n = M att' against a finite difference of C_b^n
+    rate = rng.normal(size=(50, 3))
+    h = 1e-6
+    dc = (euler_to_dcm(att + h * rate) - euler_to_dcm(att - h * rate)) / (2 * h) @ np.swapaxes(c, 1, 2)
+    w = np.stack([dc[:, 2, 1], dc[:, 0, 2], dc[:, 1, 0]], -1)
+    np.testing.assert_allclose(w, np.einsum("kij,kj->ki", euler_rate_matrix(att), rate), atol=1e-8)
+
+
+def test_m_matrix_route_matches_direction_cosines():
+    rng = np.random.default_rng(2)
+    att = np.c_[rng.uniform(-1.0, 1.0, 200), rng.uniform(-3, 3, 200), rng.uniform(-3, 3, 200)]
+    d = rng.normal(scale=10 * ARCSEC / 3, size=(200, 3))
+    att_ins = att + d
+    z = km.star_measurement(att_ins, att)
+    phi = misalignment(euler_to_dcm(att_ins), euler_to_dcm(att))
+    assert np.abs(z - phi).max() < 1e-3 * ARCSEC
+    # the opposite sign on the M term (the pitfall) is far off
+    m = euler_rate_matrix(att_ins)
+    m[:, 0, 1] *= -1
+    wrong = -np.einsum("kij,kj->ki", m, d)
+    assert np.abs(wrong - phi).max() > 1.0 * ARCSEC
+
+
+# ------------------------------------------------------------------------------------------- error model
+def _static_f(lat_deg=45.75):
+    lat = lat_deg * DEG
+    pos = np.array([lat, 0.0, 0.0])
+    g = gravity(lat, 0.0)
+    return ins15.system_matrix(pos, np.zeros(3), np.array([0, 0, g]), np.eye(3)), lat, g
+
+
+def test_earth_rate_and_tilt_terms_closed_form():
+    F, lat, g = _static_f()
+    wn, wu = EARTH_RATE_RAD_S * math.cos(lat), EARTH_RATE_RAD_S * math.sin(lat)
+    assert F[0, 2] == pytest.approx(-wn)      # phi_E' = -w_ie cos L phi_U
+    assert F[0, 1] == pytest.approx(wu)       # phi_E' = +w_ie sin L phi_N
+    assert F[1, 0] == pytest.approx(-wu)
+    assert F[2, 0] == pytest.approx(wn)       # phi_U' = +w_ie cos L phi_E
+    assert F[3, 1] == pytest.approx(-g)       # dv_E' = -g phi_N
+    assert F[4, 0] == pytest.approx(g)        # dv_N' = +g phi_E
+    assert F[1, 6] == pytest.approx(-wu)      # Earth-rate error from dL
+    assert F[2, 6] == pytest.approx(wn)
+    np.testing.assert_allclose(F[0:3, 9:12], -np.eye(3))
+
+
+def test_schuler_foucault_and_earth_rate_frequencies():
+    F, lat, g = _static_f()
+    ev = np.linalg.eigvals(F[:8, :8][np.ix_([0, 1, 2, 3, 4, 6, 7], [0, 1, 2, 3, 4, 6, 7])])
+    w = np.sort(np.abs(ev.imag[ev.imag > 1e-9]))
+    rmh, rnh = radii(lat, 0.0)
+    ws = math.sqrt(g / math.sqrt(rmh * rnh))
+    wf = EARTH_RATE_RAD_S * math.sin(lat)
+    assert w[0] == pytest.approx(EARTH_RATE_RAD_S, rel=0.02)
+    assert 0.5 * (w[1] + w[2]) == pytest.approx(ws, rel=2e-3)
+    assert 0.5 * (w[2] - w[1]) == pytest.approx(wf, rel=0.03)
+    assert 2 * math.pi / (0.5 * (w[1] + w[2])) / 60 == pytest.approx(84.4, abs=0.3)
+
+
+def test_schuler_period_on_a_static_run():
+    F, lat, g = _static_f(0.0)                 # no Foucault coupling at the equator
+    F[[5, 8], :] = 0.0                         # vertical channel held (it diverges undamped)
+    F[:, [5, 8]] = 0.0
+    phi = ins15.discretise(F, 1.0)
+    x = np.zeros(15)
+    x[3] = 0.1                                 # 0.1 m/s east velocity error
+    dv = np.empty(4 * 3600)
+    for k in range(dv.size):
+        x = phi @ x
+        dv[k] = x[3]
+    up = np.flatnonzero((dv[:-1] < 0) & (dv[1:] >= 0))
+    period_min = np.mean(np.diff(up)) / 60
+    assert period_min == pytest.approx(2 * math.pi * math.sqrt(radii(0.0, 0.0)[1] / g) / 60, abs=0.1)
+    assert period_min == pytest.approx(84.4, abs=0.3)
+
+
+@pytest.mark.parametrize("scale_ppm", [0.0, 500.0])
+def test_linear_model_follows_the_strapdown(sturn, scale_ppm):
+    imu = ImuSpec(gyro_drift_deg_h=2.0, gyro_arw_deg_rt_h=0, accel_bias_ug=300, accel_noise_ug_rt_hz=0,
+                  gyro_scale_ppm=scale_ppm)
+    run = strapdown(sturn, [5], imu, StarSensorSpec(), InitialError(30, 90))
+    aug = scale_ppm != 0
+    F = ins15.system_matrix(run.pos[:, 1:], run.vn[:, 1:], run.fn[:, 1:], run.cbn[:, 1:],
+                            run.cw_b[:, 1:] if aug else None)
+    phis = ins15.discretise(F, 0.1)[0]
+    x = np.zeros(phis.shape[-1])
+    x[:3] = run.phi_true[0, 0]
+    x[9:12] = imu.drift_rad_s
+    x[12:15] = imu.bias_m_s2
+    if aug:
+        x[15:18] = scale_ppm * 1e-6
+    for p in phis:
+        x = p @ x
+    growth = np.abs(run.phi_true[0, -1] - run.phi_true[0, 0]).max()
+    assert growth > 50 * ARCSEC
+    assert np.abs(x[:3] - run.phi_true[0, -1]).max() < 0.01 * growth
+    assert np.abs(x[3:6] - (run.vn[0, -1] - sturn.vn[-1])).max() < 0.01 * np.abs(run.vn[0, -1] - sturn.vn[-1]).max() + 1e-4
+
+
+# ------------------------------------------------------------------------------------------- filter
+def test_numpy_filter_matches_filterpy():
+    tr = generate(FlightProfile(kind="s_turns", duration_s=20.0))
+    run = strapdown(tr, [7], ImuSpec(gyro_scale_ppm=100))
+    res = km.run_filter(run)
+    spec = res.spec
+    kf = KalmanFilter(dim_x=15, dim_z=3)
+    kf.x = np.zeros(15)
+    kf.P = spec.p0(float(run.pos[0, 0, 0]))
+    kf.H = np.c_[np.eye(3), np.zeros((3, 12))]
+    kf.Q = ins15.process_noise(run.imu, 0.1)
+    z = km.star_measurement(run.att[0, 1:], run.star_att[0, 1:])
+    c = run.cbn[0, 1:]
+    r = c @ np.diag(run.star.noise_rad**2) @ np.swapaxes(c, 1, 2)
+    xs, ps, ks = [], [], []
+    for k in range(res.phi.shape[1]):
+        kf.F = res.phi[0, k]
+        kf.predict()
+        kf.update(z[k], R=r[k])
+        xs.append(kf.x.copy())
+        ps.append(kf.P.copy())
+        ks.append(kf.K.copy())
+    xs, ps, ks = np.array(xs), np.array(ps), np.array(ks)
+    for ours, theirs in ((res.kf["x"][0], xs), (res.kf["P"][0], ps), (res.kf["K"][0], ks)):
+        # per state (row): relative to the largest magnitude that row reaches in the run
+        axes = tuple(a for a in range(theirs.ndim) if a != 1)
+        scale = np.abs(theirs).max(axis=axes, keepdims=True)
+        assert np.all(np.abs(ours - theirs) <= 1e-12 * np.maximum(scale, 1e-300))
+
+
+def test_qr_features():
+    rng = np.random.default_rng(4)
+    K = rng.normal(size=(20, 15, 3))
+    f = km.qr_features(K)
+    assert f.shape == (20, 6)
+    r = km.r_from_features(f)
+    assert np.all(np.diagonal(r, axis1=1, axis2=2) >= 0)
+    np.testing.assert_allclose(np.swapaxes(r, 1, 2) @ r, np.swapaxes(K, 1, 2) @ K, atol=1e-12)
+    np.testing.assert_allclose(km.qr_features(-K), f, atol=1e-12)          # signs fixed
+    q = np.linalg.qr(K)[0]                                                  # any Q: |R| entries agree
+    np.testing.assert_allclose(np.abs(np.swapaxes(q, 1, 2) @ K)[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]],
+                               np.abs(f), atol=1e-12)
+
+
+def test_gain_feature_sets():
+    tr = generate(FlightProfile(kind="s_turns", duration_s=10.0))
+    res = km.run_filter(strapdown(tr, [1, 2]))
+    assert km.gain_features(res, "raw45").shape == (2, 100, 45)
+    assert km.gain_features(res, "qr6").shape == (2, 100, 6)
+    f9 = km.gain_features(res, "qr6_rate")
+    np.testing.assert_allclose(f9[..., 6:], res.rate_deg_s)
+
+
+def test_innovation_test_names_the_gyro_scale_factor():
+    tr = generate(FlightProfile(kind="s_turns", duration_s=100.0, turn_period_s=10.0, manoeuvre_seed=1))
+    for ppm, expected in ((200.0, "gyro scale factor z"), (0.0, None)):
+        run = strapdown(tr, [11, 12], ImuSpec(gyro_scale_ppm=ppm))
+        res = km.run_filter(run)
+        g = km.innovation_glr(run, res)
+        assert g.named == expected
+        if ppm:
+            est = g.table.set_index("candidate").loc["gyro scale factor z", "estimate"]
+            assert est == pytest.approx(ppm * 1e-6, rel=0.5)
+            aug = km.run_filter(run, km.FilterSpec(scale_states=True))
+            yaw = lambda e: np.sqrt(np.mean(e[:, 100:, 2] ** 2))  # noqa: E731
+            assert yaw(aug.att_err_arcsec) < 0.7 * yaw(res.att_err_arcsec)
+
+
+def test_mlp_learns_a_smooth_map():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(-2, 2, (400, 2))
+    y = np.c_[np.sin(x[:, 0]) + x[:, 1] ** 2, x[:, 0] * x[:, 1]]
+    net = train_mlp(x, y, MLPParams(n_in=2, n_hidden=10, n_out=2, hidden='logsig', trainer='adam', epochs=800, learning_rate=0.02, scaling='standardize', init='torch'), seed=1)
+    assert net.loss_history[-1] < 0.05 * net.loss_history[0]
+    assert net.predict(x[:5]).shape == (5, 2)
+    assert net.seconds_per_pass > 0
+
+
+# ------------------------------------------------------------------------------------------- bad input
+@pytest.mark.parametrize("kwargs, name", [
+    ({"duration_s": -5}, "duration_s"), ({"duration_s": 150.05}, "duration_s"),
+    ({"star_rate_hz": 0}, "star_rate_hz"), ({"star_rate_hz": 3}, "star_rate_hz"),
+    ({"imu_rate_hz": 5}, "imu_rate_hz"), ({"star_cross_arcsec": -1}, "star_cross_arcsec"),
+    ({"star_boresight_arcsec": 0}, "star_boresight_arcsec"), ({"gyro_arw_deg_rt_h": -0.1}, "gyro_arw_deg_rt_h"),
+    ({"accel_noise_ug_rt_hz": float("nan")}, "accel_noise_ug_rt_hz"), ({"n_hidden": 0}, "n_hidden"),
+    ({"n_hidden": 2.5}, "n_hidden"), ({"epochs": 0}, "epochs"), ({"n_train_runs": 0}, "n_train_runs"),
+    ({"yaw_amplitude_deg": -3}, "yaw_amplitude_deg"), ({"settle_s": 200}, "settle_s"),
+])
+def test_bad_study_parameters_stop_with_one_line(kwargs, name):
+    with pytest.raises(InputError) as err:
+        StudySpec(**kwargs)
+    msg = str(err.value)
+    assert name in msg and "\n" not in msg
+
+
+@pytest.mark.parametrize("make, name", [
+    (lambda: FlightProfile(duration_s=0), "duration_s"), (lambda: FlightProfile(kind="loop"), "kind"),
+    (lambda: StarSensorSpec(rate_hz=-1), "rate_hz"), (lambda: MLPParams(n_in=0), "n_in"),
+    (lambda: MLPParams(n_in=3, hidden="relu"), "hidden"), (lambda: ImuSpec(gyro_drift_deg_h=-1), "gyro_drift_deg_h"),
+])
+def test_bad_component_parameters(make, name):
+    with pytest.raises(InputError, match=name):
+        make()
+
+
+def test_notebook_stops_at_validation_with_one_line(tmp_path):
+    pm = pytest.importorskip("papermill")
+    from navlib.paths import NOTEBOOK_DIR
+
+    with pytest.raises(pm.PapermillExecutionError) as err:
+        pm.execute_notebook(str(NOTEBOOK_DIR / "celestial.ipynb"), str(tmp_path / "out.ipynb"),
+                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0}, progress_bar=False)
+    assert err.value.ename == "InputError"
+    assert "star_rate_hz" in err.value.evalue and "\n" not in err.value.evalue
