@@ -18,6 +18,7 @@ SYSTEM is compass, drift, magnetometer or accelerometer:
   NED); optional time_s, gyr_*_dps, pos_*_m.
   accelerometer columns (one unit's tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
   output_mg (output / nominal scale factor), unit; optional set_point_c.  Extra columns are ignored.
+
 --effects FILE.py adds your own effects (every navlib.workbench.effects.Effect defined in the file whose
 system matches), usable in --model and named by diagnose like catalogued ones.
 

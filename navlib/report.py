@@ -20,8 +20,10 @@ notebook outputs compare within tolerance (nbval).
 from __future__ import annotations
 
 import hashlib
+import html
 import json
 import math
+import re
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -78,6 +80,11 @@ def fmt(value: Any, spec: str = "{:.3g}") -> str:
 
 
 # ----------------------------------------------------------------------------------------------- tables
+def _breakable(text: str) -> str:
+    """HTML-escaped ``text`` with ``<wbr>`` (an optional line break) after underscores, slashes and commas."""
+    return re.sub(r"([_/,])(?=\S)", r"\1<wbr>", html.escape(str(text), quote=False))
+
+
 class Table:
     """A result table for the book: HTML (wrapping text, fitting the content column) for the page, and a
     rounded plain-text rendering no wider than :data:`PLAIN_WIDTH` characters for nbval and terminals.
@@ -117,8 +124,13 @@ class Table:
 
     def _repr_html_(self) -> str:
         f = self.formatted()
-        styler = f.style if self.index else f.style.hide(axis="index")
         digest = hashlib.sha1((f.to_csv() + str(self.caption)).encode("utf-8")).hexdigest()[:10]
+        # escaped text with line-break opportunities after "_", "/" and "," so that long identifiers
+        # (column names such as temperature_change_c) wrap inside the content column instead of widening it
+        f = f.map(_breakable)
+        f.index = f.index.map(_breakable)
+        f.columns = [_breakable(c) for c in f.columns]
+        styler = f.style if self.index else f.style.hide(axis="index")
         styler = styler.set_uuid(f"t{digest}")      # stable across runs, distinct per table
         styler = styler.set_table_attributes(f'class="navbook-table" style="{_CSS}"')
         styler = styler.set_table_styles([{"selector": "th", "props": _CELL + "text-align:left;"},

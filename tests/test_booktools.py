@@ -126,8 +126,11 @@ def test_status_markdown_counts_claims_per_chapter_and_reading(tmp_path):
     results = {"compass": {"chapter": "compass", "claims": [
         _claim("a", True), _claim("b", False), _claim("c", None), _claim("a", True, "MATLAB defaults")]}}
     md = status_markdown(results, [nb, other])
-    assert "| {doc}`Electronic compass </_generated/compass>` | as printed | 1 of 3 | 1 | 1 |" in md
+    assert "| {doc}`Electronic compass </_generated/compass>` | **all readings** | **2 of 4** | 1 | 1 |" in md
+    assert "|  | as printed | 1 of 3 | 1 | 1 |" in md
     assert "|  | MATLAB defaults | 1 of 1 | 0 | 0 |" in md
+    one_reading = status_markdown({"compass": {"claims": [_claim("a", True)]}}, [nb])
+    assert "| {doc}`Electronic compass </_generated/compass>` | as printed | 1 of 1 | 0 | 0 |" in one_reading
     assert "no results file" in md and "</_generated/gyro>" in md
 
 

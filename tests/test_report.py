@@ -70,3 +70,11 @@ def test_claims_summary_counts_per_chapter_and_reading():
     s = report.claims_summary(res).set_index("reading")
     assert s.loc["r1", "claims"] == 2 and s.loc["r1", "reproduced"] == 1 and s.loc["r1", "not reproduced"] == 1
     assert s.loc["r2", "cannot be judged"] == 1 and s.loc["r2", "reproduced"] == 0
+
+
+def test_table_html_escapes_text_and_lets_identifiers_wrap():
+    tab = report.table(pd.DataFrame({"needs_columns": ["temperature_change_c", "<b>x</b>"]}), index=False)
+    h = tab._repr_html_()
+    assert "temperature_<wbr>change_<wbr>c" in h and "needs_<wbr>columns" in h
+    assert "&lt;b&gt;x" in h and "<b>x</b>" not in h
+    assert "temperature_change_c" in repr(tab)            # the text twin (nbval) is unchanged

@@ -95,7 +95,7 @@ def _rmse(fis: SugenoFIS, X, t) -> float:
 
 
 def anfis(X, t, init: SugenoFIS, options: AnfisOptions = AnfisOptions(), check=None) -> AnfisResult:
-    """Hybrid-learning ANFIS training started from ``init`` (e.g. :func:`genfis2`).
+    """Hybrid-learning ANFIS training started from ``init`` (e.g. :func:`.genfis2`).
 
     Parameters
     ----------

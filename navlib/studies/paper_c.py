@@ -71,7 +71,7 @@ def paper_facts(path=None) -> pd.DataFrame:
     """Paper C's printed settings and claims (``data/paper_c_facts.csv``), indexed by ``key``.
 
     Columns ``value`` (float), ``unit``, ``kind`` (``claim`` or ``setting``), ``source``, ``quote``; see
-    ``data/paper_c_facts.md``.  Every key of :data:`FACT_KEYS` must be present exactly once.
+    ``data/paper_c_facts.md``.  Every key of ``FACT_KEYS`` must be present exactly once.
 
     Parameters
     ----------
@@ -111,7 +111,7 @@ def fact(key: str) -> float:
     Parameters
     ----------
     key : str
-        One of :data:`FACT_KEYS`.
+        One of ``FACT_KEYS``.
 
     Returns
     -------
@@ -268,7 +268,7 @@ class SimulationSettings:
 @dataclass(frozen=True)
 class StudyParams:
     """Everything the gyro chapter can vary; nested settings of the hot net, the cold net and the
-    simulations.  The site is paper C's (:data:`navlib.sensors.ins.LOCAL_LATITUDE_DEG`)."""
+    simulations.  The site is paper C's (``navlib.sensors.ins.LOCAL_LATITUDE_DEG``)."""
 
     hot: HotNetSettings = field(default_factory=HotNetSettings)
     cold: ColdNetSettings = field(default_factory=ColdNetSettings)
@@ -835,7 +835,7 @@ def drift_against_latitude(params: StudyParams = StudyParams(), n_grid: int = 30
 # ------------------------------------------------------------------------------------------ hot LOO
 @dataclass(frozen=True)
 class HotLoo:
-    """``summary``: per method RMS, max |error| and rows beyond the claimed accuracy under leave-one-out
+    """``summary``: per method RMS, max ``|error|`` and rows beyond the claimed accuracy under leave-one-out
     on Table 2; ``rows``: per-row errors (true - predicted, deg/h) of each method."""
 
     summary: pd.DataFrame
@@ -1009,7 +1009,7 @@ def cold_leave_one_out(params: StudyParams = StudyParams()) -> ColdLoo:
 @dataclass(frozen=True)
 class Table5:
     """``table``: per Table 5 test, the paper's 72 h position errors with the hot and cold nets and ours
-    (mean over draws of the worst 72 h error, nmi) with the mean |true - identified| drift (deg/h) per
+    (mean over draws of the worst 72 h error, nmi) with the mean ``|true - identified|`` drift (deg/h) per
     method; ``fig4``: tidy (method, compensation_deg_h, t_h, position_error_nmi) for test 1, first draw;
     ``quantities``: ``k_R``, neurons of the simulated nets, the drift actually simulated in ``fig4``."""
 

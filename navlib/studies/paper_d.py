@@ -278,8 +278,8 @@ def run_study(params: PaperDParams = PaperDParams()) -> list[Run]:
 
 # ----------------------------------------------------------------------------------------- metrics
 def metrics(err_mg, target_mg) -> dict:
-    """Paper D's five indices (its eq 16 is lost in the OCR; our reading): ME = max |e|, AE = mean e
-    (signed), MAXE = max |e/Nc|, MARE = mean |e/Nc|, RMSE = sqrt(mean e^2); e = model - target, in mg."""
+    """Paper D's five indices (its eq 16 is lost in the OCR; our reading): ME = max ``|e|``, AE = mean e
+    (signed), MAXE = max ``|e/Nc|``, MARE = mean ``|e/Nc|``, RMSE = sqrt(mean e^2); e = model - target, in mg."""
     e = np.asarray(err_mg, float)
     t = np.asarray(target_mg, float)
     rel = np.abs(e / t)

@@ -190,7 +190,7 @@ def _subset(run, sl):
 def simulate(spec: StudySpec = StudySpec()) -> StudyData:
     """Fly, filter and train for every repeat (see the module docstring); returns :class:`StudyData`.
 
-    Per repeat and simulation: KF on training and test runs; networks for every case of :data:`CASES`
+    Per repeat and simulation: KF on training and test runs; networks for every case of ``CASES``
     trained on the training runs (held-out) and on test run 0 alone (same run); for the S-turns also the
     augmented 18-state KF (gyro scale-factor states) and the innovation GLR test of the 15-state KF."""
     score_rows, trace_rows, time_rows, glr_rows, corr_rows = [], [], [], [], []

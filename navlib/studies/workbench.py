@@ -35,7 +35,7 @@ REALDATA = ROOT.parent / "shared" / "realdata"
 LEVEL_DIR = REALDATA / "broad" / "level"
 MAG_DIR = REALDATA / "broad" / "3d"
 CALIBRATION_TRIAL = "broad_05_undisturbed_slow_rotation_with_breaks_B.csv"
-#: Attached-magnet trials: file -> nominal distance of the magnet from the IMU (cm), from BROAD's trial list.
+#: Attached-magnet trials (file -> nominal distance of the magnet from the IMU in cm, from BROAD's trial list).
 ATTACHED = {"broad_32_attached_magnet_1cm.csv": 1.0, "broad_33_attached_magnet_2cm.csv": 2.0,
             "broad_34_attached_magnet_3cm.csv": 3.0, "broad_35_attached_magnet_4cm.csv": 4.0,
             "broad_36_attached_magnet_5cm.csv": 5.0}
@@ -223,7 +223,7 @@ def distance_law(trials: pd.DataFrame) -> DistanceLaw:
     """Fitted hard iron against the nominal magnet distance ``d``: a power law ``|b| = k d^-p`` (least
     squares in log-log) and a dipole law ``|b| = k (d + d0)^-3`` whose distance offset ``d0`` (the magnet's
     centre and the sensing element need not sit at the nominal distance) is fitted too (least squares on
-    log |b|)."""
+    log ``|b|``)."""
     t = trials.dropna(subset=["nominal distance (cm)"])
     d = t["nominal distance (cm)"].to_numpy(float)
     b = t["|hard iron| (uT)"].to_numpy(float)

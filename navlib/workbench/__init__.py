@@ -1,11 +1,11 @@
 """The workbench: compare a model of named physical effects with measurements, see where it fails, find
 the missing effect, add it, and watch the error fall.
 
-- :mod:`navlib.workbench.effects` -- the two types everything is built from: :class:`Effect` (name,
+- :mod:`navlib.workbench.effects` -- the two types everything is built from: :class:`.Effect` (name,
   parameters with units, needed columns, meaning, and for a user effect its contribution to the model) and
-  :class:`System` (unit, catalogue, ``load``, ``fit``, ``structure``); the registry :data:`SYSTEMS`;
-  user effects from a file (:func:`load_effects`);
-- :mod:`navlib.workbench.fit` -- :class:`Fit` (residuals, held-out error, ``add``), the compass and drift
+  :class:`.System` (unit, catalogue, ``load``, ``fit``, ``structure``); the registry :data:`.SYSTEMS`;
+  user effects from a file (:func:`.load_effects`);
+- :mod:`navlib.workbench.fit` -- :class:`.Fit` (residuals, held-out error, ``add``), the compass and drift
   systems, simulated data;
 - :mod:`navlib.workbench.magnetometer` -- the 3-D magnetometer system (hard and soft iron, misalignment,
   time lag; the local field estimated);
@@ -15,7 +15,7 @@ the missing effect, add it, and watch the error fall.
   outside the catalogue.
 
 Adding a system (e.g. an accelerometer): write ``navlib/workbench/accelerometer.py`` that defines its
-catalogue (a dict of :class:`Effect`), a loader ``load(path) -> DataFrame`` (one-line InputError naming file,
+catalogue (a dict of :class:`.Effect`), a loader ``load(path) -> DataFrame`` (one-line InputError naming file,
 column, row), ``fit(data, effects, start) -> Fit`` (use :func:`navlib.workbench.fit.best_least_squares`
 from the previous parameters and a linearised start; add user effects with
 :func:`navlib.workbench.fit.user_columns`), and ``structure(fit) -> [(what, X, scale)]``; then call

@@ -1,17 +1,19 @@
 """Which physical effect is missing from a model? Evidence from the residuals, with honest statistics.
 
-:func:`diagnose` takes a fitted model (:class:`navlib.effects.Fit`) and
+:func:`diagnose` takes a fitted model (:class:`navlib.workbench.fit.Fit`) and
 
 1. refits it with each catalogued effect that is not yet in the model and that the data can test, and
    scores each candidate by
+
    - variance explained: the share of the residual sum of squares the effect removes,
    - significance: the nested-model F test ``F = (dRSS / q) / (RSS_1 / (n - p_1))`` (q parameters added);
      for small linear problems (n <= 12, the drift tables) an exact or Monte-Carlo permutation test of the
      candidate's covariate instead, which does not lean on normal errors,
    - held-out improvement: leave-one-out RMS with and without the effect (exact for linear models, the
      leverage approximation for the compass);
+
 2. looks for structure in the residuals of the current model, with the shapes its system lists
-   (:attr:`navlib.workbench.effects.System.structure`; compass: a constant offset, heading harmonics 1..6,
+   (``System.structure``; compass: a constant offset, heading harmonics 1..6,
    offsets and one-cycle errors differing between sweeps, a trend in time; drift: curvature in each
    covariate; magnetometer: trends with time, angular rate and position).  Each shape ``X`` is first
    projected off the model's Jacobian (what the model can already absorb is not structure); what remains
@@ -242,7 +244,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
         The current model (:func:`navlib.workbench.fit.fit_model`); its ``available`` effects (catalogue and
         user effects) are the candidates.
     alpha : float
-        Family-wise false-alarm level (default :data:`DEFAULT_ALPHA`), Bonferroni over every test.
+        Family-wise false-alarm level (default ``DEFAULT_ALPHA``), Bonferroni over every test.
     seed : int
         Seed of the Monte-Carlo permutation test (drift tables with more than 7 rows).
 

@@ -10,7 +10,7 @@ a drift, ``(n, 3)`` for a 3-D field).  Catalogued effects leave ``contribution``
 A :class:`System` is one kind of measurement with its catalogue: its unit, how its files are loaded and
 validated, how a model of effects is fitted (``fit(data, effects, start) -> Fit``), and which structure
 tests look for what no catalogued effect explains.  The systems (``compass``, ``drift``, ``magnetometer``)
-are listed in :mod:`navlib.workbench.systems`; a new system is a module that builds one ``System`` and one
+are listed in ``navlib.workbench.systems``; a new system is a module that builds one ``System`` and one
 line there.
 
 Catalogued effects of the compass and drift systems are defined here; the magnetometer's in

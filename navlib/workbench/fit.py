@@ -110,7 +110,7 @@ class Fit:
 
 def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
               user_effects: tuple[Effect, ...] = ()) -> Fit:
-    """Fit the named effects of ``system`` (a name or a :class:`System`) to ``data`` (a validated frame,
+    """Fit the named effects of ``system`` (a name or a :class:`.System`) to ``data`` (a validated frame,
     see :func:`load`); ``user_effects`` are extra effects (with a contribution) the names may refer to."""
     spec = get_system(system) if isinstance(system, str) else system
     available = {**spec.catalogue, **{e.name: e for e in user_effects}}

@@ -18,7 +18,7 @@ Measurement model (body frame FRD, navigation frame NED, field in uT)::
 
 The residual is ``m - model`` (3 values per row, uT).  Structure tests (shapes no body-fixed effect
 produces): a per-axis trend in time (a drifting offset), a per-axis linear dependence on position (a
-field that changes across the room, as near a stationary magnet), and a per-axis dependence on |omega|.
+field that changes across the room, as near a stationary magnet), and a per-axis dependence on ``|omega|``.
 
 Files: ``mag_x_ut, mag_y_ut, mag_z_ut`` and the reference attitude quaternion ``q_w, q_x, q_y, q_z``
 (scalar first, rotating body FRD into NED); optional ``time_s``, ``gyr_*_dps``, ``pos_*_m`` and others
@@ -276,7 +276,7 @@ def _cell_offsets(cell: np.ndarray) -> np.ndarray:
 def magnetometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     """Shapes no body-fixed effect produces (module docstring): a field that changes in time (an offset
     per 10 % of the recording and axis), with position (an offset per position cell -- the room split at
-    the median along each axis, 8 cells -- and axis), and with the angular rate |omega| (per axis)."""
+    the median along each axis, 8 cells -- and axis), and with the angular rate ``|omega|`` (per axis)."""
     d = fit.data
     out = []
     if "time_s" in d and np.ptp(d["time_s"].to_numpy(float)) > 0:

@@ -100,7 +100,7 @@ def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=ra
     return pd.DataFrame(rows)
 
 
-#: Compass errors outside the catalogue: name -> shape (unit RMS before scaling) from (data, rng).
+#: Compass errors outside the catalogue (name -> shape of unit RMS before scaling, from (data, rng)).
 OUT_OF_CATALOGUE = {
     "three-cycle error": lambda d, rng: np.sin(3 * np.radians(d.true_heading_deg.to_numpy()) + rng.uniform(0, 2 * np.pi)),
     "four-cycle error": lambda d, rng: np.sin(4 * np.radians(d.true_heading_deg.to_numpy()) + rng.uniform(0, 2 * np.pi)),
