@@ -245,12 +245,3 @@ def test_bad_data():
         back_tune(model, x, t, lr=-1.0)
     with pytest.raises(InputError, match="x_val"):
         fit_incremental_elm(x, t, x_val=x)
-
-
-def test_incremental_fit_is_fast():
-    import time
-    x, t = compass_like(121, noise=0.05)
-    p = IncrementalELMParams(max_nodes=30, loss_goal=0.0, max_iter=200, seed=0)
-    t0 = time.perf_counter()
-    fit_incremental_elm(x, t, p)
-    assert time.perf_counter() - t0 < 5.0   # about 0.2 s here; generous for slow CI machines

@@ -12,13 +12,15 @@ import pandas as pd
 from ..angles import wrap_deg
 from ..data.compass_sweeps import unwrap_measured
 from ..errors import InputError, check_param
-from ..methods.bpnet import GradientParams, train_adam_many, train_gradient
+from ..methods.bpnet import train_adam_many, train_least_squares
+from ..methods.compensator import NetworkCompensator
 from ..methods.elm import fit_elm, fit_incremental_elm
 from ..methods.preprocess import DotScreen, dot_product_screen, median_filter, train_test_split
 from ..methods.scaling import MinMax
+from ..methods.seeding import generators
 from ..sensors.compass import heading_from_field
 from ..sensors.planar import fit_planar_model
-from .paper_a import ELM_METHODS, StudyParams, Sweeps, _output, _target, fit_elm_method, rms_deg
+from .paper_a import ELM_METHODS, METHODS, StudyParams, Sweeps, fit_method, method_id, rms_deg
 
 # ----------------------------------------------------------------------------------------------------------
 # Patent B: test error against hidden-node count
@@ -34,22 +36,22 @@ def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=rang
 
     The error is the de-normalised network output minus the true heading without wrapping (the same as
     the wrapped error wherever it is below 180 deg), in both cases computed the same way."""
-    params.validate()
     check_param("max_nodes", max_nodes, lo=1, integer=True)
-    target, t_val = _target(params, sw.x_train, sw.t_train), _target(params, sw.x_test, sw.t_test)
+    tg = params.target
+    target, t_val = tg.target(sw.x_train, sw.t_train), tg.target(sw.x_test, sw.t_test)
     xs, ts = MinMax.fit(sw.x_train, name="network input"), MinMax.fit(target, name="network target")
     xn, tn = xs.transform(sw.x_train), ts.transform(target)
     xv, tv = xs.transform(sw.x_test), ts.transform(t_val)
     span = float(ts.span[0])
     rows = []
     for seed in seeds:
-        for n in range(1, int(max_nodes) + 1):
-            model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=seed)
+        for n in range(1, int(max_nodes) + 1):      # the same stream for every n: run `seed`'s generator
+            model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=generators([seed])[0])
             rows.append(("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)),
                          span * np.sqrt(model.loss(xv, tv))))
         ip = replace(params.incremental_params(span), loss_goal=0.0, max_nodes=int(max_nodes),
                      max_iter=2 * int(max_nodes))
-        _, hist = fit_incremental_elm(xn, tn, ip, rng=seed, x_val=xv, t_val=tv)
+        _, hist = fit_incremental_elm(xn, tn, ip, rng=generators([seed])[0], x_val=xv, t_val=tv)
         tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
         for n, row in tuned.iterrows():
             rows.append(("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss)))
@@ -138,7 +140,7 @@ GLITCH_VARIANTS = {
 
 
 def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: StudyParams = StudyParams(),
-               seed: int = 0, *, method: str = "ELM back-tuned", window: int = 3, threshold: float = 4.0,
+               seed: int = 0, *, method: str = "elm_backtuned", window: int = 3, threshold: float = 4.0,
                frac: float = 0.9):
     """One run of :func:`glitch_study`: prepare ``train`` as ``variant`` (a key of :data:`GLITCH_VARIANTS`;
     split seed = ``seed``), train ``method`` (an ELM method, seed ``seed``) on the training part, and
@@ -148,20 +150,22 @@ def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: St
     part)."""
     if variant not in GLITCH_VARIANTS:
         raise InputError(f"unknown preparation {variant!r}; known: {', '.join(GLITCH_VARIANTS)}")
-    d = prepare_patent_data(train, window=window, threshold=threshold, frac=frac, rng=seed,
-                            **GLITCH_VARIANTS[variant])
+    if method_id(method) not in ELM_METHODS:
+        raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
+    d = prepare_patent_data(train, window=window, threshold=threshold, frac=frac,
+                            rng=generators([seed], base=1)[0], **GLITCH_VARIANTS[variant])
     tr, ck = d.train_idx, d.test_idx
-    net, info = fit_elm_method(method, d.x[tr], _target(params, d.x[tr], d.true_deg[tr]), params, seed)
+    comp = fit_method(method, d.x[tr], d.true_deg[tr], params, [seed])[0]
     t_test = test["true_heading_deg"].to_numpy(float)
     x_test = unwrap_measured(t_test, test["measured_heading_deg"].to_numpy(float))
-    err = wrap_deg(_output(params, x_test, net.predict(x_test)) - t_test)
+    err = wrap_deg(comp.correct(x_test) - t_test)
     clean = ~test["glitch"].to_numpy(bool) if "glitch" in test else np.ones(len(test), bool)
-    info["check_rms_deg"] = rms_deg(_output(params, d.x[ck], net.predict(d.x[ck])), d.true_deg[ck])
+    info = dict(comp.info, check_rms_deg=rms_deg(comp.correct(d.x[ck]), d.true_deg[ck]))
     return err, clean, d, info
 
 
 def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = StudyParams(),
-                 seeds=range(20), *, method: str = "ELM back-tuned", window: int = 3,
+                 seeds=range(20), *, method: str = "elm_backtuned", window: int = 3,
                  threshold: float = 4.0, frac: float = 0.9) -> pd.DataFrame:
     """What patent B's data preparation buys on a training sweep with glitches: for each variant of
     :data:`GLITCH_VARIANTS` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
@@ -170,7 +174,6 @@ def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = 
     One row per (variant, seed): ``test_rms_deg`` (test sweep), ``check_rms_deg`` (the patent's own
     held-out part of the training sweep), ``n_rejected``, ``glitches_rejected`` (rejected readings that
     were glitches, from the training sweep's ``glitch`` column), ``n_nodes``."""
-    params.validate()
     glitch = train["glitch"].to_numpy(bool) if "glitch" in train else np.zeros(len(train), bool)
     rows = []
     for variant in GLITCH_VARIANTS:
@@ -201,38 +204,36 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
 
     Methods: ``ELM back-tuned`` and ``ELM`` (as in :func:`compensate`), ``BP 1-{big_hidden}-1 (Adam)``
     (an over-sized net: 3 big_hidden + 1 weights, trained by Adam with the chapter's epochs and learning
-    rate, :func:`navlib.bpnet.train_adam_many`), ``BP 1-{big_hidden}-1 (LM/TRF)`` (the same net trained to
-    convergence by a second-order least-squares method, :func:`navlib.bpnet.train_gradient` with
-    ``method='lm'``; slower, so over ``second_order_seeds`` only), and ``physical model`` (five parameters;
+    rate, :func:`navlib.methods.bpnet.train_adam_many`), ``BP 1-{big_hidden}-1 (LM/TRF)`` (the same net trained
+    to convergence by a second-order least-squares method, :func:`navlib.methods.bpnet.train_least_squares`;
+    slower, so over ``second_order_seeds`` only), and ``physical model`` (five parameters;
     seed -1).
     One row per (n_train, method, seed): ``train_rms_deg`` (on the n readings), ``test_rms_deg``,
     ``n_nodes`` (hidden nodes; NaN for the physical model)."""
-    params.validate()
     check_param("big_hidden", big_hidden, lo=1, integer=True)
     seeds = list(seeds)
     big = f"BP 1-{int(big_hidden)}-1 (Adam)"
+    tg = params.target
     rows = []
     for n in sizes:
         sub = sw.subset(even_indices(sw.t_train.size, n))
         xtr, ttr, xte = sub.x_train, sub.t_train, sub.x_test
 
-        def add(method, seed, net, n_nodes):
+        def add(method, seed, comp, n_nodes):
             rows.append({"n_train": int(n), "method": method, "seed": seed,
-                         "train_rms_deg": rms_deg(_output(params, xtr, net.predict(xtr)), ttr),
-                         "test_rms_deg": rms_deg(_output(params, xte, net.predict(xte)), sub.t_test),
-                         "n_nodes": n_nodes})
+                         "train_rms_deg": rms_deg(comp.correct(xtr), ttr),
+                         "test_rms_deg": rms_deg(comp.correct(xte), sub.t_test), "n_nodes": n_nodes})
 
         for method in ELM_METHODS[::-1]:
-            for seed in seeds:
-                net, info = fit_elm_method(method, xtr, _target(params, xtr, ttr), params, seed)
-                add(method, seed, net, info["n_nodes"])
-        gp = GradientParams(method="adam", epochs=params.bp_epochs, lr=params.bp_lr)
-        for seed, net in zip(seeds, train_adam_many(xtr, _target(params, xtr, ttr), int(big_hidden), gp, seeds)):
-            add(big, seed, net, int(big_hidden))
-        for seed in second_order_seeds:
-            net = train_gradient(xtr, _target(params, xtr, ttr), int(big_hidden),
-                                 GradientParams(method="lm", epochs=params.bp_epochs, seed=int(seed)))
-            add(f"BP 1-{int(big_hidden)}-1 (LM/TRF)", int(seed), net, int(big_hidden))
+            for seed, comp in zip(seeds, fit_method(method, xtr, ttr, params, seeds)):
+                add(METHODS[method].label, seed, comp, comp.info["n_nodes"])
+        nets = train_adam_many(xtr, tg.target(xtr, ttr), int(big_hidden), params.adam, generators(seeds))
+        for seed, net in zip(seeds, nets):
+            add(big, seed, NetworkCompensator(net, tg), int(big_hidden))
+        second = list(second_order_seeds)
+        for seed, g in zip(second, generators(second) if second else []):
+            net = train_least_squares(xtr, tg.target(xtr, ttr), int(big_hidden), g, max_nfev=params.adam.epochs)
+            add(f"BP 1-{int(big_hidden)}-1 (LM/TRF)", int(seed), NetworkCompensator(net, tg), int(big_hidden))
         phys = fit_planar_model(sub.t_train, sub.m_train)
         rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
                      "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
