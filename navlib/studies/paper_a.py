@@ -178,15 +178,23 @@ class _Network(MethodBase):
 
 
 def _elm_train(params: StudyParams, back_tuned: bool):
+    """Plain ELM or the patent's back-tuned incremental ELM on min-max normalised data; ``info`` has
+    ``n_nodes`` and, for the back-tuned ELM, the stage ``history`` of :func:`fit_incremental_elm`."""
     def train(x, t, rngs):
         out = []
         for g in rngs:
+            info = {}
             if back_tuned:
-                reg = ScaledRegressor.fit(x, t, lambda xn, tn: fit_incremental_elm(
-                    xn, tn, params.incremental_params(float(np.ptp(t))), rng=g)[0])
+                goal = params.incremental_params(float(np.ptp(t)))
+
+                def fit(xn, tn):
+                    model, info["history"] = fit_incremental_elm(xn, tn, goal, rng=g)
+                    return model
             else:
-                reg = ScaledRegressor.fit(x, t, lambda xn, tn: fit_elm(xn, tn, params.elm_params(), rng=g))
-            reg.info = {"n_nodes": reg.n_hidden}
+                def fit(xn, tn):
+                    return fit_elm(xn, tn, params.elm_params(), rng=g)
+            reg = ScaledRegressor.fit(x, t, fit)
+            reg.info = dict(info, n_nodes=reg.n_hidden)
             out.append(reg)
         return out
     return train
