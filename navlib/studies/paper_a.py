@@ -324,10 +324,12 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
 
 
 def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20), methods=MAIN_METHODS,
-               base_seed: int = 0) -> pd.DataFrame:
+               base_seed: int = 0, keep_errors: bool = False) -> pd.DataFrame:
     """One row per (method, seed): ``method`` (id), ``label``, test-sweep error ``min_deg``, ``max_deg``,
     ``rms_deg``, ``train_time_s`` (per run; runs of one method train together), ``n_nodes`` (ELMs),
-    ``epochs`` and ``stop`` (``trainlm``).  Deterministic methods get one row with seed -1."""
+    ``epochs`` and ``stop`` (``trainlm``), and with ``keep_errors`` the error curve ``error_deg`` (an
+    array over the test sweep) and the training ``history``.  Deterministic methods get one row with
+    seed -1."""
     rows = []
     seeds = list(seeds)
     for m in methods:
@@ -337,10 +339,15 @@ def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
         fitted = fit_method(mid, sw.x_train, sw.t_train, params, seeds, base_seed)
         per = (time.perf_counter() - t0) / len(fitted)
         for s, f in zip(seeds if spec.stochastic else [-1], fitted):
-            rows.append({"method": mid, "label": spec.label, "seed": s,
-                         **error_stats(test_errors(f.correct(sw.x_test), sw)), "train_time_s": per,
-                         "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
-                         "stop": f.info.get("stop", "")})
+            err = test_errors(f.correct(sw.x_test), sw)
+            row = {"method": mid, "label": spec.label, "seed": s, **error_stats(err), "train_time_s": per,
+                   "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
+                   "stop": f.info.get("stop", "")}
+            if keep_errors:
+                net = getattr(f, "net", None)
+                row.update(error_deg=err, history=getattr(net, "history", None),
+                           de_history=f.info.get("de_history"))
+            rows.append(row)
     return pd.DataFrame(rows)
 
 
