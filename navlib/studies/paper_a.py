@@ -21,11 +21,14 @@ Error = compensated - true heading, wrapped to (-180, 180], on the test sweep.
 from __future__ import annotations
 
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
+from multiprocessing import get_context
 from typing import Callable, Literal
 
 import numpy as np
 import pandas as pd
+import torch
 from scipy.stats import mannwhitneyu
 
 from ..angles import wrap_deg
@@ -445,15 +448,28 @@ def implied_noise_ut(paper_min_deg: float, paper_max_deg: float, errors: Compass
     return best
 
 
+def _noise_level(noise, params, seeds, methods, errors, sim_seed) -> pd.DataFrame:
+    torch.set_num_threads(1)          # one core per worker process
+    sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=float(noise)), seed=sim_seed)))
+    return seed_study(sw, params, seeds, methods).assign(noise_ut=float(noise))
+
+
 def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), methods=MAIN_METHODS,
-                errors: CompassErrors = CompassErrors(), sim_seed: int = 2024) -> pd.DataFrame:
+                errors: CompassErrors = CompassErrors(), sim_seed: int = 2024, workers: int = 1) -> pd.DataFrame:
     """:func:`seed_study` on sweeps simulated with each magnetometer noise in ``levels_ut`` (the same
-    compass and simulation seed, only the noise changes); one row per (noise_ut, method, seed)."""
-    frames = []
-    for noise in levels_ut:
+    compass and simulation seed, only the noise changes); one row per (noise_ut, method, seed).  With
+    ``workers`` > 1 the levels run in that many processes (results identical: every run has its own
+    generator)."""
+    levels = [float(v) for v in levels_ut]
+    for noise in levels:
         check_param("noise level", noise, lo=0)
-        sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=float(noise)), seed=sim_seed)))
-        frames.append(seed_study(sw, params, seeds, methods).assign(noise_ut=float(noise)))
+    check_param("workers", workers, lo=1, integer=True)
+    args = (params, list(seeds), tuple(methods), errors, sim_seed)
+    if workers == 1 or len(levels) == 1:
+        frames = [_noise_level(v, *args) for v in levels]
+    else:
+        with ProcessPoolExecutor(max_workers=int(workers), mp_context=get_context("spawn")) as pool:
+            frames = list(pool.map(_noise_level, levels, *([a] * len(levels) for a in args)))
     return pd.concat(frames, ignore_index=True)
 
 
