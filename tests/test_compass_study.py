@@ -75,8 +75,12 @@ def test_claims_and_verdict_table(sw):
     vt = verdict_table(cl)
     assert list(vt.columns) == list(READINGS) and vt.notna().all().all()
     # the default noise floor is wider than ADE-BP's printed range: that claim cannot be judged
-    rng_claims = [c for c in cl if c.claim.startswith("ADE-BP error within")]
-    assert rng_claims and all(c.reproduced is None for c in rng_claims)
+    def ranges(name):
+        return [c for c in cl if c.claim.startswith(f"{name} error within") and "default" in c.claim]
+
+    assert all(c.reproduced is None for c in ranges("ADE-BP") + ranges("DE-BP"))   # floor -0.20..+0.29
+    assert all(c.reproduced in (True, False) for c in ranges("LS") + ranges("BP"))   # wider than the floor
+    assert all(c.reproduced is False for c in ranges("LS"))                          # ours -1.36..+1.56
     assert len(ordering_table(runs)) == 3 * 2          # bp_adam not run: two BP variants per reading
 
 
