@@ -294,7 +294,7 @@ def claims(runs: pd.DataFrame, reach: pd.Series, g_sum: pd.DataFrame, small_sum:
             Claim(f"back-tuning beats a plain ELM of {params.elm_nodes} nodes", "higher accuracy",
                   f"{bt:.3f} vs {med['elm']:.3f} deg rms", bool(bt < med["elm"]), r),
             Claim("back-tuning needs fewer nodes for the same training goal", "solves the node-count choice",
-                  f"{nodes:.0f} nodes vs {reach.get('ELM', np.nan):.0f} for a plain ELM",
+                  f"{nodes:.1f} nodes vs {reach.get('ELM', np.nan):.1f} for a plain ELM (medians)",
                   bool(nodes < reach.get("ELM", np.inf)), r)]
     prep, raw = g_sum.loc["median filter + screen (patent)", "test rms (deg)"], g_sum.loc["no preparation",
                                                                                          "test rms (deg)"]
