@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import math
+import zlib
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -116,7 +117,7 @@ class Table:
     def _repr_html_(self) -> str:
         f = self.formatted()
         styler = f.style if self.index else f.style.hide(axis="index")
-        styler = styler.set_uuid(f"t{abs(hash(tuple(f.columns))) % 10**8}")
+        styler = styler.set_uuid(f"t{zlib.crc32('|'.join(f.columns).encode()) % 10**8}")   # stable across runs
         styler = styler.set_table_attributes(f'class="navbook-table" style="{_CSS}"')
         styler = styler.set_table_styles([{"selector": "th", "props": _CELL + "text-align:left;"},
                                           {"selector": "td", "props": _CELL}])
