@@ -75,7 +75,7 @@ def _simulate_compass(args) -> int:
     errors = CompassErrors()
     if args.noise_ut is not None:
         errors = replace(errors, noise_ut=args.noise_ut)
-    frame = simulate_train_test(errors.validate(), seed=args.seed)
+    frame = simulate_train_test(errors, seed=args.seed)
     path = write_new_csv(frame, args.out, overwrite=args.overwrite)
     print(f"wrote {len(frame)} readings ({frame.sweep.nunique()} sweeps) to {path}")
     return 0

@@ -34,3 +34,9 @@ def check_param(name: str, value: Any, *, lo: float | None = None, hi: float | N
     if hi is not None and (v > hi or (hi_open and v == hi)):
         rel = "<" if hi_open else "<="
         raise InputError(f"parameter {name}={value!r}: must be {rel} {hi:g}")
+
+
+def check_choice(name: str, value: Any, options) -> None:
+    """Raise :class:`InputError` unless ``value`` is one of ``options`` (a ``typing.Literal``'s values)."""
+    if value not in tuple(options):
+        raise InputError(f"parameter {name}={value!r}: must be one of {', '.join(map(repr, options))}")

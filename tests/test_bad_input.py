@@ -9,6 +9,9 @@ import pytest
 from navlib.data.compass_sweeps import load_sweeps
 
 from navlib.sensors.compass import simulate_train_test
+from navlib.methods.bpnet import AdamParams
+from navlib.methods.de import DEParams
+from navlib.methods.lm import LMParams
 from navlib.studies.paper_a import StudyParams
 from navlib.errors import InputError
 from navlib.data.tables import write_new_csv
@@ -122,12 +125,17 @@ def test_write_never_overwrites(tmp_path, good):
     assert p.read_bytes() == before
 
 
-@pytest.mark.parametrize("kw,name", [({"pop_size": 3}, "NP"), ({"de_f": 0}, "F"), ({"de_f": 2.1}, "F"),
-                                     ({"ade_f_max": 3}, "F"), ({"de_cr": -0.1}, "CR"),
-                                     ({"n_hidden": 0}, "n_hidden"), ({"network_target": "x"}, "network_target")])
-def test_bad_notebook_parameters(kw, name):
-    with pytest.raises(InputError, match=name):
-        StudyParams(**kw).validate()
+@pytest.mark.parametrize("make,name", [
+    (lambda: StudyParams(de=DEParams(pop_size=3)), "NP"), (lambda: DEParams(f=0), "F"),
+    (lambda: DEParams(f=2.1), "F"), (lambda: DEParams(f_max=3), "F"), (lambda: DEParams(cr=-0.1), "CR"),
+    (lambda: StudyParams(n_hidden=0), "n_hidden"), (lambda: StudyParams(network_target="x"), "network_target"),
+    (lambda: StudyParams(hybrid_target="deg"), "hybrid_target"), (lambda: LMParams(mu_inc=0.5), "mu_inc"),
+    (lambda: LMParams(max_fail=0), "max_fail"), (lambda: AdamParams(lr=0), "lr"),
+    (lambda: StudyParams(de={"pop_size": 95}), "de")])
+def test_bad_notebook_parameters(make, name):
+    with pytest.raises(InputError, match=name) as err:
+        make()
+    assert "\n" not in str(err.value)
 
 
 def test_negative_noise_parameter():
@@ -135,7 +143,7 @@ def test_negative_noise_parameter():
 
     from navlib.sensors.compass import CompassErrors
     with pytest.raises(InputError, match="noise_ut=-0.1"):
-        replace(CompassErrors(), noise_ut=-0.1).validate()
+        replace(CompassErrors(), noise_ut=-0.1)
 
 
 def test_cli_refuses_to_overwrite_and_exits_2(tmp_path):

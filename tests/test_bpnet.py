@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 import torch
 
-from navlib.methods.bpnet import (GradientParams, forward_population, n_params, sse_objective, train_de,
-
-    train_gradient, unpack)
+from navlib.methods.bpnet import (AdamParams, forward_population, n_params, output_jacobian, sse_objective,
+                                  train_adam_many, train_de_many, train_least_squares, unpack)
+from navlib.methods.seeding import generators
 from navlib.methods.de import DEParams
 from navlib.errors import InputError
 
@@ -36,68 +36,97 @@ def test_sse_objective_in_degrees():
     assert np.allclose(obj32(pop), ref, rtol=1e-4)
 
 
-def test_gradient_bp_fits_smooth_map():
-    """LM reaches the exact map from most starts (a 1-6-1 net has local minima); Adam gets close."""
+def test_output_jacobian_matches_finite_differences():
+    rng = np.random.default_rng(5)
+    xn = np.linspace(-1, 1, 9)
+    for act in ("logsig", "tansig"):
+        th = rng.uniform(-2, 2, (2, n_params(4)))
+        out, jac = output_jacobian(th, xn, 4, act)
+        np.testing.assert_allclose(out, forward_population(th, xn, 4, activation=act), atol=1e-12)
+        eps = 1e-6
+        for d in range(th.shape[1]):
+            e = np.zeros_like(th)
+            e[:, d] = eps
+            fd = (forward_population(th + e, xn, 4, activation=act)
+                  - forward_population(th - e, xn, 4, activation=act)) / (2 * eps)
+            np.testing.assert_allclose(jac[:, :, d], fd, atol=1e-7)
+
+
+def test_second_order_and_adam_fit_a_smooth_map():
+    """LM reaches the exact map from most starts.  Adam from U(-1, 1) in 3000 epochs learns the trend but
+    hardly the two-cycle wiggle (a straight line leaves 1.95 deg RMS; Adam's median is just under it, its
+    normalised MSE falls by more than two orders of magnitude from the start) -- the chapter's finding
+    that Adam with this budget stays degrees away from the floor."""
+    torch.set_num_threads(1)
     x = np.linspace(-10, 350, 121)
     t = np.linspace(0, 360, 121)
     t = t + 3 * np.sin(np.radians(2 * t))
-    rms = {m: [np.sqrt(np.mean((train_gradient(x, t, 6, GradientParams(method=m, seed=s)).predict(x) - t) ** 2))
-               for s in range(5)] for m in ("lm", "adam")}
-    assert sum(r < 0.01 for r in rms["lm"]) >= 3
-    assert np.median(rms["adam"]) < 2.0          # a straight line leaves 2.1 deg RMS
+    line = np.polyval(np.polyfit(x, t, 1), x)
+    line_rms = np.sqrt(np.mean((line - t) ** 2))
+    lm = [np.sqrt(np.mean((train_least_squares(x, t, 6, g).predict(x) - t) ** 2)) for g in generators(range(5))]
+    nets = train_adam_many(x, t, 6, AdamParams(), generators(range(5)))
+    adam = [np.sqrt(np.mean((n.predict(x) - t) ** 2)) for n in nets]
+    assert line_rms > 1.9
+    assert sum(r < 0.01 for r in lm) >= 3
+    assert np.median(adam) < line_rms
+    assert all(n.history[-1] < n.history[0] / 100 for n in nets)
 
 
 def test_adam_training_is_reproducible():
     torch.set_num_threads(1)
     x = np.linspace(0, 1, 20)
-    a = train_gradient(x, x ** 2, 3, GradientParams(epochs=50, seed=4))
-    b = train_gradient(x, x ** 2, 3, GradientParams(epochs=50, seed=4))
+    a = train_adam_many(x, x ** 2, 3, AdamParams(epochs=50), generators([4]))[0]
+    b = train_adam_many(x, x ** 2, 3, AdamParams(epochs=50), generators([4]))[0]
     assert np.array_equal(a.theta, b.theta)
 
 
-def test_de_bp_improves_over_generations_and_reports_float64_fitness():
+def test_de_bp_beats_random_search_and_reports_float64_fitness():
+    """The evolved net is far better than the best of as many random nets as DE evaluated (a DE whose
+    mutation, crossover or selection were broken would not be)."""
     x = np.linspace(0, 360, 61)
     t = x + 4 * np.sin(np.radians(x))
-    net, res = train_de(x, t, 3, DEParams(pop_size=30, max_generations=200, seed=0, adaptive=True))
-    assert res.history[-1] < res.history[0]
+    p = DEParams(pop_size=30, max_generations=200, adaptive=True, target_fitness=-1)
+    nets, res = train_de_many(x, t, 3, p, generators([0]))
+    net = nets[0]
+    objective, _, _ = sse_objective(x, t, 3, np.float64)
+    random_best = objective(np.random.default_rng(0).uniform(-10, 10, (res[0].n_evaluations, n_params(3)))).min()
+    assert net.info["fitness"] < random_best / 4
     assert net.info["fitness"] == pytest.approx(np.sum((net.predict(x) - t) ** 2), rel=1e-9)
     assert net.method == "ADE-BP"
 
 
 def test_bad_network_inputs():
+    g = generators([0])
     with pytest.raises(InputError, match="n_hidden"):
-        train_gradient([0, 1, 2], [0, 1, 2], 0)
+        train_adam_many([0, 1, 2], [0, 1, 2], 0, AdamParams(), g)
     with pytest.raises(InputError, match="equal length"):
-        train_gradient([0, 1, 2], [0, 1], 2)
+        train_adam_many([0, 1, 2], [0, 1], 2, AdamParams(), g)
     with pytest.raises(InputError, match="constant"):
-        train_gradient([1, 1, 1], [0, 1, 2], 2)
-    with pytest.raises(InputError, match="method"):
-        train_gradient([0, 1, 2], [0, 1, 2], 2, GradientParams(method="sgd"))
+        train_adam_many([1, 1, 1], [0, 1, 2], 2, AdamParams(), g)
+    with pytest.raises(InputError, match="rngs"):
+        train_adam_many([0, 1, 2], [0, 1, 2], 2, AdamParams(), [3])
 
 
 def test_train_adam_many_matches_one_at_a_time():
-    from navlib.methods.bpnet import train_adam_many
-
+    torch.set_num_threads(1)
     x = np.linspace(0, 360, 15)
     t = x + 10 * np.sin(np.radians(x))
-    gp = GradientParams(epochs=200, lr=0.01)
-    nets = train_adam_many(x, t, 5, gp, seeds=[0, 3, 7])
+    ap = AdamParams(epochs=200, lr=0.01)
+    nets = train_adam_many(x, t, 5, ap, generators([0, 3, 7]))
     xt = np.linspace(0, 360, 121)
     for s, net in zip([0, 3, 7], nets):
-        ref = train_gradient(x, t, 5, GradientParams(epochs=200, lr=0.01, seed=s))
+        ref = train_adam_many(x, t, 5, ap, generators([s]))[0]
         np.testing.assert_allclose(net.predict(xt), ref.predict(xt), atol=1e-6)
         np.testing.assert_allclose(net.history, ref.history, rtol=1e-9)
     assert not np.allclose(nets[0].theta, nets[1].theta)
-    with pytest.raises(InputError, match="adam"):
-        train_adam_many(x, t, 5, GradientParams(method="lm"))
 
 
 def test_second_order_training_of_an_oversized_net_falls_back_to_trf_and_fits():
-    """LM needs at least as many readings as weights; with fewer, the same problem is solved by TRF."""
+    """MINPACK's LM needs at least as many readings as weights; with fewer, TRF solves the same problem."""
     x = np.linspace(0, 360, 8)
     t = x + 5 * np.sin(np.radians(x))
-    net = train_gradient(x, t, 20, GradientParams(method="lm", seed=0))
+    net = train_least_squares(x, t, 20, generators([0])[0])
     assert net.method == "BP (TRF)"
     assert np.max(np.abs(net.predict(x) - t)) < 1e-3
-    small = train_gradient(np.linspace(0, 360, 121), np.linspace(0, 360, 121), 2, GradientParams(method="lm"))
+    small = train_least_squares(np.linspace(0, 360, 121), np.linspace(0, 360, 121), 2, generators([0])[0])
     assert small.method == "BP (LM)"

@@ -2,7 +2,10 @@ import numpy as np
 import pytest
 from scipy.optimize import differential_evolution
 
-from navlib.methods.de import DEParams, ade_cr, ade_f, distinct_triples, evolve
+from dataclasses import replace
+
+from navlib.methods.de import DEParams, ade_cr, ade_f, distinct_triples, evolve, evolve_many
+from navlib.methods.seeding import generators
 from navlib.errors import InputError
 
 
@@ -43,13 +46,33 @@ def test_de_is_deterministic_with_seed_and_respects_bounds():
     assert np.all(np.abs(a.population) <= 2.0)
 
 
-def test_de_matches_scipy_quality_on_same_budget():
-    ours = evolve(rastrigin, 4, DEParams(pop_size=40, max_generations=300, f=0.5, cr=0.6, bound=5.12,
-                                         target_fitness=-1, seed=3))
-    ref = differential_evolution(lambda x: rastrigin(x.T), [(-5.12, 5.12)] * 4, strategy="rand1bin",
-                                 popsize=10, maxiter=300, mutation=0.5, recombination=0.6, tol=0,
-                                 polish=False, init="random", updating="deferred", vectorized=True, seed=3)
-    assert ours.fitness <= ref.fun + 1.0
+def test_de_matches_scipy_on_the_same_budget():
+    """Ours and scipy run the same DE/rand/1/bin (deferred updating): on a budget where neither converges,
+    their final fitness over 12 seeds has the same distribution (medians within a factor 1.5; a broken
+    mutation, crossover or selection moves ours by orders of magnitude)."""
+    def sphere(pop):
+        return np.sum((pop - 1.5) ** 2, axis=1)
+
+    ours = [r.fitness for r in evolve_many(sphere, 10, DEParams(pop_size=30, max_generations=60, f=0.5, cr=0.6,
+                                                                  bound=5, target_fitness=-1),
+                                           generators(range(12)))]
+    ref = [differential_evolution(lambda x: sphere(x.T), [(-5, 5)] * 10, strategy="rand1bin", popsize=3,
+                                  maxiter=59, mutation=0.5, recombination=0.6, tol=0, atol=0, polish=False,
+                                  init="random", updating="deferred", vectorized=True, seed=s).fun
+           for s in range(12)]
+    ratio = np.median(ours) / np.median(ref)
+    assert 1 / 1.5 < ratio < 1.5, (np.median(ours), np.median(ref))
+
+
+def test_seed_batched_runs_equal_runs_alone():
+    p = DEParams(pop_size=12, max_generations=80, bound=5, adaptive=True, target_fitness=0.5)
+    batch = evolve_many(shifted_sphere, 4, p, generators([0, 1, 2]))
+    for k in range(3):
+        alone = evolve_many(shifted_sphere, 4, p, generators([k]))[0]
+        np.testing.assert_array_equal(batch[k].x, alone.x)
+        assert batch[k].generations == alone.generations
+    assert len({r.generations for r in batch}) > 1 or all(r.generations == 80 for r in batch)
+    assert evolve(shifted_sphere, 4, replace(p, seed=2)).fitness == batch[2].fitness
 
 
 def test_ade_f_schedule():
@@ -85,4 +108,4 @@ def test_distinct_triples():
 ])
 def test_bad_de_parameters(field, value, msg):
     with pytest.raises(InputError, match=msg):
-        evolve(shifted_sphere, 2, DEParams(**{field: value}))
+        DEParams(**{field: value})

@@ -1,37 +1,48 @@
-"""Paper A's single-input single-output BP network (1-M-1) and its three trainers.
+"""Paper A's single-input single-output BP network (1-M-1), MATLAB's default BP network, and their trainers.
 
 Network (Yue et al., eqs 1-4): input = measured heading x, output = true heading; both min-max normalised
-(:class:`navlib.methods.scaling.MinMax`), ``M`` sigmoid hidden neurons, linear (purelin) output:
+(:class:`navlib.methods.scaling.MinMax`), ``M`` hidden neurons with activation ``g``, linear output:
 
-    x' = (x - x_min)/(x_max - x_min),   y_j = sigmoid(w_j x' + b_j),   o' = sum_j v_j y_j + c,
-    o = d_min + o' (d_max - d_min)
+    x' = scale(x),   y_j = g(w_j x' + b_j),   o' = sum_j v_j y_j + c,   o = scale^-1(o')          (eq-bp)
+
+- paper A's net: ``g = logsig`` (sigmoid), ``scale`` onto [0, 1];
+- MATLAB's ``feedforwardnet`` (what a MATLAB user of 2015 gets from ``train``): ``g = tansig`` (tanh),
+  ``scale`` = ``mapminmax`` onto [-1, 1], Nguyen-Widrow initialisation (:func:`nguyen_widrow`),
+  Levenberg-Marquardt training (:mod:`navlib.methods.lm`).
 
 One parameter vector ``theta = [w (M), b (M), v (M), c]`` has ``D = 3M + 1`` entries (19 for M = 6).
-Fitness (paper eq 5-6, equation image lost in the OCR): ``J = sum_k (d_k - o_k)^2`` over the training
-points, in deg^2, on the de-normalised output.
+Fitness of the DE trainers (paper eq 5-6, equation image lost in the OCR): ``J = sum_k (d_k - o_k)^2``
+over the training points, in deg^2 on the de-normalised output (:func:`sse_objective`).
 
-Trainers:
+Trainers (each trains several runs at once, one generator per run, :mod:`navlib.methods.seeding`):
 
-- :func:`train_gradient`: back-propagation by full-batch gradient descent in torch. The paper does not
-  say which optimiser its "BP network" used; we use Adam (lr 0.01, 3000 epochs) on the normalised MSE.
-  ``method="lm"`` instead uses Levenberg-Marquardt (scipy ``least_squares(method='lm')``), the trainer of
-  the paper's reference [8]; with fewer readings than weights (LM cannot run) the same least-squares
-  problem is solved by scipy's trust-region reflective method.
-- :func:`train_de` with ``DEParams(adaptive=False)`` = DE-BP, ``adaptive=True`` = ADE-BP
-  (:mod:`navlib.methods.de`); the whole population is evaluated in one vectorised call.
+- :func:`train_de_many`: DE-BP / ADE-BP, every weight and threshold evolved (paper A, first reading);
+- :func:`train_hybrid_many`: the DE / ADE stage, then ``trainlm`` from its best individual (second
+  reading: DE chooses the initial weights of an ordinary BP training);
+- :func:`train_matlab_bp_many`: MATLAB's default BP (third reading);
+- :func:`train_adam_many`: back-propagation with Adam from U(-1, 1) weights (an extra row);
+- :func:`train_least_squares`: scipy's MINPACK LM (or TRF with fewer readings than weights) to
+  convergence, for patent B's small-sample study.
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 import torch
 from scipy.optimize import least_squares
 
-from .de import DEParams, DEResult, evolve
-from ..errors import InputError, check_param
+from ..errors import InputError, check_choice, check_param
+from .de import DEParams, DEResult, evolve_many
+from .lm import LMParams, dividerand, levenberg_marquardt
 from .scaling import MinMax
+
+Activation = Literal["logsig", "tansig"]
+ACTIVATIONS = ("logsig", "tansig")
+#: tansig's active input region (MATLAB ``tansig('active')``), used by the Nguyen-Widrow rule.
+TANSIG_ACTIVE = (-2.0, 2.0)
 
 
 def n_params(n_hidden: int) -> int:
@@ -44,26 +55,46 @@ def unpack(theta: np.ndarray, n_hidden: int):
     return theta[..., :m], theta[..., m:2 * m], theta[..., 2 * m:3 * m], theta[..., 3 * m]
 
 
-def forward_population(thetas: np.ndarray, xn: np.ndarray, n_hidden: int,
-                       dtype=np.float64) -> np.ndarray:
+def forward_population(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, dtype=np.float64,
+                       activation: Activation = "logsig") -> np.ndarray:
     """Normalised outputs of many networks at once: ``thetas (P, D)``, ``xn (N,)`` -> ``(P, N)`` (float64).
 
-    Uses ``sigmoid(z) = (1 + tanh(z/2))/2`` (overflow-free) with the hidden layer laid out ``(P, M, N)`` so
-    the innermost loop runs over the N points. ``dtype=np.float32`` computes the hidden layer in single
-    precision (twice as fast; output error ~3e-6 of the normalised span)."""
+    ``logsig`` is computed as ``(1 + tanh(z/2))/2`` (overflow-free) with the hidden layer laid out
+    ``(P, M, N)``.  ``dtype=np.float32`` computes the hidden layer in single precision."""
     w, b, v, c = unpack(np.atleast_2d(thetas), n_hidden)
-    hw, hb, hv = (0.5 * w).astype(dtype), (0.5 * b).astype(dtype), (0.5 * v).astype(dtype)
+    half = activation == "logsig"
+    k = 0.5 if half else 1.0
+    hw, hb = (k * w).astype(dtype), (k * b).astype(dtype)
     z = np.multiply(hw[:, :, None], np.asarray(xn, dtype=dtype)[None, None, :])
     z += hb[:, :, None]
     np.tanh(z, out=z)
-    out = np.matmul(hv[:, None, :], z)[:, 0, :].astype(np.float64)
-    out += (0.5 * v.sum(axis=1) + c)[:, None]
+    out = np.matmul((k * v).astype(dtype)[:, None, :], z)[:, 0, :].astype(np.float64)
+    out += ((0.5 * v.sum(axis=1) if half else 0.0) + c)[:, None]
     return out
+
+
+def output_jacobian(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, activation: Activation = "logsig"):
+    """``(o', do'/dtheta)`` of many networks: shapes ``(P, N)`` and ``(P, N, D)`` (float64).
+
+    ``do'/dw_j = v_j g'(z_j) x'``, ``do'/db_j = v_j g'(z_j)``, ``do'/dv_j = g(z_j)``, ``do'/dc = 1``, with
+    ``g' = g (1 - g)`` for logsig and ``1 - g^2`` for tansig."""
+    w, b, v, c = unpack(np.atleast_2d(thetas), n_hidden)
+    z = w[:, None, :] * xn[None, :, None] + b[:, None, :]                         # (P, N, M)
+    if activation == "logsig":
+        g = 0.5 * (1.0 + np.tanh(0.5 * z))
+        dg = g * (1.0 - g)
+    else:
+        g = np.tanh(z)
+        dg = 1.0 - g * g
+    out = np.einsum("pnm,pm->pn", g, v) + c[:, None]
+    vd = dg * v[:, None, :]
+    jac = np.concatenate([vd * xn[None, :, None], vd, g, np.ones(g.shape[:2] + (1,))], axis=2)
+    return out, jac
 
 
 @dataclass
 class BPNet:
-    """A trained 1-M-1 network with its input and output scalers."""
+    """A trained 1-M-1 network with its input and output scalers (:eq:`eq-bp`)."""
 
     theta: np.ndarray
     n_hidden: int
@@ -73,17 +104,20 @@ class BPNet:
     train_time_s: float = 0.0
     history: np.ndarray = field(default=None, repr=False)   # training loss per epoch / generation
     info: dict = field(default_factory=dict)
+    activation: Activation = "logsig"
 
     def predict(self, x) -> np.ndarray:
         xn = self.x_scale.transform(np.asarray(x, dtype=float))
-        return self.t_scale.inverse(forward_population(self.theta[None, :], xn, self.n_hidden)[0])
+        return self.t_scale.inverse(forward_population(self.theta[None, :], xn, self.n_hidden,
+                                                       activation=self.activation)[0])
 
 
 def sse_objective(x, t, n_hidden: int, dtype=np.float32):
-    """Vectorised fitness ``J(theta) = sum_k (d_k - o_k)^2`` (deg^2) over the training set, plus the scalers.
+    """Vectorised fitness ``J(theta) = sum_k (d_k - o_k)^2`` (deg^2) of paper A's net over the training set,
+    plus the scalers.
 
     The hidden layer runs in ``dtype`` (float32 by default during evolution: output error ~1e-3 deg per
-    point, far below the 0.1 deg noise floor); the final network is re-scored in float64.  Layout: one
+    point, far below the 0.1 deg noise floor); final networks are re-scored in float64.  Layout: one
     GEMM ``[w b] @ [x'; 1]`` gives all ``P*M`` pre-activations at once, one batched matmul the outputs."""
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
     xn = xs.transform(np.asarray(x, dtype=float))
@@ -119,107 +153,76 @@ def _check_xy(x, t, n_hidden):
     return x, t
 
 
-def train_de(x, t, n_hidden: int = 6, params: DEParams = DEParams()) -> tuple[BPNet, DEResult]:
-    """DE-BP / ADE-BP: evolve all weights and thresholds of the 1-M-1 net (paper A)."""
-    x, t = _check_xy(x, t, n_hidden)
-    objective, xs, ts = sse_objective(x, t, n_hidden)
-    res = evolve(objective, n_params(n_hidden), params)
-    name = "ADE-BP" if params.adaptive else "DE-BP"
-    exact, _, _ = sse_objective(x, t, n_hidden, np.float64)
-    return BPNet(res.x, n_hidden, xs, ts, name, res.elapsed_s, res.history,
-                 {"generations": res.generations, "fitness": float(exact(res.x[None, :])[0])}), res
+# ------------------------------------------------------------------------------------------ initialisation
+def nguyen_widrow(n_hidden: int, rng: np.random.Generator, n_inputs: int = 1,
+                  active: tuple[float, float] = TANSIG_ACTIVE) -> tuple[np.ndarray, np.ndarray]:
+    """MATLAB's ``initnw`` for a hidden layer whose inputs lie in [-1, 1] (after ``mapminmax``).
+
+    Weight magnitude ``0.7 H^(1/n)`` along a random unit direction per unit, biases
+    ``0.7 H^(1/n) linspace(-1, 1, H) sign(w_1)``, both then stretched from [-1, 1] to the activation's
+    active region (``[-2, 2]`` for tansig).  For one input the units' active regions
+    ``|w x + b| <= 2`` are centred at ``-linspace(-1, 1, H)`` (in random order of sign) and together span
+    the input range.  Returns ``w (H, n)`` and ``b (H,)``."""
+    check_param("n_hidden", n_hidden, lo=1, integer=True)
+    check_param("n_inputs", n_inputs, lo=1, integer=True)
+    mag = 0.7 * n_hidden ** (1.0 / n_inputs)
+    d = rng.standard_normal((n_hidden, n_inputs))
+    w = mag * d / np.linalg.norm(d, axis=1, keepdims=True)
+    b = np.zeros(n_hidden) if n_hidden == 1 else mag * np.linspace(-1, 1, n_hidden) * np.sign(w[:, 0])
+    half, mid = 0.5 * (active[1] - active[0]), 0.5 * (active[1] + active[0])
+    return half * w, half * b + mid
 
 
+def matlab_initial_weights(n_hidden: int, rng: np.random.Generator) -> np.ndarray:
+    """Initial ``theta`` of ``feedforwardnet(n_hidden)`` on one input: Nguyen-Widrow hidden layer
+    (:func:`nguyen_widrow`); the purelin output layer has an unbounded active region, so ``initnw`` falls
+    back to ``rands``: output weights and bias uniform in [-1, 1]."""
+    w, b = nguyen_widrow(n_hidden, rng)
+    vc = rng.uniform(-1.0, 1.0, n_hidden + 1)
+    return np.concatenate([w[:, 0], b, vc])
+
+
+# ------------------------------------------------------------------------------------------ trainers
 @dataclass(frozen=True)
-class GradientParams:
-    """Gradient back-propagation settings. ``method``: 'adam' (default) or 'lm' (Levenberg-Marquardt)."""
+class AdamParams:
+    """Back-propagation by full-batch Adam on the normalised MSE; weights start uniform in
+    [-init_bound, init_bound]."""
 
-    method: str = "adam"
     epochs: int = 3000
     lr: float = 0.01
-    init_bound: float = 1.0     # initial weights uniform in [-init_bound, init_bound]
-    seed: int = 0
+    init_bound: float = 1.0
 
-    def validate(self) -> "GradientParams":
-        if self.method not in ("adam", "lm"):
-            raise InputError(f"parameter method={self.method!r}: must be 'adam' or 'lm'")
+    def __post_init__(self):
         check_param("epochs", self.epochs, lo=1, integer=True)
         check_param("lr", self.lr, lo=0, lo_open=True)
         check_param("init_bound", self.init_bound, lo=0, lo_open=True)
-        return self
 
 
-def train_gradient(x, t, n_hidden: int = 6, params: GradientParams = GradientParams()) -> BPNet:
-    """Plain BP: minimise the normalised MSE by Adam (torch, full batch) or by Levenberg-Marquardt."""
+def _rngs(rngs) -> list:
+    rngs = list(rngs)
+    if not rngs or not all(isinstance(g, np.random.Generator) for g in rngs):
+        raise InputError("rngs: need at least one numpy Generator (see navlib.methods.seeding)")
+    return rngs
+
+
+def train_adam_many(x, t, n_hidden: int, params: AdamParams, rngs) -> list[BPNet]:
+    """Paper A's net trained by Adam, one independent net per generator in ``rngs``, all in one torch graph.
+
+    The summed loss has each net's own MSE as its only term in that net's weights and Adam's update is
+    element-wise, so every net follows the trajectory it would follow alone (up to rounding); the batch
+    saves the per-epoch overhead.  ``train_time_s`` is the batch time divided by the number of nets."""
     x, t = _check_xy(x, t, n_hidden)
-    params.validate()
+    rngs = _rngs(rngs)
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
     xn, tn = xs.transform(x), ts.transform(t)
-    rng = np.random.default_rng(params.seed)
-    theta0 = rng.uniform(-params.init_bound, params.init_bound, n_params(n_hidden))
-    t0 = time.perf_counter()
-    if params.method == "lm":
-        m = n_hidden
-
-        def jac(th):                     # d o'/d[w, b, v, c] with sigma' = sigma (1 - sigma)
-            s = 1.0 / (1.0 + np.exp(-np.clip(xn[:, None] * th[:m] + th[m:2 * m], -500, 500)))
-            ds = s * (1 - s) * th[2 * m:3 * m]
-            return np.hstack([ds * xn[:, None], ds, s, np.ones((len(xn), 1))])
-
-        # MINPACK's Levenberg-Marquardt needs at least as many residuals as weights; an over-sized net on
-        # few readings is solved by scipy's trust-region reflective method, same problem and Jacobian.
-        solver = "lm" if len(xn) >= n_params(n_hidden) else "trf"
-        sol = least_squares(lambda th: forward_population(th[None, :], xn, n_hidden)[0] - tn, theta0,
-                            jac=jac, method=solver, max_nfev=params.epochs)
-        theta, history = sol.x, np.array([2 * sol.cost / len(x)])
-        name = "BP (LM)" if solver == "lm" else "BP (TRF)"
-    else:
-        with torch.random.fork_rng():
-            torch.manual_seed(params.seed)
-            th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
-            X = torch.tensor(xn, dtype=torch.float64)
-            T = torch.tensor(tn, dtype=torch.float64)
-            opt = torch.optim.Adam([th], lr=params.lr)
-            m = n_hidden
-            history = np.empty(params.epochs)
-            for k in range(params.epochs):
-                opt.zero_grad()
-                h = torch.sigmoid(X[:, None] * th[:m] + th[m:2 * m])
-                loss = torch.mean((h @ th[2 * m:3 * m] + th[3 * m] - T) ** 2)
-                loss.backward()
-                opt.step()
-                history[k] = loss.item()
-            theta = th.detach().numpy().copy()
-        name = "BP (Adam)"
-    return BPNet(theta, n_hidden, xs, ts, name, time.perf_counter() - t0, history)
-
-
-def train_adam_many(x, t, n_hidden: int, params: GradientParams = GradientParams(),
-                    seeds=range(20)) -> list[BPNet]:
-    """:func:`train_gradient` with Adam for several seeds at once: one torch graph holds one independent
-    1-M-1 net per seed (initial weights drawn exactly as in :func:`train_gradient`).  The summed loss has
-    each net's own MSE as its only term in that net's weights, and Adam's update is element-wise, so every
-    net follows the same trajectory as when trained alone (up to floating-point rounding); the batch only
-    saves the per-epoch overhead, which dominates for small nets.  Returns one :class:`BPNet` per seed;
-    ``train_time_s`` is the batch time divided by the number of seeds."""
-    x, t = _check_xy(x, t, n_hidden)
-    params.validate()
-    if params.method != "adam":
-        raise InputError(f"parameter method={params.method!r}: train_adam_many trains with 'adam' only")
-    seeds = [int(s) for s in seeds]
-    if not seeds:
-        raise InputError("seeds: need at least one seed")
-    xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
-    xn, tn = xs.transform(x), ts.transform(t)
-    theta0 = np.stack([np.random.default_rng(s).uniform(-params.init_bound, params.init_bound,
-                                                        n_params(n_hidden)) for s in seeds])
+    theta0 = np.stack([g.uniform(-params.init_bound, params.init_bound, n_params(n_hidden)) for g in rngs])
     m = n_hidden
     t0 = time.perf_counter()
     th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
     X = torch.tensor(xn, dtype=torch.float64)
     T = torch.tensor(tn, dtype=torch.float64)
     opt = torch.optim.Adam([th], lr=params.lr)
-    history = np.empty((len(seeds), params.epochs))
+    history = np.empty((len(rngs), params.epochs))
     for k in range(params.epochs):
         opt.zero_grad()
         h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])     # (P, N, M)
@@ -229,5 +232,132 @@ def train_adam_many(x, t, n_hidden: int, params: GradientParams = GradientParams
         opt.step()
         history[:, k] = loss.detach().numpy()
     theta = th.detach().numpy().copy()
-    per_net = (time.perf_counter() - t0) / len(seeds)
-    return [BPNet(theta[i], n_hidden, xs, ts, "BP (Adam)", per_net, history[i]) for i in range(len(seeds))]
+    per_net = (time.perf_counter() - t0) / len(rngs)
+    return [BPNet(theta[i], n_hidden, xs, ts, "BP (Adam)", per_net, history[i]) for i in range(len(rngs))]
+
+
+def train_least_squares(x, t, n_hidden: int, rng: np.random.Generator, max_nfev: int = 3000,
+                        init_bound: float = 1.0) -> BPNet:
+    """Paper A's net fitted to convergence by scipy ``least_squares`` on the normalised residuals from
+    U(-init_bound, init_bound) weights: MINPACK's Levenberg-Marquardt, or trust-region reflective when
+    there are fewer readings than weights (MINPACK's LM cannot run then)."""
+    x, t = _check_xy(x, t, n_hidden)
+    check_param("max_nfev", max_nfev, lo=1, integer=True)
+    xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
+    xn, tn = xs.transform(x), ts.transform(t)
+    theta0 = rng.uniform(-init_bound, init_bound, n_params(n_hidden))
+    t0 = time.perf_counter()
+    solver = "lm" if len(xn) >= n_params(n_hidden) else "trf"
+    sol = least_squares(lambda th: output_jacobian(th[None], xn, n_hidden)[0][0] - tn, theta0,
+                        jac=lambda th: output_jacobian(th[None], xn, n_hidden)[1][0], method=solver,
+                        max_nfev=max_nfev)
+    name = "BP (LM)" if solver == "lm" else "BP (TRF)"
+    return BPNet(sol.x, n_hidden, xs, ts, name, time.perf_counter() - t0, np.array([2 * sol.cost / len(x)]))
+
+
+def _lm_functions(x, t, n_hidden, xs: MinMax, ts: MinMax, activation: Activation):
+    """Residuals (deg) and their Jacobian for :func:`navlib.methods.lm.levenberg_marquardt`: MATLAB scores
+    the de-normalised output (``performParam.normalization = 'none'``)."""
+    xn = xs.transform(x)
+    gain, lo, out_lo = float(ts.gain[0]), float(ts.lo[0]), ts.out_lo
+
+    def residuals(th):
+        return lo + (forward_population(th, xn, n_hidden, activation=activation) - out_lo) * gain - t
+
+    def jacobian(th):
+        return gain * output_jacobian(th, xn, n_hidden, activation)[1]
+
+    return residuals, jacobian
+
+
+def train_lm_many(x, t, n_hidden: int, theta0: np.ndarray, xs: MinMax, ts: MinMax,
+                  activation: Activation = "logsig", lm: LMParams = LMParams(), splits=None,
+                  method: str = "BP (trainlm)") -> list[BPNet]:
+    """``trainlm`` (:func:`navlib.methods.lm.levenberg_marquardt`) from ``theta0 (S, D)`` for S nets at
+    once.  ``splits``: None (every reading trains, no validation stop) or one ``(train, val, test)`` index
+    triple per net (MATLAB's ``dividerand``; the test part is held out and unused)."""
+    x, t = _check_xy(x, t, n_hidden)
+    check_choice("activation", activation, ACTIVATIONS)
+    theta0 = np.atleast_2d(np.asarray(theta0, dtype=float))
+    res_fn, jac_fn = _lm_functions(x, t, n_hidden, xs, ts, activation)
+    tr_mask = val_mask = None
+    if splits is not None:
+        if len(splits) != theta0.shape[0]:
+            raise InputError(f"splits: one per net, got {len(splits)} for {theta0.shape[0]} nets")
+        tr_mask = np.zeros((len(splits), len(x)), bool)
+        val_mask = np.zeros_like(tr_mask)
+        for i, (tr, va, _) in enumerate(splits):
+            tr_mask[i, tr], val_mask[i, va] = True, True
+    t0 = time.perf_counter()
+    res = levenberg_marquardt(res_fn, jac_fn, theta0, lm, tr_mask, val_mask)
+    per_net = (time.perf_counter() - t0) / theta0.shape[0]
+    nets = []
+    for i in range(theta0.shape[0]):
+        h = res.perf[i]
+        nets.append(BPNet(res.theta[i].copy(), n_hidden, xs, ts, method, per_net, h[np.isfinite(h)],
+                          {"epochs": int(res.epochs[i]), "stop": res.stop[i],
+                           "best_epoch": int(res.best_epoch[i]),
+                           "val_history": res.val_perf[i][np.isfinite(res.val_perf[i])]}, activation))
+    return nets
+
+
+def train_matlab_bp_many(x, t, n_hidden: int, rngs, lm: LMParams = LMParams(),
+                         validation: bool = False) -> list[BPNet]:
+    """MATLAB's default BP net, one per generator: ``feedforwardnet(n_hidden)`` (tansig hidden, purelin
+    output, ``mapminmax`` of input and target onto [-1, 1] computed on all readings, Nguyen-Widrow
+    initialisation) trained by ``trainlm``; with ``validation`` the readings are split by ``dividerand``
+    70/15/15 and training stops after ``max_fail`` validation failures (MATLAB's default), without it every
+    reading trains.  Each generator draws the initial weights, then the split."""
+    x, t = _check_xy(x, t, n_hidden)
+    rngs = _rngs(rngs)
+    xs, ts = MinMax.fit(x, name="network input", out=(-1, 1)), MinMax.fit(t, name="network target", out=(-1, 1))
+    theta0 = np.stack([matlab_initial_weights(n_hidden, g) for g in rngs])
+    splits = [dividerand(len(x), g) for g in rngs] if validation else None
+    label = "BP MATLAB (trainlm" + (", val. stop)" if validation else ")")
+    return train_lm_many(x, t, n_hidden, theta0, xs, ts, "tansig", lm, splits, label)
+
+
+def train_de_many(x, t, n_hidden: int, params: DEParams, rngs) -> tuple[list[BPNet], list[DEResult]]:
+    """DE-BP / ADE-BP (paper A, first reading): every weight and threshold of paper A's net evolved by
+    :func:`navlib.methods.de.evolve_many` on the fitness :func:`sse_objective`, one run per generator,
+    all runs' populations in one array per generation.  ``info['fitness']`` is re-scored in float64."""
+    x, t = _check_xy(x, t, n_hidden)
+    rngs = _rngs(rngs)
+    objective, xs, ts = sse_objective(x, t, n_hidden)
+    results = evolve_many(objective, n_params(n_hidden), params, rngs)
+    exact, _, _ = sse_objective(x, t, n_hidden, np.float64)
+    name = "ADE-BP" if params.adaptive else "DE-BP"
+    nets = [BPNet(r.x, n_hidden, xs, ts, name, r.elapsed_s / len(rngs), r.history,
+                  {"generations": r.generations, "fitness": float(exact(r.x[None, :])[0])}) for r in results]
+    return nets, results
+
+
+def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
+                      validation: bool = False, target: Literal["deg2", "normalised"] = "normalised"
+                      ) -> list[BPNet]:
+    """DE / ADE-initialised BP (paper A, second reading): the DE stage of :func:`train_de_many` with the
+    paper's settings, then ``trainlm`` on the same net (logsig, [0, 1] scaling) from the stage's best
+    individual (:func:`train_lm_many`; with ``validation`` on a ``dividerand`` 70/15/15 split drawn from
+    the run's generator after the DE stage).
+
+    ``target`` says how the paper's stopping value ``params.target_fitness`` is read: ``'deg2'`` (a sum of
+    squares in deg^2, never reached) or ``'normalised'`` (a sum of squares of the [0, 1]-normalised
+    errors, i.e. ``target_fitness span^2`` in deg^2: reached early, the DE stage then only picks initial
+    weights).  ``info`` keeps the stage's ``de_generations``, ``de_fitness`` (deg^2), ``de_theta``."""
+    check_choice("target", target, ("deg2", "normalised"))
+    x, t = _check_xy(x, t, n_hidden)
+    rngs = _rngs(rngs)
+    span = float(np.ptp(t))
+    stage = params if target == "deg2" else replace(params, target_fitness=params.target_fitness * span ** 2)
+    de_nets, _ = train_de_many(x, t, n_hidden, stage, rngs)
+    theta0 = np.stack([n.theta for n in de_nets])
+    splits = [dividerand(len(x), g) for g in rngs] if validation else None
+    name = ("ADE-BP" if params.adaptive else "DE-BP") + " hybrid (trainlm" + (", val. stop)" if validation
+                                                                              else ")")
+    nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
+                         splits, name)
+    for net, de in zip(nets, de_nets):
+        net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
+                        de_theta=de.theta, de_history=de.history)
+        net.train_time_s += de.train_time_s
+    return nets

@@ -30,11 +30,15 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError, check_param
+from .seeding import generators
 
 
 @dataclass(frozen=True)
 class DEParams:
-    """Settings of DE/rand/1/bin; ``adaptive=True`` gives paper A's ADE. Defaults are paper A's."""
+    """Settings of DE/rand/1/bin; ``adaptive=True`` gives paper A's ADE. Defaults are paper A's.
+
+    ``seed`` is the run index of :mod:`navlib.methods.seeding` used by :func:`evolve` (``evolve_many``
+    takes one generator per run instead)."""
 
     pop_size: int = 95
     max_generations: int = 3000
@@ -47,12 +51,14 @@ class DEParams:
     cr_min: float = 0.1
     cr_max: float = 0.9
     bound: float = 10.0          # search box [-bound, bound] for every gene (initial population and trials)
-    seed: int | None = 0
+    seed: int = 0
 
-    def validate(self) -> "DEParams":
+    def __post_init__(self):
         check_param("NP (pop_size)", self.pop_size, lo=4, integer=True)
         check_param("max_generations", self.max_generations, lo=1, integer=True)
         check_param("bound", self.bound, lo=0, lo_open=True)
+        check_param("target_fitness", self.target_fitness)
+        check_param("seed", self.seed, lo=0, integer=True)
         for name in ("f", "f_min", "f_max"):
             check_param(f"F ({name})", getattr(self, name), lo=0, lo_open=True, hi=2)
         for name in ("cr", "cr_min", "cr_max"):
@@ -61,7 +67,6 @@ class DEParams:
             raise InputError(f"parameter f_min={self.f_min} is above f_max={self.f_max}")
         if self.cr_min > self.cr_max:
             raise InputError(f"parameter cr_min={self.cr_min} is above cr_max={self.cr_max}")
-        return self
 
 
 def ade_f(generation, max_generations: int, f_min: float = 0.3, f_max: float = 0.9):
@@ -115,58 +120,94 @@ def distinct_triples(rng: np.random.Generator, n: int, batch: int | None = None)
 
 def evolve(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams = DEParams(),
            initial: np.ndarray | None = None) -> DEResult:
-    """Minimise ``objective`` over the box ``[-bound, bound]^dim`` with DE/rand/1/bin (or ADE).
+    """Minimise ``objective`` over the box ``[-bound, bound]^dim`` with DE/rand/1/bin (or ADE): one run,
+    seeded by ``params.seed`` (:mod:`navlib.methods.seeding`); :func:`evolve_many` with one generator.
 
     Stops after ``max_generations`` or as soon as the best fitness is <= ``target_fitness``."""
-    params.validate()
+    init = None if initial is None else np.asarray(initial, dtype=float)[None]
+    return evolve_many(objective, dim, params, generators([params.seed]), init)[0]
+
+
+def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams,
+                rngs: list, initial: np.ndarray | None = None, chunk: int = 64) -> list[DEResult]:
+    """Several independent DE runs at once, one per generator in ``rngs``: every run's population lives in
+    one ``(S, NP, D)`` array and each generation makes one ``objective`` call on all ``S NP`` trials.
+
+    ``objective`` maps ``(K, D)`` to ``(K,)``.  Run ``s`` draws its random numbers from ``rngs[s]`` only, in
+    blocks of ``chunk`` generations, so its result does not depend on which other runs share the batch.
+    A run stops at ``max_generations`` or when its best fitness is <= ``target_fitness``; stopped runs
+    leave the batch.  ``initial``: optional ``(S, NP, D)`` starting populations."""
     check_param("dim", dim, lo=1, integer=True)
-    rng = np.random.default_rng(params.seed)
-    n, b = int(params.pop_size), float(params.bound)
+    rngs = list(rngs)
+    if not rngs:
+        raise InputError("evolve_many: need at least one generator")
+    n_runs, n, b, gmax = len(rngs), int(params.pop_size), float(params.bound), int(params.max_generations)
     t0 = time.perf_counter()
-    pop = rng.uniform(-b, b, (n, dim)) if initial is None else np.array(initial, dtype=float)
-    if pop.shape != (n, dim):
-        raise InputError(f"initial population has shape {pop.shape}, expected {(n, dim)}")
-    fit = np.asarray(objective(pop), dtype=float)
-    n_eval = n
-    history = np.empty(params.max_generations)
+    if initial is None:
+        pop = np.stack([g.uniform(-b, b, (n, dim)) for g in rngs])
+    else:
+        pop = np.array(initial, dtype=float)
+        if pop.shape != (n_runs, n, dim):
+            raise InputError(f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}")
+    fit = np.asarray(objective(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n)
+    f_schedule = (ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None)
+    history = np.full((n_runs, gmax), np.nan)
+    results: list = [None] * n_runs
+    ids = np.arange(n_runs)                 # run index of each row still in the batch
     rows = np.arange(n)
-    f_schedule = (ade_f(np.arange(params.max_generations), params.max_generations, params.f_min,
-                        params.f_max) if params.adaptive else None)
-    trial = np.empty_like(pop)
+
+    def finish(mask, g):
+        for j in np.flatnonzero(mask):
+            s, best = ids[j], int(np.argmin(fit[j]))
+            results[s] = DEResult(x=pop[j, best].copy(), fitness=float(fit[j, best]), generations=g,
+                                  n_evaluations=n * (g + 1), history=history[s, :g].copy(),
+                                  elapsed_s=time.perf_counter() - t0,
+                                  reached_target=bool(fit[j, best] <= params.target_fitness),
+                                  population=pop[j].copy())
+
     g = 0
-    chunk = 256
-    best = int(np.argmin(fit))
-    reached = fit[best] <= params.target_fitness
-    while g < params.max_generations and not reached:
-        if g % chunk == 0:      # random numbers for the next `chunk` generations, one call each
-            triples = distinct_triples(rng, n, chunk)
-            uniforms = rng.random((chunk, n, dim))
-            forced = rng.integers(0, dim, (chunk, n))
+    while True:
+        done = fit.min(axis=1) <= params.target_fitness
+        if g >= gmax:
+            done[:] = True
+        if done.any():
+            finish(done, g)
+            keep = ~done
+            if not keep.any():
+                break
+            ids, pop, fit = ids[keep], pop[keep], fit[keep]
+            if g % chunk:
+                tri, uni, forced, redraw = tri[keep], uni[keep], forced[keep], redraw[keep]
+        k = g % chunk
+        if k == 0:          # random numbers for the next `chunk` generations, per run
+            c = min(chunk, gmax - g)
+            draws = [(distinct_triples(rngs[s], n, c), rngs[s].random((c, n, dim), dtype=np.float32),
+                      rngs[s].integers(0, dim, (c, n)),
+                      rngs[s].uniform(-b, b, (c, n, dim)).astype(np.float32)) for s in ids]
+            tri, uni, forced, redraw = (np.stack(a) for a in zip(*draws))
+        s_count = ids.size
         if params.adaptive:
             f = f_schedule[g]
-            cr = ade_cr(fit, params.cr_min, params.cr_max)[:, None]
+            lo, hi = fit.min(axis=1, keepdims=True), fit.max(axis=1, keepdims=True)
+            spread = np.where(hi > lo, hi - lo, 1.0)
+            cr = np.where(hi > lo, params.cr_min + (params.cr_max - params.cr_min) * (fit - lo) / spread,
+                          params.cr_min)[..., None]
         else:
             f, cr = params.f, params.cr
-        k = g % chunk
-        x1, x2, x3 = np.take(pop, triples[k].T, axis=0)           # (3, NP, D) in one gather
-        np.subtract(x2, x3, out=trial)                            # mutation: x_r1 + F (x_r2 - x_r3)
+        sidx = np.arange(s_count)[:, None]
+        parents = pop[sidx[..., None], tri[:, k]]                          # (S, NP, 3, D) in one gather
+        trial = parents[:, :, 1] - parents[:, :, 2]                        # mutation x_r1 + F (x_r2 - x_r3)
         trial *= f
-        trial += x1
-        keep = uniforms[k] > cr                                   # binomial crossover, j_rand forced
-        keep[rows, forced[k]] = False
-        np.copyto(trial, pop, where=keep)
-        out = np.abs(trial) > b
-        if out.any():
-            trial[out] = rng.uniform(-b, b, int(np.count_nonzero(out)))
-        tfit = np.asarray(objective(trial), dtype=float)
-        n_eval += n
-        better = tfit <= fit                                      # greedy selection
-        np.copyto(pop, trial, where=better[:, None])
+        trial += parents[:, :, 0]
+        keep_parent = uni[:, k] > cr                                       # binomial crossover
+        keep_parent[sidx, rows, forced[:, k]] = False                        # j_rand forced from the mutant
+        np.copyto(trial, pop, where=keep_parent)
+        out = np.abs(trial) > b                                            # re-draw inside the box
+        np.copyto(trial, redraw[:, k], where=out)
+        tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(s_count, n)
+        better = tfit <= fit                                               # greedy selection
+        np.copyto(pop, trial, where=better[..., None])
         np.minimum(fit, tfit, out=fit)
-        best = int(np.argmin(fit))
-        history[g] = fit[best]
+        history[ids, g] = fit.min(axis=1)
         g += 1
-        reached = fit[best] <= params.target_fitness
-    return DEResult(x=pop[best].copy(), fitness=float(fit[best]), generations=g, n_evaluations=n_eval,
-                    history=history[:g].copy(), elapsed_s=time.perf_counter() - t0,
-                    reached_target=bool(reached), population=pop)
+    return results

@@ -41,15 +41,18 @@ ambiguous.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 import pandas as pd
 from scipy.special import expit
 
-from ..errors import InputError, check_param
+from ..errors import InputError, check_choice, check_param
+from .arrays import as_2d
+from .seeding import generator
 
 __all__ = [
-    "ACTIVATIONS", "SCHEDULES", "ELMParams", "ELMModel", "IncrementalELMParams",
+    "ACTIVATIONS", "SCHEDULES", "NodeDraw", "ELMParams", "ELMModel", "IncrementalELMParams",
     "random_nodes", "solve_output_weights", "fit_elm", "loss_and_gradients", "back_tune",
     "prune_nodes", "fit_incremental_elm",
 ]
@@ -80,26 +83,14 @@ def _check_seed(seed) -> None:
 def _as_rng(rng) -> np.random.Generator:
     if isinstance(rng, np.random.Generator):
         return rng
-    if rng is not None:
-        _check_seed(rng)
-        rng = int(rng)
-    return np.random.default_rng(rng)
-
-
-def _as_2d(name: str, values) -> np.ndarray:
-    v = np.asarray(values, dtype=float)
-    if v.ndim == 1:
-        v = v[:, None]
-    if v.ndim != 2 or v.shape[0] == 0 or v.shape[1] == 0:
-        raise InputError(f"{name}: need a non-empty 1-D or 2-D array (samples along axis 0), "
-                         f"got shape {np.shape(values)}")
-    if not np.all(np.isfinite(v)):
-        raise InputError(f"{name}: contains NaN or infinite values")
-    return v
+    if rng is None:
+        return np.random.default_rng()
+    _check_seed(rng)
+    return generator(int(rng))
 
 
 def _xt(x, t) -> tuple[np.ndarray, np.ndarray, bool]:
-    X, T = _as_2d("x", x), _as_2d("t", t)
+    X, T = as_2d(x, "x"), as_2d(t, "t")
     if X.shape[0] != T.shape[0]:
         raise InputError(f"x has {X.shape[0]} samples but t has {T.shape[0]}")
     return X, T, np.ndim(t) == 1
@@ -108,34 +99,35 @@ def _xt(x, t) -> tuple[np.ndarray, np.ndarray, bool]:
 # --------------------------------------------------------------------------------------------------
 # Plain ELM
 
-def _check_node_draw(p) -> None:
-    """Validate the fields :class:`ELMParams` and :class:`IncrementalELMParams` share: how hidden nodes are
-    drawn (activation, weight and bias ranges, seed)."""
-    _check_activation(p.activation)
-    check_param("weight_range", p.weight_range, lo=0, lo_open=True)
-    check_param("bias_range", p.bias_range, lo=0)
-    _check_seed(p.seed)
-
-
 @dataclass(frozen=True)
-class ELMParams:
-    """Plain ELM (Huang 2006; patent stage s701).
+class NodeDraw:
+    """How hidden nodes are drawn, shared by :class:`ELMParams` and :class:`IncrementalELMParams`:
+    ``activation``, input weights w_ij ~ U(-weight_range, weight_range), hidden biases
+    b_i ~ U(-bias_range, bias_range) (Huang 2006 uses 1 and 1 for inputs normalised to [0, 1]; a wider
+    range gives steeper, more local sigmoids and a better-conditioned H), and ``seed`` (a run index of
+    :mod:`navlib.methods.seeding`; ``None``: unseeded)."""
 
-    ``weight_range``/``bias_range``: input weights w_ij ~ U(-weight_range, weight_range) and hidden
-    biases b_i ~ U(-bias_range, bias_range) (Huang 2006 uses 1 and 1 for inputs normalised to [0, 1];
-    a wider range gives steeper, more local sigmoids and a better-conditioned H).
-    ``seed`` seeds ``numpy.random.default_rng`` (``None``: unseeded)."""
-
-    n_hidden: int = 10
-    activation: str = "sigmoid"
+    activation: Literal["sigmoid", "tanh"] = "sigmoid"
     weight_range: float = 1.0
     bias_range: float = 1.0
     seed: int | None = 0
 
-    def validate(self) -> "ELMParams":
+    def __post_init__(self):
+        _check_activation(self.activation)
+        check_param("weight_range", self.weight_range, lo=0, lo_open=True)
+        check_param("bias_range", self.bias_range, lo=0)
+        _check_seed(self.seed)
+
+
+@dataclass(frozen=True)
+class ELMParams(NodeDraw):
+    """Plain ELM (Huang 2006; patent stage s701): ``n_hidden`` random nodes (drawn as :class:`NodeDraw`)."""
+
+    n_hidden: int = 10
+
+    def __post_init__(self):
         check_param("n_hidden", self.n_hidden, lo=1, integer=True)
-        _check_node_draw(self)
-        return self
+        super().__post_init__()
 
 
 @dataclass
@@ -165,12 +157,12 @@ class ELMModel:
 
     @property
     def n_weights(self) -> int:
-        """Number of trainable numbers, d L + L + L m."""
+        """Number of trainable numbers: d L + L + L m."""
         return int(self.w.size + self.b.size + self.beta.size)
 
     def hidden(self, x) -> np.ndarray:
         """Hidden-layer output matrix H = g(x W + b), shape (N, L)."""
-        X = _as_2d("x", x)
+        X = as_2d(x, "x")
         if X.shape[1] != self.n_inputs:
             raise InputError(f"x: model has {self.n_inputs} input(s), got {X.shape[1]}")
         return _act(self.activation, X @ self.w + self.b)
@@ -227,7 +219,6 @@ def fit_elm(x, t, params: ELMParams | None = None, *, n_hidden: int | None = Non
     p = params or ELMParams()
     if n_hidden is not None:
         p = replace(p, n_hidden=n_hidden)
-    p.validate()
     X, T, squeeze = _xt(x, t)
     gen = _as_rng(p.seed if rng is None else rng)
     w, b = random_nodes(X.shape[1], int(p.n_hidden), gen, weight_range=p.weight_range,
@@ -301,7 +292,7 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
     accepted step (fewer than ``steps`` + 1 if the search stalls).
 
     Observed on the compass sweeps: tuning lowers the loss a lot for 1-3 nodes, but beyond that the
-    least-squares beta is large (``|beta| ~ 1e2..1e9`` as cond(H) grows), the loss surface is extremely
+    least-squares beta is large (|beta| ~ 1e2..1e9 as cond(H) grows), the loss surface is extremely
     curved along W and b, and the accepted steps become tiny: back-tuning then changes little."""
     check_param("steps", steps, lo=0, integer=True)
     check_param("lr", lr, lo=0, lo_open=True)
@@ -315,11 +306,11 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
 # Pruning
 
 def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
-    """Remove hidden nodes whose output weights are negligible: ``max_k |beta_jk| <= tol``.
+    """Remove hidden nodes whose output weights are negligible: max_k |beta_jk| <= ``tol``.
 
-    Since ``|g| <= 1`` for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
+    Since |g| <= 1 for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
     (patent, Fig. 1 text: "neurons whose output weight is small have little influence on the output;
-    removing these useless neurons ...").  At least one node (the largest ``|beta|``) is always kept.
+    removing these useless neurons ...").  At least one node (the largest |beta|) is always kept.
     Returns the pruned copy (beta not re-solved: the caller decides) and the removed node indices."""
     check_param("tol", tol, lo=0)
     size = np.max(np.abs(model.beta), axis=1)
@@ -336,7 +327,7 @@ def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
 # Point-incremental ELM with autonomous back-tuning
 
 @dataclass(frozen=True)
-class IncrementalELMParams:
+class IncrementalELMParams(NodeDraw):
     """Parameters of :func:`fit_incremental_elm` (patent B, Fig. 2 and "fourth step").
 
     - ``max_nodes``: cap on the hidden-node count (growth stops there; ELM stages then only re-solve).
@@ -344,11 +335,11 @@ class IncrementalELMParams:
     - ``max_iter``: stop after this many iterations (patent: "iteration count exceeds k").
     - ``lr``: first trial step of the back-tuning line search (then adapted, see :func:`back_tune`).
     - ``tune_steps``: gradient steps per back-tuning stage.
-    - ``prune_tol``: prune nodes with ``max |beta_j| <= prune_tol`` after each ELM solve (0: only exact
+    - ``prune_tol``: prune nodes with max |beta_j| <= prune_tol after each ELM solve (0: only exact
       zeros; the bound on a pruned node's contribution to the normalised output).
     - ``schedule``: which stage runs at iteration n (the patent is ambiguous, see
       :func:`fit_incremental_elm`): ``'alternate'`` (default) or ``'odd_nodes'``.
-    - ``activation``, ``weight_range``, ``bias_range``, ``seed``: as in :class:`ELMParams`."""
+    - ``activation``, ``weight_range``, ``bias_range``, ``seed``: as in :class:`NodeDraw`."""
 
     max_nodes: int = 30
     loss_goal: float = 1e-7
@@ -356,24 +347,17 @@ class IncrementalELMParams:
     lr: float = 0.1
     tune_steps: int = 50
     prune_tol: float = 1e-4
-    schedule: str = "alternate"
-    activation: str = "sigmoid"
-    weight_range: float = 1.0
-    bias_range: float = 1.0
-    seed: int | None = 0
+    schedule: Literal["alternate", "odd_nodes"] = "alternate"
 
-    def validate(self) -> "IncrementalELMParams":
+    def __post_init__(self):
         check_param("max_nodes", self.max_nodes, lo=1, integer=True)
         check_param("loss_goal", self.loss_goal, lo=0)
         check_param("max_iter", self.max_iter, lo=1, integer=True)
         check_param("lr", self.lr, lo=0, lo_open=True)
         check_param("tune_steps", self.tune_steps, lo=0, integer=True)
         check_param("prune_tol", self.prune_tol, lo=0)
-        if self.schedule not in SCHEDULES:
-            raise InputError(f"parameter schedule={self.schedule!r}: must be one of "
-                             f"{', '.join(SCHEDULES)}")
-        _check_node_draw(self)
-        return self
+        check_choice("schedule", self.schedule, SCHEDULES)
+        super().__post_init__()
 
 
 HISTORY_COLUMNS = ["iteration", "stage", "n_nodes", "loss", "val_loss"]
@@ -406,7 +390,7 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
       nodes are kept) and re-solve all output weights, beta = H^+ T.  Adding a column to a
       least-squares problem cannot raise its optimum, so this stage does not raise the loss (up to
       rounding once cond(H) nears 1/eps, see :func:`solve_output_weights`).
-    - ``'prune'`` (right after an ELM solve, only when some node has ``max |beta_j| <= prune_tol``):
+    - ``'prune'`` (right after an ELM solve, only when some node has max|beta_j| <= ``prune_tol``):
       drop those nodes and re-solve beta.  This may raise the loss slightly (by design, bounded by the
       dropped contributions before the re-solve).
     - ``'tune'``: ``tune_steps`` monotone gradient steps on W, b and beta (:func:`back_tune`); the
@@ -436,7 +420,7 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
     Returns ``(model, history)``; history has one row per stage: ``iteration``, ``stage``
     ('elm'/'prune'/'tune'), ``n_nodes`` and ``loss`` (training MSE) after the stage, ``val_loss``.
     """
-    p = (params or IncrementalELMParams()).validate()
+    p = params or IncrementalELMParams()
     X, T, squeeze = _xt(x, t)
     if (x_val is None) != (t_val is None):
         raise InputError("give both x_val and t_val, or neither")

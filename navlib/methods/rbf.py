@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from .arrays import as_2d
 
 LN2_SQRT = math.sqrt(-math.log(0.5))  # 0.8326
 
@@ -96,13 +97,13 @@ class InputScaler:
     def standardize(cls, x, names=(), units=()) -> "InputScaler":
         """z-score each column with the mean and (population) standard deviation of ``x``; a constant
         column gets scale 1."""
-        x = _as_2d(x, "x")
+        x = as_2d(x, "x")
         sd = x.std(axis=0)
         sd = np.where(sd > 0, sd, 1.0)
         return cls(tuple(x.mean(axis=0).tolist()), tuple(sd.tolist()), tuple(names), tuple(units))
 
     def transform(self, x) -> np.ndarray:
-        x = _as_2d(x, "x")
+        x = as_2d(x, "x")
         if x.shape[1] != self.n_inputs:
             raise InputError(f"input has {x.shape[1]} column(s), the scaler expects {self.n_inputs}")
         return (x - np.asarray(self.offset)) / np.asarray(self.scale)
@@ -145,18 +146,6 @@ class RBFNet:
 
 
 # ----------------------------------------------------------------------------------------------- helpers
-def _as_2d(x, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name}: not numeric") from None
-    if a.ndim == 1:
-        a = a[:, None]
-    if a.ndim != 2:
-        raise InputError(f"{name}: expected a vector or a (rows x columns) matrix, got shape {a.shape}")
-    return a
-
-
 def _dist(a: np.ndarray, c: np.ndarray) -> np.ndarray:
     d2 = ((a[:, None, :] - c[None, :, :]) ** 2).sum(axis=2)
     return np.sqrt(d2)
@@ -173,8 +162,8 @@ def _check_spread(spread) -> None:
 
 def _prepare(x, t, spread, scaler):
     _check_spread(spread)
-    X = _as_2d(x, "x")
-    T = _as_2d(t, "t")
+    X = as_2d(x, "x")
+    T = as_2d(t, "t")
     single = np.asarray(t).ndim == 1
     q, n = X.shape
     if T.shape[0] != q:
@@ -312,7 +301,7 @@ def leave_one_out(x, t, fit) -> np.ndarray:
     """Leave-one-out predictions: for each row i, ``fit(x_without_i, t_without_i)`` must return a predictor
     (a callable on raw inputs, or an object with ``.predict``) that is applied to row i.  Any scaler must be
     built inside ``fit`` from the rows it is given, so the held-out row never influences its own model."""
-    X = _as_2d(x, "x")
+    X = as_2d(x, "x")
     T = np.asarray(t, dtype=float)
     q = X.shape[0]
     if q < 2:

@@ -7,7 +7,10 @@ inputs and outputs by the max-min method,
 
 and de-normalise the network output after.  :class:`MinMax` holds ``x_min`` and ``x_max`` per column so
 the same transform can be applied to test data and inverted on predictions.  Test data outside the
-training range map outside [0, 1]; nothing is clipped.
+training range map outside [0, 1]; nothing is clipped.  MATLAB's ``mapminmax`` (the default processing
+of ``feedforwardnet``) is the same map onto [-1, 1]: ``MinMax.fit(values, out=(-1, 1))``,
+
+    x' = y_min + (y_max - y_min) (x - x_min) / (x_max - x_min).
 """
 from __future__ import annotations
 
@@ -28,10 +31,13 @@ class MinMax:
 
     lo: np.ndarray
     hi: np.ndarray
+    out_lo: float = 0.0
+    out_hi: float = 1.0
 
     @classmethod
-    def fit(cls, values, *, name: str = "values") -> "MinMax":
-        """Scaler mapping the column minima to 0 and maxima to 1.
+    def fit(cls, values, *, name: str = "values", out: tuple[float, float] = (0.0, 1.0)) -> "MinMax":
+        """Scaler mapping the column minima to ``out[0]`` and maxima to ``out[1]`` (default 0 and 1;
+        ``(-1, 1)`` is MATLAB's ``mapminmax``).
 
         Raises :class:`~navlib.errors.InputError` for an empty array, non-finite values, or a constant column (the
         transform would divide by zero); ``name`` is used in the message."""
@@ -46,7 +52,9 @@ class MinMax:
         if flat.size:
             raise InputError(f"{name}: column {int(flat[0])} is constant ({lo[flat[0]]:g}); "
                              "min-max scaling needs a range")
-        return cls(lo=lo, hi=hi)
+        if not out[1] > out[0]:
+            raise InputError(f"{name}: output range {out!r} must be increasing")
+        return cls(lo=lo, hi=hi, out_lo=float(out[0]), out_hi=float(out[1]))
 
     @property
     def span(self) -> np.ndarray:
@@ -59,17 +67,22 @@ class MinMax:
             raise InputError(f"MinMax: fitted on {self.lo.size} column(s), got {v2.shape[1]}")
         return v2
 
+    @property
+    def gain(self) -> np.ndarray:
+        """Original units per normalised unit, per column: ``(hi - lo) / (out_hi - out_lo)``."""
+        return self.span / (self.out_hi - self.out_lo)
+
     def transform(self, values) -> np.ndarray:
-        """``(x - lo) / (hi - lo)``, same shape as ``values``."""
+        """``out_lo + (x - lo) / gain``, same shape as ``values`` (``(x - lo)/(hi - lo)`` by default)."""
         v = np.asarray(values, dtype=float)
-        return ((self._check(v) - self.lo) / self.span).reshape(v.shape)
+        return (self.out_lo + (self._check(v) - self.lo) / self.gain).reshape(v.shape)
 
     def inverse(self, values) -> np.ndarray:
-        """``lo + x' (hi - lo)``, same shape as ``values``: undoes :meth:`transform`."""
+        """``lo + (x' - out_lo) gain``, same shape as ``values``: undoes :meth:`transform`."""
         v = np.asarray(values, dtype=float)
-        return (self.lo + self._check(v) * self.span).reshape(v.shape)
+        return (self.lo + (self._check(v) - self.out_lo) * self.gain).reshape(v.shape)
 
     def inverse_scale(self, values) -> np.ndarray:
-        """Scale a *difference* (e.g. an error) back to original units: ``x' (hi - lo)`` (no offset)."""
+        """Scale a *difference* (e.g. an error) back to original units: ``x' gain`` (no offset)."""
         v = np.asarray(values, dtype=float)
-        return (self._check(v) * self.span).reshape(v.shape)
+        return (self._check(v) * self.gain).reshape(v.shape)

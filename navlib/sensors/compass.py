@@ -83,7 +83,7 @@ class CompassErrors:
     reference_temperature_c: float = 20.0
     noise_ut: float = 0.04                                                # white noise per axis, 1 sigma
 
-    def validate(self) -> "CompassErrors":
+    def __post_init__(self):
         check_param("noise_ut", self.noise_ut, lo=0)
         for name in ("hard_iron_ut", "scale_error", "nonorthogonality_deg", "misalignment_deg",
                      "hard_iron_tc_ut_per_c"):
@@ -95,7 +95,6 @@ class CompassErrors:
             raise InputError(f"parameter soft_iron: must be a 3x3 matrix of finite numbers")
         if np.any(np.abs(np.asarray(self.scale_error)) >= 0.5):
             raise InputError("parameter scale_error: each axis must be within (-0.5, 0.5)")
-        return self
 
     def scaled(self, factor: float) -> "CompassErrors":
         """All deterministic error sources multiplied by ``factor`` (noise unchanged)."""
@@ -131,13 +130,12 @@ class SweepConfig:
     glitch_prob: float = 0.0
     glitch_ut: float = 15.0
 
-    def validate(self) -> "SweepConfig":
+    def __post_init__(self):
         check_param("n_points", self.n_points, lo=2, integer=True)
         check_param("step_deg", self.step_deg, lo=0, lo_open=True, hi=360)
         check_param("gravity_noise_ms2", self.gravity_noise_ms2, lo=0)
         check_param("glitch_prob", self.glitch_prob, lo=0, hi=1)
         check_param("glitch_ut", self.glitch_ut, lo=0)
-        return self
 
 
 def _rot_x(a):
@@ -182,8 +180,6 @@ def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField = 
     ``heading_error_deg`` (wrapped measured - true), the raw field ``mag_x_ut, mag_y_ut, mag_z_ut``, the
     accelerometer ``acc_x_ms2, acc_y_ms2, acc_z_ms2`` (specific force, sensor frame), ``temperature_c``,
     ``glitch`` (1 where a spike was injected) and ``sweep``."""
-    errors.validate()
-    config.validate()
     rng = np.random.default_rng(seed)
     psi = config.start_deg + config.step_deg * np.arange(config.n_points)
     true = np.where(psi == 360.0, 360.0, np.mod(psi, 360.0))   # paper A reads 0..360 inclusive
