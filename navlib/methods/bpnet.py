@@ -94,7 +94,7 @@ def output_jacobian(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, activatio
 
 @dataclass
 class BPNet:
-    """A trained 1-M-1 network with its input and output scalers (:eq:`eq-bp`)."""
+    """A trained 1-M-1 network with its input and output scalers (the equation in the module docstring)."""
 
     theta: np.ndarray
     n_hidden: int

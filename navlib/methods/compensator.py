@@ -13,7 +13,7 @@ heading handed to ``fit`` and ``correct`` may be unwrapped along the sweep (netw
 input); models of periodic form (Smith, the planar model) do not mind.
 
 Registries of concrete methods, keyed by stable ids with display labels, live with the studies that use
-them (:data:`navlib.studies.paper_a.METHODS`).
+them (``navlib.studies.paper_a.METHODS``).
 """
 from __future__ import annotations
 

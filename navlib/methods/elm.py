@@ -292,7 +292,7 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
     accepted step (fewer than ``steps`` + 1 if the search stalls).
 
     Observed on the compass sweeps: tuning lowers the loss a lot for 1-3 nodes, but beyond that the
-    least-squares beta is large (|beta| ~ 1e2..1e9 as cond(H) grows), the loss surface is extremely
+    least-squares beta is large (``|beta|`` ~ 1e2..1e9 as cond(H) grows), the loss surface is extremely
     curved along W and b, and the accepted steps become tiny: back-tuning then changes little."""
     check_param("steps", steps, lo=0, integer=True)
     check_param("lr", lr, lo=0, lo_open=True)
@@ -306,11 +306,11 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
 # Pruning
 
 def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
-    """Remove hidden nodes whose output weights are negligible: max_k |beta_jk| <= ``tol``.
+    """Remove hidden nodes whose output weights are negligible: ``max_k |beta_jk| <= tol``.
 
-    Since |g| <= 1 for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
+    Since ``|g| <= 1`` for sigmoid and tanh, such a node changes the (normalised) output by at most ``tol``
     (patent, Fig. 1 text: "neurons whose output weight is small have little influence on the output;
-    removing these useless neurons ...").  At least one node (the largest |beta|) is always kept.
+    removing these useless neurons ...").  At least one node (the largest ``|beta|``) is always kept.
     Returns the pruned copy (beta not re-solved: the caller decides) and the removed node indices."""
     check_param("tol", tol, lo=0)
     size = np.max(np.abs(model.beta), axis=1)
@@ -335,7 +335,7 @@ class IncrementalELMParams(NodeDraw):
     - ``max_iter``: stop after this many iterations (patent: "iteration count exceeds k").
     - ``lr``: first trial step of the back-tuning line search (then adapted, see :func:`back_tune`).
     - ``tune_steps``: gradient steps per back-tuning stage.
-    - ``prune_tol``: prune nodes with max |beta_j| <= prune_tol after each ELM solve (0: only exact
+    - ``prune_tol``: prune nodes with ``max |beta_j| <= prune_tol`` after each ELM solve (0: only exact
       zeros; the bound on a pruned node's contribution to the normalised output).
     - ``schedule``: which stage runs at iteration n (the patent is ambiguous, see
       :func:`fit_incremental_elm`): ``'alternate'`` (default) or ``'odd_nodes'``.
@@ -390,7 +390,7 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
       nodes are kept) and re-solve all output weights, beta = H^+ T.  Adding a column to a
       least-squares problem cannot raise its optimum, so this stage does not raise the loss (up to
       rounding once cond(H) nears 1/eps, see :func:`solve_output_weights`).
-    - ``'prune'`` (right after an ELM solve, only when some node has max|beta_j| <= ``prune_tol``):
+    - ``'prune'`` (right after an ELM solve, only when some node has ``max |beta_j| <= prune_tol``):
       drop those nodes and re-solve beta.  This may raise the loss slightly (by design, bounded by the
       dropped contributions before the re-solve).
     - ``'tune'``: ``tune_steps`` monotone gradient steps on W, b and beta (:func:`back_tune`); the

@@ -1,7 +1,7 @@
 """Paper A's comparison under every plausible reading of its training, as one reusable study: every
 compensation method trained on sweep 1 and scored on sweep 2, repeated over seeds for the stochastic ones.
 
-Methods are registered in :data:`METHODS` under stable ids (labels are for display only):
+Methods are registered in ``METHODS`` under stable ids (labels are for display only):
 
 - ``uncompensated``; ``ls8`` (Smith's A..E fitted at 0, 45, ..., 315 deg, :mod:`navlib.methods.smith`);
   ``physical`` (the exact planar model fitted to all of sweep 1, our noise floor);
@@ -304,7 +304,7 @@ def label(mid: str) -> str:
 
 
 def fit_method(method: str, x, reference, params: StudyParams = StudyParams(), seeds=(0,), base_seed: int = 0):
-    """Fit ``method`` (an id of :data:`METHODS`) on measured headings ``x`` (unwrapped) and true headings,
+    """Fit ``method`` (an id of ``METHODS``) on measured headings ``x`` (unwrapped) and true headings,
     one run per seed (run ``k`` uses generator ``k`` of :func:`navlib.methods.seeding.generators`).
     Returns the fitted compensators (one for a deterministic method)."""
     spec = METHODS[method_id(method)]
@@ -313,7 +313,7 @@ def fit_method(method: str, x, reference, params: StudyParams = StudyParams(), s
 
 
 def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), seed: int = 0):
-    """Train ``method`` (an id of :data:`METHODS`) on the training sweep and return ``(compensated test
+    """Train ``method`` (an id of ``METHODS``) on the training sweep and return ``(compensated test
     headings, info)``; ``info`` has ``train_time_s``, ``model`` (the fitted compensator) and what the
     trainer reports (``history``, ``n_nodes``, ``epochs``, ...)."""
     t0 = time.perf_counter()

@@ -71,7 +71,7 @@ class PatentData:
     """A sweep prepared as patent B's second to fifth steps describe (:func:`prepare_patent_data`).
 
     ``keep``: mask over the input rows (False = discarded by the dot-product screen); ``screen``: the
-    :class:`navlib.preprocess.DotScreen` (None when not screened); ``true_deg``/``measured_deg``: the kept
+    :class:`navlib.methods.preprocess.DotScreen` (None when not screened); ``true_deg``/``measured_deg``: the kept
     readings (measured heading recomputed from the filtered field); ``x``: the measured heading unwrapped
     along the kept readings; ``x_scale``/``t_scale``: min-max scalers of ``x`` and ``true_deg``;
     ``train_idx``/``test_idx``: the random split (indices into the kept readings)."""
@@ -98,13 +98,13 @@ def prepare_patent_data(frame: pd.DataFrame, *, window: int = 3, threshold: floa
     ``mag_*_ut`` and the accelerometer ``acc_*_ms2`` columns):
 
     1. sliding median filter of ``window`` readings over each field and accelerometer component
-       (:func:`navlib.preprocess.median_filter`; ``mode='closed'`` for a 0..360 deg inclusive sweep), the
+       (:func:`navlib.methods.preprocess.median_filter`; ``mode='closed'`` for a 0..360 deg inclusive sweep), the
        measured heading recomputed from the filtered field (skipped if ``median`` is False);
     2. discard readings whose field-gravity inner product is abnormal (robust z-score > ``threshold``,
-       :func:`navlib.preprocess.dot_product_screen`; skipped if ``screen`` is False);
-    3. min-max normalisation of input and target (:class:`navlib.scaling.MinMax`);
+       :func:`navlib.methods.preprocess.dot_product_screen`; skipped if ``screen`` is False);
+    3. min-max normalisation of input and target (:class:`navlib.methods.scaling.MinMax`);
     4. random split, ``frac`` for training and the rest for the patent's check
-       (:func:`navlib.preprocess.train_test_split`, ``rng`` a seed or Generator).
+       (:func:`navlib.methods.preprocess.train_test_split`, ``rng`` a seed or Generator).
 
     The patent prescribes the order (filter, then screen) but no window, threshold or split seed."""
     missing = [c for c in ("true_heading_deg", "measured_heading_deg", *MAG_COLUMNS, *ACC_COLUMNS)
@@ -143,7 +143,7 @@ GLITCH_VARIANTS = {
 def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: StudyParams = StudyParams(),
                seed: int = 0, *, method: str = "elm_backtuned", window: int = 3, threshold: float = 4.0,
                frac: float = 0.9):
-    """One run of :func:`glitch_study`: prepare ``train`` as ``variant`` (a key of :data:`GLITCH_VARIANTS`;
+    """One run of :func:`glitch_study`: prepare ``train`` as ``variant`` (a key of ``GLITCH_VARIANTS``;
     split seed = ``seed``), train ``method`` (an ELM method, seed ``seed``) on the training part, and
     compensate every reading of ``test``.  Returns ``(test_errors_deg, clean, data, info)``: the wrapped
     test-sweep errors, the mask of glitch-free test readings (``glitch`` column; all True without it), the
@@ -169,7 +169,7 @@ def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = 
                  seeds=range(20), *, method: str = "elm_backtuned", window: int = 3,
                  threshold: float = 4.0, frac: float = 0.9) -> pd.DataFrame:
     """What patent B's data preparation buys on a training sweep with glitches: for each variant of
-    :data:`GLITCH_VARIANTS` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
+    ``GLITCH_VARIANTS`` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
     sweep (a compensation cannot repair a reading hit by a spike).
 
     One row per (variant, seed): ``test_rms_deg`` (test sweep), ``check_rms_deg`` (the patent's own
@@ -203,7 +203,7 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
     """Patent B's claim that its ELM overfits less than a large network on small samples: train on ``n``
     evenly spread readings of the training sweep (:func:`even_indices`) and score on the whole test sweep.
 
-    Methods: ``ELM back-tuned`` and ``ELM`` (as in :func:`compensate`), ``BP 1-{big_hidden}-1 (Adam)``
+    Methods: ``ELM back-tuned`` and ``ELM`` (as in :func:`navlib.studies.paper_a.compensate`), ``BP 1-{big_hidden}-1 (Adam)``
     (an over-sized net: 3 big_hidden + 1 weights, trained by Adam with the chapter's epochs and learning
     rate, :func:`navlib.methods.bpnet.train_adam_many`), ``BP 1-{big_hidden}-1 (LM/TRF)`` (the same net trained
     to convergence by a second-order least-squares method, :func:`navlib.methods.bpnet.train_least_squares`;
