@@ -15,38 +15,24 @@ Run: ``.venv/bin/python benchmarks/bench_paper_d.py``.
 from __future__ import annotations
 
 import os
+import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))   # the peer adapters
 
 import numpy as np  # noqa: E402
 from anfis_toolbox.membership import GaussianMF  # noqa: E402
 from anfis_toolbox.model import TSKANFIS  # noqa: E402
 from anfis_toolbox.optim.hybrid import HybridTrainer  # noqa: E402
-from simpful import FuzzySet, FuzzySystem, Gaussian_MF, LinguisticVariable  # noqa: E402
 from sko.AFSA import AFSA  # noqa: E402
 
 from navlib.methods.anfis import AnfisOptions, anfis  # noqa: E402
 from navlib.methods.fish_swarm import FishSwarmParams, minimise  # noqa: E402
 from navlib.methods.subclust import genfis2  # noqa: E402
 from navlib.studies import paper_d as D  # noqa: E402
-
-
-def simpful_system(fis):
-    fs = FuzzySystem(show_banner=False, operators=["AND_PRODUCT"])
-    R, n = fis.centers.shape
-    names = [f"x{i}" for i in range(n)]
-    for i, nm in enumerate(names):
-        sets = [FuzzySet(function=Gaussian_MF(mu=float(fis.centers[r, i]), sigma=float(fis.sigmas[r, i])),
-                         term=f"m{r}") for r in range(R)]
-        fs.add_linguistic_variable(nm, LinguisticVariable(sets, universe_of_discourse=[-1e4, 1e4]))
-    rules = []
-    for r in range(R):
-        terms = "+".join(f"{float(fis.consequents[r, i])!r}*{names[i]}" for i in range(n))
-        fs.set_output_function(f"f{r}", f"{terms}+{float(fis.consequents[r, -1])!r}")
-        rules.append("IF " + " AND ".join(f"({nm} IS m{r})" for nm in names) + f" THEN (y IS f{r})")
-    fs.add_rules(rules)
-    return fs, names
+from peers import simpful_system  # noqa: E402
 
 
 def main():

@@ -4,11 +4,11 @@ import math
 
 import numpy as np
 import pytest
-from simpful import FuzzySet, FuzzySystem, Gaussian_MF, LinguisticVariable
 
 from navlib.errors import InputError
 from navlib.methods.anfis import AnfisOptions, anfis, premise_gradient, update_step
 from navlib.methods.subclust import SubclustOptions, SugenoFIS, genfis2, subclust
+from peers import simpful_system
 
 
 def test_two_points_both_accepted_then_exhausted():
@@ -74,19 +74,7 @@ def test_subclust_bad_data():
 
 
 def _simpful(fis: SugenoFIS, X):
-    fs = FuzzySystem(show_banner=False, operators=["AND_PRODUCT"])
-    R, n = fis.centers.shape
-    names = [f"x{i}" for i in range(n)]
-    for i, name in enumerate(names):
-        sets = [FuzzySet(function=Gaussian_MF(mu=float(fis.centers[r, i]), sigma=float(fis.sigmas[r, i])), term=f"m{r}")
-                for r in range(R)]
-        fs.add_linguistic_variable(name, LinguisticVariable(sets, universe_of_discourse=[-1e3, 1e3]))
-    rules = []
-    for r in range(R):
-        terms = "+".join(f"{float(fis.consequents[r, i])!r}*{names[i]}" for i in range(n))
-        fs.set_output_function(f"f{r}", f"{terms}+{float(fis.consequents[r, -1])!r}")
-        rules.append("IF " + " AND ".join(f"({nm} IS m{r})" for nm in names) + f" THEN (y IS f{r})")
-    fs.add_rules(rules)
+    fs, names = simpful_system(fis)
     out = []
     for x in X:
         for nm, v in zip(names, x):
