@@ -36,6 +36,7 @@ from scipy.optimize import least_squares
 
 from ..errors import InputError, check_choice, check_param
 from .de import DEParams, DEResult, evolve_many
+from .jit import logsig_sse
 from .lm import LMParams, dividerand, levenberg_marquardt
 from .scaling import MinMax
 
@@ -116,26 +117,29 @@ def sse_objective(x, t, n_hidden: int, dtype=np.float32):
     """Vectorised fitness ``J(theta) = sum_k (d_k - o_k)^2`` (deg^2) of paper A's net over the training set,
     plus the scalers.
 
-    The hidden layer runs in ``dtype`` (float32 by default during evolution: output error ~1e-3 deg per
-    point, far below the 0.1 deg noise floor); final networks are re-scored in float64.  Layout: one
-    GEMM ``[w b] @ [x'; 1]`` gives all ``P*M`` pre-activations at once, one batched matmul the outputs."""
+    ``dtype=np.float32`` (the default, used during evolution): the compiled kernel
+    :func:`navlib.methods.jit.logsig_sse`, hidden layer in single precision (output error ~1e-3 deg per
+    point, far below the 0.1 deg noise floor; about 5x faster than numpy's float32 ``tanh``).
+    ``dtype=np.float64``: numpy in double precision, for re-scoring final networks and as the reference
+    the kernel is tested against."""
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
-    xn = xs.transform(np.asarray(x, dtype=float))
-    t = np.asarray(t, dtype=float)
+    xn = np.ascontiguousarray(xs.transform(np.asarray(x, dtype=float)), dtype=float)
+    t = np.ascontiguousarray(t, dtype=float)
     lo, span = float(ts.lo[0]), float(ts.span[0])
-    m, n = n_hidden, len(xn)
-    X = (0.5 * np.stack([xn, np.ones_like(xn)])).astype(dtype)            # sigmoid(z) = (1 + tanh(z/2))/2
+    m, n = int(n_hidden), len(xn)
+    if dtype == np.float32:
+        def objective(thetas: np.ndarray) -> np.ndarray:
+            return logsig_sse(np.ascontiguousarray(np.atleast_2d(thetas), dtype=float), xn, t, lo, span, m)
+        return objective, xs, ts
+    X = 0.5 * np.stack([xn, np.ones_like(xn)])                            # sigmoid(z) = (1 + tanh(z/2))/2
 
     def objective(thetas: np.ndarray) -> np.ndarray:
         thetas = np.atleast_2d(thetas)
         p = thetas.shape[0]
-        wb = np.empty((p, m, 2), dtype=dtype)
-        wb[..., 0] = thetas[:, :m]
-        wb[..., 1] = thetas[:, m:2 * m]
-        z = wb.reshape(p * m, 2) @ X
-        np.tanh(z, out=z)
+        wb = np.stack([thetas[:, :m], thetas[:, m:2 * m]], axis=2)
+        z = np.tanh(wb.reshape(p * m, 2) @ X)
         hv = (0.5 * span) * thetas[:, 2 * m:3 * m]
-        o = np.matmul(hv.astype(dtype)[:, None, :], z.reshape(p, m, n))[:, 0, :].astype(np.float64)
+        o = np.matmul(hv[:, None, :], z.reshape(p, m, n))[:, 0, :]
         o += (lo + span * (0.5 * thetas[:, 2 * m:3 * m].sum(axis=1) + thetas[:, 3 * m]))[:, None]
         o -= t
         return np.einsum("pn,pn->p", o, o)
