@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, prange, types
+from numba import njit, types
 from numba.extending import intrinsic
 
 #: Fast-math flags that keep the order of operations (no reassociation).
@@ -71,37 +71,38 @@ def logsig_vec(z):
     return out
 
 
-@njit(fastmath=FASTMATH, error_model="numpy", parallel=True, cache=True)
+@njit(fastmath=FASTMATH, error_model="numpy", cache=True)
 def logsig_sse(thetas, xn, t, lo, span, n_hidden):
     """Sum of squared errors of many 1-M-1 logsig nets, ``thetas (P, 3M+1) = [w, b, v, c]``:
 
         o_k = lo + span (sum_j v_j sigmoid(w_j x'_k + b_j) + c),     J = sum_k (o_k - t_k)^2
 
     with ``x'`` the normalised inputs ``xn (N,)``, ``t (N,)`` the targets and ``lo``/``span`` the target's
-    min-max scaler.  Hidden layer and output sum in float32, the error and its square in float64.  Blocks
-    of networks run on numba's threads (each net's value does not depend on the thread count)."""
+    min-max scaler.  Hidden layer and output sum in float32, the error and its square in float64.
+
+    Single-threaded on purpose: on a machine whose cores are shared, numba's thread barrier waited for
+    descheduled threads (a 2-thread run was up to 15x slower than 1 thread under load); the chapters use
+    processes where they run things in parallel."""
     m = n_hidden
     n_pop, n = thetas.shape[0], xn.shape[0]
     out = np.empty(n_pop)
     x32 = np.empty(n, np.float32)
     for k in range(n):
         x32[k] = xn[k]
-    block = 64
-    for blk in prange((n_pop + block - 1) // block):
-        acc = np.empty(n, np.float32)
-        for p in range(blk * block, min(n_pop, (blk + 1) * block)):
+    acc = np.empty(n, np.float32)
+    for p in range(n_pop):
+        for k in range(n):
+            acc[k] = 0.0
+        for j in range(m):
+            w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
             for k in range(n):
-                acc[k] = 0.0
-            for j in range(m):
-                w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
-                for k in range(n):
-                    acc[k] += v * logsig32(w * x32[k] + b)
-            c = lo + span * thetas[p, 3 * m]
-            s = 0.0
-            for k in range(n):
-                e = c + span * np.float64(acc[k]) - t[k]
-                s += e * e
-            out[p] = s
+                acc[k] += v * logsig32(w * x32[k] + b)
+        c = lo + span * thetas[p, 3 * m]
+        s = 0.0
+        for k in range(n):
+            e = c + span * np.float64(acc[k]) - t[k]
+            s += e * e
+        out[p] = s
     return out
 
 
@@ -186,7 +187,7 @@ def sample_uniform(state, count):
     return out
 
 
-@njit(error_model="numpy", parallel=True, cache=True)
+@njit(error_model="numpy", cache=True)
 def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
     """Trial vectors of one DE/rand/1/bin generation for every run of a batch (written into ``trial``).
 
@@ -200,7 +201,7 @@ def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
     ADE's ``cr_min + (cr_max - cr_min)(f_i - f_min)/(f_max - f_min)`` within the run (``cr_min`` for all
     when every fitness is equal)."""
     n_runs, n_pop, dim = pop.shape
-    for s in prange(n_runs):             # runs on numba's threads: each run has its own stream
+    for s in range(n_runs):
         lo, hi = fit[s, 0], fit[s, 0]
         if adaptive:
             for i in range(1, n_pop):
