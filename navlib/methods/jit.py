@@ -246,3 +246,141 @@ def de_select(pop, fit, trial, tfit, best):
                     pop[s, i, j] = trial[s, i, j]
             b = min(b, fit[s, i])
         best[s] = b
+
+
+# ----------------------------------------------------------------------------------------------- trainlm
+#: Stop reasons of :func:`lm_1m1`, by code (0 = still training).
+LM_STOPS = ("", "maximum epoch", "performance goal", "maximum mu", "minimum gradient", "validation stop")
+
+
+@njit(cache=True)
+def _net_residuals(theta, xn, t, m, tansig, lo, out_lo, gain, r, h):
+    """Residuals (target units) of one 1-M-1 net, as :func:`navlib.methods.bpnet.forward_population`
+    computes the output, ``lo + (o' - out_lo) gain - t``; ``h (N, M)`` receives the hidden layer's tanh
+    values (of ``z`` for tansig, of ``z/2`` for logsig), which :func:`_net_jacobian` reuses."""
+    k = 1.0 if tansig else 0.5
+    bias = theta[3 * m]
+    if not tansig:
+        for j in range(m):
+            bias += 0.5 * theta[2 * m + j]
+    for i in range(xn.shape[0]):
+        o = 0.0
+        for j in range(m):
+            h[i, j] = np.tanh((k * theta[j]) * xn[i] + k * theta[m + j])
+            o += (k * theta[2 * m + j]) * h[i, j]
+        r[i] = lo + (o + bias - out_lo) * gain - t[i]
+
+
+@njit(cache=True)
+def _net_jacobian(theta, xn, m, tansig, gain, h, jac):
+    """Jacobian of the residuals (``gain`` times :func:`navlib.methods.bpnet.output_jacobian`), from the
+    hidden tanh values ``h`` of :func:`_net_residuals` at the same ``theta``."""
+    for i in range(xn.shape[0]):
+        for j in range(m):
+            if tansig:
+                g = h[i, j]
+                dg = 1.0 - g * g
+            else:
+                g = 0.5 * (1.0 + h[i, j])
+                dg = g * (1.0 - g)
+            vd = dg * theta[2 * m + j]
+            jac[i, j] = gain * (vd * xn[i])
+            jac[i, m + j] = gain * vd
+            jac[i, 2 * m + j] = gain * g
+        jac[i, 3 * m] = gain
+
+
+@njit(cache=True)
+def _wmse(r, w, wsum):
+    s = 0.0
+    for i in range(r.shape[0]):
+        s += w[i] * r[i] * r[i]
+    return s / wsum
+
+
+@njit(cache=True)
+def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_max, goal, mu0, mu_dec, mu_inc,
+           mu_max, min_grad, max_fail):
+    """MATLAB's ``trainlm`` for S independent 1-M-1 nets (the algorithm, stop tests and their order as in
+    :func:`navlib.methods.lm.levenberg_marquardt`, which is the generic reference this kernel is tested
+    against), compiled for the network of :mod:`navlib.methods.bpnet`: one net after another, each with
+    its own training weights ``wt[s]`` and validation weights ``wv[s]`` (0/1).
+
+    Returns ``(theta (S, D), epochs (S,), stop codes (S,) into LM_STOPS, perf (S, E+1), val_perf (S, E+1),
+    best_epoch (S,))``; histories are NaN after the stop."""
+    n_nets, dim = theta0.shape
+    n = xn.shape[0]
+    out = theta0.copy()
+    epochs = np.zeros(n_nets, np.int64)
+    stop = np.zeros(n_nets, np.int64)
+    hist = np.full((n_nets, epochs_max + 1), np.nan)
+    vhist = np.full((n_nets, epochs_max + 1), np.nan)
+    best_epoch = np.zeros(n_nets, np.int64)
+    r = np.empty(n)
+    r2 = np.empty(n)
+    h = np.empty((n, m))
+    h2 = np.empty((n, m))
+    jac = np.empty((n, dim))
+    jw = np.empty((n, dim))
+    a = np.empty((dim, dim))
+    for s in range(n_nets):
+        theta = theta0[s].copy()
+        w, v = wt[s], wv[s]
+        wsum, vsum = w.sum(), v.sum()
+        _net_residuals(theta, xn, t, m, tansig, lo, out_lo, gain, r, h)
+        perf = _wmse(r, w, wsum)
+        vperf = _wmse(r, v, vsum) if do_val else np.nan
+        hist[s, 0], vhist[s, 0] = perf, vperf
+        best, best_v, fails, mu = theta.copy(), vperf, 0, mu0
+        _net_jacobian(theta, xn, m, tansig, gain, h, jac)
+        for epoch in range(epochs_max + 1):
+            for i in range(n):
+                for p in range(dim):
+                    jw[i, p] = w[i] * jac[i, p]
+            jj = np.dot(jw.T, jac)                     # J' W J and J' W e (BLAS)
+            je = np.dot(jw.T, r)
+            g2 = 0.0
+            for p in range(dim):
+                g2 += (2.0 * je[p] / wsum) ** 2
+            why = (1 if epoch == epochs_max else 2 if perf <= goal else 3 if mu > mu_max
+                   else 4 if np.sqrt(g2) <= min_grad else 5 if do_val and fails >= max_fail else 0)
+            if why:
+                stop[s] = why
+                break
+            while True:
+                for p in range(dim):
+                    for q in range(dim):
+                        a[p, q] = jj[p, q]
+                    a[p, p] += mu
+                try:
+                    step = -np.linalg.solve(a, je)
+                except Exception:      # singular: a NaN step fails the test below and raises mu
+                    step = np.full(dim, np.nan)
+                trial = theta + step
+                _net_residuals(trial, xn, t, m, tansig, lo, out_lo, gain, r2, h2)
+                perf2 = _wmse(r2, w, wsum)
+                if perf2 < perf:
+                    theta, perf = trial, perf2
+                    r[:] = r2
+                    h[:, :] = h2
+                    mu = max(mu * mu_dec, 1e-20)
+                    break
+                mu *= mu_inc
+                if mu > mu_max:
+                    break
+            epochs[s] = epoch + 1
+            hist[s, epoch + 1] = perf
+            _net_jacobian(theta, xn, m, tansig, gain, h, jac)
+            if do_val:
+                vperf = _wmse(r, v, vsum)
+                vhist[s, epoch + 1] = vperf
+                if vperf < best_v:
+                    best[:], best_v, best_epoch[s], fails = theta, vperf, epoch + 1, 0
+                elif vperf > best_v:
+                    fails += 1
+        if do_val:
+            out[s] = best
+        else:
+            out[s] = theta
+            best_epoch[s] = epochs[s]
+    return out, epochs, stop, hist, vhist, best_epoch
