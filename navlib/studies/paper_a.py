@@ -375,10 +375,21 @@ def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
     array over the test sweep) and the training ``history``.  Deterministic methods get one row with
     seed -1.  ``workers`` > 1 runs the methods (and batches of seeds) in that many processes
     (:mod:`navlib.studies.parallel`); the numbers do not depend on it."""
-    seeds = list(seeds)
-    tasks, cost = _tasks(sw, params, seeds, methods, base_seed, keep_errors, workers)
+    return seed_studies([(sw, params, seeds, methods)], base_seed, keep_errors, workers)[0]
+
+
+def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers: int = 1) -> list[pd.DataFrame]:
+    """Several :func:`seed_study` at once, ``studies`` a list of ``(sweeps, params, seeds, methods)``: all
+    their tasks share the worker processes (the expensive ones start first), one frame per study."""
+    tasks, cost, owner = [], [], []
+    for k, (sw, params, seeds, methods) in enumerate(studies):
+        t, c = _tasks(sw, params, [int(v) for v in seeds], methods, base_seed, keep_errors, workers)
+        tasks += t
+        cost += c
+        owner += [k] * len(t)
     parts = run_tasks(_method_runs, tasks, workers, cost)
-    return pd.DataFrame([row for part in parts for row in part])
+    return [pd.DataFrame([row for o, part in zip(owner, parts) if o == k for row in part])
+            for k in range(len(studies))]
 
 
 def summarize(runs: pd.DataFrame) -> pd.DataFrame:
@@ -485,16 +496,10 @@ def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), 
     for noise in levels:
         check_param("noise level", noise, lo=0)
     check_param("workers", workers, lo=1, integer=True)
-    seeds = list(seeds)
-    tasks, cost, level_of = [], [], []
-    for noise in levels:
-        sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), seed=sim_seed)))
-        t, c = _tasks(sw, params, seeds, methods, 0, False, 1)
-        tasks += t
-        cost += c
-        level_of += [noise] * len(t)
-    parts = run_tasks(_method_runs, tasks, workers, cost)
-    return pd.DataFrame([dict(row, noise_ut=noise) for noise, part in zip(level_of, parts) for row in part])
+    studies = [(Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), seed=sim_seed))),
+                params, seeds, methods) for noise in levels]
+    frames = seed_studies(studies, workers=workers)
+    return pd.concat([f.assign(noise_ut=noise) for noise, f in zip(levels, frames)], ignore_index=True)
 
 
 def noise_summary(noise_runs: pd.DataFrame) -> pd.DataFrame:
