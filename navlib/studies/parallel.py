@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import atexit
 import os
+import signal
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Callable, Sequence
@@ -28,6 +29,7 @@ _POOLS: dict[int, ProcessPoolExecutor] = {}
 def _init_worker() -> None:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     torch.set_num_threads(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)     # an interrupt stops the parent, which stops the pool
 
 
 def executor(workers: int) -> ProcessPoolExecutor:
