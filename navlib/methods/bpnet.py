@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 import torch
 from scipy.optimize import least_squares
+from torch.optim.adam import adam as adam_step
 
 from ..errors import InputError, check_choice, check_param
 from .de import DEParams, DEResult, evolve_many
@@ -215,35 +216,38 @@ def _adam_trajectories(theta0: np.ndarray, xn: np.ndarray, tn: np.ndarray, n_hid
         dL/dv_j = sum_k g_k h_jk,   dL/dc = sum_k g_k,   dL/db_j = sum_k g_k v_j h_jk (1 - h_jk),
         dL/dw_j = sum_k g_k v_j h_jk (1 - h_jk) x'_k                                           (eq-adam-grad)
 
-    and ``torch.optim.Adam(fused=True)`` (the fastest of its CPU implementations for one ``(P, D)``
-    tensor) takes the step.  Runs single-threaded (restoring the caller's thread count), so the result
-    does not depend on ``torch.set_num_threads``.  Returns the final ``theta (P, D)`` and the loss
-    history ``(P, epochs)`` (the loss before each step)."""
+    and torch's fused Adam kernel (the fastest of its CPU implementations for one ``(P, D)`` tensor) takes
+    the step, through the functional ``torch.optim.adam.adam`` with the state ``torch.optim.Adam`` keeps
+    (moments, a float32 step count): the same update, bit for bit, as ``torch.optim.Adam(fused=True)``,
+    without the optimizer object's per-step bookkeeping, which costs more than the kernel on these
+    tensors.  Runs single-threaded (restoring the caller's thread count), so the result does not depend on
+    ``torch.set_num_threads``.  Returns the final ``theta (P, D)`` and the loss history ``(P, epochs)``
+    (the loss before each step)."""
     m, n = n_hidden, xn.size
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
         th = torch.tensor(theta0, dtype=torch.float64)
-        th.grad = grad = torch.zeros_like(th)
+        grad, exp_avg, exp_avg_sq = torch.zeros_like(th), torch.zeros_like(th), torch.zeros_like(th)
+        step = torch.zeros((), dtype=torch.float32)
         X = torch.tensor(xn, dtype=torch.float64)
         T = torch.tensor(tn, dtype=torch.float64)
         w, b = th[:, :m, None], th[:, m:2 * m, None]                       # (P, M, 1)
         v, c = th[:, None, 2 * m:3 * m], th[:, 3 * m:, None]               # (P, 1, M), (P, 1, 1)
         xr, scale = X[None, None, :], 2.0 / n
         sigmoid_backward = torch.ops.aten.sigmoid_backward                  # dy * y (1 - y), as autograd
-        history = torch.empty((th.shape[0], params.epochs), dtype=torch.float64)
-        opt = torch.optim.Adam([th], lr=params.lr, fused=True)
+        history = torch.empty((params.epochs, th.shape[0], 1), dtype=torch.float64)   # rows contiguous
         with torch.no_grad():
             for k in range(params.epochs):
                 h = torch.addcmul(b, w, xr).sigmoid_()                        # (P, M, N)
-                e = torch.baddbmm(c, v, h)[:, 0, :].sub_(T)                   # o' - t', (P, N)
-                torch.mean(e * e, dim=1, out=history[:, k])
+                e = torch.baddbmm(c, v, h).sub_(T)                            # o' - t', (P, 1, N)
+                torch.mean(e * e, dim=2, out=history[k])
                 g = e.mul_(scale)
-                dz = sigmoid_backward(v.transpose(1, 2) * g[:, None, :], h)   # dL/dz, (P, M, N)
-                torch.cat([dz @ X, dz.sum(dim=2), (h * g[:, None, :]).sum(dim=2), g.sum(dim=1, keepdim=True)],
-                          dim=1, out=grad)
-                opt.step()
-        return th.numpy().copy(), history.numpy()
+                dz = sigmoid_backward(v.transpose(1, 2) * g, h)               # dL/dz, (P, M, N)
+                torch.cat([dz @ X, dz.sum(dim=2), (h * g).sum(dim=2), g.sum(dim=2)], dim=1, out=grad)
+                adam_step([th], [grad], [exp_avg], [exp_avg_sq], [], [step], fused=True, amsgrad=False,
+                          beta1=0.9, beta2=0.999, lr=params.lr, weight_decay=0.0, eps=1e-8, maximize=False)
+        return th.numpy().copy(), history[:, :, 0].T.numpy().copy()
     finally:
         torch.set_num_threads(threads)
 
