@@ -8,11 +8,12 @@ both on torch's default thread count (as the former code did: on a shared machin
 each other) and single-threaded (the part of the gain that is the gradient and the step alone).
 
 For each shape the chapter trains (20 or 4 nets of 1-6-1 on the 121-reading sweep; 20 nets of 1-50-1 on 8
-and 60 readings, patent B's small-sample study) it prints the time per epoch of both and their ratio, then
-the time of ``paper_a.seed_study(..., methods=("bp_adam",))`` over 20 and 4 seeds with each trainer, and as
-its last line ``adam_speedup=<geometric mean of the per-epoch ratios against the former code>``.
+and 60 readings, patent B's small-sample study) it prints the time per epoch of each and the ratios, with
+``--study`` the time of ``paper_a.seed_study(..., methods=("bp_adam",))`` over 20 and 4 seeds with each
+trainer, and as its last line ``adam_speedup=<geometric mean of the per-epoch ratios against the former code>``.
 
-Run: ``.venv/bin/python benchmarks/bench_adam.py [--repeats 3] [--epochs 500]`` (best of the repeats).
+Run: ``.venv/bin/python benchmarks/bench_adam.py [--repeats 3] [--epochs 300] [--study]`` (best of the
+repeats).
 """
 from __future__ import annotations
 
@@ -74,8 +75,9 @@ def best_time(fn, repeats):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--epochs", type=int, default=500)
-    ap.add_argument("--no-study", action="store_true", help="skip the seed-study timings")
+    ap.add_argument("--epochs", type=int, default=300)
+    ap.add_argument("--study", action="store_true",
+                    help="also time the seed study (slow: the former code takes about a minute per run)")
     a = ap.parse_args(argv)
     sw = Sweeps(*split_sweeps(load_sweeps(DATA_DIR / "compass_sweeps.csv")))
     params = AdamParams(epochs=a.epochs)
@@ -96,7 +98,7 @@ def main(argv=None):
         ratios.append(times["autograd (former)"] / times["ours"])
         print(f"{nets:3d} nets 1-{m}-1 on {n:3d} readings: " + "  ".join(f"{k} {v:.3f}" for k, v in times.items())
               + f"  ratio {ratios[-1]:.1f} (1 thread: {times['autograd 1 thread'] / times['ours']:.1f})")
-    if not a.no_study:
+    if a.study:
         for seeds in (range(20), range(4)):
             times = {}
             for name, fn in TRAINERS.items():
