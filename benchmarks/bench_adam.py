@@ -1,7 +1,8 @@
 """Adam-trained BP nets: our analytic-gradient trainer against the autograd path it replaced, in one run.
 
 :func:`navlib.methods.bpnet.train_adam_many` trains many 1-M-1 logsig nets by full-batch Adam with the
-gradient written out in torch operations and ``torch.optim.Adam(fused=True)``; the former implementation
+gradient written out in torch operations and torch's fused Adam step (bit-identical to
+``torch.optim.Adam(fused=True)``); the former implementation
 built an autograd graph every epoch and stepped torch's default Adam (kept here as ``autograd_trajectories``,
 the same as the reference in ``tests/test_bpnet.py``).  Ours runs single-threaded; the autograd path runs
 both on torch's default thread count (as the former code did: on a shared machine its threads wait for
@@ -91,6 +92,7 @@ def main(argv=None):
         for name, fn in TRAINERS.items():
             bpnet._adam_trajectories = fn
             try:
+                train_adam_many(x, t, m, AdamParams(epochs=5), generators(range(nets)))      # warm-up
                 times[name] = best_time(lambda: train_adam_many(x, t, m, params, generators(range(nets))),
                                         a.repeats) / a.epochs * 1e3
             finally:
