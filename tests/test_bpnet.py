@@ -122,6 +122,59 @@ def test_train_adam_many_matches_one_at_a_time():
     assert not np.allclose(nets[0].theta, nets[1].theta)
 
 
+def autograd_adam(theta0, xn, tn, m, epochs, lr):
+    """The reference: the same nets trained by autograd back-propagation and torch's default Adam."""
+    th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
+    X, T = torch.tensor(xn), torch.tensor(tn)
+    opt = torch.optim.Adam([th], lr=lr)
+    history = np.empty((theta0.shape[0], epochs))
+    for k in range(epochs):
+        opt.zero_grad()
+        h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])
+        out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m:3 * m]) + th[:, 3 * m:3 * m + 1]
+        loss = torch.mean((out - T) ** 2, dim=1)
+        loss.sum().backward()
+        opt.step()
+        history[:, k] = loss.detach().numpy()
+    return th.detach().numpy(), history
+
+
+@pytest.mark.parametrize("m, n", [(5, 15), (50, 8)])
+def test_analytic_adam_follows_the_autograd_trajectory(m, n):
+    """The hand-written gradient and the fused Adam step reproduce autograd + default Adam up to rounding
+    over 200 epochs (a wrong term of the gradient, e.g. a missing x' in dL/dw, moves the weights by far
+    more than 1e-8 relative).  The nets' own U(-1, 1) draws and the normalisation are those of
+    train_adam_many."""
+    x = np.linspace(0, 360, n)
+    t = x + 10 * np.sin(np.radians(2 * x))
+    ap = AdamParams(epochs=200, lr=0.01)
+    seeds = [0, 3, 7]
+    nets = train_adam_many(x, t, m, ap, generators(seeds))
+    theta0 = np.stack([g.uniform(-1, 1, n_params(m)) for g in generators(seeds)])
+    xn, tn = nets[0].x_scale.transform(x), nets[0].t_scale.transform(t)
+    theta, history = autograd_adam(theta0, xn, tn, m, ap.epochs, ap.lr)
+    assert history[:, -1].max() < history[:, 0].min() / 2          # the nets did train
+    for i, net in enumerate(nets):
+        np.testing.assert_allclose(net.history, history[i], rtol=1e-8)
+        np.testing.assert_allclose(net.theta, theta[i], rtol=1e-8, atol=1e-10)
+
+
+def test_adam_result_does_not_depend_on_the_thread_count():
+    x = np.linspace(0, 360, 60)
+    t = x + 10 * np.sin(np.radians(x))
+    threads = torch.get_num_threads()
+    try:
+        runs = []
+        for k in (1, 2):
+            torch.set_num_threads(k)
+            runs.append(train_adam_many(x, t, 50, AdamParams(epochs=100), generators(range(20))))
+            assert torch.get_num_threads() == k                       # the caller's setting is restored
+    finally:
+        torch.set_num_threads(threads)
+    for a, b in zip(*runs):
+        assert np.array_equal(a.theta, b.theta)
+
+
 def test_second_order_training_of_an_oversized_net_falls_back_to_trf_and_fits():
     """MINPACK's LM needs at least as many readings as weights; with fewer, TRF solves the same problem."""
     x = np.linspace(0, 360, 8)
