@@ -246,9 +246,10 @@ def test_small_sample_study(sw):
     assert (bt.train_rms_deg <= StudyParams().elm_goal_deg + 1e-9).all()
 
 
-def test_patent_b_small_sample_claim_reads_the_trainlm_row():
+def test_patent_b_small_sample_claim_per_trainer():
     """The claim compares the overfitting gap (test - training RMS) of the back-tuned ELM and of the
-    over-sized trainlm net on the smallest sample; a renamed row would silently drop the claim."""
+    over-sized net on the smallest sample, once per trainer (trainlm, Adam); a renamed row would silently
+    drop a claim."""
     runs = pd.DataFrame({"method": ["elm_backtuned", "ls8", "ade_bp_pure", "physical", "elm"],
                          "rms_deg": [0.12, 0.5, 3.0, 0.11, 0.13], "n_nodes": [10, np.nan, 6, np.nan, 19]})
     g_sum = pd.DataFrame({"test rms (deg)": [0.3, 0.6]}, index=["median filter + screen (patent)",
@@ -258,15 +259,17 @@ def test_patent_b_small_sample_claim_reads_the_trainlm_row():
         small = pd.DataFrame([{"n_train": n, "method": m, "seed": 0, "train_rms_deg": tr, "test_rms_deg": te,
                                "n_nodes": 1} for n, m, tr, te in
                               [(8, "ELM back-tuned", 0.05, elm_test_deg), (8, "BP 1-50-1 (trainlm)", 0.0, 0.5),
+                               (8, "BP 1-50-1 (Adam)", 0.02, 0.1),
                                (15, "ELM back-tuned", 0.05, 0.2), (15, "BP 1-50-1 (trainlm)", 0.0, 0.4)]])
         cl = patent_b_claims(runs, pd.Series({"ELM": 12.0}), g_sum, small_sample_summary(small), StudyParams(), 50)
         found = [c for c in cl if c.claim.startswith("on 8 readings")]
-        assert len(found) == 1 and "trainlm" in found[0].claim
-        return found[0]
+        assert len(found) == 2 and "trainlm" in found[0].claim and "Adam" in found[1].claim
+        return found
 
-    assert small_claim(0.9).reproduced is False          # ELM gap 0.85 deg vs 0.5 deg
-    assert small_claim(0.3).reproduced is True           # ELM gap 0.25 deg vs 0.5 deg
-    assert "0.25 vs 0.50" in small_claim(0.3).ours
+    assert small_claim(0.9)[0].reproduced is False       # ELM gap 0.85 deg vs 0.5 deg
+    assert small_claim(0.3)[0].reproduced is True        # ELM gap 0.25 deg vs 0.5 deg
+    assert "0.25 vs 0.50" in small_claim(0.3)[0].ours
+    assert small_claim(0.3)[1].reproduced is False       # ELM gap 0.25 deg vs Adam's 0.08 deg
 
 
 def test_parallel_studies_give_the_same_numbers(sw):
