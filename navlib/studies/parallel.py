@@ -15,6 +15,8 @@ from __future__ import annotations
 import atexit
 import os
 import signal
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
 from typing import Callable, Sequence
@@ -58,20 +60,43 @@ def run_tasks(fn: Callable, tasks: Sequence[tuple], workers: int = 1, cost: Sequ
     ones (:func:`executor`).
 
     ``cost``: optional estimated cost per task; tasks start most expensive first (longest processing time
-    first), which keeps every process busy until the end.  This process takes the next task that no worker
-    has started, so it never idles while a worker imports.  Results come back in the order of ``tasks``."""
+    first).  Every process takes the next task when it is free (a worker is handed one only when it has
+    finished the last), so none idles while another has a queue, and this process never waits for a worker
+    that is still importing.  Results come back in the order of ``tasks``."""
     check_param("workers", workers, lo=1, integer=True)
     tasks = list(tasks)
     if workers == 1 or len(tasks) <= 1:
         return [fn(*t) for t in tasks]
     order = sorted(range(len(tasks)), key=lambda i: -cost[i]) if cost is not None else list(range(len(tasks)))
+    queue = iter(order)
+    lock = threading.Lock()
     pool = executor(workers - 1)
-    futures = {i: pool.submit(fn, *tasks[i]) for i in order}
+    futures: dict = {}
     results: dict = {}
-    for i in order:                       # take over every task no worker has picked up yet
-        if futures[i].cancel():
-            results[i] = fn(*tasks[i])
-    return [results[i] if i in results else futures[i].result() for i in range(len(tasks))]
+
+    def take():
+        with lock:
+            return next(queue, None)
+
+    def feed(_=None):                     # runs again whenever a worker's task completes
+        i = take()
+        if i is None:
+            return
+        futures[i] = pool.submit(fn, *tasks[i])
+        futures[i].add_done_callback(feed)
+
+    for _ in range(workers - 1):
+        feed()
+    while (i := take()) is not None:
+        results[i] = fn(*tasks[i])
+    for i, f in list(futures.items()):
+        results[i] = f.result()
+    while len(results) < len(tasks):      # a task a callback took just before the queue ran out
+        for i, f in list(futures.items()):
+            if i not in results:
+                results[i] = f.result()
+        time.sleep(0.001)
+    return [results[i] for i in range(len(tasks))]
 
 
 def start(workers: int) -> None:
