@@ -121,6 +121,25 @@ def test_compiled_back_tuning_matches_numpy_reference(activation, lr):
                                    err_msg=name)
 
 
+@pytest.mark.parametrize("lr", [1e-300, 1e-16, 1e-15])
+def test_stalled_line_search_matches_numpy_reference(lr):
+    # tiny trial steps: those that change no weight are skipped by the compiled loop, the step
+    # bookkeeping (halvings, the step handed to the next stage) must still be the reference's
+    x, t = compass_like(121, noise=0.05, seed=2)
+    model = fit_elm(x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=2))
+    model.beta *= 0.8
+    X, T = x[:, None], t[:, None]
+    *_, ref_losses, ref_step = reference.back_tune(model.w, model.b, model.beta, X, T, "sigmoid", 10, lr)
+    tuned, losses, step = _back_tune(model, X, T, 10, lr)
+    assert step == ref_step and len(losses) == len(ref_losses)
+    np.testing.assert_allclose(losses, ref_losses, rtol=1e-10, atol=0)
+    if lr == 1e-300:                         # nothing can move: 40 halvings (into subnormals), then stop
+        assert len(losses) == 1 and 0 < step < lr * 1e-12
+        np.testing.assert_array_equal(tuned.w, model.w)
+    if lr == 1e-15:                          # steps of about one ulp of the weights are still taken
+        assert len(losses) == 11
+
+
 def test_incremental_elm_matches_numpy_reference():
     # the whole scheme (ELM, prune and tune stages, validation loss) with the numpy reference swapped in
     x, t = compass_like(121, noise=0.05, seed=5)
