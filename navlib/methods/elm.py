@@ -548,6 +548,10 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
     - ``'tune'``: ``tune_steps`` monotone gradient steps on W, b and beta (:func:`back_tune`); the
       line-search step carries over from one tuning stage to the next.
 
+    Speed: the tuning loop is compiled (see :func:`back_tune`), and an ELM stage whose nodes are
+    exactly those of one of the last two solves (tuning stalled at ``max_nodes``) reuses that solve
+    instead of repeating it; neither changes a result.
+
     Which stage runs when (``params.schedule``) — the patent's text disagrees with itself:
 
     - ``'alternate'`` (default, the claims: "when n is odd run stage one (s701), when n is even run
@@ -587,21 +591,32 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
     model = ELMModel(w=np.empty((d, 0)), b=np.empty(0), beta=np.empty((0, m)),
                      activation=p.activation, squeeze_output=squeeze)
     step = float(p.lr)
+    solved: list = []    # the last two (w, b, beta) of solve()
+
+    def solve(w: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """beta = H^+ T for the hidden nodes (w, b).  Once tuning has stalled at the node cap, the ELM
+        stages re-solve the very same nodes again and again: the solve is deterministic, so the last
+        result for these nodes is reused (bit for bit what solving again gives)."""
+        for w0, b0, beta0 in solved:
+            if np.array_equal(w0, w) and np.array_equal(b0, b):
+                return beta0.copy()
+        beta = solve_output_weights(_act(p.activation, X @ w + b), T)
+        solved[:] = [*solved[-1:], (w.copy(), b.copy(), beta.copy())]
+        return beta
 
     def elm_stage(it: int, model: ELMModel) -> tuple[ELMModel, float]:
         if model.n_hidden < p.max_nodes:
             w1, b1 = random_nodes(d, 1, gen, weight_range=p.weight_range, bias_range=p.bias_range)
             model = replace(model, w=np.hstack([model.w, w1]), b=np.concatenate([model.b, b1]))
-        H = _act(p.activation, X @ model.w + model.b)
-        model = replace(model, beta=solve_output_weights(H, T))
+        model = replace(model, beta=solve(model.w, model.b))
         loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
         rec.add(it, "elm", model, loss)
-        pruned, removed = prune_nodes(model, p.prune_tol)
-        if removed.size:
-            H = _act(p.activation, X @ pruned.w + pruned.b)
-            model = replace(pruned, beta=solve_output_weights(H, T))
-            loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
-            rec.add(it, "prune", model, loss)
+        if np.any(np.max(np.abs(model.beta), axis=1) <= p.prune_tol):    # some node is negligible
+            pruned, removed = prune_nodes(model, p.prune_tol)
+            if removed.size:
+                model = replace(pruned, beta=solve(pruned.w, pruned.b))
+                loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
+                rec.add(it, "prune", model, loss)
         return model, loss
 
     def tune_stage(it: int, model: ELMModel, step: float) -> tuple[ELMModel, float, float]:
