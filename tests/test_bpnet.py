@@ -1,3 +1,4 @@
+import scipy.special
 import numpy as np
 import pytest
 import torch
@@ -130,3 +131,22 @@ def test_second_order_training_of_an_oversized_net_falls_back_to_trf_and_fits():
     assert np.max(np.abs(net.predict(x) - t)) < 1e-3
     small = train_least_squares(np.linspace(0, 360, 121), np.linspace(0, 360, 121), 2, generators([0])[0])
     assert small.method == "BP (LM)"
+
+
+def test_compiled_sigmoid_is_float32_accurate_everywhere():
+    from navlib.methods.jit import logsig_vec
+    z = np.concatenate([np.linspace(-200, 200, 200001), [0.0, -1e-8, 1e-8, 88.7, -88.7, 1e30, -1e30]])
+    exact = scipy.special.expit(z)
+    got = logsig_vec(z.astype(np.float32)).astype(float)
+    assert np.max(np.abs(got - exact)) < 2e-7
+    assert np.all(np.diff(logsig_vec(np.linspace(-30, 30, 10001, dtype=np.float32))) >= 0)   # monotone
+
+
+def test_compiled_fitness_matches_double_precision_on_evolved_like_nets():
+    x = np.linspace(0, 360, 121)
+    t = x + 15 * np.sin(np.radians(x)) + 3 * np.cos(2 * np.radians(x))
+    obj64, _, _ = sse_objective(x, t, 6, np.float64)
+    obj32, _, _ = sse_objective(x, t, 6)
+    pop = np.random.default_rng(7).uniform(-10, 10, (500, 19))
+    np.testing.assert_allclose(obj32(pop), obj64(pop), rtol=2e-5)
+    np.testing.assert_allclose(obj32(pop[:1]), obj64(pop[:1]), rtol=2e-5)    # any population size

@@ -15,7 +15,8 @@ from navlib.sensors.compass import SweepConfig, simulate_train_test
 from navlib.methods.compensator import HeadingTarget
 from navlib.methods.de import DEParams
 from navlib.studies.paper_a import (LEGACY_NAMES, METHODS, READINGS, StudyParams, Sweeps, claims, compensate,
-                                    fit_method, method_id, ordering_probability, ordering_table, seed_study,
+                                    fit_method, method_id, noise_study, ordering_probability, ordering_table,
+                                    seed_study,
                                     summarize, test_errors as heading_errors, verdict_table)
 from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, glitch_study,
     node_count_curve, prepare_patent_data, small_sample_study)
@@ -240,3 +241,18 @@ def test_small_sample_study(sw):
     # with 15 nodes or fewer (back-tuned ELM's goal) the training readings are fitted closely
     bt = runs[runs.method == "ELM back-tuned"]
     assert (bt.train_rms_deg <= StudyParams().elm_goal_deg + 1e-9).all()
+
+
+def test_parallel_studies_give_the_same_numbers(sw):
+    """Workers only change where runs execute: seed and noise studies equal with 1 and 2 processes."""
+    p = StudyParams(de=DEParams(max_generations=40), lm=replace(StudyParams().lm, epochs=20))
+    methods = ("ls8", "ade_bp_pure", "de_bp_hybrid_trainlm", "bp_matlab_val", "elm_backtuned")
+    cols = ["method", "seed", "min_deg", "max_deg", "rms_deg", "n_nodes", "epochs", "stop"]
+    one = seed_study(sw, p, seeds=range(4), methods=methods)
+    two = seed_study(sw, p, seeds=range(4), methods=methods, workers=2)
+    pd.testing.assert_frame_equal(one[cols], two[cols])
+    assert len(one) == 1 + 4 * 4
+    n1 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"))
+    n2 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"), workers=2)
+    pd.testing.assert_frame_equal(n1[cols + ["noise_ut"]], n2[cols + ["noise_ut"]])
+    assert set(n1.noise_ut) == {0.01, 0.05} and len(n1) == 2 * (1 + 2)

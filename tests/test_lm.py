@@ -140,3 +140,35 @@ def test_de_to_lm_hand_over():
     deg2 = train_hybrid_many(x, t, 3, de, generators([0]), LMParams(epochs=0), target="deg2")[0]
     assert deg2.info["de_generations"] == 400                          # 0.2 deg^2 is never reached
 
+
+
+@pytest.mark.parametrize("activation,validation", [("tansig", False), ("tansig", True), ("logsig", False),
+                                                   ("logsig", True)])
+def test_compiled_trainlm_equals_the_generic_numpy_trainlm(activation, validation):
+    """The compiled kernel (default) and levenberg_marquardt: the same epochs, stop reasons and best epochs;
+    the same initial MSE to 1e-13 and the MSE history to 1e-3 over the first 20 epochs (J'J + mu I has
+    condition numbers near 1e10: BLAS and the kernel sum J'J in different orders, and the 1e-16
+    difference becomes 1e-6 in the first step and up to 5e-4 after 20 epochs), the same final MSE and
+    outputs, with and without the validation stop, for both networks of the chapter."""
+    rng = np.random.default_rng(8)
+    x = np.linspace(-10, 370, 80)
+    t = np.linspace(0, 360, 80) + 4 * np.sin(np.radians(2 * x)) + 0.5 * rng.standard_normal(80)
+    out = (-1, 1) if activation == "tansig" else (0, 1)
+    xs, ts = MinMax.fit(x, out=out), MinMax.fit(t, out=out)
+    gens = generators(range(4))
+    theta0 = np.stack([matlab_initial_weights(5, g) for g in gens])
+    splits = [dividerand(x.size, g) for g in gens] if validation else None
+    p = LMParams(epochs=150)
+    fast = train_lm_many(x, t, 5, theta0, xs, ts, activation, p, splits)
+    ref = train_lm_many(x, t, 5, theta0, xs, ts, activation, p, splits, compiled=False)
+    for a, b in zip(fast, ref):
+        assert a.info["epochs"] == b.info["epochs"] and a.info["stop"] == b.info["stop"]
+        assert a.info["best_epoch"] == b.info["best_epoch"]
+        assert a.history[0] == pytest.approx(b.history[0], rel=1e-13)      # the same network and data
+        np.testing.assert_allclose(a.history[:20], b.history[:20], rtol=1e-3)
+        np.testing.assert_allclose(a.history[-1], b.history[-1], rtol=1e-2)
+        np.testing.assert_allclose(a.predict(x), b.predict(x), atol=1e-2)      # deg, on a 360 deg span
+    assert {n.info["stop"] for n in fast} <= {"maximum epoch", "validation stop", "minimum gradient",
+                                              "maximum mu"}
+    if validation:
+        assert any(n.info["stop"] == "validation stop" for n in fast)

@@ -3,7 +3,7 @@
 Storn & Price (1997), as used by paper A (Yue et al.):
 
     mutation   v_i = x_r1 + F (x_r2 - x_r3),       r1, r2, r3 distinct and != i
-    crossover  u_ij = v_ij if rand_ij <= CR_i or j == j_rand(i) else x_ij
+    crossover  u_ij = v_ij if rand_ij < CR_i or j == j_rand(i) else x_ij
     selection  x_i <- u_i if J(u_i) <= J(x_i)
 
 DE (paper's DE-BP): fixed F = 0.5, CR = 0.6.
@@ -20,6 +20,12 @@ and the CR equation as printed in the digest (min-max scaled fitness; lower fitn
 (all individuals get CR_min when f_max == f_min).  Out-of-bounds genes of a trial are re-drawn uniformly
 within the bounds, as scipy does.  The objective receives the whole trial population ``(NP, D)`` and returns
 ``(NP,)`` fitness values: one vectorised call per generation.
+
+Implementation (speed, :mod:`navlib.methods.jit`): mutation, crossover and selection of all runs are one
+compiled loop each per generation.  Each run draws its random numbers from its own xoshiro256** stream,
+seeded from the run's numpy Generator (the initial population comes from the Generator itself);
+``rand_ij`` are uniforms at 16-bit resolution (``k / 2^16``: a crossover probability is CR rounded up to
+the next multiple of 2^-16, within 1.6e-5 of it).
 """
 from __future__ import annotations
 
@@ -30,6 +36,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError, check_param
+from .jit import de_select, de_trials, xoshiro_states
 from .seeding import generators
 
 
@@ -98,26 +105,6 @@ class DEResult:
     population: np.ndarray = field(repr=False, default=None)
 
 
-def distinct_triples(rng: np.random.Generator, n: int, batch: int | None = None) -> np.ndarray:
-    """For each i in 0..n-1, three indices distinct from each other and from i, uniformly at random.
-
-    Draws three distinct offsets from 1..n-1 (the second skips the first, the third skips both) and
-    returns ``(i + offset) mod n``; shape ``(n, 3)``, or ``(batch, n, 3)`` for several generations at once
-    (one vectorised call instead of one per generation)."""
-    if n < 4:
-        raise InputError(f"parameter NP={n}: DE/rand/1 needs at least 4 individuals")
-    shape = (1 if batch is None else batch, n)
-    o1 = rng.integers(1, n, shape)
-    o2 = rng.integers(1, n - 1, shape)
-    o2 += o2 >= o1
-    lo, hi = np.minimum(o1, o2), np.maximum(o1, o2)
-    o3 = rng.integers(1, n - 2, shape)
-    o3 += o3 >= lo
-    o3 += o3 >= hi
-    r = (np.arange(n)[None, :, None] + np.stack([o1, o2, o3], axis=-1)) % n
-    return r[0] if batch is None else r
-
-
 def evolve(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams = DEParams(),
            initial: np.ndarray | None = None) -> DEResult:
     """Minimise ``objective`` over the box ``[-bound, bound]^dim`` with DE/rand/1/bin (or ADE): one run,
@@ -129,12 +116,13 @@ def evolve(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEPa
 
 
 def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams,
-                rngs: list, initial: np.ndarray | None = None, chunk: int = 64) -> list[DEResult]:
+                rngs: list, initial: np.ndarray | None = None) -> list[DEResult]:
     """Several independent DE runs at once, one per generator in ``rngs``: every run's population lives in
     one ``(S, NP, D)`` array and each generation makes one ``objective`` call on all ``S NP`` trials.
 
-    ``objective`` maps ``(K, D)`` to ``(K,)``.  Run ``s`` draws its random numbers from ``rngs[s]`` only, in
-    blocks of ``chunk`` generations, so its result does not depend on which other runs share the batch.
+    ``objective`` maps ``(K, D)`` to ``(K,)``.  Run ``s`` draws its random numbers from ``rngs[s]`` only (its
+    initial population, then the seed of its xoshiro256** stream), so its result does not depend on which
+    other runs share the batch.
     A run stops at ``max_generations`` or when its best fitness is <= ``target_fitness``; stopped runs
     leave the batch.  ``initial``: optional ``(S, NP, D)`` starting populations."""
     check_param("dim", dim, lo=1, integer=True)
@@ -149,12 +137,11 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
         pop = np.array(initial, dtype=float)
         if pop.shape != (n_runs, n, dim):
             raise InputError(f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}")
-    fit = np.asarray(objective(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n)
+    fit = np.ascontiguousarray(np.asarray(objective(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n))
     f_schedule = (ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None)
     history = np.full((n_runs, gmax), np.nan)
     results: list = [None] * n_runs
     ids = np.arange(n_runs)                 # run index of each row still in the batch
-    rows = np.arange(n)
 
     def finish(mask, g):
         for j in np.flatnonzero(mask):
@@ -165,6 +152,9 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
                                   reached_target=bool(fit[j, best] <= params.target_fitness),
                                   population=pop[j].copy())
 
+    trial = np.empty_like(pop)
+    best = np.empty(n_runs)
+    state = xoshiro_states(rngs)        # each run's own stream for mutation, crossover and re-draws
     g = 0
     while True:
         done = fit.min(axis=1) <= params.target_fitness
@@ -175,39 +165,14 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
             keep = ~done
             if not keep.any():
                 break
-            ids, pop, fit = ids[keep], pop[keep], fit[keep]
-            if g % chunk:
-                tri, uni, forced, redraw = tri[keep], uni[keep], forced[keep], redraw[keep]
-        k = g % chunk
-        if k == 0:          # random numbers for the next `chunk` generations, per run
-            c = min(chunk, gmax - g)
-            draws = [(distinct_triples(rngs[s], n, c), rngs[s].random((c, n, dim), dtype=np.float32),
-                      rngs[s].integers(0, dim, (c, n)),
-                      rngs[s].uniform(-b, b, (c, n, dim)).astype(np.float32)) for s in ids]
-            tri, uni, forced, redraw = (np.stack(a) for a in zip(*draws))
-        s_count = ids.size
-        if params.adaptive:
-            f = f_schedule[g]
-            lo, hi = fit.min(axis=1, keepdims=True), fit.max(axis=1, keepdims=True)
-            spread = np.where(hi > lo, hi - lo, 1.0)
-            cr = np.where(hi > lo, params.cr_min + (params.cr_max - params.cr_min) * (fit - lo) / spread,
-                          params.cr_min)[..., None]
-        else:
-            f, cr = params.f, params.cr
-        sidx = np.arange(s_count)[:, None]
-        parents = pop[sidx[..., None], tri[:, k]]                          # (S, NP, 3, D) in one gather
-        trial = parents[:, :, 1] - parents[:, :, 2]                        # mutation x_r1 + F (x_r2 - x_r3)
-        trial *= f
-        trial += parents[:, :, 0]
-        keep_parent = uni[:, k] > cr                                       # binomial crossover
-        keep_parent[sidx, rows, forced[:, k]] = False                        # j_rand forced from the mutant
-        np.copyto(trial, pop, where=keep_parent)
-        out = np.abs(trial) > b                                            # re-draw inside the box
-        np.copyto(trial, redraw[:, k], where=out)
-        tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(s_count, n)
-        better = tfit <= fit                                               # greedy selection
-        np.copyto(pop, trial, where=better[..., None])
-        np.minimum(fit, tfit, out=fit)
-        history[ids, g] = fit.min(axis=1)
+            ids, pop, fit = ids[keep], np.ascontiguousarray(pop[keep]), np.ascontiguousarray(fit[keep])
+            state = np.ascontiguousarray(state[keep])
+            trial, best = trial[:keep.sum()], best[:keep.sum()]
+        f = f_schedule[g] if params.adaptive else params.f
+        de_trials(pop, fit, state, float(f), float(params.cr), bool(params.adaptive), float(params.cr_min),
+                  float(params.cr_max), b, trial)
+        tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(ids.size, n)
+        de_select(pop, fit, trial, tfit, best)                             # greedy selection, in place
+        history[ids, g] = best
         g += 1
     return results

@@ -21,14 +21,11 @@ Error = compensated - true heading, wrapped to (-180, 180], on the test sweep.
 from __future__ import annotations
 
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
-from multiprocessing import get_context
 from typing import Callable, Literal
 
 import numpy as np
 import pandas as pd
-import torch
 from scipy.stats import mannwhitneyu
 
 from ..angles import wrap_deg
@@ -47,6 +44,7 @@ from ..report import Claim, method_stats
 from ..sensors.compass import CompassErrors, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
 from ..sensors.planar import fit_planar_model
+from .parallel import run_tasks
 
 
 @dataclass(frozen=True)
@@ -326,32 +324,72 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
     return fitted.correct(sw.x_test), info
 
 
-def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20), methods=MAIN_METHODS,
-               base_seed: int = 0, keep_errors: bool = False) -> pd.DataFrame:
-    """One row per (method, seed): ``method`` (id), ``label``, test-sweep error ``min_deg``, ``max_deg``,
-    ``rms_deg``, ``train_time_s`` (per run; runs of one method train together), ``n_nodes`` (ELMs),
-    ``epochs`` and ``stop`` (``trainlm``), and with ``keep_errors`` the error curve ``error_deg`` (an
-    array over the test sweep) and the training ``history``.  Deterministic methods get one row with
-    seed -1."""
+#: CPU seconds per run of each method at the chapter's defaults (measured; for ordering parallel tasks,
+#: most expensive first).  Methods not listed count as cheap.
+RUN_COST_S = {"de_bp_pure": 0.3, "ade_bp_pure": 0.3, "de_bp_hybrid_trainlm": 0.14,
+              "ade_bp_hybrid_trainlm": 0.07, "de_bp_hybrid_trainlm_val": 0.1, "ade_bp_hybrid_trainlm_val": 0.03,
+              "bp_adam": 0.05, "bp_matlab": 0.06, "bp_matlab_val": 0.02, "elm_backtuned": 0.1}
+
+
+def _method_runs(sw: Sweeps, params: StudyParams, mid: str, seeds: list, base_seed: int,
+                 keep_errors: bool) -> list[dict]:
+    """The rows of :func:`seed_study` for one method and the given seeds (one batch)."""
+    spec = METHODS[mid]
+    t0 = time.perf_counter()
+    fitted = fit_method(mid, sw.x_train, sw.t_train, params, seeds, base_seed)
+    per = (time.perf_counter() - t0) / len(fitted)
     rows = []
-    seeds = list(seeds)
+    for s, f in zip(seeds if spec.stochastic else [-1], fitted):
+        err = test_errors(f.correct(sw.x_test), sw)
+        row = {"method": mid, "label": spec.label, "seed": s, **error_stats(err), "train_time_s": per,
+               "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
+               "stop": f.info.get("stop", "")}
+        if keep_errors:
+            net = getattr(f, "net", None)
+            row.update(error_deg=err, history=getattr(net, "history", None),
+                       de_history=f.info.get("de_history"))
+        rows.append(row)
+    return rows
+
+
+def _tasks(sw, params, seeds, methods, base_seed, keep_errors, workers):
+    """One task per method, the seeds of a stochastic method cut into ``workers`` batches when parallel."""
+    tasks, cost = [], []
     for m in methods:
         mid = method_id(m)
-        spec = METHODS[mid]
-        t0 = time.perf_counter()
-        fitted = fit_method(mid, sw.x_train, sw.t_train, params, seeds, base_seed)
-        per = (time.perf_counter() - t0) / len(fitted)
-        for s, f in zip(seeds if spec.stochastic else [-1], fitted):
-            err = test_errors(f.correct(sw.x_test), sw)
-            row = {"method": mid, "label": spec.label, "seed": s, **error_stats(err), "train_time_s": per,
-                   "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
-                   "stop": f.info.get("stop", "")}
-            if keep_errors:
-                net = getattr(f, "net", None)
-                row.update(error_deg=err, history=getattr(net, "history", None),
-                           de_history=f.info.get("de_history"))
-            rows.append(row)
-    return pd.DataFrame(rows)
+        chunks = [seeds]
+        if METHODS[mid].stochastic and workers > 1 and len(seeds) >= 2 * workers:
+            chunks = [list(c) for c in np.array_split(np.asarray(seeds), workers)]
+        for c in chunks:
+            tasks.append((sw, params, mid, [int(v) for v in c], base_seed, keep_errors))
+            cost.append(RUN_COST_S.get(mid, 0.001) * len(c) * params.de.max_generations / 3000
+                        if METHODS[mid].stochastic else 0.001)
+    return tasks, cost
+
+
+def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20), methods=MAIN_METHODS,
+               base_seed: int = 0, keep_errors: bool = False, workers: int = 1) -> pd.DataFrame:
+    """One row per (method, seed): ``method`` (id), ``label``, test-sweep error ``min_deg``, ``max_deg``,
+    ``rms_deg``, ``train_time_s`` (per run; runs of one batch train together), ``n_nodes`` (ELMs),
+    ``epochs`` and ``stop`` (``trainlm``), and with ``keep_errors`` the error curve ``error_deg`` (an
+    array over the test sweep) and the training ``history``.  Deterministic methods get one row with
+    seed -1.  ``workers`` > 1 runs the methods (and batches of seeds) in that many processes
+    (:mod:`navlib.studies.parallel`); the numbers do not depend on it."""
+    return seed_studies([(sw, params, seeds, methods)], base_seed, keep_errors, workers)[0]
+
+
+def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers: int = 1) -> list[pd.DataFrame]:
+    """Several :func:`seed_study` at once, ``studies`` a list of ``(sweeps, params, seeds, methods)``: all
+    their tasks share the worker processes (the expensive ones start first), one frame per study."""
+    tasks, cost, owner = [], [], []
+    for k, (sw, params, seeds, methods) in enumerate(studies):
+        t, c = _tasks(sw, params, [int(v) for v in seeds], methods, base_seed, keep_errors, workers)
+        tasks += t
+        cost += c
+        owner += [k] * len(t)
+    parts = run_tasks(_method_runs, tasks, workers, cost)
+    return [pd.DataFrame([row for o, part in zip(owner, parts) if o == k for row in part])
+            for k in range(len(studies))]
 
 
 def summarize(runs: pd.DataFrame) -> pd.DataFrame:
@@ -448,29 +486,20 @@ def implied_noise_ut(paper_min_deg: float, paper_max_deg: float, errors: Compass
     return best
 
 
-def _noise_level(noise, params, seeds, methods, errors, sim_seed) -> pd.DataFrame:
-    torch.set_num_threads(1)          # one core per worker process
-    sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=float(noise)), seed=sim_seed)))
-    return seed_study(sw, params, seeds, methods).assign(noise_ut=float(noise))
-
-
 def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), methods=MAIN_METHODS,
                 errors: CompassErrors = CompassErrors(), sim_seed: int = 2024, workers: int = 1) -> pd.DataFrame:
     """:func:`seed_study` on sweeps simulated with each magnetometer noise in ``levels_ut`` (the same
     compass and simulation seed, only the noise changes); one row per (noise_ut, method, seed).  With
-    ``workers`` > 1 the levels run in that many processes (results identical: every run has its own
-    generator)."""
+    ``workers`` > 1 the (level, method) tasks run in that many processes (results identical: every run
+    has its own generator)."""
     levels = [float(v) for v in levels_ut]
     for noise in levels:
         check_param("noise level", noise, lo=0)
     check_param("workers", workers, lo=1, integer=True)
-    args = (params, list(seeds), tuple(methods), errors, sim_seed)
-    if workers == 1 or len(levels) == 1:
-        frames = [_noise_level(v, *args) for v in levels]
-    else:
-        with ProcessPoolExecutor(max_workers=int(workers), mp_context=get_context("spawn")) as pool:
-            frames = list(pool.map(_noise_level, levels, *([a] * len(levels) for a in args)))
-    return pd.concat(frames, ignore_index=True)
+    studies = [(Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), seed=sim_seed))),
+                params, seeds, methods) for noise in levels]
+    frames = seed_studies(studies, workers=workers)
+    return pd.concat([f.assign(noise_ut=noise) for noise, f in zip(levels, frames)], ignore_index=True)
 
 
 def noise_summary(noise_runs: pd.DataFrame) -> pd.DataFrame:

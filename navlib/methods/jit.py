@@ -1,0 +1,386 @@
+"""Compiled (numba) inner loops of the optimisers and networks: what runs millions of times per chapter.
+
+Everything here is an exact restatement of a numpy formulation documented elsewhere (the module that calls
+it says which); the tests compare each kernel with that numpy reference.
+
+- :func:`logsig_sse`: the fitness ``J = sum_k (d_k - o_k)^2`` of many 1-M-1 logsig networks
+  (:func:`navlib.methods.bpnet.sse_objective`), hidden layer in single precision.  The sigmoid is
+  evaluated as ``1 / (1 + 2^y)``, ``y = -z log2(e)``, with ``2^y`` from Cephes' ``exp2f`` polynomial
+  (Moshier 1992: range reduction to ``y = k + f``, ``|f| <= 1/2``, degree-6 polynomial for ``2^f``, and the
+  exponent ``k`` written into the float's bits), so the loop over the training points vectorises (libm's
+  ``expf`` does not): absolute error of the sigmoid <= 2e-7 over all inputs, the accuracy of float32.
+- :func:`de_trials`, :func:`de_select`: one generation of DE/rand/1/bin (and ADE's per-individual CR) for
+  all runs of a batch (:func:`navlib.methods.de.evolve_many`), each run drawing from its own xoshiro256**
+  stream (:func:`xoshiro_states`, seeded from the run's numpy Generator).
+
+Kernels are compiled on first use and cached on disk (``cache=True``; about 1 s per kernel the first
+time).  ``error_model='numpy'``: a float division never raises (it cannot divide by zero here), which
+lets the compiler vectorise it.  Only the fast-math flags that do not reorder arithmetic are used
+(``nnan``, ``ninf``, ``nsz``, ``arcp``, ``contract``, ``afn``).
+"""
+from __future__ import annotations
+
+import numpy as np
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
+
+#: Fast-math flags that keep the order of operations (no reassociation).
+FASTMATH = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}
+
+_F = np.float32
+_LOG2E = _F(1.4426950408889634)
+# Cephes exp2f: 2^f = 1 + f P(f), |f| <= 1/2, relative error ~2e-7.
+_P0, _P1, _P2 = _F(1.535336188319500e-4), _F(1.339887440266574e-3), _F(9.618437357674640e-3)
+_P3, _P4, _P5 = _F(5.550332471162809e-2), _F(2.402264791363012e-1), _F(6.931472028550421e-1)
+
+
+@intrinsic
+def _bits_to_f32(typingctx, i):
+    """Reinterpret the bits of an int32 as a float32 (a bit cast, no conversion)."""
+    sig = types.float32(types.int32)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.FloatType())
+
+    return sig, codegen
+
+
+@njit(fastmath=FASTMATH, error_model="numpy", inline="always", cache=True)
+def logsig32(z):
+    """``1 / (1 + exp(-z))`` in float32 (see the module docstring)."""
+    y = min(max(z * -_LOG2E, _F(-126.0)), _F(126.0))
+    k = np.int32(y + _F(127.5))                      # y + 127.5 > 0, so truncation = floor: k - 127 = round(y)
+    f = y - (_F(k) - _F(127.0))
+    q = _P0
+    q = q * f + _P1
+    q = q * f + _P2
+    q = q * f + _P3
+    q = q * f + _P4
+    q = q * f + _P5
+    q = q * f + _F(1.0)
+    return _F(1.0) / (_F(1.0) + q * _bits_to_f32(k << np.int32(23)))
+
+
+@njit(fastmath=FASTMATH, error_model="numpy", cache=True)
+def logsig_vec(z):
+    """:func:`logsig32` over a float32 array (for tests)."""
+    out = np.empty_like(z)
+    for i in range(z.size):
+        out.flat[i] = logsig32(z.flat[i])
+    return out
+
+
+@njit(fastmath=FASTMATH, error_model="numpy", cache=True)
+def logsig_sse(thetas, xn, t, lo, span, n_hidden):
+    """Sum of squared errors of many 1-M-1 logsig nets, ``thetas (P, 3M+1) = [w, b, v, c]``:
+
+        o_k = lo + span (sum_j v_j sigmoid(w_j x'_k + b_j) + c),     J = sum_k (o_k - t_k)^2
+
+    with ``x'`` the normalised inputs ``xn (N,)``, ``t (N,)`` the targets and ``lo``/``span`` the target's
+    min-max scaler.  Hidden layer and output sum in float32, the error and its square in float64.
+
+    Single-threaded on purpose: on a machine whose cores are shared, numba's thread barrier waited for
+    descheduled threads (a 2-thread run was up to 15x slower than 1 thread under load); the chapters use
+    processes where they run things in parallel."""
+    m = n_hidden
+    n_pop, n = thetas.shape[0], xn.shape[0]
+    out = np.empty(n_pop)
+    x32 = np.empty(n, np.float32)
+    for k in range(n):
+        x32[k] = xn[k]
+    acc = np.empty(n, np.float32)
+    for p in range(n_pop):
+        for k in range(n):
+            acc[k] = 0.0
+        for j in range(m):
+            w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
+            for k in range(n):
+                acc[k] += v * logsig32(w * x32[k] + b)
+        c = lo + span * thetas[p, 3 * m]
+        s = 0.0
+        for k in range(n):
+            e = c + span * np.float64(acc[k]) - t[k]
+            s += e * e
+        out[p] = s
+    return out
+
+
+# ----------------------------------------------------------------------------------------------- random
+# xoshiro256** (Blackman & Vigna 2018, "Scrambled linear pseudorandom number generators"): one 256-bit
+# state per DE run, seeded from that run's numpy Generator, so the kernels draw a run's random numbers
+# in the order the run needs them, whatever other runs share the batch.
+_U = np.uint64
+
+
+def xoshiro_states(rngs) -> np.ndarray:
+    """One xoshiro256** state per numpy Generator in ``rngs``: ``(S, 4)`` uint64, each drawn from its
+    generator (never all zero)."""
+    out = np.stack([g.integers(1, 2 ** 63, size=4, dtype=np.int64).astype(np.uint64) for g in rngs])
+    return np.ascontiguousarray(out)
+
+
+@njit(inline="always", cache=True)
+def _rotl(x, k):
+    return (x << _U(k)) | (x >> _U(64 - k))
+
+
+@njit(inline="always", cache=True)
+def next_u64(state, s):
+    """Next 64-bit output of run ``s``'s xoshiro256** state (``state (S, 4)``, advanced in place)."""
+    s0, s1, s2, s3 = state[s, 0], state[s, 1], state[s, 2], state[s, 3]
+    result = _rotl(s1 * _U(5), 7) * _U(9)
+    t = s1 << _U(17)
+    s2 ^= s0
+    s3 ^= s1
+    s1 ^= s2
+    s0 ^= s3
+    s2 ^= t
+    s3 = _rotl(s3, 45)
+    state[s, 0], state[s, 1], state[s, 2], state[s, 3] = s0, s1, s2, s3
+    return result
+
+
+@njit(inline="always", cache=True)
+def _below(x32, m):
+    """Integer in [0, m) from 32 random bits (multiply-shift; bias below m / 2^32)."""
+    return np.int64((x32 * _U(m)) >> _U(32))
+
+
+@njit(inline="always", cache=True)
+def _parents(state, s, i, n):
+    """Three indices distinct from each other and from ``i`` in [0, n), and a gene index source: the
+    offsets o1 in 1..n-1, o2 in 1..n-2 (skipping o1), o3 in 1..n-3 (skipping both) from ``(i + o) mod n``,
+    (multiply-shift on 32-bit halves).  Returns ``(r1, r2, r3, x)`` with ``x`` 32
+    unused random bits."""
+    a, b = next_u64(state, s), next_u64(state, s)
+    o1 = 1 + _below(a >> _U(32), n - 1)
+    o2 = 1 + _below(a & _U(0xFFFFFFFF), n - 2)
+    if o2 >= o1:
+        o2 += 1
+    lo, hi = min(o1, o2), max(o1, o2)
+    o3 = 1 + _below(b >> _U(32), n - 3)
+    if o3 >= lo:
+        o3 += 1
+    if o3 >= hi:
+        o3 += 1
+    return (i + o1) % n, (i + o2) % n, (i + o3) % n, b & _U(0xFFFFFFFF)
+
+
+@njit(cache=True)
+def sample_parents(state, n, count):
+    """``count`` parent triples for individual 0 of a population of ``n`` and the j_rand draws for
+    ``D = 7`` genes, from run 0 of ``state`` (for tests of the kernel's sampling)."""
+    out = np.empty((count, 4), np.int64)
+    for k in range(count):
+        r1, r2, r3, x = _parents(state, 0, 0, n)
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = r1, r2, r3, _below(x, 7)
+    return out
+
+
+@njit(cache=True)
+def sample_uniform(state, count):
+    """``count`` uniforms in [0, 1) (53 bits) from run 0 of ``state`` (for tests)."""
+    out = np.empty(count)
+    for k in range(count):
+        out[k] = np.float64(next_u64(state, 0) >> _U(11)) * 2.0 ** -53
+    return out
+
+
+@njit(error_model="numpy", cache=True)
+def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
+    """Trial vectors of one DE/rand/1/bin generation for every run of a batch (written into ``trial``).
+
+    ``pop (S, NP, D)``, ``fit (S, NP)``, ``state (S, 4)`` the runs' xoshiro256** states (advanced in place).
+    Per individual: parents r1, r2, r3 (distinct, != i) and j_rand uniformly at random, then
+
+        v_ij = x_r1,j + F (x_r2,j - x_r3,j);  u_ij = v_ij if U_ij < CR_i or j = j_rand(i) else x_ij;
+        u_ij <- U(-bound, bound)   (a fresh uniform)   if |u_ij| > bound
+
+    with ``U_ij`` uniform at 16-bit resolution (``k / 2^16``).  ``CR_i`` = ``cr`` or, if ``adaptive``,
+    ADE's ``cr_min + (cr_max - cr_min)(f_i - f_min)/(f_max - f_min)`` within the run (``cr_min`` for all
+    when every fitness is equal)."""
+    n_runs, n_pop, dim = pop.shape
+    for s in range(n_runs):
+        lo, hi = fit[s, 0], fit[s, 0]
+        if adaptive:
+            for i in range(1, n_pop):
+                lo = min(lo, fit[s, i])
+                hi = max(hi, fit[s, i])
+        for i in range(n_pop):
+            c = cr
+            if adaptive:
+                c = cr_min + (cr_max - cr_min) * (fit[s, i] - lo) / (hi - lo) if hi > lo else cr_min
+            threshold = np.int64(np.ceil(c * 65536.0))       # U < c  <=>  k < ceil(c 2^16)
+            r1, r2, r3, x = _parents(state, s, i, n_pop)
+            jr = _below(x, dim)
+            n_out = 0
+            bits = _U(0)
+            for j in range(dim):
+                if j % 4 == 0:
+                    bits = next_u64(state, s)
+                k16 = np.int64((bits >> _U(16 * (j % 4))) & _U(0xFFFF))
+                if k16 < threshold or j == jr:
+                    u = pop[s, r1, j] + f * (pop[s, r2, j] - pop[s, r3, j])
+                else:
+                    u = pop[s, i, j]
+                trial[s, i, j] = u
+                n_out += abs(u) > bound
+            if n_out:
+                for j in range(dim):
+                    if abs(trial[s, i, j]) > bound:
+                        unit = np.float64(next_u64(state, s) >> _U(11)) * 2.0 ** -53
+                        trial[s, i, j] = -bound + 2.0 * bound * unit
+
+
+@njit(cache=True)
+def de_select(pop, fit, trial, tfit, best):
+    """Greedy selection ``x_i <- u_i if J(u_i) <= J(x_i)`` in place; ``best[s]`` = run s's best fitness."""
+    n_runs, n_pop, dim = pop.shape
+    for s in range(n_runs):
+        b = np.inf
+        for i in range(n_pop):
+            if tfit[s, i] <= fit[s, i]:
+                fit[s, i] = tfit[s, i]
+                for j in range(dim):
+                    pop[s, i, j] = trial[s, i, j]
+            b = min(b, fit[s, i])
+        best[s] = b
+
+
+# ----------------------------------------------------------------------------------------------- trainlm
+#: Stop reasons of :func:`lm_1m1`, by code (0 = still training).
+LM_STOPS = ("", "maximum epoch", "performance goal", "maximum mu", "minimum gradient", "validation stop")
+
+
+@njit(cache=True)
+def _net_residuals(theta, xn, t, m, tansig, lo, out_lo, gain, r, h):
+    """Residuals (target units) of one 1-M-1 net, as :func:`navlib.methods.bpnet.forward_population`
+    computes the output, ``lo + (o' - out_lo) gain - t``; ``h (N, M)`` receives the hidden layer's tanh
+    values (of ``z`` for tansig, of ``z/2`` for logsig), which :func:`_net_jacobian` reuses."""
+    k = 1.0 if tansig else 0.5
+    bias = theta[3 * m]
+    if not tansig:
+        for j in range(m):
+            bias += 0.5 * theta[2 * m + j]
+    for i in range(xn.shape[0]):
+        o = 0.0
+        for j in range(m):
+            h[i, j] = np.tanh((k * theta[j]) * xn[i] + k * theta[m + j])
+            o += (k * theta[2 * m + j]) * h[i, j]
+        r[i] = lo + (o + bias - out_lo) * gain - t[i]
+
+
+@njit(cache=True)
+def _net_jacobian(theta, xn, m, tansig, gain, h, jac):
+    """Jacobian of the residuals (``gain`` times :func:`navlib.methods.bpnet.output_jacobian`), from the
+    hidden tanh values ``h`` of :func:`_net_residuals` at the same ``theta``."""
+    for i in range(xn.shape[0]):
+        for j in range(m):
+            if tansig:
+                g = h[i, j]
+                dg = 1.0 - g * g
+            else:
+                g = 0.5 * (1.0 + h[i, j])
+                dg = g * (1.0 - g)
+            vd = dg * theta[2 * m + j]
+            jac[i, j] = gain * (vd * xn[i])
+            jac[i, m + j] = gain * vd
+            jac[i, 2 * m + j] = gain * g
+        jac[i, 3 * m] = gain
+
+
+@njit(cache=True)
+def _wmse(r, w, wsum):
+    s = 0.0
+    for i in range(r.shape[0]):
+        s += w[i] * r[i] * r[i]
+    return s / wsum
+
+
+@njit(cache=True)
+def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_max, goal, mu0, mu_dec, mu_inc,
+           mu_max, min_grad, max_fail):
+    """MATLAB's ``trainlm`` for S independent 1-M-1 nets (the algorithm, stop tests and their order as in
+    :func:`navlib.methods.lm.levenberg_marquardt`, which is the generic reference this kernel is tested
+    against), compiled for the network of :mod:`navlib.methods.bpnet`: one net after another, each with
+    its own training weights ``wt[s]`` and validation weights ``wv[s]`` (0/1).
+
+    Returns ``(theta (S, D), epochs (S,), stop codes (S,) into LM_STOPS, perf (S, E+1), val_perf (S, E+1),
+    best_epoch (S,))``; histories are NaN after the stop."""
+    n_nets, dim = theta0.shape
+    n = xn.shape[0]
+    out = theta0.copy()
+    epochs = np.zeros(n_nets, np.int64)
+    stop = np.zeros(n_nets, np.int64)
+    hist = np.full((n_nets, epochs_max + 1), np.nan)
+    vhist = np.full((n_nets, epochs_max + 1), np.nan)
+    best_epoch = np.zeros(n_nets, np.int64)
+    r = np.empty(n)
+    r2 = np.empty(n)
+    h = np.empty((n, m))
+    h2 = np.empty((n, m))
+    jac = np.empty((n, dim))
+    jw = np.empty((n, dim))
+    a = np.empty((dim, dim))
+    for s in range(n_nets):
+        theta = theta0[s].copy()
+        w, v = wt[s], wv[s]
+        wsum, vsum = w.sum(), v.sum()
+        _net_residuals(theta, xn, t, m, tansig, lo, out_lo, gain, r, h)
+        perf = _wmse(r, w, wsum)
+        vperf = _wmse(r, v, vsum) if do_val else np.nan
+        hist[s, 0], vhist[s, 0] = perf, vperf
+        best, best_v, fails, mu = theta.copy(), vperf, 0, mu0
+        _net_jacobian(theta, xn, m, tansig, gain, h, jac)
+        for epoch in range(epochs_max + 1):
+            for i in range(n):
+                for p in range(dim):
+                    jw[i, p] = w[i] * jac[i, p]
+            jj = np.dot(jw.T, jac)                     # J' W J and J' W e (BLAS)
+            je = np.dot(jw.T, r)
+            g2 = 0.0
+            for p in range(dim):
+                g2 += (2.0 * je[p] / wsum) ** 2
+            why = (1 if epoch == epochs_max else 2 if perf <= goal else 3 if mu > mu_max
+                   else 4 if np.sqrt(g2) <= min_grad else 5 if do_val and fails >= max_fail else 0)
+            if why:
+                stop[s] = why
+                break
+            while True:
+                for p in range(dim):
+                    for q in range(dim):
+                        a[p, q] = jj[p, q]
+                    a[p, p] += mu
+                try:
+                    step = -np.linalg.solve(a, je)
+                except Exception:      # singular: a NaN step fails the test below and raises mu
+                    step = np.full(dim, np.nan)
+                trial = theta + step
+                _net_residuals(trial, xn, t, m, tansig, lo, out_lo, gain, r2, h2)
+                perf2 = _wmse(r2, w, wsum)
+                if perf2 < perf:
+                    theta, perf = trial, perf2
+                    r[:] = r2
+                    h[:, :] = h2
+                    mu = max(mu * mu_dec, 1e-20)
+                    break
+                mu *= mu_inc
+                if mu > mu_max:
+                    break
+            epochs[s] = epoch + 1
+            hist[s, epoch + 1] = perf
+            _net_jacobian(theta, xn, m, tansig, gain, h, jac)
+            if do_val:
+                vperf = _wmse(r, v, vsum)
+                vhist[s, epoch + 1] = vperf
+                if vperf < best_v:
+                    best[:], best_v, best_epoch[s], fails = theta, vperf, epoch + 1, 0
+                elif vperf > best_v:
+                    fails += 1
+        if do_val:
+            out[s] = best
+        else:
+            out[s] = theta
+            best_epoch[s] = epochs[s]
+    return out, epochs, stop, hist, vhist, best_epoch
