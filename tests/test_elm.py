@@ -9,6 +9,7 @@ from navlib.methods.seeding import generator
 from navlib.methods.elm import (ACTIVATIONS, ELMModel, ELMParams, IncrementalELMParams, _back_tune, back_tune,
                                fit_elm, fit_incremental_elm, loss_and_gradients, prune_nodes)
 from navlib.errors import InputError
+from navlib.methods.jit import column_sums, pairwise_sum
 
 import elm_reference as reference
 
@@ -84,6 +85,21 @@ def test_gradients_match_finite_differences():
                 arr[idx] = old
                 num[idx] = (lp - lm) / (2 * eps)
             np.testing.assert_allclose(grad, num, rtol=1e-5, atol=1e-9, err_msg=f"{act} d/d{name}")
+
+
+def test_compiled_sums_follow_numpy_order():
+    # numpy sums pairwise (blocks of 8, split above 128 entries); a plain running sum differs in the last
+    # bits for most of these sizes, so equality checks the order (under the locked numpy)
+    rng = np.random.default_rng(3)
+    plain_differs = 0
+    for n in (0, 1, 7, 8, 9, 121, 128, 129, 300, 1000, 4099):
+        a = rng.normal(size=n) * 10.0 ** rng.uniform(-4, 4, n)
+        assert pairwise_sum(a) == np.sum(a), n
+        plain_differs += sum(a.tolist()) != np.sum(a)
+        m = rng.normal(size=(max(n, 1), 3))
+        np.testing.assert_array_equal(column_sums(m), m.sum(axis=0))
+        np.testing.assert_array_equal(column_sums(m[:, :1].copy()), m[:, :1].sum(axis=0))
+    assert plain_differs >= 3
 
 
 @pytest.mark.parametrize("activation", ACTIVATIONS)

@@ -32,11 +32,11 @@ step is accepted only if the loss drops by at least 1e-4 * step * ||grad||^2, ot
 so back-tuning can never increase the training loss (a property of the code, tested, not of a lucky
 learning rate).
 
-Speed: the loss, its gradients and the whole line-search loop are compiled with numba (``cache=True``:
-compiled once, then loaded from ``__pycache__``).  The kernels evaluate the numpy expressions above in
-numpy's order (the same BLAS call for every matrix product, numpy's pairwise sums, no fast-math), so
-they agree with the plain-numpy loop up to rounding; with the sigmoid and contiguous inputs they give
-the same bits on our machine.  The plain ELM (:func:`fit_elm`, :meth:`ELMModel.loss`) stays in numpy.
+Speed: the loss, its gradients and the whole line-search loop are compiled with numba
+(:mod:`navlib.methods.jit`, ``cache=True``: compiled once, then loaded from ``__pycache__``).  The kernels
+evaluate the numpy expressions above in numpy's order (the same BLAS call for every matrix product,
+numpy's pairwise sums, no fast-math), so they agree with the plain-numpy loop up to rounding; with the
+sigmoid and contiguous inputs they give the same bits on our machine.  The plain ELM (:func:`fit_elm`, :meth:`ELMModel.loss`) stays in numpy.
 
 Point-incremental scheme (patent "fourth step" and Fig. 2): the hidden layer starts with one node and
 grows by one random node per ELM stage; ELM solve and back-tuning alternate; nodes whose output weight
@@ -51,11 +51,11 @@ from typing import Literal
 
 import numpy as np
 import pandas as pd
-from numba import njit
 from scipy.special import expit
 
 from ..errors import InputError, check_choice, check_param
 from .arrays import as_2d
+from .jit import elm_back_tune, elm_loss, elm_loss_grad
 from .seeding import generator
 
 __all__ = [
@@ -236,159 +236,6 @@ def fit_elm(x, t, params: ELMParams | None = None, *, n_hidden: int | None = Non
 
 
 # --------------------------------------------------------------------------------------------------
-# Compiled kernels (numba, ``cache=True``): the loss, its gradients and the whole back-tuning loop.
-# They evaluate the same expressions as the numpy code they replace, in the same order, so that the
-# results equal numpy's up to rounding (on our machine: bit for bit with the sigmoid):
-# sigmoid as 1 / (1 + exp(-z)) (scipy's ``expit``); every matrix product by the BLAS routine numpy's
-# ``@`` calls for those shapes (dot, gemv or gemm; numba calls it through scipy's BLAS); sums in
-# numpy's order (pairwise in blocks of 8 over a contiguous run, column sums row after row).  No
-# fast-math flags: the compiler may neither reorder a floating-point sum nor fuse a multiply-add.
-
-@njit(cache=True, error_model="numpy")
-def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
-    """Sum of a[lo:lo+n], n <= 128, in numpy's order: 8 running sums combined pairwise, then the rest."""
-    if n < 8:
-        res = 0.0
-        for i in range(lo, lo + n):
-            res += a[i]
-        return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = 8
-    while i < n - (n % 8):
-        j = lo + i
-        r0 += a[j]
-        r1 += a[j + 1]
-        r2 += a[j + 2]
-        r3 += a[j + 3]
-        r4 += a[j + 4]
-        r5 += a[j + 5]
-        r6 += a[j + 6]
-        r7 += a[j + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < n:
-        res += a[lo + i]
-        i += 1
-    return res
-
-
-@njit(cache=True, error_model="numpy")
-def _pairwise_sum(a: np.ndarray) -> float:
-    """``np.sum(a)`` of a contiguous array in numpy's order (numpy's ``pairwise_sum``: halve, rounded to
-    a multiple of 8, until a block has at most 128 entries); without recursion, which numba's cache
-    does not handle."""
-    a = a.ravel()
-    los, ns, ops = np.empty(128, np.int64), np.empty(128, np.int64), np.empty(128, np.int64)
-    vals = np.empty(128)
-    los[0], ns[0], ops[0] = 0, a.size, 0
-    top, nv = 1, 0
-    while top > 0:
-        top -= 1
-        lo, n, op = los[top], ns[top], ops[top]
-        if op == 1:                          # both halves done: left + right
-            nv -= 1
-            vals[nv - 1] = vals[nv - 1] + vals[nv]
-        elif n <= 128:
-            vals[nv] = _block_sum(a, lo, n)
-            nv += 1
-        else:
-            n2 = n // 2
-            n2 -= n2 % 8
-            ops[top] = 1                     # stays below the halves, so it runs after both
-            los[top + 1], ns[top + 1], ops[top + 1] = lo + n2, n - n2, 0
-            los[top + 2], ns[top + 2], ops[top + 2] = lo, n2, 0
-            top += 3
-    return vals[0]
-
-
-@njit(cache=True, error_model="numpy")
-def _column_sums(a: np.ndarray) -> np.ndarray:
-    """``a.sum(axis=0)`` of a C-contiguous (N, L) array in numpy's order: row after row, or pairwise when
-    there is a single column."""
-    if a.shape[1] == 1:
-        return np.full(1, _pairwise_sum(a))
-    out = a[0].copy()
-    for n in range(1, a.shape[0]):
-        out += a[n]
-    return out
-
-
-@njit(cache=True, error_model="numpy")
-def _matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a @ b`` for 2-D contiguous arrays by the BLAS call numpy's matmul makes for these shapes:
-    dot for (1, q) @ (q, 1), gemv when one side is a single row or column, gemm otherwise."""
-    p, q = a.shape
-    r = b.shape[1]
-    if p == 1 and r == 1:
-        return np.full((1, 1), np.dot(np.ascontiguousarray(a).reshape(q), np.ascontiguousarray(b).reshape(q)))
-    if p == 1:
-        return np.dot(np.ascontiguousarray(a).reshape(q), b).reshape(1, r)
-    if r == 1:
-        return np.dot(a, np.ascontiguousarray(b).reshape(q)).reshape(p, 1)
-    return np.dot(a, b)
-
-
-@njit(cache=True, error_model="numpy")
-def _hidden_nb(w, b, X, sigmoid):
-    """H = g(X W + b) (sigmoid as scipy's ``expit``: 1 / (1 + exp(-z)))."""
-    z = _matmul(X, w) + b
-    return 1.0 / (1.0 + np.exp(-z)) if sigmoid else np.tanh(z)
-
-
-@njit(cache=True, error_model="numpy")
-def _loss_nb(w, b, beta, X, T, sigmoid) -> float:
-    """E = mean((g(X W + b) beta - T)^2)."""
-    r = _matmul(_hidden_nb(w, b, X, sigmoid), beta) - T
-    return _pairwise_sum(r * r) / r.size
-
-
-@njit(cache=True, error_model="numpy")
-def _loss_grad_nb(w, b, beta, X, T, sigmoid):
-    """(E, dE/dW, dE/db, dE/dbeta), the equations of :func:`loss_and_gradients`."""
-    a2 = _hidden_nb(w, b, X, sigmoid)
-    r = _matmul(a2, beta) - T
-    loss = _pairwise_sum(r * r) / r.size
-    d3 = (2.0 / r.size) * r
-    d2 = _matmul(d3, np.ascontiguousarray(beta.T)) * (a2 * (1.0 - a2) if sigmoid else 1.0 - a2 * a2)
-    return loss, _matmul(X.T, d2), _column_sums(d2), _matmul(a2.T, d3)
-
-
-@njit(cache=True, error_model="numpy")
-def _back_tune_nb(w, b, beta, X, T, sigmoid, steps, step, max_halvings, armijo):
-    """The loop of :func:`_back_tune` in one compiled call: returns the tuned (w, b, beta), the losses
-    (the starting loss, then one per accepted step) and the trial step for the next call."""
-    loss, gw, gb, gbeta = _loss_grad_nb(w, b, beta, X, T, sigmoid)
-    losses = np.empty(steps + 1)
-    losses[0] = loss
-    count = 1
-    w1, b1, beta1 = w, b, beta
-    for _ in range(steps):
-        g2 = _pairwise_sum(gw * gw) + _pairwise_sum(gb * gb) + _pairwise_sum(gbeta * gbeta)
-        if g2 == 0.0:
-            break
-        found = False
-        for _ in range(max_halvings):
-            w1, b1, beta1 = w - step * gw, b - step * gb, beta - step * gbeta
-            # A step too small to change any weight gives exactly the current loss (the same
-            # computation on the same numbers), which the test below rejects: skip evaluating it.
-            if not (np.array_equal(w1, w) and np.array_equal(b1, b) and np.array_equal(beta1, beta)):
-                new = _loss_nb(w1, b1, beta1, X, T, sigmoid)
-                if new <= loss - armijo * step * g2 and new < loss:
-                    found = True
-                    break
-            step *= 0.5
-        if not found:  # no decrease found at any step size: (numerically) stationary, stop this stage
-            break
-        w, b, beta = w1, b1, beta1
-        loss, gw, gb, gbeta = _loss_grad_nb(w, b, beta, X, T, sigmoid)
-        losses[count] = loss
-        count += 1
-        step *= 2.0  # let the step grow again; the line search halves it back when needed
-    return w.copy(), b.copy(), beta.copy(), losses[:count].copy(), step
-
-
-# --------------------------------------------------------------------------------------------------
 # Back-tuning (patent s702, s1001-s1104)
 
 def loss_and_gradients(model: ELMModel, x, t) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
@@ -407,14 +254,14 @@ def _f64(a) -> np.ndarray:
 
 
 def _loss(w, b, beta, X, T, act) -> float:
-    """Training MSE of the net (W, b, beta) on (X, T) (compiled: :func:`_loss_nb`)."""
-    return float(_loss_nb(_f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid"))
+    """Training MSE of the net (W, b, beta) on (X, T) (compiled: :func:`navlib.methods.jit.elm_loss`)."""
+    return float(elm_loss(_f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid"))
 
 
 def _loss_grad(w, b, beta, X, T, act):
     """Loss and gradients (dE/dW, dE/db, dE/dbeta) as :func:`loss_and_gradients` (compiled:
-    :func:`_loss_grad_nb`)."""
-    loss, gw, gb, gbeta = _loss_grad_nb(_f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid")
+    :func:`navlib.methods.jit.elm_loss_grad`)."""
+    loss, gw, gb, gbeta = elm_loss_grad(_f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid")
     return float(loss), gw, gb, gbeta
 
 
@@ -422,8 +269,8 @@ def _back_tune(model: ELMModel, X, T, steps: int, step: float, max_halvings: int
                armijo: float = 1e-4) -> tuple[ELMModel, list[float], float]:
     """Gradient descent with backtracking; returns the tuned copy, the loss after each accepted step
     (the first entry is the starting loss) and the trial step for the next call.  The whole loop runs
-    in one compiled call (:func:`_back_tune_nb`)."""
-    w, b, beta, losses, step = _back_tune_nb(_f64(model.w), _f64(model.b), _f64(model.beta), _f64(X),
+    in one compiled call (:func:`navlib.methods.jit.elm_back_tune`)."""
+    w, b, beta, losses, step = elm_back_tune(_f64(model.w), _f64(model.b), _f64(model.beta), _f64(X),
                                              _f64(T), model.activation == "sigmoid", int(steps),
                                              float(step), int(max_halvings), float(armijo))
     return replace(model, w=w, b=b, beta=beta), losses.tolist(), float(step)
