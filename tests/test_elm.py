@@ -6,10 +6,12 @@ import pytest
 
 from navlib.methods.seeding import generator
 
-from navlib.methods.elm import (ELMModel, ELMParams, IncrementalELMParams, back_tune, fit_elm,
-
-    fit_incremental_elm, loss_and_gradients, prune_nodes)
+from navlib.methods.elm import (ACTIVATIONS, ELMModel, ELMParams, IncrementalELMParams, _back_tune, back_tune,
+                               fit_elm, fit_incremental_elm, loss_and_gradients, prune_nodes)
 from navlib.errors import InputError
+from navlib.methods.jit import column_sums, pairwise_sum
+
+import elm_reference as reference
 
 
 def compass_like(n: int = 121, noise: float = 0.0, seed: int = 0):
@@ -83,6 +85,92 @@ def test_gradients_match_finite_differences():
                 arr[idx] = old
                 num[idx] = (lp - lm) / (2 * eps)
             np.testing.assert_allclose(grad, num, rtol=1e-5, atol=1e-9, err_msg=f"{act} d/d{name}")
+
+
+def test_compiled_sums_follow_numpy_order():
+    # numpy sums pairwise (blocks of 8, split above 128 entries); a plain running sum differs in the last
+    # bits for most of these sizes, so equality checks the order (under the locked numpy)
+    rng = np.random.default_rng(3)
+    plain_differs = 0
+    for n in (0, 1, 7, 8, 9, 121, 128, 129, 300, 1000, 4099):
+        a = rng.normal(size=n) * 10.0 ** rng.uniform(-4, 4, n)
+        assert pairwise_sum(a) == np.sum(a), n
+        plain_differs += sum(a.tolist()) != np.sum(a)
+        m = rng.normal(size=(max(n, 1), 3))
+        np.testing.assert_array_equal(column_sums(m), m.sum(axis=0))
+        np.testing.assert_array_equal(column_sums(m[:, :1].copy()), m[:, :1].sum(axis=0))
+    assert plain_differs >= 3
+
+
+@pytest.mark.parametrize("activation", ACTIVATIONS)
+def test_compiled_loss_and_gradients_match_numpy(activation):
+    # several inputs and outputs: every matrix product and sum of the compiled kernel is exercised
+    rng = np.random.default_rng(8)
+    X, T = rng.uniform(0, 1, (37, 3)), rng.normal(size=(37, 2))
+    m = ELMModel(w=rng.normal(size=(3, 5)), b=rng.normal(size=5), beta=rng.normal(size=(5, 2)),
+                 activation=activation, squeeze_output=False)
+    ours = loss_and_gradients(m, X, T)
+    ref = reference.loss_grad(m.w, m.b, m.beta, X, T, activation)
+    assert ours[0] == pytest.approx(ref[0], rel=1e-13)
+    for name, a, r in zip(("W", "b", "beta"), ours[1:], ref[1:]):
+        assert a.shape == r.shape, name
+        np.testing.assert_allclose(a, r, rtol=1e-12, atol=1e-15 * np.abs(r).max(), err_msg=f"dE/d{name}")
+
+
+@pytest.mark.parametrize("activation", ACTIVATIONS)
+@pytest.mark.parametrize("lr", [1e-2, 1e3])
+def test_compiled_back_tuning_matches_numpy_reference(activation, lr):
+    # the same accepted steps, halvings and doublings as the plain-numpy loop, up to rounding
+    x, t = compass_like(121, noise=0.05, seed=3)
+    model = fit_elm(x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=3, activation=activation))
+    model.beta *= 0.8                        # off the least-squares optimum, so that tuning has work to do
+    X, T = x[:, None], t[:, None]
+    w, b, beta, ref_losses, ref_step = reference.back_tune(model.w, model.b, model.beta, X, T, activation,
+                                                           40, lr)
+    tuned, losses, step = _back_tune(model, X, T, 40, lr)
+    assert len(ref_losses) == 41 and ref_losses[-1] < 0.5 * ref_losses[0]   # the comparison has teeth
+    assert len(losses) == len(ref_losses)
+    np.testing.assert_allclose(losses, ref_losses, rtol=1e-10, atol=0)
+    assert step == ref_step                                                   # a power of two times lr
+    for name, ref in (("w", w), ("b", b), ("beta", beta)):
+        np.testing.assert_allclose(getattr(tuned, name), ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max(),
+                                   err_msg=name)
+
+
+@pytest.mark.parametrize("lr", [1e-300, 1e-16, 1e-15])
+def test_stalled_line_search_matches_numpy_reference(lr):
+    # tiny trial steps: those that change no weight are skipped by the compiled loop, the step
+    # bookkeeping (halvings, the step handed to the next stage) must still be the reference's
+    x, t = compass_like(121, noise=0.05, seed=2)
+    model = fit_elm(x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=2))
+    model.beta *= 0.8
+    X, T = x[:, None], t[:, None]
+    *_, ref_losses, ref_step = reference.back_tune(model.w, model.b, model.beta, X, T, "sigmoid", 10, lr)
+    tuned, losses, step = _back_tune(model, X, T, 10, lr)
+    assert step == ref_step and len(losses) == len(ref_losses)
+    np.testing.assert_allclose(losses, ref_losses, rtol=1e-10, atol=0)
+    if lr == 1e-300:                         # nothing can move: 40 halvings (into subnormals), then stop
+        assert len(losses) == 1 and 0 < step < lr * 1e-12
+        np.testing.assert_array_equal(tuned.w, model.w)
+    if lr == 1e-15:                          # steps of about one ulp of the weights are still taken
+        assert len(losses) == 11
+
+
+def test_incremental_elm_matches_numpy_reference():
+    # the whole scheme (ELM, prune and tune stages, validation loss) with the numpy reference swapped in
+    x, t = compass_like(121, noise=0.05, seed=5)
+    p = IncrementalELMParams(max_nodes=6, loss_goal=0.0, max_iter=12, weight_range=5.0, bias_range=5.0,
+                             prune_tol=1e-2, seed=4)
+    # contiguous copies: numpy's own products round differently on strided views
+    args = (x[::2].copy(), t[::2].copy(), p)
+    kw = dict(x_val=x[1::2].copy(), t_val=t[1::2].copy())
+    model, hist = fit_incremental_elm(*args, **kw)
+    with reference.numpy_reference():
+        ref_model, ref_hist = fit_incremental_elm(*args, **kw)
+    assert hist[["iteration", "stage", "n_nodes"]].equals(ref_hist[["iteration", "stage", "n_nodes"]])
+    assert (hist.stage == "tune").sum() == 6 and hist.loss.iloc[-1] < 0.1 * hist.loss.iloc[1]
+    np.testing.assert_allclose(hist[["loss", "val_loss"]], ref_hist[["loss", "val_loss"]], rtol=1e-10, atol=0)
+    np.testing.assert_allclose(model.predict(x), ref_model.predict(x), rtol=1e-10, atol=1e-12)
 
 
 @pytest.mark.parametrize("seed", range(5))

@@ -12,11 +12,15 @@ it says which); the tests compare each kernel with that numpy reference.
 - :func:`de_trials`, :func:`de_select`: one generation of DE/rand/1/bin (and ADE's per-individual CR) for
   all runs of a batch (:func:`navlib.methods.de.evolve_many`), each run drawing from its own xoshiro256**
   stream (:func:`xoshiro_states`, seeded from the run's numpy Generator).
+- :func:`elm_back_tune` (with :func:`elm_loss`, :func:`elm_loss_grad`): patent B's back-tuning of an ELM,
+  the whole Armijo line-search loop of :func:`navlib.methods.elm.back_tune` in one call, in double
+  precision and numpy's order of operations (:func:`pairwise_sum`, :func:`column_sums`,
+  :func:`blas_matmul`), without fast-math: the same numbers as the numpy loop (bit for bit on our machine).
 
 Kernels are compiled on first use and cached on disk (``cache=True``; about 1 s per kernel the first
 time).  ``error_model='numpy'``: a float division never raises (it cannot divide by zero here), which
 lets the compiler vectorise it.  Only the fast-math flags that do not reorder arithmetic are used
-(``nnan``, ``ninf``, ``nsz``, ``arcp``, ``contract``, ``afn``).
+(``nnan``, ``ninf``, ``nsz``, ``arcp``, ``contract``, ``afn``), and none in the ELM kernels.
 """
 from __future__ import annotations
 
@@ -384,3 +388,156 @@ def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_ma
             out[s] = theta
             best_epoch[s] = epochs[s]
     return out, epochs, stop, hist, vhist, best_epoch
+
+
+# ----------------------------------------------------------------------------------------------- ELM back-tuning
+# The numpy expressions of navlib.methods.elm (loss, gradients, the Armijo line search of ``_back_tune``)
+# in numpy's order, so that the results equal numpy's up to rounding (on our machine: bit for bit with the
+# sigmoid and contiguous inputs): sigmoid as 1 / (1 + exp(-z)) (scipy's ``expit``, libm's exp); every
+# matrix product by the BLAS routine numpy's ``@`` calls for those shapes (dot, gemv or gemm; numba calls it
+# through scipy's BLAS); sums in numpy's order (pairwise in blocks of 8 over a contiguous run, column sums
+# row after row).  No fast-math flags at all, not even ``contract``: a fused multiply-add rounds once where
+# numpy rounds twice.
+
+@njit(cache=True, error_model="numpy")
+def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """Sum of a[lo:lo+n], n <= 128, in numpy's order: 8 running sums combined pairwise, then the rest."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        j = lo + i
+        r0 += a[j]
+        r1 += a[j + 1]
+        r2 += a[j + 2]
+        r3 += a[j + 3]
+        r4 += a[j + 4]
+        r5 += a[j + 5]
+        r6 += a[j + 6]
+        r7 += a[j + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, error_model="numpy")
+def pairwise_sum(a: np.ndarray) -> float:
+    """``np.sum(a)`` of a contiguous array in numpy's order (numpy's ``pairwise_sum``: halve, rounded to
+    a multiple of 8, until a block has at most 128 entries); without recursion, which numba's cache
+    does not handle."""
+    a = a.ravel()
+    los, ns, ops = np.empty(128, np.int64), np.empty(128, np.int64), np.empty(128, np.int64)
+    vals = np.empty(128)
+    los[0], ns[0], ops[0] = 0, a.size, 0
+    top, nv = 1, 0
+    while top > 0:
+        top -= 1
+        lo, n, op = los[top], ns[top], ops[top]
+        if op == 1:                          # both halves done: left + right
+            nv -= 1
+            vals[nv - 1] = vals[nv - 1] + vals[nv]
+        elif n <= 128:
+            vals[nv] = _block_sum(a, lo, n)
+            nv += 1
+        else:
+            n2 = n // 2
+            n2 -= n2 % 8
+            ops[top] = 1                     # stays below the halves, so it runs after both
+            los[top + 1], ns[top + 1], ops[top + 1] = lo + n2, n - n2, 0
+            los[top + 2], ns[top + 2], ops[top + 2] = lo, n2, 0
+            top += 3
+    return vals[0]
+
+
+@njit(cache=True, error_model="numpy")
+def column_sums(a: np.ndarray) -> np.ndarray:
+    """``a.sum(axis=0)`` of a C-contiguous (N, L) array in numpy's order: row after row, or pairwise when
+    there is a single column."""
+    if a.shape[1] == 1:
+        return np.full(1, pairwise_sum(a))
+    out = a[0].copy()
+    for n in range(1, a.shape[0]):
+        out += a[n]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def blas_matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` for 2-D contiguous arrays by the BLAS call numpy's matmul makes for these shapes:
+    dot for (1, q) @ (q, 1), gemv when one side is a single row or column, gemm otherwise."""
+    p, q = a.shape
+    r = b.shape[1]
+    if p == 1 and r == 1:
+        return np.full((1, 1), np.dot(np.ascontiguousarray(a).reshape(q), np.ascontiguousarray(b).reshape(q)))
+    if p == 1:
+        return np.dot(np.ascontiguousarray(a).reshape(q), b).reshape(1, r)
+    if r == 1:
+        return np.dot(a, np.ascontiguousarray(b).reshape(q)).reshape(p, 1)
+    return np.dot(a, b)
+
+
+@njit(cache=True, error_model="numpy")
+def elm_hidden(w, b, X, sigmoid):
+    """H = g(X W + b) (sigmoid as scipy's ``expit``: 1 / (1 + exp(-z)))."""
+    z = blas_matmul(X, w) + b
+    return 1.0 / (1.0 + np.exp(-z)) if sigmoid else np.tanh(z)
+
+
+@njit(cache=True, error_model="numpy")
+def elm_loss(w, b, beta, X, T, sigmoid) -> float:
+    """E = mean((g(X W + b) beta - T)^2)."""
+    r = blas_matmul(elm_hidden(w, b, X, sigmoid), beta) - T
+    return pairwise_sum(r * r) / r.size
+
+
+@njit(cache=True, error_model="numpy")
+def elm_loss_grad(w, b, beta, X, T, sigmoid):
+    """(E, dE/dW, dE/db, dE/dbeta), the equations of :func:`navlib.methods.elm.loss_and_gradients`."""
+    a2 = elm_hidden(w, b, X, sigmoid)
+    r = blas_matmul(a2, beta) - T
+    loss = pairwise_sum(r * r) / r.size
+    d3 = (2.0 / r.size) * r
+    d2 = blas_matmul(d3, np.ascontiguousarray(beta.T)) * (a2 * (1.0 - a2) if sigmoid else 1.0 - a2 * a2)
+    return loss, blas_matmul(X.T, d2), column_sums(d2), blas_matmul(a2.T, d3)
+
+
+@njit(cache=True, error_model="numpy")
+def elm_back_tune(w, b, beta, X, T, sigmoid, steps, step, max_halvings, armijo):
+    """The loop of ``navlib.methods.elm._back_tune`` in one compiled call: returns the tuned (w, b, beta), the losses
+    (the starting loss, then one per accepted step) and the trial step for the next call."""
+    loss, gw, gb, gbeta = elm_loss_grad(w, b, beta, X, T, sigmoid)
+    losses = np.empty(steps + 1)
+    losses[0] = loss
+    count = 1
+    w1, b1, beta1 = w, b, beta
+    for _ in range(steps):
+        g2 = pairwise_sum(gw * gw) + pairwise_sum(gb * gb) + pairwise_sum(gbeta * gbeta)
+        if g2 == 0.0:
+            break
+        found = False
+        for _ in range(max_halvings):
+            w1, b1, beta1 = w - step * gw, b - step * gb, beta - step * gbeta
+            # A step too small to change any weight gives exactly the current loss (the same
+            # computation on the same numbers), which the test below rejects: skip evaluating it.
+            if not (np.array_equal(w1, w) and np.array_equal(b1, b) and np.array_equal(beta1, beta)):
+                new = elm_loss(w1, b1, beta1, X, T, sigmoid)
+                if new <= loss - armijo * step * g2 and new < loss:
+                    found = True
+                    break
+            step *= 0.5
+        if not found:  # no decrease found at any step size: (numerically) stationary, stop this stage
+            break
+        w, b, beta = w1, b1, beta1
+        loss, gw, gb, gbeta = elm_loss_grad(w, b, beta, X, T, sigmoid)
+        losses[count] = loss
+        count += 1
+        step *= 2.0  # let the step grow again; the line search halves it back when needed
+    return w.copy(), b.copy(), beta.copy(), losses[:count].copy(), step
