@@ -36,6 +36,7 @@ $(STAMP): environment.lock pyproject.toml
 
 book: $(STAMP)
 	@rm -rf $(GENERATED)
+	@$(PY) -m navlib.booktools compile
 	@$(PY) -m navlib.booktools execute --out $(GENERATED) $(NOTEBOOKS)
 	@$(PY) -m navlib.booktools status $(GENERATED)/results --notebooks $(GENERATED) --out $(GENERATED)/status.md
 	@$(PY) -m navlib.booktools api-modules --out $(GENERATED)/api_modules.md
@@ -59,6 +60,7 @@ test-lib: $(STAMP)
 # The folder is cleared first so a stale file cannot pass test-results.
 test-notebooks: $(STAMP)
 	@rm -rf $(GENERATED)/results
+	@$(PY) -m navlib.booktools compile
 	@NAVBOOK_RESULTS_DIR=$(CURDIR)/$(GENERATED)/results $(PY) -m pytest -q -p no:cacheprovider --nbval \
 	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks
 
@@ -67,6 +69,7 @@ test-results: $(STAMP)
 	@$(PY) -m navlib.booktools check-results --fresh $(GENERATED)/results --reference notebooks/results $(NOTEBOOKS)
 
 notebooks: $(STAMP)
+	@$(PY) -m navlib.booktools compile
 	@$(PY) -m navlib.booktools execute --in-place $(NOTEBOOKS)
 
 bench: $(STAMP)
