@@ -199,7 +199,7 @@ def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
     Per individual: parents r1, r2, r3 (distinct, != i) and j_rand uniformly at random, then
 
         v_ij = x_r1,j + F (x_r2,j - x_r3,j);  u_ij = v_ij if U_ij < CR_i or j = j_rand(i) else x_ij;
-        u_ij <- U(-bound, bound)   (a fresh uniform)   if |u_ij| > bound
+        u_ij <- U(-bound, bound)   (a fresh uniform)   if abs(u_ij) > bound
 
     with ``U_ij`` uniform at 16-bit resolution (``k / 2^16``).  ``CR_i`` = ``cr`` or, if ``adaptive``,
     ADE's ``cr_min + (cr_max - cr_min)(f_i - f_min)/(f_max - f_min)`` within the run (``cr_min`` for all
