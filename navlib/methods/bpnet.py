@@ -261,7 +261,7 @@ def train_adam_many(x, t, n_hidden: int, params: AdamParams, rngs) -> list[BPNet
 
     Each net's loss is its own normalised MSE and Adam's update is element-wise, so every net follows the
     trajectory it would follow alone (up to rounding); the batch saves the per-epoch overhead.  The
-    gradient is analytic (:func:`_adam_trajectories`), the same as back-propagation by autograd up to
+    gradient is analytic (``_adam_trajectories``), the same as back-propagation by autograd up to
     rounding.  ``train_time_s`` is the batch time divided by the number of nets."""
     x, t = _check_xy(x, t, n_hidden)
     rngs = _rngs(rngs)
