@@ -19,8 +19,10 @@ repeats).
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -33,6 +35,9 @@ from navlib.paths import DATA_DIR
 from navlib.studies import paper_a
 from navlib.studies.paper_a import StudyParams, Sweeps
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))   # the peer adapters
+from peers import autograd_adam  # noqa: E402
+
 
 def autograd_trajectories(theta0, xn, tn, n_hidden, params, threads=None):
     """The former trainer: autograd back-propagation and torch's default Adam (same signature as
@@ -42,19 +47,7 @@ def autograd_trajectories(theta0, xn, tn, n_hidden, params, threads=None):
     caller = torch.get_num_threads()
     torch.set_num_threads(threads or caller)
     try:
-        th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
-        X, T = torch.tensor(xn, dtype=torch.float64), torch.tensor(tn, dtype=torch.float64)
-        opt = torch.optim.Adam([th], lr=params.lr)
-        history = np.empty((theta0.shape[0], params.epochs))
-        for k in range(params.epochs):
-            opt.zero_grad()
-            h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])
-            out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m:3 * m]) + th[:, 3 * m:3 * m + 1]
-            loss = torch.mean((out - T) ** 2, dim=1)
-            loss.sum().backward()
-            opt.step()
-            history[:, k] = loss.detach().numpy()
-        return th.detach().numpy().copy(), history
+        return autograd_adam(theta0, xn, tn, n_hidden, params.epochs, params.lr)
     finally:
         torch.set_num_threads(caller)
 

@@ -2,6 +2,8 @@
 dependencies): a ``simpful`` Sugeno system with the same rules as a :class:`navlib.methods.subclust.SugenoFIS`."""
 from __future__ import annotations
 
+import numpy as np
+import torch
 from simpful import FuzzySet, FuzzySystem, Gaussian_MF, LinguisticVariable
 
 
@@ -22,3 +24,20 @@ def simpful_system(fis):
         rules.append("IF " + " AND ".join(f"({nm} IS m{r})" for nm in names) + f" THEN (y IS f{r})")
     fs.add_rules(rules)
     return fs, names
+
+
+def autograd_adam(theta0, xn, tn, m, epochs, lr):
+    """The reference: the same nets trained by autograd back-propagation and torch's default Adam."""
+    th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
+    X, T = torch.tensor(xn), torch.tensor(tn)
+    opt = torch.optim.Adam([th], lr=lr)
+    history = np.empty((theta0.shape[0], epochs))
+    for k in range(epochs):
+        opt.zero_grad()
+        h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])
+        out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m:3 * m]) + th[:, 3 * m:3 * m + 1]
+        loss = torch.mean((out - T) ** 2, dim=1)
+        loss.sum().backward()
+        opt.step()
+        history[:, k] = loss.detach().numpy()
+    return th.detach().numpy(), history

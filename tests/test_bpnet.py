@@ -8,6 +8,7 @@ from navlib.methods.bpnet import (AdamParams, forward_population, n_params, outp
 from navlib.methods.seeding import generators
 from navlib.methods.de import DEParams
 from navlib.errors import InputError
+from peers import autograd_adam
 
 
 def reference_forward(theta, xn, m):
@@ -120,23 +121,6 @@ def test_train_adam_many_matches_one_at_a_time():
         np.testing.assert_allclose(net.predict(xt), ref.predict(xt), atol=1e-6)
         np.testing.assert_allclose(net.history, ref.history, rtol=1e-9)
     assert not np.allclose(nets[0].theta, nets[1].theta)
-
-
-def autograd_adam(theta0, xn, tn, m, epochs, lr):
-    """The reference: the same nets trained by autograd back-propagation and torch's default Adam."""
-    th = torch.tensor(theta0, dtype=torch.float64, requires_grad=True)
-    X, T = torch.tensor(xn), torch.tensor(tn)
-    opt = torch.optim.Adam([th], lr=lr)
-    history = np.empty((theta0.shape[0], epochs))
-    for k in range(epochs):
-        opt.zero_grad()
-        h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])
-        out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m:3 * m]) + th[:, 3 * m:3 * m + 1]
-        loss = torch.mean((out - T) ** 2, dim=1)
-        loss.sum().backward()
-        opt.step()
-        history[:, k] = loss.detach().numpy()
-    return th.detach().numpy(), history
 
 
 @pytest.mark.parametrize("m, n", [(5, 15), (50, 8)])
