@@ -1,5 +1,6 @@
 """Peer libraries built from our objects, for tests and benchmarks only (the peers are not library
-dependencies): a ``simpful`` Sugeno system with the same rules as a :class:`navlib.methods.subclust.SugenoFIS`."""
+dependencies): a ``simpful`` Sugeno system with the same rules as a :class:`navlib.methods.subclust.SugenoFIS`,
+and paper A's net trained by torch autograd and torch's default Adam (the reference of our Adam trainer)."""
 from __future__ import annotations
 
 import numpy as np
