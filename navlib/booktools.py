@@ -46,6 +46,8 @@ import time
 from html.parser import HTMLParser
 from pathlib import Path
 
+from . import verdicts
+from .errors import InputError
 from .report import claims_summary, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
@@ -330,10 +332,29 @@ def _md_cell(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
+def _status_table(summary, chapter_doc: dict, titles: dict) -> list[str]:
+    lines = ["| chapter | reading | reproduced | not reproduced | cannot be judged |", "|---|---|---|---|---|"]
+    for chap, rows in summary.groupby("chapter", sort=False):
+        doc = chapter_doc.get(chap)
+        name = _md_cell(titles.get(chap, chap))
+        label = f"{{doc}}`{name} <{doc}>`" if doc else name
+        if len(rows) > 1:                   # the chapter's total first, then one row per reading
+            lines.append(f"| {label} | **all readings** | **{rows['reproduced'].sum()} of "
+                         f"{rows['claims'].sum()}** | {rows['not reproduced'].sum()} | "
+                         f"{rows['cannot be judged'].sum()} |")
+            label = ""
+        for row in rows.to_dict("records"):
+            lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of "
+                         f"{row['claims']} | {row['not reproduced']} | {row['cannot be judged']} |")
+            label = ""
+    return lines
+
+
 def status_markdown(results: dict[str, dict], notebooks: list[Path]) -> str:
-    """The landing page's status table (MyST markdown): per chapter and reading, how many of the paper's
-    claims are reproduced, not reproduced, or cannot be judged, each chapter linked; then the chapters that
-    wrote no results file."""
+    """The landing page's status tables (MyST markdown): per chapter and reading, how many claims are
+    reproduced, not reproduced, or cannot be judged, each chapter linked; the papers' claims and the
+    book's own claims in separate tables, with their totals; then the chapters that wrote no results
+    file."""
     chapter_doc, titles = {}, {}
     for nb in notebooks:
         chapter = results_chapter(nb) or nb.stem
@@ -342,24 +363,21 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path]) -> str:
     lines = []
     summary = claims_summary(results)
     if len(summary):
-        lines += ["| chapter | reading of the paper | reproduced | not reproduced | cannot be judged |",
-                  "|---|---|---|---|---|"]
-        for chap, rows in summary.groupby("chapter", sort=False):
-            doc = chapter_doc.get(chap)
-            name = _md_cell(titles.get(chap, chap))
-            label = f"{{doc}}`{name} <{doc}>`" if doc else name
-            if len(rows) > 1:                   # the chapter's total first, then one row per reading
-                lines.append(f"| {label} | **all readings** | **{rows['reproduced'].sum()} of "
-                             f"{rows['claims'].sum()}** | {rows['not reproduced'].sum()} | "
-                             f"{rows['cannot be judged'].sum()} |")
-                label = ""
-            for row in rows.to_dict("records"):
-                lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of "
-                             f"{row['claims']} | {row['not reproduced']} | {row['cannot be judged']} |")
-                label = ""
-        lines.append("")
-        lines.append("Counts are computed by each chapter's code from its claims (the table "
-                     "*Results at a glance* at the top of the chapter) when the book is built.")
+        for source, title in (("paper", "The papers' claims"), ("book", "The book's own claims")):
+            part = summary[summary["source"] == source]
+            if not len(part):
+                continue
+            lines += [f"**{title}**: {part['reproduced'].sum()} of {part['claims'].sum()} reproduced, "
+                      f"{part['not reproduced'].sum()} not reproduced, {part['cannot be judged'].sum()} "
+                      f"cannot be judged.", ""]
+            lines += _status_table(part, chapter_doc, titles) + [""]
+        lines.append("A claim is *reproduced* when the 95 % interval of our statistic lies wholly on the "
+                     "claim's side of its boundary, *not reproduced* when it lies wholly on the other side, "
+                     "and *cannot be judged* when the interval contains the boundary, when our experiment's "
+                     "noise floor cannot resolve the claim, when the statistic is true by construction of "
+                     "our simulator, or when the paper prints nothing to compare with "
+                     "(`navlib.verdicts`). Counts are computed from each chapter's claims (its *Results at "
+                     "a glance*) when the book is built.")
     else:
         lines.append("No chapter has written its results yet.")
     missing = [c for c in chapter_doc if c not in results]
@@ -419,6 +437,78 @@ def _is_num(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+CLAIM_TEXT_KEYS = ("claim", "paper", "ours", "reading")
+
+
+def claim_problems(c: dict) -> list[str]:
+    """Schema problems of one stored claim, and whether its verdict follows from its interval, boundary,
+    side, noise floor and by-construction flag by the one rule (:func:`navlib.verdicts.decide`): a
+    verdict set by hand fails here."""
+    p = []
+    for k in CLAIM_TEXT_KEYS:
+        if not isinstance(c.get(k), str) or not c.get(k).strip():
+            p.append(f"{k} missing or empty")
+    if c.get("source") not in verdicts.SOURCES:
+        p.append(f"source {c.get('source')!r}: must be 'paper' or 'book'")
+    rule = c.get("rule")
+    if rule not in verdicts.RULES:
+        p.append(f"rule {rule!r}: must be one of {sorted(verdicts.RULES)}")
+    interval, boundary, side = c.get("interval"), c.get("boundary"), c.get("holds_when")
+    if rule == "no statistic":
+        if interval is not None:
+            p.append("rule 'no statistic' with an interval")
+    else:
+        if not (isinstance(interval, list) and len(interval) == 2 and all(_is_num(v) for v in interval)
+                and interval[0] <= interval[1]):
+            p.append(f"interval {interval!r}: must be [lo, hi] with lo <= hi")
+            interval = None
+        if not _is_num(boundary):
+            p.append(f"boundary {boundary!r}: must be a number")
+            boundary = None
+        if side not in verdicts.SIDES:
+            p.append(f"holds_when {side!r}: must be 'above' or 'below'")
+            side = None
+        est = c.get("estimate")
+        if not _is_num(est):
+            p.append(f"estimate {est!r}: must be a number")
+        elif interval is not None and not (interval[0] - 1e-12 * abs(est) <= est <= interval[1]
+                                           + 1e-12 * abs(est)):
+            p.append(f"estimate {est} lies outside its interval {interval}")
+        if not isinstance(c.get("statistic"), str) or not c["statistic"].strip():
+            p.append("statistic missing: say what the interval is of, with its unit")
+    floor = c.get("floor")
+    floor_value = None
+    if floor is not None:
+        if not (isinstance(floor, dict) and _is_num(floor.get("value"))
+                and all(isinstance(floor.get(k), str) and floor[k].strip() for k in ("assumption", "needs"))):
+            p.append("floor must be null or {value, assumption, needs}")
+        else:
+            floor_value = floor["value"]
+    if not isinstance(c.get("by_construction"), bool):
+        p.append("by_construction must be true or false")
+    dec = c.get("decided_by")
+    if not (isinstance(dec, list) and all(isinstance(d, str) and d.strip() for d in dec)):
+        p.append("decided_by must be a list of texts (possibly empty)")
+    if "reproduced" not in c or c["reproduced"] not in (True, False, None):
+        p.append("reproduced must be true, false or null")
+    elif not p:
+        try:
+            want, basis = verdicts.decide(interval, boundary, side, floor_value, c["by_construction"])
+        except InputError as err:
+            return p + [str(err)]
+        if c["reproduced"] is not want:
+            p.append(f"verdict {c.get('verdict')!r} does not follow from interval {interval}, boundary "
+                     f"{boundary} ({side}), floor {floor_value}: the rule gives "
+                     f"{verdicts.verdict_name(want)!r}")
+        if c.get("verdict") != verdicts.verdict_name(c["reproduced"]):
+            p.append(f"verdict {c.get('verdict')!r} disagrees with reproduced={c['reproduced']}")
+        if c.get("basis") != basis:
+            p.append(f"basis {c.get('basis')!r}, the rule gives {basis!r}")
+    if c.get("reproduced") is None and not (isinstance(c.get("why"), str) and c["why"].strip()):
+        p.append("cannot be judged without a why")
+    return p
+
+
 def validate_results(res: dict, name: str) -> list[str]:
     """Schema problems of one results file (see ``navlib.report.write_results``)."""
     p = []
@@ -434,11 +524,8 @@ def validate_results(res: dict, name: str) -> list[str]:
         if not isinstance(c, dict):
             p.append(f"{name}: claims[{i}] is not an object")
             continue
-        for k in ("claim", "paper", "ours", "reading"):
-            if not isinstance(c.get(k), str) or not c.get(k).strip():
-                p.append(f"{name}: claims[{i}].{k} missing or empty")
-        if "reproduced" not in c or c["reproduced"] not in (True, False, None):
-            p.append(f"{name}: claims[{i}].reproduced must be true, false or null")
+        p += [f"{name}: claims[{i}] ({c.get('claim')!r}, {c.get('reading')}): {q}"
+              for q in claim_problems(c)]
     methods = res.get("methods")
     if methods is not None:
         unit = res.get("unit")
@@ -500,9 +587,18 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
     if len(fc) != len(rc):
         p.append(f"{name}: {len(fc)} claims, reference {len(rc)}")
     for i, (a, b) in enumerate(zip(fc, rc)):
-        for k in ("claim", "reading", "paper"):
+        for k in ("claim", "reading", "paper", "source", "rule", "holds_when", "by_construction"):
             if a.get(k) != b.get(k):
                 p.append(f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}")
+        for k in ("estimate", "boundary"):
+            x, y = a.get(k), b.get(k)
+            if (_is_num(x) and _is_num(y) and not _close(x, y, rtol, atol)) or (_is_num(x) != _is_num(y)):
+                p.append(f"{name}: claims[{i}].{k} = {x}, reference {y} (tolerance {rtol:g} relative)")
+        x, y = a.get("interval"), b.get("interval")
+        if (x is None) != (y is None) or (x is not None and y is not None and not (
+                len(x) == len(y) == 2 and all(_is_num(u) and _is_num(v) and _close(u, v, rtol, atol)
+                                              for u, v in zip(x, y)))):
+            p.append(f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)")
         if a.get("reproduced") != b.get("reproduced"):
             p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
                      f"{a.get('reproduced')}, reference {b.get('reproduced')}")

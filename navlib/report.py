@@ -8,13 +8,16 @@ A chapter notebook uses it like this::
     report.table(df, formats={"rms (deg)": "{:.3f}"})     # an HTML table (text/plain kept for nbval)
     report.glue_number("ade_rms", 4.23, "{:.2f}")         # prose: {glue:text}`ade_rms`
     report.glue_figure("fig-compass-errors", fig)         # markdown: ```{glue:figure} fig-compass-errors
-    claims = [report.Claim("ADE-BP beats DE-BP", "-0.22..0.20 vs -0.31..0.25", "4.2 vs 10.4 deg RMS",
-                           True, reading="pure DE")]
+    d = verdicts.paired_difference(rms_de, rms_ade)           # the same seeds
+    claims = [report.Claim("ADE-BP beats DE-BP", "-0.22..0.20 vs -0.31..0.25 deg", reading="pure DE",
+                           statistic="RMS DE-BP - RMS ADE-BP, deg", estimate=d, boundary=0.0,
+                           holds_when="above", unit="deg")]
     report.glue_table("compass_glance", report.glance(claims))   # Results at a glance (chapter top)
     report.write_results("compass", claims=claims, unit="deg",
                          methods={"ADE-BP": report.method_stats(rms, mins, maxs)})
 
-Every number shown comes from the code that ran; nothing is typed in.  Rounding happens here, so stored
+Every verdict follows from the claim's interval by the one rule of :mod:`navlib.verdicts`.  Every number
+shown comes from the code that ran; nothing is typed in.  Rounding happens here, so stored
 notebook outputs compare within tolerance (nbval).
 """
 from __future__ import annotations
@@ -25,13 +28,14 @@ import json
 import math
 import re
 import os
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 import numpy as np
 import pandas as pd
 
+from . import verdicts
 from .errors import InputError
 from .paths import ROOT
 
@@ -176,9 +180,9 @@ def glue_text(name: str, text: str) -> str:
     return str(text)
 
 
-def glue_table(name: str, tab: Table | pd.DataFrame) -> None:
+def glue_table(name: str, tab: "Table | Glance | pd.DataFrame") -> None:
     """Glue a table for a MyST ``{glue:}`` directive (e.g. inside the Results-at-a-glance admonition)."""
-    _glue(name, tab if isinstance(tab, Table) else Table(tab))
+    _glue(name, tab if isinstance(tab, (Table, Glance)) else Table(tab))
 
 
 def glue_figure(name: str, fig) -> None:
@@ -204,35 +208,213 @@ def style() -> None:
 # ----------------------------------------------------------------------------------------------- claims
 @dataclass(frozen=True)
 class Claim:
-    """One claim of a paper and our verdict on it, under one reading of the paper's method.
+    """One claim (the paper's or the book's own) and our verdict on it, under one reading of the paper.
 
-    ``reproduced``: True, False, or None when it cannot be judged (``why`` says why); ``paper`` and
-    ``ours`` are short texts with units."""
+    The verdict is never set by hand: it follows from the statistic's 95 % interval, the ``boundary``
+    and the side on which the claim holds (``holds_when``), the noise ``floor`` of our experiment and
+    whether the statistic is true ``by_construction`` of our simulator, by the one rule of
+    :func:`navlib.verdicts.decide`.
+
+    ``claim``: the claim in a few words; ``paper``: what the paper prints (text with units, or "(not in
+    the paper)" for the book's own claims); ``source``: ``"paper"`` or ``"book"``; ``statistic``: what the
+    interval is of, with its unit; ``estimate``: a :class:`navlib.verdicts.Estimate` (value, interval,
+    rule), None when there is no statistic; ``unit``: the unit shown beside numbers; ``decided_by``: the
+    simulator or method assumptions the verdict depends on; ``why``: the reason in words (required when
+    the claim cannot be judged for lack of a statistic or by construction; otherwise added to the
+    generated reason); ``ours``: an optional short text shown before the interval (e.g. "4.21 vs 9.58
+    deg"); ``key``: a name for the prose (:func:`glue_claims`)."""
 
     claim: str
     paper: str
-    ours: str
-    reproduced: bool | None
     reading: str = "as printed"
+    source: str = "paper"
+    statistic: str = ""
+    estimate: verdicts.Estimate | None = None
+    boundary: float | None = None
+    holds_when: str | None = None
+    unit: str = ""
+    floor: verdicts.Floor | None = None
+    by_construction: bool = False
+    decided_by: tuple[str, ...] = ()
     why: str = ""
+    ours: str = ""
+    key: str = ""
+    spec: str = "{:.3g}"
 
     def __post_init__(self):
-        if self.reproduced not in (True, False, None):
-            raise InputError(f"Claim.reproduced={self.reproduced!r}: must be True, False or None")
-        for f in ("claim", "paper", "ours", "reading"):
+        for f in ("claim", "paper", "reading"):
             if not str(getattr(self, f)).strip():
                 raise InputError(f"Claim.{f} is empty")
+        if self.source not in verdicts.SOURCES:
+            raise InputError(f"Claim.source={self.source!r}: must be 'paper' or 'book'")
+        if not isinstance(self.decided_by, tuple) or not all(isinstance(d, str) and d.strip()
+                                                               for d in self.decided_by):
+            raise InputError(f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts")
+        if self.estimate is not None:
+            if not isinstance(self.estimate, verdicts.Estimate):
+                raise InputError(f"Claim.estimate: a navlib.verdicts.Estimate, got "
+                                 f"{type(self.estimate).__name__}")
+            if not str(self.statistic).strip():
+                raise InputError(f"Claim {self.claim!r}: say what the statistic is (with its unit)")
+            if self.boundary is None or not math.isfinite(float(self.boundary)):
+                raise InputError(f"Claim {self.claim!r}: a statistic needs a finite boundary")
+            if self.holds_when not in verdicts.SIDES:
+                raise InputError(f"Claim {self.claim!r}: holds_when={self.holds_when!r}: must be 'above' "
+                                 f"or 'below'")
+        elif not self.why.strip():
+            raise InputError(f"Claim {self.claim!r}: without a statistic, 'why' must say why")
+        if self.by_construction and not self.why.strip():
+            raise InputError(f"Claim {self.claim!r}: true by construction: 'why' must say which setting")
+        if self.floor is not None and not isinstance(self.floor, verdicts.Floor):
+            raise InputError("Claim.floor: a navlib.verdicts.Floor")
+        if self.key and not self.key.isidentifier():
+            raise InputError(f"Claim.key={self.key!r}: use letters, digits and underscores")
+
+    # -- the rule
+    @property
+    def interval(self) -> tuple[float, float] | None:
+        return None if self.estimate is None else self.estimate.interval
+
+    @property
+    def rule(self) -> str:
+        return "no statistic" if self.estimate is None else self.estimate.rule
+
+    def _decision(self) -> tuple[bool | None, str]:
+        return verdicts.decide(self.interval, self.boundary, self.holds_when,
+                               None if self.floor is None else self.floor.value, self.by_construction)
+
+    @property
+    def reproduced(self) -> bool | None:
+        return self._decision()[0]
+
+    @property
+    def basis(self) -> str:
+        return self._decision()[1]
 
     @property
     def verdict(self) -> str:
-        return {True: "reproduced", False: "not reproduced", None: "cannot be judged"}[self.reproduced]
+        return verdicts.verdict_name(self.reproduced)
+
+    # -- display
+    def _num(self, v) -> str:
+        return fmt(v, self.spec) + (f" {self.unit}" if self.unit else "")
+
+    @property
+    def boundary_text(self) -> str:
+        if self.boundary is None:
+            return "–"
+        return ("< " if self.holds_when == "below" else "> ") + self._num(self.boundary)
+
+    @property
+    def interval_text(self) -> str:
+        """``value [lo, hi] unit`` (the 95 % interval), or "–" without a statistic."""
+        e = self.estimate
+        if e is None:
+            return "–"
+        if e.rule == "exact":
+            return self._num(e.value) + " (exact)"
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{fmt(e.value, self.spec)} [{fmt(e.lo, self.spec)}, {fmt(e.hi, self.spec)}]{unit}"
+
+    @property
+    def ours_text(self) -> str:
+        return f"{self.ours}; {self.interval_text}" if self.ours and self.estimate is not None else (
+            self.ours or self.interval_text)
+
+    @property
+    def reason(self) -> str:
+        """Why the verdict is what it is, in words (never empty for *cannot be judged*)."""
+        basis, extra = self.basis, self.why.strip()
+        if basis == "straddles":
+            lo, hi = self.interval
+            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
+                    f"{self._num(self.boundary)}")
+        elif basis == "noise floor":
+            f = self.floor
+            text = (f"our experiment cannot resolve it: its noise floor {self._num(f.value)} is not "
+                    f"{self.holds_when} the boundary {self._num(self.boundary)} (set by {f.assumption}); "
+                    f"it would need {f.needs}")
+        else:
+            text = ""
+        return "; ".join(t for t in (text, extra) if t)
+
+    def record(self) -> dict:
+        """The claim as stored in a results file (see :func:`write_results`)."""
+        e = self.estimate
+        return {"claim": self.claim, "reading": self.reading, "source": self.source, "paper": self.paper,
+                "ours": self.ours_text, "statistic": self.statistic or None, "unit": self.unit,
+                "rule": self.rule, "estimate": None if e is None else plain(e.value),
+                "interval": None if e is None else [plain(e.lo), plain(e.hi)],
+                "n": None if e is None else int(e.n),
+                "boundary": None if self.boundary is None else plain(self.boundary),
+                "holds_when": self.holds_when,
+                "floor": None if self.floor is None else {"value": plain(self.floor.value),
+                                                          "assumption": self.floor.assumption,
+                                                          "needs": self.floor.needs},
+                "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
+                "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
+                "why": self.reason, "key": self.key or None}
 
 
-def glance(claims: Iterable[Claim]) -> Table:
-    """The Results-at-a-glance table: claim | reading | paper | ours | verdict (with the reason)."""
-    rows = [{"claim": c.claim, "reading": c.reading, "paper": c.paper, "ours": c.ours,
-             "verdict": c.verdict + (f": {c.why}" if c.why else "")} for c in claims]
-    return Table(pd.DataFrame(rows, columns=["claim", "reading", "paper", "ours", "verdict"]), index=False)
+GLANCE_COLUMNS = ["claim", "reading", "paper", "ours: value [95 % interval]", "boundary", "verdict"]
+
+
+def _glance_frame(claims: list[Claim]) -> pd.DataFrame:
+    rows = [{"claim": c.claim, "reading": c.reading, "paper": c.paper, GLANCE_COLUMNS[3]: c.ours_text,
+             "boundary": c.boundary_text, "verdict": c.verdict + (f": {c.reason}" if c.reason else "")}
+            for c in claims]
+    return pd.DataFrame(rows, columns=GLANCE_COLUMNS)
+
+
+def tally(claims: Iterable[Claim]) -> str:
+    """"k of n reproduced, m not reproduced, j cannot be judged"."""
+    v = [c.verdict for c in claims]
+    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
+            f"{v.count('cannot be judged')} cannot be judged")
+
+
+class Glance:
+    """The Results-at-a-glance tables: the paper's claims and the book's own claims apart, each row with
+    the claim, the reading, the paper's number, ours with its 95 % interval, the boundary and the verdict
+    with its reason."""
+
+    def __init__(self, claims: Iterable[Claim]):
+        claims = list(claims)
+        self.paper = [c for c in claims if c.source == "paper"]
+        self.book = [c for c in claims if c.source == "book"]
+
+    def tables(self) -> list[Table]:
+        out = []
+        if self.paper:
+            out.append(Table(_glance_frame(self.paper), index=False,
+                             caption=f"The paper's claims: {tally(self.paper)}"))
+        if self.book:
+            out.append(Table(_glance_frame(self.book), index=False,
+                             caption=f"The book's own claims: {tally(self.book)}"))
+        return out
+
+    def _repr_html_(self) -> str:
+        return "\n".join(t._repr_html_() for t in self.tables())
+
+    def __repr__(self) -> str:
+        return "\n\n".join(repr(t) for t in self.tables())
+
+
+def glance(claims: Iterable[Claim]) -> Glance:
+    """The Results-at-a-glance tables (see :class:`Glance`)."""
+    return Glance(claims)
+
+
+def glue_claims(claims: Iterable[Claim]) -> None:
+    """Glue, for every claim with a ``key``, its verdict (``{glue:text}`key```) and a sentence with the
+    interval and the boundary (``{glue:text}`key_detail```), so prose that states a verdict comes from the
+    claim itself."""
+    for c in claims:
+        if not c.key:
+            continue
+        glue_text(c.key, c.verdict)
+        detail = f"{c.verdict}: ours {c.interval_text}, boundary {c.boundary_text}"
+        glue_text(f"{c.key}_detail", detail + (f" ({c.reason})" if c.reason else ""))
 
 
 # ----------------------------------------------------------------------------------------------- results
@@ -280,7 +462,13 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     claims = list(claims)
     if not claims:
         raise InputError(f"write_results({chapter!r}): a chapter states at least one claim")
-    out["claims"] = [{**{k: plain(v) for k, v in asdict(c).items()}, "verdict": c.verdict} for c in claims]
+    if not all(isinstance(c, Claim) for c in claims):
+        raise InputError(f"write_results({chapter!r}): claims must be navlib.report.Claim objects")
+    keys = [(c.claim, c.reading) for c in claims]
+    if len(set(keys)) != len(keys):
+        dup = next(k for k in keys if keys.count(k) > 1)
+        raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
+    out["claims"] = [c.record() for c in claims]
     if extra:
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}
@@ -311,18 +499,19 @@ def read_results(folder: str | os.PathLike | None = None) -> dict[str, dict]:
 
 
 def claims_summary(results: Mapping[str, dict]) -> pd.DataFrame:
-    """Per chapter and reading: claims reproduced, not reproduced, not judged (for the landing page)."""
+    """Per chapter, source (the paper's claims or the book's own) and reading: claims reproduced, not
+    reproduced, cannot be judged (for the landing page)."""
     rows = []
     for chapter, res in results.items():
         for c in res.get("claims", []):
-            rows.append({"chapter": chapter, "reading": c.get("reading", "as printed"),
-                         "reproduced": c.get("reproduced")})
+            rows.append({"chapter": chapter, "source": c.get("source", "paper"),
+                         "reading": c.get("reading", "as printed"), "reproduced": c.get("reproduced")})
+    cols = ["chapter", "source", "reading", "claims", "reproduced", "not reproduced", "cannot be judged"]
     if not rows:
-        return pd.DataFrame(columns=["chapter", "reading", "claims", "reproduced", "not reproduced",
-                                     "cannot be judged"])
+        return pd.DataFrame(columns=cols)
     df = pd.DataFrame(rows)
-    g = df.groupby(["chapter", "reading"], sort=False)["reproduced"]
+    g = df.groupby(["chapter", "source", "reading"], sort=False)["reproduced"]
     return pd.DataFrame({"claims": g.size(),
                          "reproduced": g.apply(lambda s: int((s == True).sum())),  # noqa: E712
                          "not reproduced": g.apply(lambda s: int((s == False).sum())),  # noqa: E712
-                         "cannot be judged": g.apply(lambda s: int(s.isna().sum()))}).reset_index()
+                         "cannot be judged": g.apply(lambda s: int(s.isna().sum()))}).reset_index()[cols]

@@ -1,6 +1,7 @@
 import json
 
 import nbformat
+import pytest
 
 from navlib.booktools import check_html, missing_figures, strip_metadata
 
@@ -115,22 +116,34 @@ def _nb(path, write_call, title="Electronic compass"):
     return path
 
 
-def _claim(text, reproduced, reading="as printed"):
-    return {"claim": text, "paper": "-0.22..0.20 deg", "ours": "4.2 deg", "reproduced": reproduced,
-            "reading": reading, "why": ""}
+def _claim(text, reproduced, reading="as printed", source="paper"):
+    """A stored claim whose interval gives ``reproduced`` by the rule (boundary 1, holds below)."""
+    interval = {True: [0.2, 0.5], False: [1.5, 2.0], None: [0.5, 1.5]}[reproduced]
+    from navlib import report, verdicts
+    c = report.Claim(text, "-0.22..0.20 deg", reading=reading, source=source, statistic="rms, deg",
+                     estimate=verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20),
+                     boundary=1.0, holds_when="below", unit="deg")
+    return c.record()
 
 
 def test_status_markdown_counts_claims_per_chapter_and_reading(tmp_path):
     nb = _nb(tmp_path / "compass.ipynb", 'report.write_results("compass", claims=claims)')
     other = _nb(tmp_path / "gyro.ipynb", "x = 1", title="Gyro drift")
     results = {"compass": {"chapter": "compass", "claims": [
-        _claim("a", True), _claim("b", False), _claim("c", None), _claim("a", True, "MATLAB defaults")]}}
+        _claim("a", True), _claim("b", False), _claim("c", None), _claim("a", True, "MATLAB defaults"),
+        _claim("rate", True, "ours", source="book"), _claim("rate2", None, "ours", source="book")]}}
     md = status_markdown(results, [nb, other])
-    assert "| {doc}`Electronic compass </_generated/compass>` | **all readings** | **2 of 4** | 1 | 1 |" in md
-    assert "|  | as printed | 1 of 3 | 1 | 1 |" in md
-    assert "|  | MATLAB defaults | 1 of 1 | 0 | 0 |" in md
+    papers, book = md.split("**The book's own claims**")
+    assert "| {doc}`Electronic compass </_generated/compass>` | **all readings** | **2 of 4** | 1 | 1 |" in papers
+    assert "|  | as printed | 1 of 3 | 1 | 1 |" in papers
+    assert "|  | MATLAB defaults | 1 of 1 | 0 | 0 |" in papers
+    assert "**The papers' claims**: 2 of 4 reproduced, 1 not reproduced, 1 cannot be judged." in papers
+    assert book.startswith(": 1 of 2 reproduced, 0 not reproduced, 1 cannot be judged.")
+    assert "| {doc}`Electronic compass </_generated/compass>` | ours | 1 of 2 | 0 | 1 |" in book
+    assert "rate" not in papers.split("|---|")[1] or "ours" not in papers
     one_reading = status_markdown({"compass": {"claims": [_claim("a", True)]}}, [nb])
     assert "| {doc}`Electronic compass </_generated/compass>` | as printed | 1 of 1 | 0 | 0 |" in one_reading
+    assert "The book's own claims" not in one_reading
     assert "no results file" in md and "</_generated/gyro>" in md
 
 
@@ -159,6 +172,43 @@ def test_validate_results_checks_the_schema():
     problems = " ".join(validate_results(bad, "compass.json"))
     assert "reproduced must be" in problems and "lacks 'p90_rms_mg'" in problems
     assert validate_results({"chapter": "compass", "claims": []}, "compass.json")
+
+
+@pytest.mark.parametrize("field,value,message", [
+    ("source", "ours", "source"), ("rule", "eyeball", "rule"), ("interval", [2.0, 1.0], "interval"),
+    ("holds_when", "left", "holds_when"), ("boundary", None, "boundary"), ("statistic", "", "statistic"),
+    ("estimate", 9.0, "outside its interval"), ("decided_by", "noise", "decided_by"),
+    ("floor", {"value": 0.1}, "floor"), ("ours", "", "ours")])
+def test_validate_results_names_each_bad_claim_field(field, value, message):
+    res = _results()
+    res["claims"][0][field] = value
+    problems = " ".join(validate_results(res, "compass.json"))
+    assert message in problems and "claims[0]" in problems
+
+
+@pytest.mark.parametrize("verdict", [True, False, None])
+def test_a_hand_edited_verdict_is_rejected(verdict):
+    """Each claim's verdict is derived again from its interval, boundary and side."""
+    res = _results(verdict=verdict)
+    assert validate_results(res, "compass.json") == []
+    for other in {True, False, None} - {verdict}:
+        edited = json.loads(json.dumps(res))
+        edited["claims"][0]["reproduced"] = other
+        edited["claims"][0]["verdict"] = {True: "reproduced", False: "not reproduced",
+                                          None: "cannot be judged"}[other]
+        edited["claims"][0]["why"] = "edited by hand"
+        assert any("does not follow" in p for p in validate_results(edited, "compass.json"))
+
+
+def test_a_floor_on_the_wrong_side_makes_a_stored_claim_undecidable():
+    res = _results(verdict=True)                        # interval [0.2, 0.5] below the boundary 1
+    c = res["claims"][0]
+    c["floor"] = {"value": 1.2, "assumption": "sensor noise 3 ug", "needs": "noise below 2.5 ug"}
+    assert any("does not follow" in p for p in validate_results(res, "compass.json"))
+    c.update(reproduced=None, verdict="cannot be judged", basis="noise floor", why="floor")
+    assert validate_results(res, "compass.json") == []
+    c["why"] = ""
+    assert any("without a why" in p for p in validate_results(res, "compass.json"))
 
 
 def test_compare_results_tolerance_and_verdicts():
@@ -197,7 +247,9 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path):
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell(
         "from navlib import report\n"
-        "report.write_results('demo_chapter', claims=[report.Claim('c', 'p', 'o', True)])"))
+        "from navlib import verdicts\n"
+        "report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
+        "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])"))
     path = tmp_path / "demo.ipynb"
     nbformat.write(nb, path)
     assert execute([path], None, in_place=True) == 0

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib import report
+from navlib import report, verdicts
 from navlib.errors import InputError
 
 
@@ -32,44 +32,105 @@ def test_table_html_has_the_book_class_a_stable_id_and_no_index_when_asked():
     assert other.split('id="')[1][:12] != a.split('id="')[1][:12]     # two tables, two ids
 
 
-def test_claim_validation_and_glance():
-    with pytest.raises(InputError, match="reproduced"):
-        report.Claim("c", "p", "o", "yes")
-    with pytest.raises(InputError, match="Claim.ours"):
-        report.Claim("c", "p", " ", True)
-    g = report.glance([report.Claim("c", "p", "o", None, why="no data")])
-    assert list(g.frame.columns) == ["claim", "reading", "paper", "ours", "verdict"]
-    assert g.frame.loc[0, "verdict"] == "cannot be judged: no data"
+def _claim(interval=(0.2, 0.5), source="paper", **kw):
+    e = verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20)
+    return report.Claim("c", "p", source=source, statistic="rms, deg", estimate=e, boundary=1.0,
+                        holds_when="below", unit="deg", **kw)
+
+
+def test_claim_validation():
+    with pytest.raises(InputError, match="source"):
+        _claim(source="mine")
+    with pytest.raises(InputError, match="holds_when"):
+        report.Claim("c", "p", statistic="x", estimate=verdicts.exact(1.0), boundary=0.0, holds_when="up")
+    with pytest.raises(InputError, match="boundary"):
+        report.Claim("c", "p", statistic="x", estimate=verdicts.exact(1.0), holds_when="above")
+    with pytest.raises(InputError, match="statistic"):
+        report.Claim("c", "p", estimate=verdicts.exact(1.0), boundary=0.0, holds_when="above")
+    with pytest.raises(InputError, match="why"):
+        report.Claim("c", "p")                                  # no statistic and no reason
+    with pytest.raises(InputError, match="by construction"):
+        _claim(by_construction=True)
+    with pytest.raises(InputError, match="decided_by"):
+        _claim(decided_by="noise")
+    with pytest.raises(InputError, match="Claim.claim"):
+        report.Claim(" ", "p", why="x")
+
+
+def test_claim_verdict_follows_from_interval_boundary_and_floor():
+    assert _claim((0.2, 0.5)).verdict == "reproduced"
+    assert _claim((1.5, 2.0)).verdict == "not reproduced"
+    c = _claim((0.5, 1.5))
+    assert c.verdict == "cannot be judged" and "contains the boundary" in c.reason
+    floored = _claim((0.2, 0.5), floor=verdicts.Floor(1.2, "sensor noise 3 ug", "noise below 2.5 ug"))
+    assert floored.verdict == "cannot be judged"
+    assert "sensor noise 3 ug" in floored.reason and "noise below 2.5 ug" in floored.reason
+    built = _claim((0.2, 0.5), by_construction=True, why="the simulator was set to it")
+    assert built.verdict == "cannot be judged" and built.basis == "by construction"
+    none = report.Claim("c", "p", why="Table 5 prints no drift")
+    assert none.verdict == "cannot be judged" and none.rule == "no statistic" and none.reason
+
+
+def test_glance_shows_interval_and_boundary_and_the_book_apart():
+    g = report.glance([_claim((0.2, 0.5)), _claim((0.5, 1.5), source="book")])
+    paper, book = g.tables()
+    assert list(paper.frame.columns) == report.GLANCE_COLUMNS
+    assert paper.frame.loc[0, report.GLANCE_COLUMNS[3]] == "0.35 [0.2, 0.5] deg"
+    assert paper.frame.loc[0, "boundary"] == "< 1 deg"
+    assert "1 of 1 reproduced" in paper.caption and "The paper's claims" in paper.caption
+    assert "The book's own claims" in book.caption and book.frame.loc[0, "verdict"].startswith("cannot be")
+    assert "The book's own claims" in repr(g) and "The book's own claims" in g._repr_html_()
+    assert len(report.glance([_claim()]).tables()) == 1
 
 
 def test_write_and_read_results_round_trip(tmp_path):
     rms = np.array([1.0, 2.0, 3.0, 4.0])
-    path = report.write_results("compass", claims=[report.Claim("c", "p", "o", False)], unit="deg",
-                                methods={"ADE-BP": report.method_stats(rms, -rms, rms)}, folder=tmp_path)
+    path = report.write_results("compass", claims=[_claim((1.5, 2.0), decided_by=("noise 0.04 uT",))],
+                                unit="deg", methods={"ADE-BP": report.method_stats(rms, -rms, rms)},
+                                folder=tmp_path)
     assert repr(path) == "results written: compass.json"
     res = report.read_results(tmp_path)["compass"]
     assert res["methods"]["ADE-BP"]["median_rms_deg"] == 2.5 and res["methods"]["ADE-BP"]["n_seeds"] == 4
     assert res["methods"]["ADE-BP"]["median_min_deg"] == -2.5
-    assert res["claims"][0]["verdict"] == "not reproduced"
+    c = res["claims"][0]
+    assert c["verdict"] == "not reproduced" and c["interval"] == [1.5, 2.0] and c["boundary"] == 1.0
+    assert c["holds_when"] == "below" and c["source"] == "paper" and c["decided_by"] == ["noise 0.04 uT"]
+    assert c["rule"] == "median over runs" and c["n"] == 20
     assert json.loads(path.read_text())["unit"] == "deg"
+    from navlib.booktools import validate_results
+    assert validate_results(res, "compass.json") == []
 
 
 def test_write_results_refuses_bad_input(tmp_path):
-    claim = report.Claim("c", "p", "o", True)
+    claim = _claim()
     with pytest.raises(InputError, match="unit"):
         report.write_results("compass", claims=[claim], methods={"m": {"median_rms": 1.0}}, folder=tmp_path)
     with pytest.raises(InputError, match="at least one claim"):
         report.write_results("compass", claims=[], folder=tmp_path)
     with pytest.raises(InputError, match="chapter name"):
         report.write_results("my chapter", claims=[claim], folder=tmp_path)
+    with pytest.raises(InputError, match="twice"):
+        report.write_results("compass", claims=[claim, claim], folder=tmp_path)
 
 
-def test_claims_summary_counts_per_chapter_and_reading():
-    res = {"a": {"claims": [{"reproduced": True, "reading": "r1"}, {"reproduced": False, "reading": "r1"},
-                            {"reproduced": None, "reading": "r2"}]}}
-    s = report.claims_summary(res).set_index("reading")
-    assert s.loc["r1", "claims"] == 2 and s.loc["r1", "reproduced"] == 1 and s.loc["r1", "not reproduced"] == 1
-    assert s.loc["r2", "cannot be judged"] == 1 and s.loc["r2", "reproduced"] == 0
+def test_claims_summary_counts_per_chapter_source_and_reading():
+    res = {"a": {"claims": [{"reproduced": True, "reading": "r1", "source": "paper"},
+                            {"reproduced": False, "reading": "r1", "source": "paper"},
+                            {"reproduced": None, "reading": "r2", "source": "paper"},
+                            {"reproduced": True, "reading": "r1", "source": "book"}]}}
+    s = report.claims_summary(res).set_index(["source", "reading"])
+    assert s.loc[("paper", "r1"), "claims"] == 2 and s.loc[("paper", "r1"), "reproduced"] == 1
+    assert s.loc[("paper", "r1"), "not reproduced"] == 1
+    assert s.loc[("paper", "r2"), "cannot be judged"] == 1 and s.loc[("paper", "r2"), "reproduced"] == 0
+    assert s.loc[("book", "r1"), "claims"] == 1
+
+
+def test_glue_claims_glues_verdict_and_detail(monkeypatch):
+    glued = {}
+    monkeypatch.setattr(report, "_glue", lambda name, obj: glued.__setitem__(name, obj))
+    report.glue_claims([_claim((1.5, 2.0), key="d_rmse"), _claim()])
+    assert glued == {"d_rmse": "not reproduced",
+                     "d_rmse_detail": "not reproduced: ours 1.75 [1.5, 2] deg, boundary < 1 deg"}
 
 
 def test_table_html_escapes_text_and_lets_identifiers_wrap():

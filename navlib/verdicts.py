@@ -1,0 +1,256 @@
+"""One rule for every verdict in the book.
+
+A quantitative claim becomes a **statistic** of our runs with a 95 % **interval**, a **boundary** and the
+side of the boundary on which the claim holds (``holds_when`` = ``"above"`` or ``"below"``):
+
+.. math::
+
+    \\text{verdict} = \\begin{cases}
+      \\text{reproduced} & [\\ell, u] \\text{ lies wholly on the claim's side of } b,\\\\
+      \\text{not reproduced} & [\\ell, u] \\text{ lies wholly on the other side},\\\\
+      \\text{cannot be judged} & \\text{otherwise (the interval contains } b\\text{).}
+    \\end{cases}
+
+A claim also *cannot be judged* when
+
+* the **noise floor** of our experiment (the best value of the statistic that our simulator and sensor
+  noise allow, e.g. the RMS of the exact physical model) does not lie strictly on the claim's side of the
+  boundary: the experiment cannot resolve the claim, and the reason names the assumption that decides it
+  and the value it would need (:class:`Floor`);
+* the statistic is **true by construction** of our simulator (we set it), or
+* there is **no statistic** (the paper prints nothing we can compare with).
+
+Comparisons ("X beats Y", "k times better") are judged on the interval of the **paired** difference or
+ratio over the same seeds or runs (:func:`paired_difference`, :func:`paired_ratio`); rates on the Wilson
+interval (:func:`wilson`); statistics of a real table on a bootstrap over its rows (:func:`bootstrap`); a
+deterministic computation on real data (no randomness anywhere) has a zero-width interval (:func:`exact`).
+
+:func:`decide` is the rule; ``booktools check-results`` calls it again on every stored claim, so a verdict
+that does not follow from its interval, boundary and side fails the test.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Literal, Sequence
+
+import numpy as np
+from scipy import stats
+
+from .errors import InputError
+
+#: The 95 % intervals of the book.
+LEVEL = 0.95
+SIDES = ("above", "below")
+Side = Literal["above", "below"]
+SOURCES = ("paper", "book")
+VERDICTS = ("reproduced", "not reproduced", "cannot be judged")
+#: Why a claim cannot be judged (``basis`` of :func:`decide`).
+BASES = ("interval", "straddles", "noise floor", "by construction", "no statistic")
+
+#: The rules a claim's interval may come from (the name stored in the results file -> what it means).
+RULES = {
+    "median over runs": "distribution-free interval of the median over seeds or runs (order statistics)",
+    "mean over runs": "Student-t interval of the mean over seeds or runs",
+    "quantile over runs": "distribution-free interval of a quantile over seeds or runs (order statistics)",
+    "paired difference": "interval of the median paired difference over the same seeds or runs",
+    "paired ratio": "interval of the median paired ratio over the same seeds or runs",
+    "wilson rate": "Wilson score interval of a rate over independent trials",
+    "bootstrap over rows": "percentile bootstrap over the rows of a real table",
+    "exact": "deterministic computation on fixed data: the interval is the value itself",
+    "no statistic": "nothing to compute: the paper prints no number we can compare with",
+}
+
+
+# ------------------------------------------------------------------------------------------ intervals
+@dataclass(frozen=True)
+class Estimate:
+    """A statistic's point value and 95 % interval ``[lo, hi]``, the rule it came from and ``n`` (runs,
+    trials or rows it rests on)."""
+
+    value: float
+    lo: float
+    hi: float
+    rule: str
+    n: int
+
+    def __post_init__(self):
+        if self.rule not in RULES:
+            raise InputError(f"Estimate.rule={self.rule!r}: must be one of {sorted(RULES)}")
+        for name in ("value", "lo", "hi"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or math.isnan(v):
+                raise InputError(f"Estimate.{name}={v!r}: must be a number")
+        if not self.lo <= self.hi:
+            raise InputError(f"Estimate interval [{self.lo}, {self.hi}]: lo must not exceed hi")
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return (self.lo, self.hi)
+
+
+def _sample(x, name: str, min_n: int = 2) -> np.ndarray:
+    a = np.asarray(x, dtype=float).ravel()
+    if a.size < min_n:
+        raise InputError(f"{name}: needs at least {min_n} values, got {a.size}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{name}: values must be finite")
+    return a
+
+
+def _order_ranks(n: int, q: float, level: float) -> tuple[int, int] | None:
+    """0-based ranks ``(i, j)`` of the order statistics that bracket the ``q`` quantile with coverage of at
+    least ``level`` (equal tails, :math:`B \\sim \\mathrm{Bin}(n, q)`), or None when ``n`` is too small."""
+    a = (1 - level) / 2
+    cdf = stats.binom.cdf(np.arange(n + 1), n, q)
+    low = np.flatnonzero(cdf <= a)           # P(x_(r) > quantile) = P(B <= r - 1) <= a
+    high = np.flatnonzero(cdf >= 1 - a)      # P(x_(s) < quantile) = 1 - P(B <= s - 1) <= a
+    if low.size == 0 or high.size == 0 or high[0] + 1 > n:
+        return None
+    r, s = int(low[-1]) + 1, int(high[0]) + 1   # 1-based ranks
+    return r - 1, s - 1
+
+
+def quantile_ci(x, q: float = 0.5, level: float = LEVEL, rule: str = "quantile over runs") -> Estimate:
+    """The ``q`` quantile of ``x`` with a distribution-free interval from its order statistics
+    (:math:`x_{(r)} \\le \\xi_q \\le x_{(s)}` with :math:`P(B \\le r-1) \\le \\alpha/2` and
+    :math:`P(B \\ge s) \\le \\alpha/2`, :math:`B \\sim \\mathrm{Bin}(n, q)`).  Too few runs for that coverage
+    (fewer than 6 for the median, 50 for the 90th percentile) raise :class:`InputError` naming the number
+    needed: give more runs or judge another statistic."""
+    a = np.sort(_sample(x, "quantile_ci"))
+    ranks = _order_ranks(a.size, q, level)
+    if ranks is None:
+        need = next(n for n in range(a.size + 1, 100000) if _order_ranks(n, q, level) is not None)
+        raise InputError(f"quantile_ci: a {level:.0%} interval of the {q:g} quantile needs at least {need} "
+                         f"runs, got {a.size}")
+    return Estimate(float(np.quantile(a, q)), float(a[ranks[0]]), float(a[ranks[1]]), rule, int(a.size))
+
+
+def median_ci(x, level: float = LEVEL) -> Estimate:
+    """The median over runs with its distribution-free (order-statistic) interval; see :func:`quantile_ci`."""
+    return quantile_ci(x, 0.5, level, rule="median over runs")
+
+
+def mean_ci(x, level: float = LEVEL) -> Estimate:
+    """The mean over runs with its Student-t interval :math:`\\bar x \\pm t_{n-1} s / \\sqrt n`."""
+    a = _sample(x, "mean_ci")
+    m = float(a.mean())
+    half = float(stats.t.ppf(0.5 + level / 2, a.size - 1) * a.std(ddof=1) / math.sqrt(a.size))
+    return Estimate(m, m - half, m + half, "mean over runs", int(a.size))
+
+
+def paired_difference(a, b, level: float = LEVEL) -> Estimate:
+    """Median of the paired differences ``a - b`` over the same seeds or runs, with its order-statistic
+    interval. ``a[i]`` and ``b[i]`` must come from the same seed or run."""
+    x, y = _sample(a, "paired_difference a"), _sample(b, "paired_difference b")
+    if x.size != y.size:
+        raise InputError(f"paired_difference: {x.size} values against {y.size}: pairs need the same runs")
+    e = quantile_ci(x - y, 0.5, level)
+    return Estimate(e.value, e.lo, e.hi, "paired difference", e.n)
+
+
+def paired_ratio(a, b, level: float = LEVEL) -> Estimate:
+    """Median of the paired ratios ``a / b`` over the same seeds or runs, with its order-statistic
+    interval (``b`` must be positive)."""
+    x, y = _sample(a, "paired_ratio a"), _sample(b, "paired_ratio b")
+    if x.size != y.size:
+        raise InputError(f"paired_ratio: {x.size} values against {y.size}: pairs need the same runs")
+    if np.any(y <= 0):
+        raise InputError("paired_ratio: the denominators must be positive")
+    e = quantile_ci(x / y, 0.5, level)
+    return Estimate(e.value, e.lo, e.hi, "paired ratio", e.n)
+
+
+def wilson(k: int, n: int, level: float = LEVEL) -> Estimate:
+    """A rate ``k / n`` over independent trials with its Wilson score interval."""
+    if not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer))) or n < 1 or not 0 <= k <= n:
+        raise InputError(f"wilson: k={k!r}, n={n!r}: need whole numbers with 0 <= k <= n and n >= 1")
+    ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
+    return Estimate(k / n, float(ci.low), float(ci.high), "wilson rate", int(n))
+
+
+def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequence | int,
+              n_resamples: int = 2000, level: float = LEVEL, paired: bool = True) -> Estimate:
+    """A statistic of a real table with a percentile bootstrap interval over its rows.
+
+    ``data`` is a sequence of equal-length arrays (columns; rows are resampled together when ``paired``),
+    ``statistic(*columns)`` returns a number.  ``seed`` is a :class:`numpy.random.SeedSequence` (or an
+    integer entropy) so that the interval is the same in every run."""
+    cols = [np.asarray(c, dtype=float) for c in data]
+    if not cols or any(c.shape[0] != cols[0].shape[0] for c in cols) or cols[0].shape[0] < 2:
+        raise InputError("bootstrap: give at least one column, all of the same length >= 2")
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    res = stats.bootstrap(tuple(cols), statistic, n_resamples=n_resamples, confidence_level=level,
+                          method="percentile", paired=paired, vectorized=False,
+                          rng=np.random.default_rng(ss))
+    value = float(statistic(*cols))
+    lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+    return Estimate(value, min(lo, value), max(hi, value), "bootstrap over rows", int(cols[0].shape[0]))
+
+
+def exact(value: float) -> Estimate:
+    """A deterministic statistic of fixed data (no random draw anywhere): its interval is itself."""
+    v = float(value)
+    return Estimate(v, v, v, "exact", 1)
+
+
+# ------------------------------------------------------------------------------------------ the rule
+@dataclass(frozen=True)
+class Floor:
+    """The best value of a claim's statistic that our experiment can resolve (its noise floor), the
+    assumption that sets it, and what the claim would need.
+
+    ``value``: the floor in the statistic's unit (for ``holds_when="below"`` the smallest value our
+    experiment can show, for ``"above"`` the largest); ``assumption``: what decides it ("sensor noise
+    3 ug per reading"); ``needs``: the value the assumption would need for the claim to be resolvable
+    ("noise below 2.83 ug")."""
+
+    value: float
+    assumption: str
+    needs: str
+
+    def __post_init__(self):
+        if not isinstance(self.value, (int, float)) or not math.isfinite(self.value):
+            raise InputError(f"Floor.value={self.value!r}: must be a finite number")
+        for f in ("assumption", "needs"):
+            if not str(getattr(self, f)).strip():
+                raise InputError(f"Floor.{f} is empty: say what decides the floor and what it would need")
+
+
+def on_side(value: float, boundary: float, holds_when: str) -> bool:
+    """Whether ``value`` lies strictly on the claim's side of ``boundary``."""
+    return value < boundary if holds_when == "below" else value > boundary
+
+
+def decide(interval: Sequence[float] | None, boundary: float | None, holds_when: str | None,
+           floor: float | None = None, by_construction: bool = False) -> tuple[bool | None, str]:
+    """The verdict (True = reproduced, False = not reproduced, None = cannot be judged) and its basis
+    (one of :data:`BASES`) from a 95 % interval, the boundary, the claim's side and the noise floor.
+
+    The rule, in order: true by construction of our simulator -> cannot be judged; no statistic ->
+    cannot be judged; a floor not strictly on the claim's side -> cannot be judged (the experiment cannot
+    resolve the claim); the whole interval on the claim's side -> reproduced; the whole interval on the
+    other side -> not reproduced; otherwise (the interval touches or contains the boundary) -> cannot be
+    judged."""
+    if by_construction:
+        return None, "by construction"
+    if interval is None or boundary is None or holds_when is None:
+        return None, "no statistic"
+    if holds_when not in SIDES:
+        raise InputError(f"holds_when={holds_when!r}: must be 'above' or 'below'")
+    lo, hi = float(interval[0]), float(interval[1])
+    b = float(boundary)
+    if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(b)) or lo > hi:
+        raise InputError(f"interval [{lo}, {hi}] and boundary {b}: need finite numbers with lo <= hi")
+    if floor is not None and not on_side(float(floor), b, holds_when):
+        return None, "noise floor"
+    if on_side(lo, b, holds_when) and on_side(hi, b, holds_when):
+        return True, "interval"
+    other = "above" if holds_when == "below" else "below"
+    if on_side(lo, b, other) and on_side(hi, b, other):
+        return False, "interval"
+    return None, "straddles"
+
+
+def verdict_name(reproduced: bool | None) -> str:
+    return {True: "reproduced", False: "not reproduced", None: "cannot be judged"}[reproduced]
