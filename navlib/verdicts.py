@@ -174,7 +174,7 @@ def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequ
     """A statistic of a real table with a percentile bootstrap interval over its rows.
 
     ``data`` is a sequence of equal-length arrays (columns; rows are resampled together when ``paired``),
-    ``statistic(*columns)`` returns a number.  ``seed`` is a :class:`numpy.random.SeedSequence` (or an
+    ``statistic(*columns)`` returns a number.  ``seed`` is a ``numpy.random.SeedSequence`` (or an
     integer entropy) so that the interval is the same in every run."""
     cols = [np.asarray(c, dtype=float) for c in data]
     if not cols or any(c.shape[0] != cols[0].shape[0] for c in cols) or cols[0].shape[0] < 2:
