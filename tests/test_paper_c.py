@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from navlib import verdicts
 from navlib.errors import InputError
 from navlib.paths import DATA_DIR
 from navlib.report import Claim
@@ -13,6 +14,8 @@ from navlib.studies import paper_c as pc
 
 P = pc.StudyParams()
 FAST = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=1))
+#: the fewest draws with which every claim has its interval (6 runs: 3 tests x 2 draws)
+CLAIMS = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=2))
 
 
 def _t2():
@@ -93,11 +96,21 @@ def test_experiment_seeds_follow_the_seedsequence_convention():
     ref = np.random.SeedSequence(2012).spawn(6)[3].spawn(3)
     assert a == [int(c.generate_state(1)[0]) for c in ref]
     assert pc.experiment_seeds(2012, "fig3", 3) == a
-    every = [s for e in ("fig1", "hot_reference", "cold_training", "fig3", "table5", "table5_drifts")
+    every = [s for e in ("fig1", "hot_reference", "cold_training", "fig3", "table5", "table5_drifts",
+                         "rounding", "bootstrap")
              for s in pc.experiment_seeds(2012, e, 3)]
     assert len(set(every)) == len(every)                  # no two experiments share a draw
     with pytest.raises(InputError, match="experiment"):
         pc.experiment_seeds(1, "fig9", 1)
+
+
+def test_bootstrap_seeds_are_children_of_the_bootstrap_experiment():
+    ss = [pc.bootstrap_seed(2012, b) for b in pc.BOOTSTRAPS]
+    ref = np.random.SeedSequence(2012).spawn(8)[7].spawn(len(pc.BOOTSTRAPS))
+    assert [tuple(a.generate_state(2)) for a in ss] == [tuple(b.generate_state(2)) for b in ref]
+    assert len({tuple(a.generate_state(2)) for a in ss}) == len(ss)
+    with pytest.raises(InputError, match="statistic"):
+        pc.bootstrap_seed(2012, "loo_rad")
 
 
 # ------------------------------------------------------------------------------------------ tables, physics
@@ -210,6 +223,12 @@ def test_fig3_position_errors():
     # ~0.6 nmi per day per 0.001 deg/h: test 1 (-0.0034 deg/h) is 5-7 nmi before, < 1 nmi after
     assert 5.0 < t["ours before"].iloc[0] < 7.5 and t["ours after"].iloc[0] < 1.0
     assert np.all(t["ours before min"] <= t["ours before max"])
+    # one row per run; the table's means are the runs' means; the best compensation is never worse
+    r = pc.fig3_position_errors(CLAIMS).runs
+    assert len(r) == 3 * CLAIMS.sim.n_seeds and set(r["draw"]) == {1, 2}
+    np.testing.assert_allclose(r.groupby("test")["after_nmi"].mean(),
+                               pc.fig3_position_errors(CLAIMS).table.set_index("test")["ours after"])
+    assert np.all(r["best_nmi"] <= r["after_nmi"] + 1e-9) and np.all(r["best_nmi"] <= r["before_nmi"] + 1e-9)
 
 
 def test_slopes_and_drift_against_latitude():
@@ -295,6 +314,12 @@ def test_table5_simulation():
     assert t["|drift err| hot + rate corr."].iloc[0] < 0.5 * t["|drift err| hot net"].iloc[0]
     assert r.quantities.loc["k_R", "value"] == pytest.approx(
         pc.cold_leave_one_out(FAST).quantities.loc["k_R from Table 4", "value"])
+    # the runs behind the table: every method on the same runs, the table's means are theirs
+    runs = r.runs
+    assert len(runs) == 3 * FAST.sim.n_seeds
+    for m in pc.TABLE5_METHODS:
+        np.testing.assert_allclose(runs.groupby("test")[f"{m} (nmi)"].mean(), t.set_index("test")[f"ours {m}"])
+    assert np.all(np.abs(runs["final drift (deg/h)"]) <= FAST.sim.cold_drift_half_range_deg_h)
 
 
 # ------------------------------------------------------------------------------------------ verdict
@@ -312,19 +337,148 @@ def test_reference_gap_and_verdict():
     assert v["Table 3, paper's printed errors: max |err|"] == pytest.approx(0.0002)
 
 
-def test_claims_one_per_reading():
-    cl = pc.claims(FAST)
-    assert all(isinstance(c, Claim) for c in cl)
-    keys = [(c.claim, c.reading) for c in cl]
-    assert len(keys) == len(set(keys))
-    t3 = {c.reading: c.reproduced for c in cl if c.claim.endswith("(Table 3)")}
+def test_printed_decimals_read_the_printed_text(tmp_path):
+    np.testing.assert_array_equal(pc.printed_decimals(3, "paper_rbf_drift_deg_h"), [5, 4, 4])   # "0.0020": 4
+    np.testing.assert_array_equal(pc.printed_decimals(2, "latitude_deg"), np.full(16, 4))
+    assert list(pc.printed_decimals(5, "test")) == [0, 0, 0]
+    with pytest.raises(InputError, match="no column"):
+        pc.printed_decimals(3, "latitude")
+    with pytest.raises(InputError, match="table"):
+        pc.printed_decimals(1, "latitude_deg")
+
+
+def test_latitude_rounding_effect():
+    a = pc.latitude_rounding_effect(P, "arcmin", n_draws=40)
+    assert a == pc.latitude_rounding_effect(pc.StudyParams(), "arcmin", n_draws=40)      # seeded
+    # by hand: the net's slope times the rounding of one test latitude is a lower bound of the typical move
+    x2, y2 = _t2()
+    net = pc.design_hot_net(x2, y2, P.hot)
+    x3 = pc.measured_tables().table3["latitude_error_deg"].to_numpy()
+    h = 0.5e-4
+    slope = np.abs(net.predict(x3 + 1e-6) - net.predict(x3 - 1e-6)) / 2e-6
+    assert 0.3 * slope.max() * h < a < 10 * slope.max() * h
+    # resolvable at the 4th printed decimal of the outputs, not at the 5th
+    assert 0.5e-5 < a < 0.5e-4
+    with pytest.raises(InputError, match="n_draws"):
+        pc.latitude_rounding_effect(P, "arcmin", n_draws=3)
+
+
+@pytest.fixture(scope="module")
+def claims():
+    return pc.claims(CLAIMS)
+
+
+def _by_key(cl):
+    return {c.key: c for c in cl}
+
+
+def test_claims_one_per_reading_all_judged_by_the_rule(claims):
+    assert all(isinstance(c, Claim) for c in claims)
+    keys = [(c.claim, c.reading) for c in claims]
+    assert len(keys) == len(set(keys)) == 16
+    assert len({c.key for c in claims}) == 16 and all(c.key.startswith("gyro_") for c in claims)
+    for c in claims:
+        assert c.source == "paper" and c.paper != "(not in the paper)"
+        # the verdict is the rule's, from the stored interval, boundary, side and floor
+        assert c.reproduced == verdicts.decide(c.interval, c.boundary, c.holds_when,
+                                               None if c.floor is None else c.floor.value)[0]
+        assert c.estimate is not None or (c.verdict == "cannot be judged" and c.why)
+        if c.estimate is not None:
+            assert c.holds_when == "below" and c.statistic and c.unit
+    t3 = {c.reading: c for c in claims if c.claim.endswith("(Table 3)")}
     assert len(t3) == 6
-    assert t3["input in arcmin, goal as MSE"] is True and t3["input in deg, goal as MSE"] is False
-    outputs = {c.reading: c.reproduced for c in cl if c.claim.startswith("Table 3's RBF outputs")}
-    assert outputs == {"input in arcmin, goal as MSE": True, "input in deg, goal as MSE": False}
-    loo = [c for c in cl if "leave-one-out (Table 2)" in c.claim and "arcmin" in c.reading][0]
-    assert loo.reproduced is False                      # two Table 2 rows miss by more than 0.0003
-    assert any(c.reproduced is None and c.why for c in cl)
+    for c in t3.values():                      # the paper's bound, on Table 3's 3 rows: exact, and says so
+        assert c.boundary == pc.fact("claimed_accuracy") and c.rule == "exact"
+        assert any("3 rows" in d for d in c.decided_by)
+    e = pc.table3_identification(CLAIMS).errors
+    assert t3["input in arcmin, goal as MSE"].estimate.value == pytest.approx(np.max(np.abs(e["err our RBF"])))
+    assert t3["input in arcmin, goal as MSE"].reproduced is True
+    assert t3["input in deg, goal as MSE"].reproduced is False
+    assert _by_key(claims)["gyro_cold_accuracy"].basis == "no statistic"
+
+
+def test_table3_output_claims_take_their_boundary_from_the_printed_precision(claims):
+    k = _by_key(claims)
+    dec = pc.printed_decimals(3, "paper_rbf_drift_deg_h")
+    out = pc.table3_identification(CLAIMS).outputs
+    for unit in ("arcmin", "deg"):
+        c = k[f"gyro_t3_outputs_{unit}"]
+        assert c.boundary == pytest.approx(0.5 * 10.0 ** -dec.min())           # not a tolerance of ours
+        assert c.rule == "exact" and any("3 rows" in d for d in c.decided_by)
+        # the floor (latitudes' rounding) is given and is what the rounding study says
+        assert c.floor is not None and c.floor.value == pytest.approx(pc.latitude_rounding_effect(CLAIMS, unit))
+    ours = out["our RBF"].to_numpy()
+    assert k["gyro_t3_outputs_arcmin"].estimate.value == pytest.approx(np.max(np.abs(ours - out["paper RBF"])))
+    assert k["gyro_t3_outputs_arcmin"].reproduced is True and k["gyro_t3_outputs_deg"].reproduced is False
+
+
+def test_leave_one_out_claims_bootstrap_the_rows(claims):
+    k = _by_key(claims)
+    for unit in ("arcmin", "deg"):
+        c = k[f"gyro_loo_accuracy_{unit}"]
+        x2, y2 = _t2()
+        hot = pc.HotNetSettings(input_unit=unit)
+        e = y2 - np.array([pc.design_hot_net(np.delete(x2, i), np.delete(y2, i), hot).predict([x2[i]])[0]
+                           for i in range(16)])
+        ref = verdicts.bootstrap([e], lambda v: np.sqrt(np.mean(v ** 2)),
+                                 seed=pc.bootstrap_seed(CLAIMS.sim.seed, f"loo_{unit}"))
+        assert c.rule == "bootstrap over rows" and c.estimate.n == 16
+        assert c.interval == pytest.approx(ref.interval) and c.estimate.value == pytest.approx(ref.value)
+        assert c.boundary == pc.fact("claimed_accuracy")
+    assert k["gyro_loo_accuracy_deg"].reproduced is True
+
+
+def test_comparisons_are_paired_over_the_same_rows_or_runs(claims):
+    k = _by_key(claims)
+    seed = CLAIMS.sim.seed
+    rms = lambda v: np.sqrt(np.mean(np.square(v)))      # noqa: E731
+    # simulated Table 5: the median paired difference over the same runs, cold - hot (claim holds below 0)
+    runs = pc.table5_simulation(CLAIMS).runs
+    c = k["gyro_cold_beats_hot_sim"]
+    ref = verdicts.paired_difference(runs["cold net (nmi)"], runs["hot net (nmi)"])
+    assert c.rule == "paired difference" and c.interval == pytest.approx(ref.interval)
+    assert (c.boundary, c.holds_when) == (0.0, "below")
+    # the pairing matters: unpaired (the hot runs shuffled) the interval differs
+    shuffled = verdicts.paired_difference(runs["cold net (nmi)"], runs["hot net (nmi)"].to_numpy()[::-1])
+    assert shuffled.interval != pytest.approx(c.interval)
+    # real tables: a bootstrap that resamples the rows of both methods together
+    for key, frame, a, b, name in (
+            ("gyro_cold_beats_hot_table4", pc.cold_leave_one_out(CLAIMS).rows, "err cold net", "err hot net",
+             "table4_cold_vs_hot"),
+            ("gyro_nonlinear", pc.hot_leave_one_out(CLAIMS).rows, "err our RBF", "err straight line", "nonlinear")):
+        c = k[key]
+        ref = verdicts.bootstrap([frame[a], frame[b]], lambda x, y: rms(x) - rms(y),
+                                 seed=pc.bootstrap_seed(seed, name))
+        unpaired = verdicts.bootstrap([frame[a], frame[b]], lambda x, y: rms(x) - rms(y),
+                                      seed=pc.bootstrap_seed(seed, name), paired=False)
+        assert c.rule == "bootstrap over rows" and c.interval == pytest.approx(ref.interval)
+        assert c.interval != pytest.approx(unpaired.interval)
+        assert c.estimate.value == pytest.approx(rms(frame[a]) - rms(frame[b]))
+        assert (c.boundary, c.holds_when) == (0.0, "below")
+        assert c.reproduced is False                          # the claimed method's error is the larger
+
+
+def test_range_and_position_claims(claims):
+    k = _by_key(claims)
+    # the hot net's Table 4 miss: the RMS's distance outside the printed range, below 0 inside
+    c = k["gyro_cold_hot_miss"]
+    lo, hi = pc.fact("cold_hot_net_drift_error_min"), pc.fact("cold_hot_net_drift_error_max")
+    e = pc.table4_hot_net(CLAIMS)["err ours"].to_numpy()
+    r = np.sqrt(np.mean(e ** 2))
+    assert c.estimate.value == pytest.approx(max(lo - r, r - hi))
+    assert (c.boundary, c.holds_when, c.rule) == (0.0, "below", "bootstrap over rows")
+    # position after identification: median over the simulated runs, with the best compensation as floor
+    c = k["gyro_position_after"]
+    runs = pc.fig3_position_errors(CLAIMS).runs
+    assert c.interval == pytest.approx(verdicts.median_ci(runs["after_nmi"]).interval)
+    assert c.boundary == pc.fact("position_goal") and c.holds_when == "below"
+    assert c.floor is not None and c.floor.value == pytest.approx(np.median(runs["best_nmi"]))
+    assert c.floor.value <= c.estimate.value
+
+
+def test_claims_need_enough_runs_for_their_intervals():
+    with pytest.raises(InputError, match="at least 6 runs"):
+        pc.claims(FAST)
 
 
 def test_methods_summary():
