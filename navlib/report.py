@@ -303,7 +303,8 @@ class Claim:
     def boundary_text(self) -> str:
         if self.boundary is None:
             return "–"
-        return ("< " if self.holds_when == "below" else "> ") + self._num(self.boundary)
+        unit = f" {self.unit}" if self.unit else ""
+        return ("< " if self.holds_when == "below" else "> ") + fmt(self.boundary, "{:.4g}") + unit
 
     @property
     def interval_text(self) -> str:
@@ -328,11 +329,11 @@ class Claim:
         if basis == "straddles":
             lo, hi = self.interval
             text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
-                    f"{self._num(self.boundary)}")
+                    f"{fmt(self.boundary, '{:.4g}')}")
         elif basis == "noise floor":
             f = self.floor
             text = (f"our experiment cannot resolve it: its noise floor {self._num(f.value)} is not "
-                    f"{self.holds_when} the boundary {self._num(self.boundary)} (set by {f.assumption}); "
+                    f"{self.holds_when} the boundary {fmt(self.boundary, '{:.4g}')} (set by {f.assumption}); "
                     f"it would need {f.needs}")
         else:
             text = ""
