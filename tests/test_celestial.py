@@ -1,9 +1,11 @@
 """Paper E (INS/celestial): trajectory kinematics, strapdown, 15-state error model against closed forms,
 measurement through M against the direction-cosine route, KF against filterpy, QR gain features, GLR
-innovation test, MLP, bad input."""
+innovation test (pooled and per run), MLP, the chapter's claims under the one verdict rule (on synthetic
+scores with known answers, and on a tiny simulation), bad input."""
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from filterpy.kalman import KalmanFilter
 
@@ -16,6 +18,8 @@ from navlib.sensors.strapdown import (ImuSpec, InitialError, StarSensorSpec, mis
                                       strapdown)
 from navlib.sensors.trajectory import (EARTH_RATE_RAD_S, FlightProfile, dcm_to_euler, euler_rate_matrix,
                                        euler_to_dcm, generate, gravity, radii)
+from navlib import verdicts
+from navlib.studies import paper_e
 from navlib.studies.paper_e import StudySpec
 
 QUIET = ImuSpec(gyro_drift_deg_h=0, gyro_arw_deg_rt_h=0, accel_bias_ug=0, accel_noise_ug_rt_hz=0)
@@ -213,6 +217,22 @@ def test_innovation_test_names_the_gyro_scale_factor():
             assert yaw(aug.att_err_arcsec) < 0.7 * yaw(res.att_err_arcsec)
 
 
+def test_per_run_innovation_test_is_the_pooled_test_on_each_run_alone():
+    tr = generate(FlightProfile(kind="s_turns", duration_s=60.0, turn_period_s=8.0, manoeuvre_seed=2))
+    both = strapdown(tr, [21, 22], ImuSpec(gyro_scale_ppm=300.0))
+    per = km.innovation_glr_per_run(both, km.run_filter(both))
+    assert len(per) == 2
+    pooled = km.innovation_glr(both, km.run_filter(both))
+    for i, seed in enumerate((21, 22)):
+        one = strapdown(tr, [seed], ImuSpec(gyro_scale_ppm=300.0))
+        alone = km.innovation_glr(one, km.run_filter(one))
+        np.testing.assert_allclose(per[i].table["chi2"], alone.table["chi2"], rtol=1e-8)
+        assert per[i].named == alone.named
+    # pooling adds the evidence of both runs: not the same statistic as either run alone
+    z = pooled.table.set_index("candidate").loc["gyro scale factor z", "chi2"]
+    assert not any(np.isclose(z, p.table.set_index("candidate").loc["gyro scale factor z", "chi2"]) for p in per)
+
+
 def test_mlp_learns_a_smooth_map():
     rng = np.random.default_rng(0)
     x = rng.uniform(-2, 2, (400, 2))
@@ -232,6 +252,7 @@ def test_mlp_learns_a_smooth_map():
     ({"accel_noise_ug_rt_hz": float("nan")}, "accel_noise_ug_rt_hz"), ({"n_hidden": 0}, "n_hidden"),
     ({"n_hidden": 2.5}, "n_hidden"), ({"epochs": 0}, "epochs"), ({"n_train_runs": 0}, "n_train_runs"),
     ({"yaw_amplitude_deg": -3}, "yaw_amplitude_deg"), ({"settle_s": 200}, "settle_s"),
+    ({"n_timings": 0}, "n_timings"), ({"timing_epochs": 1.5}, "timing_epochs"),
 ])
 def test_bad_study_parameters_stop_with_one_line(kwargs, name):
     with pytest.raises(InputError) as err:
@@ -259,3 +280,195 @@ def test_notebook_stops_at_validation_with_one_line(tmp_path):
                             cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0}, progress_bar=False)
     assert err.value.ename == "InputError"
     assert "star_rate_hz" in err.value.evalue and "\n" not in err.value.evalue
+
+
+# ------------------------------------------------------------------------------------------- claims
+def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=0.5, aug_factor=0.5,
+              bp9_worst=2.0, kf_worst=4.0, t45_over_t6=2.0, named=None, gyro_scale_ppm=100.0, permute=None):
+    """A StudyData with hand-made per-run scores whose claims have known answers.  KF per-run errors vary
+    from run to run; BPKF = factor x KF on the same run (``bp_factor`` per case and mode), 6 QR = qr_factor x
+    45 raw, 6 QR + rates yaw = rate_factor x 6 QR yaw, augmented KF = aug_factor x 9-input BPKF; the worst
+    and pitch and roll of the S-turn 9-input BPKF set to ``bp9_worst`` (its worst angle unless its yaw is larger),
+    the KF's worst angle to ``kf_worst``; timings with the given
+    ratio; ``named`` the per-run innovation-test results."""
+    spec = StudySpec(n_repeats=n_repeats, n_test_runs=n_runs, gyro_scale_ppm=gyro_scale_ppm)
+    bp_factor = {**{("level_raw45", "held-out"): 1.2, ("level_raw45", "same run"): 0.5,
+                    ("level_qr6", "held-out"): 0.9, ("level_qr6", "same run"): 0.6}, **(bp_factor or {})}
+    rng = np.random.default_rng(0)
+    rows = []
+    runs = [(r, i) for r in range(n_repeats) for i in range(n_runs)]
+    kf = {(r, i): 1.0 + 3.0 * rng.random(3) for r, i in runs}
+
+    def add(case, mode, method, err):
+        for (r, i), e in err.items():
+            for a, ax in enumerate(paper_e.AXES):
+                rows.append({"repeat": r, "case": case, "mode": mode, "method": method, "run": i, "axis": ax,
+                             "rms_arcsec": float(e[a])})
+
+    for mode in ("held-out", "same run"):
+        for case in paper_e.CASES:
+            add(case, mode, "KF", kf)
+        raw = {k: v * bp_factor[("level_raw45", mode)] * (1 + 0.1 * rng.random()) for k, v in kf.items()}
+        add("level_raw45", mode, "BPKF", raw)
+        add("level_qr6", mode, "BPKF", {k: v * bp_factor[("level_qr6", mode)] for k, v in kf.items()} if
+            mode == "same run" else {k: v * qr_factor for k, v in raw.items()})
+        q6 = {k: v * (0.8 + 0.1 * rng.random()) for k, v in kf.items()}
+        add("sturn_qr6", mode, "BPKF", q6)
+        add("sturn_raw45", mode, "BPKF", q6)
+        q9 = {k: np.r_[bp9_worst, bp9_worst, v[2] * rate_factor] for k, v in q6.items()}
+        add("sturn_qr6_rate", mode, "BPKF", q9)
+        for case in ("sturn_qr6", "sturn_qr6_rate", "sturn_raw45"):
+            add(case, mode, "augmented KF", {k: v * aug_factor for k, v in q9.items()})
+    scores = pd.DataFrame(rows)
+    worst_kf = (scores["case"] == "sturn_qr6_rate") & (scores["method"] == "KF")
+    scale = scores[worst_kf].groupby(["mode", "repeat", "run"])["rms_arcsec"].transform("max")
+    scores.loc[worst_kf, "rms_arcsec"] *= kf_worst / scale
+    if permute is not None:                          # one method scored on other runs than the rest
+        case, mode, method = permute
+        sel = (scores["case"] == case) & (scores["mode"] == mode) & (scores["method"] == method)
+        sub = scores[sel].copy()
+        sub["run"] = sub["run"] + n_runs
+        scores = pd.concat([scores[~sel], sub], ignore_index=True)
+    n_t = 12
+    t6 = 1e-3 * (1.0 + rng.random(n_t))
+    timings = pd.DataFrame([{"timing": j, "n_in": n, "seconds_per_pass": t}
+                            for j in range(n_t) for n, t in ((45, t6[j] * t45_over_t6), (6, t6[j]))])
+    timings = timings.sample(frac=1.0, random_state=1).reset_index(drop=True)   # rows out of order
+    named = named if named is not None else ["gyro scale factor z"] * 16
+    glr_runs = pd.DataFrame([{"repeat": 0, "kind": "s_turns", "runs": "test", "run": i, "named": v}
+                             for i, v in enumerate(named)])
+    empty = pd.DataFrame()
+    return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty)
+
+
+def by_key(data):
+    return {c.key: c for c in paper_e.claims(data)}
+
+
+def test_claims_sources_sides_boundaries_and_keys():
+    cl = paper_e.claims(fake_data())
+    paper = paper_e.paper_numbers()["value"]
+    keys = [c.key for c in cl]
+    assert len(set(keys)) == len(keys) and all(keys)
+    for c in cl:
+        assert (c.source == "book") == (c.paper == "(not in the paper)")
+        assert c.estimate is not None and c.statistic
+    c = {c.key: c for c in cl}
+    assert {k for k, v in c.items() if v.source == "book"} == {"cel_kf_within", "cel_innov", "cel_aug"}
+    for k in ("cel_imp45_held", "cel_imp45_same", "cel_imp6_held", "cel_imp6_same"):
+        assert c[k].boundary == paper["improvement_min_pct"] and c[k].holds_when == "above"
+        assert c[k].estimate.rule == "paired ratio"
+    assert "training data" in c["cel_imp45_same"].reading and "training data" in c["cel_imp6_same"].reading
+    assert c["cel_time"].boundary == pytest.approx(paper["train_time_45_s"] / paper["train_time_6_s"])
+    assert c["cel_time"].holds_when == "above" and c["cel_time"].estimate.rule == "paired ratio"
+    for k in ("cel_qr", "cel_rates", "cel_aug"):
+        assert c[k].boundary == 0 and c[k].holds_when == "above" and c[k].estimate.rule == "paired difference"
+    for k in ("cel_within", "cel_kf_within"):
+        assert c[k].boundary == paper["attitude_error_max_arcsec"] and c[k].holds_when == "below"
+        assert c[k].statistic == c["cel_within"].statistic
+        assert any("star-sensor noise" in d for d in c[k].decided_by)
+        assert any("device" in d for d in c[k].decided_by)
+    assert c["cel_innov"].estimate.rule == "wilson rate" and c["cel_innov"].holds_when == "above"
+
+
+def test_improvement_is_the_median_of_paired_ratios_over_the_same_runs():
+    data = fake_data()
+    s = data.scores
+    sel = (s["case"] == "level_raw45") & (s["mode"] == "held-out")
+    rms = s[sel].groupby(["method", "repeat", "run"])["rms_arcsec"].apply(lambda v: np.sqrt(np.mean(v**2)))
+    bp, kf = rms.loc["BPKF"].sort_index().to_numpy(), rms.loc["KF"].sort_index().to_numpy()
+    want = 100 * (1 - np.median(bp / kf))
+    assert want != pytest.approx(100 * (1 - np.median(bp) / np.median(kf)), abs=1e-6)   # pairing matters
+    c = by_key(data)["cel_imp45_held"]
+    assert c.estimate.value == pytest.approx(want) and c.estimate.n == bp.size
+    assert c.estimate.lo <= c.estimate.value <= c.estimate.hi
+    r = verdicts.paired_ratio(bp, kf)
+    assert (c.estimate.lo, c.estimate.hi) == pytest.approx((100 * (1 - r.hi), 100 * (1 - r.lo)))
+
+
+@pytest.mark.parametrize("factor, verdict", [(0.5, "reproduced"), (0.9, "not reproduced"), (1.3, "not reproduced")])
+def test_improvement_claim_lands_on_each_side(factor, verdict):
+    c = by_key(fake_data(bp_factor={("level_qr6", "held-out"): factor}, qr_factor=1.0))
+    # qr_factor=1 ties 6 QR to 45 raw, whose factor is set for the held-out reading
+    assert by_key(fake_data(bp_factor={("level_raw45", "held-out"): factor}))["cel_imp45_held"].verdict == verdict
+    assert c["cel_imp6_same"].verdict == "reproduced"          # 0.6 x KF on the same run: 40 %
+
+
+def test_comparisons_refuse_scores_from_other_runs():
+    with pytest.raises(InputError, match="same runs"):
+        paper_e.claims(fake_data(n_runs=4, n_repeats=2, permute=("level_raw45", "held-out", "KF")))
+    data = fake_data()
+    with pytest.raises(InputError, match="angle"):
+        paper_e.per_run(data, "level_qr6", "held-out", "BPKF", "heading")
+
+
+def test_accuracy_comparisons_hold_on_the_right_side():
+    assert by_key(fake_data(qr_factor=0.8))["cel_qr"].verdict == "reproduced"        # 6 QR smaller error
+    assert by_key(fake_data(qr_factor=1.2))["cel_qr"].verdict == "not reproduced"
+    assert by_key(fake_data(rate_factor=0.5))["cel_rates"].verdict == "reproduced"
+    assert by_key(fake_data(rate_factor=1.5))["cel_rates"].verdict == "not reproduced"
+    assert by_key(fake_data(aug_factor=0.5))["cel_aug"].verdict == "reproduced"
+    assert by_key(fake_data(aug_factor=1.5))["cel_aug"].verdict == "not reproduced"
+
+
+def test_five_arcsec_claim_and_the_plain_kf_beside_it():
+    c = by_key(fake_data(bp9_worst=2.0, kf_worst=4.0))
+    assert c["cel_within"].verdict == "reproduced" and c["cel_kf_within"].verdict == "reproduced"
+    assert c["cel_within"].estimate.value == pytest.approx(2.0)
+    assert c["cel_kf_within"].estimate.value == pytest.approx(4.0)
+    assert "plain KF" in c["cel_within"].ours and "plain KF: reproduced" in c["cel_within"].reason
+    c = by_key(fake_data(bp9_worst=6.0, kf_worst=8.0))
+    assert c["cel_within"].verdict == "not reproduced" and c["cel_kf_within"].verdict == "not reproduced"
+
+
+def test_time_ratio_is_paired_by_repetition():
+    for ratio, verdict in ((12.0, "reproduced"), (2.0, "not reproduced")):
+        c = by_key(fake_data(t45_over_t6=ratio))["cel_time"]
+        assert c.estimate.value == pytest.approx(ratio) and c.estimate.lo == pytest.approx(ratio)
+        assert c.verdict == verdict
+    assert "against 10x: reproduced" in by_key(fake_data(t45_over_t6=12.0))["cel_time"].reason
+    assert "against 10x: not reproduced" in by_key(fake_data(t45_over_t6=8.0))["cel_time"].reason
+
+
+def test_innovation_claim_is_a_wilson_rate_over_runs():
+    c = by_key(fake_data(named=["gyro scale factor z"] * 16))["cel_innov"]
+    assert c.verdict == "reproduced" and c.estimate.n == 16 and c.estimate.lo < 1.0
+    c = by_key(fake_data(named=["gyro scale factor z"] * 2 + ["none"] * 14))["cel_innov"]
+    assert c.verdict == "not reproduced"
+    # without a scale factor in the device the right answer is "none"
+    c = by_key(fake_data(named=["none"] * 16, gyro_scale_ppm=0.0))["cel_innov"]
+    assert c.verdict == "reproduced"
+
+
+def test_too_few_runs_cannot_be_judged_with_the_reason():
+    c = by_key(fake_data(n_repeats=1, n_runs=4))
+    assert c["cel_imp45_held"].verdict == "cannot be judged"
+    assert c["cel_imp45_held"].estimate is None and "needs at least 6" in c["cel_imp45_held"].reason
+
+
+def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run():
+    spec = StudySpec(duration_s=30.0, n_train_runs=2, n_test_runs=3, n_repeats=2, epochs=5, n_timings=6,
+                     timing_epochs=2, settle_s=5.0)
+    data = paper_e.simulate(spec)
+    n = spec.n_repeats * spec.n_test_runs
+    for mode in ("held-out", "same run"):
+        for method in ("KF", "BPKF"):
+            assert len(paper_e.per_run(data, "level_qr6", mode, method)) == n
+    assert sorted(data.timings.groupby("timing")["n_in"].apply(sorted).map(tuple).unique()) == [(6, 45)]
+    assert len(data.timings) == 2 * spec.n_timings
+    assert len(data.glr_runs) == 2 * spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
+    c = by_key(data)
+    assert c["cel_imp6_same"].estimate.n == n and c["cel_imp6_held"].estimate.n == n
+    assert c["cel_time"].estimate.n == spec.n_timings
+    assert c["cel_innov"].estimate.n == spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
+
+
+def test_wall_clock_claims_go_to_extra_with_their_verdict():
+    data = fake_data(t45_over_t6=2.0)
+    cl = paper_e.claims(data)
+    stored, extra = paper_e.results_parts(cl, data)
+    assert [c.key for c in stored] == [c.key for c in cl if c.key not in paper_e.WALL_CLOCK_KEYS]
+    t = {c.key: c for c in cl}["cel_time"]
+    assert extra["cel_time_verdict"] == t.verdict == "not reproduced"
+    assert extra["cel_time_interval"] == [t.estimate.lo, t.estimate.hi]
+    assert extra["time_ratio_45_over_6"] == pytest.approx(2.0)

@@ -262,19 +262,9 @@ class GlrResult:
     alpha: float
 
 
-def innovation_glr(run: InsRun, result: FilterResult, alpha: float = 0.01) -> GlrResult:
-    """Generalised likelihood ratio test of the filter's innovations ``nu_k`` (covariance ``S_k`` when the
-    model is right) for each candidate's signature ``g_k`` (:func:`innovation_signatures`), pooled over
-    runs::
-
-        theta_hat = sum g^T S^-1 nu / sum g^T S^-1 g,    chi2 = (sum g^T S^-1 nu)^2 / sum g^T S^-1 g
-
-    ``chi2 ~ chi2(1)`` if the effect is absent; p-values Bonferroni-corrected over the testable candidates
-    (those whose signature is not numerically zero).  The named effect is the most significant one."""
-    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
-    nu, s = result.kf["innov"], result.kf["S"]
+def _glr(sig: dict, nu: np.ndarray, s: np.ndarray, alpha: float) -> GlrResult:
+    """The GLR table of :func:`innovation_glr` from signatures, innovations and their covariances."""
     sinv_nu = np.linalg.solve(s, nu[..., None])[..., 0]
-    sig = innovation_signatures(run, result)
     rows = []
     for name, g in sig.items():
         sinv_g = np.linalg.solve(s, g[..., None])[..., 0]
@@ -292,6 +282,30 @@ def innovation_glr(run: InsRun, result: FilterResult, alpha: float = 0.01) -> Gl
     sig_rows = df[df["significant"]]
     named = None if sig_rows.empty else str(sig_rows.sort_values("chi2", ascending=False)["candidate"].iloc[0])
     return GlrResult(table=df, named=named, alpha=alpha)
+
+
+def innovation_glr(run: InsRun, result: FilterResult, alpha: float = 0.01) -> GlrResult:
+    """Generalised likelihood ratio test of the filter's innovations ``nu_k`` (covariance ``S_k`` when the
+    model is right) for each candidate's signature ``g_k`` (:func:`innovation_signatures`), pooled over
+    runs::
+
+        theta_hat = sum g^T S^-1 nu / sum g^T S^-1 g,    chi2 = (sum g^T S^-1 nu)^2 / sum g^T S^-1 g
+
+    ``chi2 ~ chi2(1)`` if the effect is absent; p-values Bonferroni-corrected over the testable candidates
+    (those whose signature is not numerically zero).  The named effect is the most significant one."""
+    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
+    return _glr(innovation_signatures(run, result), result.kf["innov"], result.kf["S"], alpha)
+
+
+def innovation_glr_per_run(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[GlrResult]:
+    """The test of :func:`innovation_glr` on each run alone (the sums over one run's epochs): one
+    :class:`GlrResult` per run, in run order, so that how often the test names an effect is a rate over
+    independent runs."""
+    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
+    sig = innovation_signatures(run, result)
+    nu, s = result.kf["innov"], result.kf["S"]
+    return [_glr({k: g[i:i + 1] for k, g in sig.items()}, nu[i:i + 1], s[i:i + 1], alpha)
+            for i in range(nu.shape[0])]
 
 
 def rate_correlation(result: FilterResult, axis: int = 2) -> tuple[float, float]:
