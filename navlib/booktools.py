@@ -484,6 +484,8 @@ def claim_problems(c: dict) -> list[str]:
             p.append("floor must be null or {value, assumption, needs}")
         else:
             floor_value = floor["value"]
+    if not isinstance(c.get("volatile", False), bool):
+        p.append("volatile must be true or false")
     if not isinstance(c.get("by_construction"), bool):
         p.append("by_construction must be true or false")
     dec = c.get("decided_by")
@@ -564,9 +566,10 @@ def _close(a, b, rtol: float, atol: float) -> bool:
 
 def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol: float = ATOL) -> list[str]:
     """Differences between a fresh results file and its committed reference: the same methods and
-    statistics (numbers within ``atol + rtol * |reference|``, seed counts equal), the same claims (text,
-    reading, the paper's side) with the same verdicts, and the same ``extra`` keys (their values are
-    free-form, timings among them, and are not compared)."""
+    statistics (numbers within ``atol + rtol * |reference|``, seed counts equal), the same claims (texts,
+    source, rule, side) with the same verdicts, estimates, intervals and boundaries (within the same
+    tolerance; a ``volatile`` claim, a timing, is compared on its verdict, texts and boundary only), and
+    the same ``extra`` keys (their values are free-form, timings among them, and are not compared)."""
     p = []
     fm, rm = fresh.get("methods") or {}, ref.get("methods") or {}
     if fresh.get("unit") != ref.get("unit"):
@@ -590,6 +593,18 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
         for k in ("claim", "reading", "paper", "source", "rule", "holds_when", "by_construction"):
             if a.get(k) != b.get(k):
                 p.append(f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}")
+        if a.get("reproduced") != b.get("reproduced"):
+            p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
+                     f"{a.get('reproduced')}, reference {b.get('reproduced')}")
+        if a.get("volatile") != b.get("volatile"):
+            p.append(f"{name}: claims[{i}].volatile {a.get('volatile')!r} differs from the reference "
+                     f"{b.get('volatile')!r}")
+        if a.get("volatile") and b.get("volatile"):
+            # a timing: its numbers follow this machine's clock; its verdict must still be the reference's
+            x, y = a.get("boundary"), b.get("boundary")
+            if not (_is_num(x) and _is_num(y) and _close(x, y, rtol, atol)):
+                p.append(f"{name}: claims[{i}].boundary = {x}, reference {y}")
+            continue
         for k in ("estimate", "boundary"):
             x, y = a.get(k), b.get(k)
             if (_is_num(x) and _is_num(y) and not _close(x, y, rtol, atol)) or (_is_num(x) != _is_num(y)):
@@ -599,9 +614,6 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
                 len(x) == len(y) == 2 and all(_is_num(u) and _is_num(v) and _close(u, v, rtol, atol)
                                               for u, v in zip(x, y)))):
             p.append(f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)")
-        if a.get("reproduced") != b.get("reproduced"):
-            p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
-                     f"{a.get('reproduced')}, reference {b.get('reproduced')}")
     fe, re_ = fresh.get("extra") or {}, ref.get("extra") or {}
     if set(fe) != set(re_):
         p.append(f"{name}: extra keys {sorted(fe)} differ from the reference's {sorted(re_)}")

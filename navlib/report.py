@@ -222,7 +222,9 @@ class Claim:
     simulator or method assumptions the verdict depends on; ``why``: the reason in words (required when
     the claim cannot be judged for lack of a statistic or by construction; otherwise added to the
     generated reason); ``ours``: an optional short text shown before the interval (e.g. "4.21 vs 9.58
-    deg"); ``key``: a name for the prose (:func:`glue_claims`)."""
+    deg"); ``key``: a name for the prose (:func:`glue_claims`); ``volatile``: the statistic is measured on
+    this machine's clock (a timing), so a rerun reproduces its verdict but not its numbers (the results
+    check then compares the verdict and the texts only)."""
 
     claim: str
     paper: str
@@ -240,6 +242,7 @@ class Claim:
     ours: str = ""
     key: str = ""
     spec: str = "{:.3g}"
+    volatile: bool = False
 
     def __post_init__(self):
         for f in ("claim", "paper", "reading"):
@@ -354,7 +357,7 @@ class Claim:
                                                           "needs": self.floor.needs},
                 "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
                 "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
-                "why": self.reason, "key": self.key or None}
+                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile)}
 
 
 GLANCE_COLUMNS = ["claim", "reading", "paper", "ours: value [95 % interval]", "boundary", "verdict"]

@@ -283,3 +283,18 @@ def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
     assert check_html(tmp_path) == 1
     err = capsys.readouterr().err
     assert "_generated/gyro.html: chapter without" in err and "intro.html" not in err
+
+
+def test_compare_results_checks_intervals_except_for_a_volatile_timing():
+    ref = _results()
+    moved = json.loads(json.dumps(ref))
+    moved["claims"][0]["interval"] = [0.2, 0.6]
+    assert any("interval" in p for p in compare_results(moved, ref, "c"))
+    vol_ref, vol = json.loads(json.dumps(ref)), json.loads(json.dumps(moved))
+    vol_ref["claims"][0]["volatile"] = vol["claims"][0]["volatile"] = True
+    assert compare_results(vol, vol_ref, "c") == []                 # a timing's numbers may move
+    flipped = json.loads(json.dumps(vol))
+    flipped["claims"][0].update(_claim("ADE-BP beats DE-BP", True, reading=ref["claims"][0]["reading"]))
+    flipped["claims"][0]["volatile"] = True
+    assert any("verdict" in p for p in compare_results(flipped, vol_ref, "c"))    # its verdict may not
+    assert any("volatile" in p for p in compare_results(vol, ref, "c"))
