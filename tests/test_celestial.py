@@ -463,12 +463,11 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
     assert c["cel_innov"].estimate.n == spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
 
 
-def test_wall_clock_claims_go_to_extra_with_their_verdict():
+def test_the_timing_claim_is_stored_as_volatile_and_the_others_are_not():
     data = fake_data(t45_over_t6=2.0)
     cl = paper_e.claims(data)
-    stored, extra = paper_e.results_parts(cl, data)
-    assert [c.key for c in stored] == [c.key for c in cl if c.key not in paper_e.WALL_CLOCK_KEYS]
+    assert [c.key for c in cl if c.volatile] == ["cel_time"]
     t = {c.key: c for c in cl}["cel_time"]
-    assert extra["cel_time_verdict"] == t.verdict == "not reproduced"
-    assert extra["cel_time_interval"] == [t.estimate.lo, t.estimate.hi]
+    assert t.verdict == "not reproduced" and t.record()["volatile"] is True
+    extra = paper_e.results_extra(data)
     assert extra["time_ratio_45_over_6"] == pytest.approx(2.0)
