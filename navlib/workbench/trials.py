@@ -14,6 +14,34 @@ from .diagnose import diagnose
 from .effects import CATALOGUES
 from .fit import effect_rms, fit_model, simulate
 
+#: Entropy of every trial study's seeds: a trial's seed is ``SeedSequence(TRIAL_ENTROPY, spawn_key=...)``
+#: with the trial's coordinates in its study as the spawn key (:func:`trial_seed`), so no two trials of a
+#: study share a draw and the rates' Wilson intervals rest on independent trials.
+TRIAL_ENTROPY = 0
+#: First element of the spawn key: which study the trial belongs to.
+STUDY_KEYS = {"hidden effect": 1, "out of catalogue": 2}
+SYSTEM_KEYS = {"compass": 0, "drift": 1}
+
+
+def trial_seed(study: str, *coords: int) -> np.random.SeedSequence:
+    """The seed of one trial: a ``numpy.random.SeedSequence`` whose spawn key is the study
+    (``STUDY_KEYS``) and the trial's coordinates in it (whole numbers >= 0, e.g. the indices of its
+    noise level, hidden effect, effect size and its seed number): different coordinates give independent
+    streams, with no arithmetic that could make two trials collide."""
+    if study not in STUDY_KEYS:
+        raise InputError(f"trial_seed: unknown study {study!r}; known: {', '.join(STUDY_KEYS)}")
+    key = tuple(int(c) for c in coords)
+    if any(c < 0 for c in key):
+        raise InputError(f"trial_seed: coordinates must be whole numbers >= 0, got {coords!r}")
+    return np.random.SeedSequence(TRIAL_ENTROPY, spawn_key=(STUDY_KEYS[study],) + key)
+
+
+def _seed_label(seed):
+    """How a trial's seed is stored in a study's table: a SeedSequence's spawn key as text ("1/0/16/..."),
+    an integer seed as itself."""
+    return "/".join(map(str, seed.spawn_key)) if isinstance(seed, np.random.SeedSequence) else seed
+
+
 def random_params(system: str, rng: np.random.Generator, effects) -> dict:
     """Plausible random parameters for the given effects (used to build data with hidden effects)."""
     p = {}
@@ -52,8 +80,8 @@ def scale_effect(system: str, data: pd.DataFrame, params: dict, effect: str, tar
     return p
 
 
-def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: float, seed: int,
-                        n: int | None = None) -> dict:
+def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: float,
+                        seed: int | np.random.SeedSequence, n: int | None = None) -> dict:
     """One trial: data from a random model, with ``hidden`` (or nothing) left out of the fitted model.
 
     With ``hidden`` set: the data contain every catalogue effect, ``hidden`` scaled so that its RMS is
@@ -76,7 +104,7 @@ def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: fl
         model = tuple(e for e in cat if e != hidden)
     d = diagnose(fit_model(system, data, model))
     return {"system": system, "hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise,
-            "n": len(data), "seed": seed, "named": d.missing or "(none)",
+            "n": len(data), "seed": _seed_label(seed), "named": d.missing or "(none)",
             "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
             "consistent_with_noise": d.consistent_with_noise}
 
@@ -84,19 +112,25 @@ def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: fl
 def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=range(10), n=None,
                         include_none: bool = True, none_seeds=None) -> pd.DataFrame:
     """Detection and false-alarm trials over hidden effects, effect sizes, noise levels and seeds.
-    Every (noise level, seed) pair draws its own data, so trials at different noise levels are
-    independent; nothing-hidden trials use seeds of their own (default: twice as many as ``seeds``)."""
+
+    Every trial draws its own data: its seed is :func:`trial_seed` of its coordinates (system, table size
+    ``n``, noise level, hidden effect, effect size, seed number), so trials of different hidden effects,
+    sizes, noise levels and table sizes are independent; nothing-hidden trials have coordinates of their
+    own (default: twice as many seeds as ``seeds``)."""
     rows = []
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
+    base = (SYSTEM_KEYS[system], 0 if n is None else int(n))
     for j, noise in enumerate(noises):
-        for hidden in CATALOGUES[system]:
-            for ratio in ratios:
+        for h, hidden in enumerate(CATALOGUES[system], start=1):
+            for r, ratio in enumerate(ratios):
                 for seed in seeds:
-                    rows.append(hidden_effect_trial(system, hidden, ratio, noise, 100_000 * j + seed, n))
+                    rows.append(hidden_effect_trial(system, hidden, ratio, noise,
+                                                    trial_seed("hidden effect", *base, j, h, r, seed), n))
         if include_none:
             for seed in none_seeds:
-                rows.append(hidden_effect_trial(system, None, 0.0, noise, 100_000 * j + 50_000 + seed, n))
+                rows.append(hidden_effect_trial(system, None, 0.0, noise,
+                                                trial_seed("hidden effect", *base, j, 0, 0, seed), n))
     return pd.DataFrame(rows)
 
 
@@ -109,7 +143,7 @@ OUT_OF_CATALOGUE = {
 }
 
 
-def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int) -> dict:
+def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int | np.random.SeedSequence) -> dict:
     """One trial: compass sweeps from a random subset of the catalogue plus an error of kind ``kind``
     (:data:`OUT_OF_CATALOGUE`) whose RMS about its mean is ``ratio * noise``; the model is exactly the
     catalogued effects present, plus misalignment (every model has a heading offset, which also takes the
@@ -128,20 +162,21 @@ def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int) -> 
     data["measured_heading_deg"] = np.mod(data["measured_heading_deg"] + extra, 360.0)
     model = tuple(e for e in cat if e in present or e == "misalignment")
     d = diagnose(fit_model("compass", data, model))
-    return {"kind": kind, "ratio": ratio, "noise": noise, "seed": seed, "model": " + ".join(model),
+    return {"kind": kind, "ratio": ratio, "noise": noise, "seed": _seed_label(seed), "model": " + ".join(model),
             "named": d.missing or "(none)", "quiet": d.missing is None,
             "detected": not d.consistent_with_noise}
 
 
 def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10)) -> pd.DataFrame:
-    """:func:`out_of_catalogue_trial` over every kind, size, noise level and seed (independent draws)."""
+    """:func:`out_of_catalogue_trial` over every kind, size, noise level and seed; each trial's seed is
+    :func:`trial_seed` of its coordinates (kind, noise level, size, seed number): independent draws."""
     rows = []
     for j, noise in enumerate(noises):
         for i, kind in enumerate(OUT_OF_CATALOGUE):
-            for ratio in ratios:
+            for r, ratio in enumerate(ratios):
                 for seed in seeds:
-                    rows.append(out_of_catalogue_trial(kind, ratio, noise, 1_000_000 * (i + 1) + 100_000 * j
-                                                       + 1000 * int(ratio) + seed))
+                    rows.append(out_of_catalogue_trial(kind, ratio, noise,
+                                                       trial_seed("out of catalogue", i, j, r, seed)))
     return pd.DataFrame(rows)
 
 
