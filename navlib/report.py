@@ -302,12 +302,14 @@ class Claim:
     def _num(self, v) -> str:
         return fmt(v, self.spec) + (f" {self.unit}" if self.unit else "")
 
+    def _bound(self) -> str:
+        return fmt(self.boundary, "{:.4g}") + (f" {self.unit}" if self.unit else "")
+
     @property
     def boundary_text(self) -> str:
         if self.boundary is None:
             return "–"
-        unit = f" {self.unit}" if self.unit else ""
-        return ("< " if self.holds_when == "below" else "> ") + fmt(self.boundary, "{:.4g}") + unit
+        return ("< " if self.holds_when == "below" else "> ") + self._bound()
 
     @property
     def interval_text(self) -> str:
@@ -332,11 +334,11 @@ class Claim:
         if basis == "straddles":
             lo, hi = self.interval
             text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
-                    f"{fmt(self.boundary, '{:.4g}')}")
+                    f"{self._bound()}")
         elif basis == "noise floor":
             f = self.floor
             text = (f"our experiment cannot resolve it: its noise floor {self._num(f.value)} is not "
-                    f"{self.holds_when} the boundary {fmt(self.boundary, '{:.4g}')} (set by {f.assumption}); "
+                    f"{self.holds_when} the boundary {self._bound()} (set by {f.assumption}); "
                     f"it would need {f.needs}")
         else:
             text = ""
