@@ -29,7 +29,7 @@ import pandas as pd
 from ..data.tumble import read_tumble, require_levels
 from ..errors import InputError
 from .effects import Effect, System, register_system
-from .fit import Fit, fit_linear, fit_model, user_columns
+from .fit import MEASURED, Fit, fit_linear, fit_model, user_columns
 from .diagnose import diagnose
 from .trials import wilson
 
@@ -128,6 +128,7 @@ def accelerometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     return out
 
 
+MEASURED["accelerometer"] = (("output_mg",), False)
 SYSTEM = register_system(System(
     "accelerometer", "mg", ACCELEROMETER_EFFECTS, load_accelerometer, _fit_accelerometer, accelerometer_structure,
     "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg"))

@@ -23,6 +23,17 @@
    ``alpha / m`` (m = number of tests), so data with nothing missing are called "consistent with noise" with
    probability at least ``1 - alpha``.
 
+Before any test the data are screened once (:func:`navlib.workbench.screen.screen`): outlying rows are
+set aside (robust, MAD-studentised residuals of the richest model the data can test; listed in
+``outliers``) and the model is refitted without them; residuals at the data's numerical precision
+(RMS <= 1e-9 of the measured values) are called noise without a test; and for a time series the noise's
+serial correlation is modelled (AR(p) by restricted maximum likelihood, :mod:`navlib.workbench.serial`).
+With correlated noise every F test above -- candidates, structure, conditional -- is computed by
+generalised least squares: on the whitened residual ``W r``, whitened Jacobians ``W J`` and whitened
+shapes ``W X``, with each model's residual first freed of what its whitened Jacobian can absorb (one
+Gauss-Newton step of the GLS fit from the least-squares solution; exact for a linear model).  Independent
+samples (``W = I``) give the least-squares tests unchanged.
+
 The effect to add (``missing``) is the significant candidate with the strongest evidence (smallest p) that
 also improves the held-out RMS *and* explains what it claims.  If the residual shows significant structure,
 the candidate is added and the structure re-tested: a structure no longer significant is *gone* (the
@@ -47,6 +58,8 @@ from ..errors import check_param
 from ..errors import InputError
 from .effects import testable
 from .fit import Fit, drift_design, orth_basis
+from .screen import Screening, screen as screen_data
+from .serial import NoiseModel
 
 SMALL_SAMPLE = 12
 # Family-wise false-alarm level. Bonferroni keeps the false-alarm rate at or below alpha; the users' target
@@ -95,14 +108,29 @@ class Diagnosis:
     alpha: float
     tests: int
     message: str
+    screening: Screening | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def outliers(self) -> list[dict]:
+        """The observations set aside before the tests: ``{"row", "column", "residual", "robust_z"}``."""
+        return [o.to_dict() for o in self.screening.outliers] if self.screening is not None else []
 
     def to_dict(self) -> dict:
-        d = asdict(self)
+        d = {k: getattr(self, k) for k in ("system", "model", "unit", "n", "rms", "loo_rms", "missing",
+                                            "consistent_with_noise")}
+        d["candidates"] = [asdict(c) for c in self.candidates]
         for c in d["candidates"]:
             c.pop("log_p")
             c.pop("explains")
+        d["structure"] = [asdict(s) for s in self.structure]
         for s in d["structure"]:
             s.pop("log_p")
+        d.update({"untestable": dict(self.untestable), "alpha": self.alpha, "tests": self.tests,
+                  "message": self.message, "outliers": self.outliers})
+        if self.screening is not None:
+            extra = self.screening.to_dict()
+            extra.pop("outliers")
+            d.update(extra)
         return d
 
     def candidate_table(self) -> pd.DataFrame:
@@ -121,6 +149,11 @@ class Diagnosis:
         lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   rows: {self.n}",
                  f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
                  f"tests: {self.tests}, each at alpha/m = {self.alpha / max(self.tests, 1):.2g}"]
+        if self.screening is not None:
+            if self.screening.outliers:
+                lines.append(self.screening.outlier_line(self.unit))
+            if self.screening.noise.series is not None:
+                lines.append("noise: " + self.screening.noise.describe())
         if self.candidates:
             lines.append("")
             lines.append(f"{'candidate':<20}{'rms after':>12}{'held-out':>12}{'var. expl.':>12}{'p':>11}  sig.")
@@ -191,13 +224,27 @@ def _projector(J: np.ndarray) -> np.ndarray:
     return orth_basis(J)
 
 
-def _structure(fit: Fit) -> list[Finding]:
-    """The system's structure tests on the residuals of ``fit`` (module docstring, point 2)."""
+def _gls(fit: Fit, noise: NoiseModel | None) -> tuple[np.ndarray, np.ndarray]:
+    """The residual of ``fit`` as the tests see it and the orthonormal basis of its Jacobian: with
+    correlated noise, ``W r`` freed of what ``W J`` absorbs (the GLS residual, to first order) and the
+    basis of ``W J``; otherwise ``r`` and the basis of ``J``."""
+    if noise is None or not noise.correlated:
+        return fit.residuals, _projector(fit.jacobian)
+    e = noise.whiten(fit.residuals)
+    Q = _projector(noise.whiten(fit.jacobian))
+    return e - Q @ (Q.T @ e), Q
+
+
+def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
+    """The system's structure tests on the residuals of ``fit`` (module docstring, point 2); generalised
+    least squares with the whitening of ``noise`` when it is correlated."""
     r = fit.residuals
-    Q = _projector(fit.jacobian)
+    e, Q = _gls(fit, noise)
+    white = noise is not None and noise.correlated
     out = []
-    for what, X, scale in fit.spec.structure(fit):
-        X = np.asarray(X, float)
+    for what, X0, scale in fit.spec.structure(fit):
+        X0 = np.asarray(X0, float)
+        X = noise.whiten(X0) if white else X0
         X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
         Xp = X - Q @ (Q.T @ X)
         # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns;
@@ -209,24 +256,26 @@ def _structure(fit: Fit) -> list[Finding]:
         df2 = len(r) - Q.shape[1] - q
         if q == 0 or df2 < 3:
             continue                                   # the model already spans this shape, or too few rows
-        drop = float(np.sum((u.T @ r) ** 2))
-        p, logp = _f_test(float(np.sum(r ** 2)), float(np.sum(r ** 2)) - drop, q, df2)
-        qx = orth_basis(X)                              # amplitude: the shape fitted to the residual itself
+        drop = float(np.sum((u.T @ e) ** 2))
+        p, logp = _f_test(float(np.sum(e ** 2)), float(np.sum(e ** 2)) - drop, q, df2)
+        qx = orth_basis(X0)                             # amplitude: the shape fitted to the residual itself
         amp = scale * float(np.sqrt(np.mean((qx @ (qx.T @ r)) ** 2)))
         out.append(Finding(what, amp, p, log_p=logp))
     return out
 
 
-def _conditional_p(fit: Fit, f1: Fit, found: list[Finding]) -> float:
+def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | None = None) -> float:
     """p of the candidate's improvement when the structure ``found`` is allowed for in both models: the
     residuals of ``fit`` and of ``f1`` (= fit + candidate) are each regressed on their model's Jacobian and
-    the structure shapes, and the two remaining sums of squares are F-tested."""
+    the structure shapes, and the two remaining sums of squares are F-tested (all whitened when the noise
+    is correlated)."""
     shapes = {what: X for what, X, _ in fit.spec.structure(fit)}
     S = np.column_stack([shapes[s.what] for s in found if s.what in shapes])
+    w = noise.whiten if noise is not None and noise.correlated else np.asarray
 
     def rss_p(f):
-        u = orth_basis(np.column_stack([f.jacobian, S]))
-        r = f.residuals
+        u = orth_basis(w(np.column_stack([f.jacobian, S])))
+        r = w(f.residuals)
         return float(r @ r - np.sum((u.T @ r) ** 2)), u.shape[1]
 
     rss0, _ = rss_p(fit)
@@ -234,7 +283,7 @@ def _conditional_p(fit: Fit, f1: Fit, found: list[Finding]) -> float:
     return _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
 
 
-def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
+def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:
     """Rank the effects not yet in ``fit`` by the evidence that adding each explains the residuals; name the
     one to add, or say the residuals are consistent with noise, or name the structure no effect explains.
 
@@ -247,31 +296,67 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
         Family-wise false-alarm level (default ``DEFAULT_ALPHA``), Bonferroni over every test.
     seed : int
         Seed of the Monte-Carlo permutation test (drift tables with more than 7 rows).
+    screen : bool or Screening
+        ``True`` (default): screen the data first (:func:`navlib.workbench.screen.screen`: outliers set
+        aside and the model refitted without them, numerical floor, serial correlation); a
+        :class:`~navlib.workbench.screen.Screening` already made on these data (``fit`` must be fitted to
+        its rows, as :func:`navlib.workbench.loop.loop` does); ``False``: no screen, independent samples
+        (the numerical floor still applies).
 
     Returns
     -------
     Diagnosis
-        ``missing`` (the effect to add or None), candidates, structure findings, the message.
+        ``missing`` (the effect to add or None), candidates, structure findings, the message, and the
+        screening (``outliers``, noise model, floor).
+
+    Raises
+    ------
+    InputError
+        From the screen, when more than 5 % of the rows are outliers.
     """
     alpha = DEFAULT_ALPHA if alpha is None else alpha
     check_param("alpha", alpha, lo=0, lo_open=True, hi=1, hi_open=True)
+    reuse = None
+    if isinstance(screen, Screening):
+        sc = screen
+    else:
+        sc = screen_data(fit, outliers=bool(screen), serial=bool(screen))
+        if sc.outliers:
+            fit = sc.refit(fit)
+        elif sc.rich is not None and sc.rich.data is fit.data:
+            reuse = sc.rich                            # fitted from fit.params: the same as fit.add
+    noise = sc.noise
     ok, why = testable(fit.available, fit.data)
     untestable = {k: v for k, v in why.items() if k not in fit.effects}
+    unit = fit.unit
+    if fit.rms <= sc.floor:
+        msg = (f"the residuals are consistent with noise: their rms {_fmt(fit.rms)} {unit} is at the data's "
+               f"numerical precision (at most {sc.floor / sc.scale:.0e} of the measured values' rms "
+               f"{_fmt(sc.scale)} {unit}); nothing to test")
+        return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, None, True,
+                                 [], [], untestable, alpha, 0, msg, sc))
     cands = []
     fits = {}
     for effect in ok:
         if effect in fit.effects:
             continue
         try:
-            f1 = fit.add(effect)
+            if reuse is not None and set(reuse.effects) == set(fit.effects) | {effect}:
+                f1 = reuse
+            else:
+                f1 = fit.add(effect)
         except InputError as err:                      # e.g. too few rows for one more parameter
             untestable[effect] = str(err)
             continue
         fits[effect] = f1
         q, df2 = f1.n_params - fit.n_params, f1.n - f1.n_params
         drop = max(fit.rss - f1.rss, 0.0)
-        p, logp = _f_test(fit.rss, f1.rss, q, df2)
-        test = "F"
+        if noise.correlated:
+            (e0, _), (e1, _) = _gls(fit, noise), _gls(f1, noise)
+            p, logp = _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
+        else:
+            p, logp = _f_test(fit.rss, f1.rss, q, df2)
+        test = "F" if not noise.correlated else "F (GLS)"
         if (fit.system == "drift" and fit.n <= SMALL_SAMPLE
                 and all(e in fit.spec.catalogue for e in fit.effects + (effect,))):
             pp = _permutation_p(fit, effect, drop, seed)
@@ -279,7 +364,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
                 p, logp, test = pp, math.log(max(pp, 1e-300)), "permutation"
         cands.append(Candidate(effect, f1.rms, f1.loo_rms, drop / fit.rss if fit.rss > 0 else 0.0, p, test,
                                log_p=logp))
-    structure = _structure(fit)
+    structure = _structure(fit, noise)
     m = len(cands) + len(structure)
     level = alpha / max(m, 1)
     for s in structure:
@@ -296,17 +381,17 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
             missing = c.effect
             break
         f1 = fits[c.effect]
-        after = {s.what: s for s in _structure(f1)}
+        # a candidate that brings the residual down to the numerical floor leaves no structure
+        after = {s.what: s for s in _structure(f1, noise)} if f1.rms > sc.floor else {}
         gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level]
         remaining = [s for s in found if s.what not in gone]
         # named only if it still matters once the structure it leaves in place is allowed for
-        if not remaining or _conditional_p(fit, f1, remaining) < level:
+        if not remaining or _conditional_p(fit, f1, remaining, noise) < level:
             c.explains = "; ".join(gone)
             missing = c.effect
             found = remaining
             break
         blocked.append(c.effect)
-    unit = fit.unit
     if missing:
         c = next(c for c in cands if c.effect == missing)
         msg = (f"add '{missing}': it removes {100 * c.variance_explained:.1f} % of the residual variance "
@@ -328,5 +413,15 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0) -> Diagnosis:
             msg += f" (only {fit.n} rows: small effects cannot be excluded)"
     if missing and found:
         msg += "; structure it does not explain remains: " + "; ".join(s.what for s in found)
-    return Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
-                     missing is None and not found, cands, structure, untestable, alpha, m, msg)
+    if noise.correlated:
+        msg += (f" [serially correlated noise, AR({noise.order}) with lag-1 correlation {noise.lag1:.2f}: "
+                f"tests on whitened residuals]")
+    return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
+                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc))
+
+
+def _finish(d: Diagnosis) -> Diagnosis:
+    """Put the outlier line (if rows were set aside) on a line of its own before the message."""
+    if d.screening is not None and d.screening.outliers:
+        d.message = d.screening.outlier_line(d.unit) + "\n" + d.message
+    return d

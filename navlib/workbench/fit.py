@@ -27,6 +27,28 @@ from .effects import COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, get_system,
 
 RAD = 180.0 / np.pi
 
+#: Each system's measured columns, in the order of the residual's axes (``residual[i * k + j]`` is row i,
+#: column j), and whether the measurement is an angle whose residual is wrapped to (-180, 180] deg.  The
+#: outlier screen names a column from here; a system module adds its own entry when it registers.
+MEASURED: dict[str, tuple[tuple[str, ...], bool]] = {"compass": (("measured_heading_deg",), True),
+                                                    "drift": (("drift_deg_h",), False)}
+
+
+def measured_columns(system: str, axes: int) -> tuple[str, ...]:
+    """The names of a system's measured columns (:data:`MEASURED`; ``"axis j"`` for a system without an
+    entry)."""
+    cols = MEASURED.get(system, ((), False))[0]
+    return cols if len(cols) == axes else tuple(f"axis {j}" for j in range(axes))
+
+
+def residuals_on(fit: "Fit", frame: pd.DataFrame) -> np.ndarray:
+    """Residuals (measured - model, in the system's unit; wrapped for an angle) of ``fit`` on the rows of
+    ``frame``, shape (rows, axes): also on rows the fit did not use."""
+    cols, wrapped = MEASURED[fit.system]
+    model = np.asarray(fit.predict(frame), float).reshape(len(frame), -1)
+    r = frame[list(cols)].to_numpy(float) - model
+    return wrap_deg(r) if wrapped else r
+
 
 @dataclass
 class Fit:

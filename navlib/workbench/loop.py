@@ -17,14 +17,23 @@ from ..errors import InputError, check_param
 from .diagnose import Diagnosis, diagnose
 from .effects import Effect
 from .fit import Fit, fit_model
+from .screen import Screening, screen
 
 
 @dataclass
 class LoopResult:
-    """The loop's steps: ``fits[i]`` was diagnosed as ``diagnoses[i]``; the last one ends the loop."""
+    """The loop's steps: ``fits[i]`` was diagnosed as ``diagnoses[i]``; the last one ends the loop.
+    ``screening``: what the screen before the first test found (outliers set aside, noise model)."""
 
     fits: list
     diagnoses: list
+    screening: Screening | None = None
+
+    @property
+    def outliers(self) -> list[dict]:
+        """The observations set aside before the first test: ``{"row", "column", "residual",
+        "robust_z"}`` (row 1-based among the data rows)."""
+        return [o.to_dict() for o in self.screening.outliers] if self.screening is not None else []
 
     @property
     def final(self) -> Fit:
@@ -57,14 +66,22 @@ class LoopResult:
 
     def to_dict(self) -> dict:
         """The ``--json`` schema: ``{"steps": [{"model", "rms", "loo_rms", "missing"}], "final": {"model",
-        "rms", "loo_rms", "consistent_with_noise", "unexplained"}}`` (rms in the system's unit)."""
+        "rms", "loo_rms", "consistent_with_noise", "unexplained"}, "outliers": [{"row", "column",
+        "residual", "robust_z"}], "rows", "rows_used", "noise": {...}, ...}`` (rms and residuals in the
+        system's unit; the screen's fields: :meth:`navlib.workbench.screen.Screening.to_dict`)."""
         f = self.final
-        return {"system": f.system, "unit": f.unit,
-                "steps": [{"model": list(fi.effects), "rms": fi.rms, "loo_rms": fi.loo_rms, "missing": d.missing}
-                          for fi, d in zip(self.fits, self.diagnoses)],
-                "final": {"model": list(f.effects), "rms": f.rms, "loo_rms": f.loo_rms,
-                          "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
-                          "message": self.final_diagnosis.message}}
+        out = {"system": f.system, "unit": f.unit,
+               "steps": [{"model": list(fi.effects), "rms": fi.rms, "loo_rms": fi.loo_rms, "missing": d.missing}
+                         for fi, d in zip(self.fits, self.diagnoses)],
+               "final": {"model": list(f.effects), "rms": f.rms, "loo_rms": f.loo_rms,
+                         "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
+                         "message": self.final_diagnosis.message},
+               "outliers": self.outliers}
+        if self.screening is not None:
+            extra = self.screening.to_dict()
+            extra.pop("outliers")
+            out.update(extra)
+        return out
 
 
 def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effect, ...] = (),
@@ -74,6 +91,9 @@ def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effe
     Starting from ``start_model`` (effect names), fit, :func:`~navlib.workbench.diagnose.diagnose`, add the
     named effect, refit (from the previous parameters and the linearised start), and repeat until the
     diagnosis names nothing (consistent with noise, or structure no effect explains) or ``max_steps``.
+    The data are screened once, before the first test (:func:`navlib.workbench.screen.screen`): outlying
+    rows are set aside (listed in ``outliers``) and every step is fitted and tested without them, with the
+    noise model (serial correlation) the screen estimated.
 
     Parameters
     ----------
@@ -95,12 +115,14 @@ def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effe
     LoopResult
     """
     check_param("max_steps", max_steps, lo=0, integer=True)
-    fits = [fit_model(system, data, list(start_model), user_effects=tuple(user_effects))]
-    diagnoses = [diagnose(fits[0], alpha=alpha)]
+    first = fit_model(system, data, list(start_model), user_effects=tuple(user_effects))
+    sc = screen(first)
+    fits = [sc.refit(first)]
+    diagnoses = [diagnose(fits[0], alpha=alpha, screen=sc)]
     while diagnoses[-1].missing is not None and len(fits) <= max_steps:
         fits.append(fits[-1].add(diagnoses[-1].missing))
-        diagnoses.append(diagnose(fits[-1], alpha=alpha))
-    return LoopResult(fits, diagnoses)
+        diagnoses.append(diagnose(fits[-1], alpha=alpha, screen=sc))
+    return LoopResult(fits, diagnoses, sc)
 
 
 def loop_figure(result: LoopResult):
@@ -170,7 +192,12 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     for i, (f, d) in enumerate(zip(result.fits, result.diagnoses)):
         lines.append(f"| {i} | {' + '.join(f.effects) or '(none)'} | {f.rms:.4g} | {f.loo_rms:.4g} | "
                      f"{d.missing or '-'} |")
-    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message, "",
-              f"![the loop]({png.name})", ""]
+    sc = result.screening
+    if sc is not None and sc.outliers:
+        lines += ["", f"**Outliers:** {sc.outlier_line(unit)}."]
+    if sc is not None and sc.noise.series is not None:
+        lines += ["", f"**Noise:** {sc.noise.describe()}."]
+    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.replace("\n", "\n\n"),
+              "", f"![the loop]({png.name})", ""]
     md.write_text("\n".join(lines))
     return png, md

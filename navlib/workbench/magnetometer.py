@@ -37,7 +37,7 @@ from ..angles import wrap_deg
 from ..data.tables import Column, read_table, where
 from ..errors import InputError
 from .effects import Effect, System, register_system
-from .fit import Fit, best_least_squares, lstsq, user_columns, user_design
+from .fit import MEASURED, Fit, best_least_squares, lstsq, user_columns, user_design
 
 MAG = ("mag_x_ut", "mag_y_ut", "mag_z_ut")
 QUAT = ("q_w", "q_x", "q_y", "q_z")
@@ -342,6 +342,7 @@ def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     return radius * (U @ np.diag(np.sqrt(w)) @ U.T), c
 
 
+MEASURED["magnetometer"] = (MAG, False)
 SYSTEM = register_system(System(
     "magnetometer", "uT", MAGNETOMETER_EFFECTS, load_magnetometer, _fit_magnetometer, magnetometer_structure,
     "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT"))
@@ -360,4 +361,57 @@ def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, 
     frame["time_s"] = 0.1 * np.arange(n)
     m = predict_field(p, frame) + noise_ut * rng.standard_normal((n, 3))
     frame[list(MAG)] = m
+    return frame
+
+
+def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) -> np.ndarray:
+    """Gaussian AR(1) noise along axis 0: marginal standard deviation ``sd`` and lag-1 correlation
+    ``correlation`` (stationary from the first sample: ``e_0 ~ N(0, sd^2)``,
+    ``e_t = c e_(t-1) + sd sqrt(1 - c^2) u_t``)."""
+    shape = tuple(np.atleast_1d(shape))
+    u = rng.standard_normal(shape)
+    e = np.empty(shape)
+    e[0] = sd * u[0]
+    s = sd * np.sqrt(1.0 - correlation ** 2)
+    for t in range(1, shape[0]):
+        e[t] = correlation * e[t - 1] + s * u[t]
+    return e
+
+
+def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: float = 10.0,
+                         noise_ut: float = 0.1, noise_correlation: float = 0.0, turn_rate_dps: float = 45.0,
+                         turn_time_s: float = 1.0, seed=0) -> pd.DataFrame:
+    """A magnetometer turned by hand and sampled at ``rate_hz``: the body rate of each axis is an
+    Ornstein-Uhlenbeck process (standard deviation ``turn_rate_dps``, correlation time ``turn_time_s``),
+    integrated from a random attitude into the reference quaternion (so the attitude, and every effect's
+    shape, changes slowly from sample to sample, as in BROAD's hand-held trials); the field follows the
+    model of the module docstring with ``params`` (plus the local field, default BROAD's room) and AR(1)
+    noise of marginal standard deviation ``noise_ut`` and lag-1 correlation ``noise_correlation``
+    (:func:`ar1_noise`, the same process on each axis, independent between axes).  Columns as a BROAD
+    3-D file: ``time_s``, quaternion, gyro, field."""
+    for name, value, lo in (("duration_s", duration_s, 0.0), ("rate_hz", rate_hz, 0.0),
+                            ("turn_rate_dps", turn_rate_dps, 0.0), ("turn_time_s", turn_time_s, 0.0)):
+        if not (np.isfinite(value) and value > lo):
+            raise InputError(f"parameter {name}={value!r}: must be > {lo:g}")
+    if not (np.isfinite(noise_ut) and noise_ut >= 0):
+        raise InputError(f"parameter noise_ut={noise_ut!r}: must be >= 0")
+    if not (-1.0 < noise_correlation < 1.0):
+        raise InputError(f"parameter noise_correlation={noise_correlation!r}: must be in (-1, 1)")
+    rng = np.random.default_rng(seed)
+    n = int(round(duration_s * rate_hz))
+    if n < 30:
+        raise InputError(f"duration_s x rate_hz = {n} samples; at least 30 are needed")
+    dt = 1.0 / rate_hz
+    w = ar1_noise(rng, (n, 3), turn_rate_dps, float(np.exp(-dt / turn_time_s)))   # body rate, deg/s
+    steps = Rotation.from_rotvec(np.radians(w[:-1]) * dt)
+    rots = [Rotation.random(random_state=rng)]                                  # body -> NED
+    for k in range(n - 1):
+        rots.append(rots[-1] * steps[k])
+    q = Rotation.concatenate(rots).as_quat()[:, [3, 0, 1, 2]]
+    q = q * np.where(q[:, :1] < 0, -1.0, 1.0)
+    frame = pd.DataFrame({"time_s": dt * np.arange(n)})
+    frame[list(QUAT)] = q
+    frame[list(GYR)] = w
+    p = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8, **params}
+    frame[list(MAG)] = predict_field(p, frame) + ar1_noise(rng, (n, 3), noise_ut, noise_correlation)
     return frame

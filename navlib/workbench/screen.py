@@ -1,0 +1,403 @@
+"""Before any test: set aside outlying rows, find the data's numerical floor, and model the noise's serial
+correlation.  :func:`screen` does all three once per data set; :func:`navlib.workbench.diagnose.diagnose`
+and :func:`navlib.workbench.loop.loop` test on what it leaves.
+
+**Outliers.**  The F tests compare variances, so one wild sample inflates the noise estimate until nothing
+is significant (a 300 uT spike among 0.4 uT residuals hides every effect).  The screen fits the *richest*
+model the data can test (every testable effect, catalogued and the user's: so no missing effect, e.g. a
+time lag on the fast turns, is mistaken for outliers) and studentises its residuals with a robust scale,
+per measured column::
+
+    z_ij = (u_ij - med_j) / s_j,   u_ij = r_ij / sqrt(1 - h_ij),   s_j = 1.4826 MAD_j(u)
+
+(``h`` the leverage of the observation; median and MAD over the rows kept; 1.4826 makes the MAD a
+consistent estimate of a normal standard deviation: Hampel 1974, JASA 69:383; Rousseeuw and Croux 1993,
+JASA 88:1273).  An observation is an outlier when ``|z| > c`` with the Bonferroni cutoff
+``c = max(Z_MIN, t_nu^-1(1 - OUTLIER_ALPHA / (2 N)))`` over the N observations, so a file of clean Gaussian
+noise has about an ``OUTLIER_ALPHA`` chance of losing any row.  Student's t with ``nu = 0.367 (N - p)``
+degrees of freedom rather than the normal quantile allows for the MAD's own scatter on short tables: the
+MAD has 36.7 % efficiency at the normal (Rousseeuw and Croux 1993), so it is about as precise as a variance
+from ``0.367 (N - p)`` squares (a Satterthwaite-style approximation; on a 19-row table the cutoff is about
+11, on hundreds of rows it is ``Z_MIN``).  In a time series (``time_s``, or a
+magnetometer's file order) an outlier must also stand out from its neighbours in time -- the robust z of
+``u_t`` minus the median of the samples within :data:`ISOLATION` of it must exceed ``c`` too (a Hampel
+filter, Pearson 2002) -- and be isolated: no other flagged sample within :data:`ISOLATION` samples.  A spike
+is; a physical disturbance that lasts two samples or more (a magnet passed at close range) is not, and
+stays in the data for the structure tests.  The screen
+is iterated (Rousseeuw and Leroy 1987, *Robust Regression and Outlier Detection*, ch. 6: reweighted least
+squares): the rows flagged whose ``|z|`` is within a factor :data:`DOMINANCE` of the largest are set aside,
+the model is refitted without them, every row (set-aside ones too) is judged again against the cleaner
+fit, until the set is stable; so a huge spike that distorts the first fit cannot condemn innocent rows.
+A row with any outlying column is set aside whole.  More than :data:`MAX_OUTLIER_SHARE` of the rows (at
+least one row) flagged: the data are refused (InputError) -- a least-squares model is no description of
+them.  Fewer than :data:`MIN_DOF` residual degrees of freedom: no screen (said in the result).
+
+**Numerical floor.**  Residuals at the data's own precision are not evidence of anything: when the
+residual RMS is at most ``FLOOR_REL`` (1e-9) times the RMS of the measured values, the residuals are
+called noise without a test (round-off of float arithmetic is ~1e-16 of the values; no sensor resolves
+1e-9 of its range).  The robust scale is never taken below this floor either.
+
+**Serial correlation.**  :mod:`navlib.workbench.serial`: an AR(p) model of the noise estimated by REML from
+the richest model's residuals with the model's Jacobian *and the system's structure shapes* as regressors
+(so a slow structure outside the catalogue is not mistaken for correlated noise, and stays testable), and
+without the observations whose robust |z| exceeds :data:`Z_NOISE` (3.5, the "potential outlier" cutoff of
+Iglewicz and Hoaglin 1993, *How to Detect and Handle Outliers*): the noise model describes the bulk of
+the data, so a localised disturbance (a magnet passed at close range) is not taken for strongly
+correlated noise that would then hide it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ..errors import InputError
+from .effects import testable
+from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
+from .serial import NoiseModel, estimate, series_of
+
+#: Lowest robust |z| that flags an outlier.
+Z_MIN = 5.0
+#: Chance that a file of clean Gaussian noise loses any row to the screen (Bonferroni over observations).
+OUTLIER_ALPHA = 0.01
+#: More than this share of the rows flagged: the data are refused.
+MAX_OUTLIER_SHARE = 0.05
+#: Fewest residual degrees of freedom of the screening model for the screen to run.
+MIN_DOF = 10
+#: Each round sets aside the flagged rows whose |z| is at least the largest |z| divided by this.
+DOMINANCE = 10.0
+#: Observations with a robust |z| above this are left out of the noise model's estimate (they are what the
+#: tests look at, not the noise; 3.5 is Iglewicz and Hoaglin's cutoff for a potential outlier).
+Z_NOISE = 3.5
+#: Residuals whose RMS is at most this share of the RMS of the measured values are noise.
+FLOOR_REL = 1e-9
+MAX_ROUNDS = 12
+#: Tables of at most this many rows are screened with deletion residuals (and without structure shapes).
+SMALL_TABLE = 60
+#: In a time series a flagged sample is an outlier only if no other flagged sample lies within this many
+#: samples of it in its segment.
+ISOLATION = 2
+MAD_SD = 1.482602218505602          # 1 / Phi^-1(3/4)
+#: Asymptotic efficiency of the MAD at the normal (Rousseeuw and Croux 1993).
+MAD_EFFICIENCY = 0.367
+
+
+@dataclass(frozen=True)
+class Outlier:
+    """One outlying observation: ``row`` is 1-based among the data rows (the loaders' row numbers),
+    ``column`` the measured column, ``residual`` measured - model in the system's unit (the richest model
+    fitted without the outliers), ``z`` its robust studentised value."""
+
+    row: int
+    column: str
+    residual: float
+    z: float
+
+    def to_dict(self) -> dict:
+        return {"row": self.row, "column": self.column, "residual": self.residual, "robust_z": self.z}
+
+
+@dataclass
+class Screening:
+    """What :func:`screen` found on one data set.
+
+    ``data``: the rows kept (original index); ``kept``: their 0-based positions in the data screened;
+    ``outliers``: the observations set aside; ``cutoff``: the |z| that flags one; ``model``: the effects
+    of the screening (richest) model; ``noise``: the serial-correlation model the tests whiten with;
+    ``scale``, ``floor``: RMS of the measured values and the numerical floor (``FLOOR_REL * scale``);
+    ``note``: why the screen did not run, if it did not; ``rich``: the richest model fitted to ``data``."""
+
+    data: pd.DataFrame
+    kept: np.ndarray
+    n_rows: int
+    outliers: list
+    cutoff: float
+    model: tuple
+    noise: NoiseModel
+    scale: float
+    floor: float
+    note: str = ""
+    rich: Fit | None = field(default=None, repr=False)
+
+    @property
+    def rows_set_aside(self) -> list[int]:
+        return sorted({o.row for o in self.outliers})
+
+    def refit(self, fit: Fit) -> Fit:
+        """``fit``'s model on the rows kept (``fit`` itself when no row was set aside)."""
+        if len(self.kept) == self.n_rows:
+            return fit
+        return fit_model(fit.spec, self.data, fit.effects, user_effects=fit.user_effects)
+
+    def outlier_line(self, unit: str) -> str:
+        """One line for a report: the rows set aside (empty when none)."""
+        if not self.outliers:
+            return ""
+        rows = self.rows_set_aside
+        shown = "; ".join(f"row {o.row} {o.column} {o.residual:+.4g} {unit} (z {o.z:.3g})"
+                          for o in self.outliers[:5])
+        more = f"; and {len(self.outliers) - 5} more" if len(self.outliers) > 5 else ""
+        return (f"set aside {len(rows)} outlying row{'s' if len(rows) > 1 else ''} of {self.n_rows} "
+                f"(robust |z| > {self.cutoff:.3g} against {' + '.join(self.model) or 'the model'}): "
+                f"{shown}{more}")
+
+    def to_dict(self) -> dict:
+        return {"rows": self.n_rows, "rows_used": int(len(self.kept)),
+                "outliers": [o.to_dict() for o in self.outliers], "outlier_cutoff": self.cutoff,
+                "screening_model": list(self.model), "numerical_floor": self.floor,
+                "noise": self.noise.to_dict(), "screen_note": self.note}
+
+
+def cutoff(n_obs: int, dof: int) -> float:
+    """The robust |z| above which one of ``n_obs`` observations with ``dof`` residual degrees of freedom
+    is an outlier (module docstring)."""
+    nu = max(MAD_EFFICIENCY * dof, 1.0)
+    return float(max(Z_MIN, stats.t.isf(OUTLIER_ALPHA / (2 * max(n_obs, 1)), nu)))
+
+
+def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
+    """RMS of the measured values of ``frame`` (:data:`navlib.workbench.fit.MEASURED`; for a system
+    without an entry, of the model's prediction plus the residual)."""
+    if fit.system in MEASURED:
+        v = frame[list(MEASURED[fit.system][0])].to_numpy(float)
+    else:
+        v = np.asarray(fit.predict(frame), float).ravel() + fit.residuals
+    return float(np.sqrt(np.mean(v ** 2)))
+
+
+def _robust_z(u: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
+    """(u - median) / (1.4826 MAD) per column, median and MAD over the rows ``ref``; the scale is never
+    below ``floor``."""
+    med = np.nanmedian(u[ref], axis=0)
+    mad = np.nanmedian(np.abs(u[ref] - med), axis=0)
+    s = np.maximum(MAD_SD * mad, max(floor, 1e-300))
+    return (u - med) / s
+
+
+def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str) -> np.ndarray | None:
+    """``u_t`` minus the median of its neighbours within ``ISOLATION`` samples in time (same segment; NaN
+    where a segment has a single sample), or None if the data are not a time series
+    (:func:`navlib.workbench.serial.series_of`).  The median (a Hampel filter's reference, Pearson 2002,
+    *IEEE Trans. Control Syst. Technol.* 10:55) keeps a spike from making its neighbours look like spikes."""
+    n, k = u.shape
+    ser = series_of(data, n * k, system)
+    if ser is None:
+        return None
+    x = u.ravel()[ser.order]
+    seg = np.cumsum(ser.pos == 0)
+    m = len(x)
+    near = np.full((m, 2 * ISOLATION), np.nan)
+    col = 0
+    for off in [o for o in range(-ISOLATION, ISOLATION + 1) if o]:
+        idx = np.arange(m) + off
+        ok = (idx >= 0) & (idx < m)
+        ok[ok] &= seg[idx[ok]] == seg[ok]
+        near[ok, col] = x[idx[ok]]
+        col += 1
+    has = ~np.all(np.isnan(near), axis=1)
+    ref = np.full(m, np.nan)
+    ref[has] = np.nanmedian(near[has], axis=1)
+    gap = x - ref
+    out = np.empty(n * k)
+    out[ser.order] = gap
+    return out.reshape(n, k)
+
+
+def _richest(fit: Fit) -> list[tuple[str, ...]]:
+    """Models to screen with, richest first: every testable effect (catalogue and user), the testable
+    catalogue, the model itself."""
+    ok, _ = testable(fit.available, fit.data)
+    every = tuple(e for e in fit.available if e in ok or e in fit.effects)
+    cat = tuple(e for e in every if e in fit.spec.catalogue or e in fit.effects)
+    out = []
+    for m in (every, cat, tuple(fit.effects)):
+        if m not in out:
+            out.append(m)
+    return out
+
+
+def _fit_rich(fit: Fit, frame: pd.DataFrame, models) -> Fit | None:
+    for m in models:
+        try:
+            f = fit_model(fit.spec, frame, m, start=fit.params, user_effects=fit.user_effects)
+        except InputError:
+            continue
+        if f.n - f.n_params >= MIN_DOF:
+            return f
+    return None
+
+
+def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening:
+    """Screen the data of ``fit`` (module docstring): outliers set aside, the numerical floor, the noise's
+    serial correlation.  ``outliers=False`` / ``serial=False`` skip those parts.
+
+    Raises
+    ------
+    InputError
+        When more than ``MAX_OUTLIER_SHARE`` of the rows are outliers.
+    """
+    data = fit.data
+    n = len(data)
+    scale = measurement_scale(fit, data)
+    floor = FLOOR_REL * scale
+    models = _richest(fit)
+    rich = _fit_rich(fit, data, models)
+    kept = np.arange(n)
+    found: list[Outlier] = []
+    note = ""
+    c = cutoff(rich.n, rich.n - rich.n_params) if rich is not None else float("nan")
+    if rich is None:
+        note = f"not run: fewer than {MIN_DOF} residual degrees of freedom"
+    elif not outliers:
+        note = "not run"
+    elif fit.system not in MEASURED:
+        note = f"not run: system '{fit.system}' names no measured columns"
+    zk = None
+    if rich is not None and outliers and fit.system in MEASURED and rich.rms > floor:
+        rich, kept, found, zk = _screen_rows(fit, data, rich, c, floor)
+    if rich is not None and len(kept) < n:
+        data = data.iloc[kept]
+    noise = NoiseModel(n_obs=fit.n)
+    if serial and rich is not None and rich.rms > floor:
+        ser = series_of(rich.data, rich.n, rich.system)
+        if ser is not None:
+            if zk is not None:                         # the noise model describes the bulk of the data
+                ser = ser.without(np.abs(zk.ravel()) > Z_NOISE)
+            shapes = [np.asarray(X, float) for _, X, _ in rich.spec.structure(rich)]
+            noise = estimate(rich.residuals, np.column_stack([rich.jacobian] + shapes), ser)
+    return Screening(data, kept, n, found, c, rich.effects if rich is not None else tuple(fit.effects), noise,
+                     scale, floor, note, rich)
+
+
+def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
+    """The system's structure shapes evaluated on the rows of ``frame`` (columns side by side)."""
+    probe = replace(rich, data=frame)                # the structure functions read only the data
+    cols = [np.asarray(X, float) for _, X, _ in rich.spec.structure(probe)]
+    return np.column_stack(cols) if cols else np.zeros((len(frame) * (rich.n // len(rich.data)), 0))
+
+
+def _isolated(row_flag: np.ndarray, data: pd.DataFrame, axes: int, system: str) -> np.ndarray:
+    """In a time series, the flagged rows with no other flagged row within ``ISOLATION`` samples of
+    their segment (a run of flagged samples is an event, left to the structure tests)."""
+    ser = series_of(data, len(data) * axes, system)
+    if ser is None:
+        return row_flag
+    n = len(data)
+    rows, pos = ser.order[:n] // axes, ser.pos[:n]   # axis 0: rows in time order
+    f = row_flag[rows]
+    seg = np.cumsum(pos == 0)
+    near = np.zeros(n, bool)
+    for k in range(1, ISOLATION + 1):
+        same = seg[k:] == seg[:-k]
+        near[k:] |= f[:-k] & same
+        near[:-k] |= f[k:] & same
+    out = np.zeros(n, bool)
+    out[rows] = f & ~near
+    return out
+
+
+def _deletion_z(fit: Fit, data: pd.DataFrame, rich: Fit, floor: float) -> np.ndarray:
+    """Robust z of every row's deletion residual: the model refitted without the row, the row's
+    prediction error scaled by ``sqrt(1 - h)`` (its leverage in the full fit), against the median and MAD
+    of the other rows' studentised residuals in that refit.  On a short table one outlier at a
+    high-leverage point pulls the full fit towards itself and inflates everyone's residuals (masking);
+    without it, it stands out (the deletion diagnostics of Belsley, Kuh and Welsch 1980, *Regression
+    Diagnostics*, with a robust scale)."""
+    n = len(data)
+    axes = rich.n // n
+    h_full = np.clip(np.sum(orth_basis(rich.jacobian) ** 2, axis=1), 0.0, 0.99).reshape(n, axes)
+    z = np.zeros((n, axes))
+    for i in range(n):
+        others = np.delete(np.arange(n), i)
+        try:
+            fi = fit_model(fit.spec, data.iloc[others], rich.effects, start=rich.params,
+                           user_effects=fit.user_effects)
+        except InputError:
+            continue
+        r = residuals_on(fi, data)
+        h = np.zeros((n, axes))
+        h[others] = np.clip(np.sum(orth_basis(fi.jacobian) ** 2, axis=1), 0.0, 0.99).reshape(n - 1, axes)
+        u = r / np.sqrt(1.0 - h)
+        u[i] = r[i] * np.sqrt(1.0 - h_full[i])
+        z[i] = _robust_z(u, others, floor)[i]
+    return z
+
+
+def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float):
+    """The iteration of the module docstring; returns the richest fit on the rows kept, their positions
+    and the outliers."""
+    n = len(data)
+    axes = rich.n // n
+    cols = measured_columns(fit.system, axes)
+    aside = np.zeros(n, bool)
+    limit = max(1, int(math.floor(MAX_OUTLIER_SHARE * n)))
+    shapes_all = _shapes_on(rich, data)
+    dof = rich.n - rich.n_params
+    if n <= SMALL_TABLE or dof - shapes_all.shape[1] < max(MIN_DOF, dof / 2):
+        shapes_all = shapes_all[:, :0]               # too few rows to take the structure out as well
+
+    def judge(rich, aside):
+        """Robust z of every observation against ``rich`` (fitted to the rows not ``aside``) and the
+        structure shapes, and which observations are outliers."""
+        kept = np.flatnonzero(~aside)
+        r = r_model = residuals_on(rich, data)
+        obs = (kept[:, None] * axes + np.arange(axes)).ravel()
+        if shapes_all.shape[1]:
+            S = shapes_all[obs]
+            q = orth_basis(np.column_stack([rich.jacobian, S]))
+            rk = r[kept].ravel()
+            # rows kept: the residual of model + shapes; rows set aside: minus the shapes' prediction
+            coef = np.linalg.lstsq(S, rk, rcond=1e-10)[0]
+            r = r - (shapes_all @ coef).reshape(n, axes)
+            r[kept] = (rk - q @ (q.T @ rk)).reshape(len(kept), axes)
+        else:
+            q = orth_basis(rich.jacobian)
+        lev = np.sum(q ** 2, axis=1)
+        h = np.zeros((n, axes))
+        h[kept] = np.clip(lev, 0.0, 0.99).reshape(len(kept), axes)
+        u = r / np.sqrt(1.0 - h)
+        z = _robust_z(u, kept, floor)
+        flagged = np.abs(z) > c
+        gap = _neighbour_gap(u, data, fit.system)
+        if gap is not None:
+            zg = _robust_z(gap, kept, floor)
+            flagged &= np.isnan(zg) | (np.abs(zg) > c)
+            flagged &= _isolated(flagged.any(axis=1), data, axes, fit.system)[:, None]
+        return r_model, z, flagged
+
+    for k in range(MAX_ROUNDS):
+        r, z, flagged = judge(rich, aside)
+        if k == 0 and n <= SMALL_TABLE:             # a short table: deletion residuals against masking
+            zd = _deletion_z(fit, data, rich, floor)
+            flagged = flagged | (np.abs(zd) > c)
+            z = np.where(np.abs(zd) > np.abs(z), zd, z)
+        row_flag = flagged.any(axis=1)
+        zmax = np.where(flagged, np.abs(z), 0.0).max(axis=1)
+        new = row_flag & ~aside
+        dominant = new & (zmax >= zmax[new].max() / DOMINANCE) if new.any() else new
+        nxt = (aside & row_flag) | dominant
+        if np.array_equal(nxt, aside) or nxt.all():
+            break
+        aside = nxt
+        rich = fit_model(fit.spec, data.iloc[np.flatnonzero(~aside)], rich.effects, start=rich.params,
+                         user_effects=fit.user_effects)
+    else:
+        r, z, flagged = judge(rich, aside)
+    bad = np.flatnonzero(aside | flagged.any(axis=1))
+    if len(bad) > limit:
+        j = int(np.argmax(np.abs(z[bad[0]])))
+        raise InputError(
+            f"{len(bad)} of {n} rows are outliers (robust |z| > {c:.3g} against the model "
+            f"{' + '.join(rich.effects) or '(none)'}; e.g. column '{cols[j]}', rows "
+            f"{', '.join(str(int(b) + 1) for b in bad[:6])}{', ...' if len(bad) > 6 else ''}): more than "
+            f"{limit} ({100 * MAX_OUTLIER_SHARE:g} % of the rows, at least 1) that the screen sets aside; a "
+            f"least-squares model does not describe these data -- check the file")
+    kept = np.flatnonzero(~aside)
+    found = []
+    for i in np.flatnonzero(aside):
+        js = np.flatnonzero(flagged[i]) if flagged[i].any() else [int(np.argmax(np.abs(z[i])))]
+        found += [Outlier(int(i) + 1, cols[j], float(r[i, j]), float(z[i, j])) for j in js]
+    return rich, kept, found, z[kept]

@@ -1,0 +1,280 @@
+"""Serially correlated residuals: an AR(p) model of the noise and the whitening that keeps the workbench's
+F tests honest on time series.
+
+Samples of a recording (a magnetometer at 10 Hz turned by hand, a compass read every few seconds) are
+rarely independent: the noise wanders, and neighbouring samples share it.  A shape that varies slowly in
+time (a constant offset, a field that drifts, anything that follows a slow hand rotation) then picks up
+far more of the noise than the independent-sample F test expects -- with a lag-1 correlation of 0.9 the
+variance of a mean is (1 + 0.9) / (1 - 0.9) = 19 times larger -- and every such shape looks significant.
+The workbench therefore models the noise and tests on whitened residuals (generalised least squares).
+
+**The series.**  The residuals of one measurement axis in time order: by ``time_s`` when the data have it,
+else in file order for a system that records time series (:data:`FILE_ORDER_SYSTEMS`, the
+magnetometer); data with neither (a drift table, a tumble test, heading bins) are not a series and are not
+whitened.  A series is cut into segments where a time step exceeds :data:`GAP_FACTOR` times the median
+step (gaps where the reference was lost, rows set aside); within a segment the samples are taken as
+equally spaced.
+
+**The model.**  Every axis and segment shares one stationary AR(p) process, ``p <= MAX_ORDER``,
+parametrised by its partial autocorrelations ``kappa_1..kappa_p`` in (-1, 1), so every value is a
+stationary process (Barndorff-Nielsen and Schou 1973, J. Multivariate Anal. 3:408).  Whitening is the exact
+inverse Cholesky factor of its correlation matrix on each segment: the t-th sample of a segment is
+predicted from the previous ``min(t, p)`` with the Durbin-Levinson coefficients of that order and divided
+by the square root of the prediction-error variance (Brockwell and Davis 1991, *Time Series: Theory and
+Methods*, sections 5.2 and 8.7), so ``W e`` has independent samples of one variance.
+
+**The estimate.**  The kappas maximise the *restricted* (REML) log likelihood of the residual ``r`` given
+the regressors ``X`` (the columns a least-squares fit has already taken out of it: the model's Jacobian
+and the structure shapes), with ``R`` the AR correlation matrix and ``W' W = R^-1``::
+
+    l_R(kappa) = -1/2 [ (N - k) log RSS_W  +  log det R  +  log det (X' R^-1 X) ],
+    RSS_W = min_b |W (r - X b)|^2
+
+(Harville 1977, JASA 72:320).  Restricted rather than plain likelihood because the residuals of a fit
+with many smooth regressors look less correlated than the noise was: least-squares residual
+autocorrelations, and plain ML, are biased towards zero, which would leave the tests too liberal; REML
+removes most of that bias for AR errors in regression (Cheang and Reinsel 2000, JASA 95:1173).  The order
+``p`` is chosen by AIC (Akaike 1974, IEEE Trans. Autom. Control 19:716), forward: orders 1, 2, ... up to
+``MAX_ORDER`` while each lowers the AIC.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import minimize, minimize_scalar
+
+#: A time step more than this many times the median step starts a new segment.
+GAP_FACTOR = 2.5
+#: Highest AR order tried.
+MAX_ORDER = 3
+#: Partial autocorrelations are kept within +-KAPPA_MAX (a unit root cannot be whitened).
+KAPPA_MAX = 0.995
+#: Fewest samples beyond the regressors for an estimate (fewer: the samples are taken as independent).
+MIN_SAMPLES = 20
+#: Systems whose rows are a time series in file order when the data have no ``time_s`` column.
+FILE_ORDER_SYSTEMS = {"magnetometer"}
+
+
+@dataclass(frozen=True)
+class Series:
+    """Where the observations of a residual vector sit in time: ``order`` lists observation indices axis by
+    axis, each axis in time order; ``pos`` is each ordered observation's place in its segment (0 starts a
+    segment); ``source`` says what ordered them (``"time_s"`` or ``"file order"``)."""
+
+    order: np.ndarray
+    pos: np.ndarray
+    source: str
+
+    @property
+    def segments(self) -> int:
+        return int(np.sum(self.pos == 0))
+
+    def without(self, drop: np.ndarray) -> "Series":
+        """The series without the observations ``drop`` (a boolean mask over observations): each one
+        removed ends its segment, and the next sample starts a new one."""
+        gone = np.asarray(drop, bool)[self.order]
+        if not gone.any():
+            return self
+        start = self.pos == 0
+        start[1:] |= gone[:-1]                   # after a removed sample a new segment starts
+        start = start[~gone]
+        seg = np.cumsum(start) - 1
+        first = np.flatnonzero(start)
+        return Series(self.order[~gone], np.arange(len(seg)) - first[seg], self.source)
+
+
+def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
+    """The :class:`Series` of a residual vector of ``n_obs`` observations on ``data`` (``n_obs / len(data)``
+    axes, flattened row by row as the systems do), or None when the data are not a time series."""
+    n = len(data)
+    if n < 3 or n_obs % n:
+        return None
+    axes = n_obs // n
+    if "time_s" in data and np.ptp(data["time_s"].to_numpy(float)) > 0:
+        t = data["time_s"].to_numpy(float)
+        rows = np.argsort(t, kind="stable")
+        source = "time_s"
+        step = np.diff(t[rows])
+    elif system in FILE_ORDER_SYSTEMS:
+        rows = np.arange(n)
+        source = "file order"
+        step = np.ones(n - 1)
+    else:
+        return None
+    positive = step[step > 0]
+    typical = float(np.median(positive)) if positive.size else 1.0
+    new = np.concatenate([[True], step > GAP_FACTOR * typical])
+    seg = np.cumsum(new) - 1
+    first = np.flatnonzero(new)
+    pos_rows = np.arange(n) - first[seg]
+    order = np.concatenate([rows * axes + j for j in range(axes)])
+    pos = np.tile(pos_rows, axes)
+    return Series(order, pos, source)
+
+
+def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
+    """Durbin-Levinson: from partial autocorrelations ``kappa`` (length p) the AR coefficients of every
+    order, ``phi[m, 1..m]`` (row m = order m), and the prediction-error variances ``v[m]`` relative to the
+    process variance, ``v[m] = prod_{j<=m} (1 - kappa_j^2)``."""
+    kappa = np.asarray(kappa, float)
+    p = len(kappa)
+    phi = np.zeros((p + 1, p + 1))
+    v = np.ones(p + 1)
+    for m in range(1, p + 1):
+        phi[m, m] = kappa[m - 1]
+        phi[m, 1:m] = phi[m - 1, 1:m] - kappa[m - 1] * phi[m - 1, m - 1:0:-1]
+        v[m] = v[m - 1] * (1.0 - kappa[m - 1] ** 2)
+    return phi, v
+
+
+def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
+    """``W x`` in series order: each sample minus its best linear prediction from the previous
+    ``min(pos, p)`` samples of its segment, divided by the root of that prediction's error variance
+    (relative to the process variance).  ``x``: (N,) or (N, k) in observation order."""
+    x = np.asarray(x, float)
+    xo = x[series.order]
+    p = len(kappa)
+    if p == 0:
+        return xo
+    phi, v = levinson(kappa)
+    m = np.minimum(series.pos, p)
+    out = xo.copy()
+    for j in range(1, p + 1):
+        ok = np.flatnonzero(series.pos >= j)
+        c = phi[m[ok], j]
+        out[ok] -= (c[:, None] * xo[ok - j]) if xo.ndim == 2 else c * xo[ok - j]
+    scale = 1.0 / np.sqrt(v[m])
+    return out * (scale[:, None] if xo.ndim == 2 else scale)
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """The residuals' serial correlation: AR(p) partial autocorrelations ``kappa`` (empty = independent
+    samples), the :class:`Series` they act on (None = not a time series) and the REML log likelihoods of
+    the orders tried."""
+
+    kappa: tuple = ()
+    series: Series | None = None
+    n_obs: int = 0
+    loglik: tuple = ()
+    note: str = ""
+
+    @property
+    def order(self) -> int:
+        return len(self.kappa)
+
+    @property
+    def correlated(self) -> bool:
+        return self.series is not None and self.order > 0
+
+    @property
+    def lag1(self) -> float:
+        """Lag-1 autocorrelation of the AR model (= kappa_1)."""
+        return float(self.kappa[0]) if self.kappa else 0.0
+
+    @property
+    def inflation(self) -> float:
+        """How many times larger the variance of a long-run mean is than for independent samples:
+        ``v_p / (1 - sum phi_p)^2`` (the AR spectrum at frequency 0 over the process variance)."""
+        if not self.correlated:
+            return 1.0
+        phi, v = levinson(self.kappa)
+        return float(v[-1] / (1.0 - phi[-1, 1:].sum()) ** 2)
+
+    @property
+    def effective_samples(self) -> float:
+        """``n_obs / inflation``: the number of independent samples a slowly varying shape effectively
+        sees."""
+        return self.n_obs / self.inflation
+
+    def whiten(self, x: np.ndarray) -> np.ndarray:
+        """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent."""
+        return whiten(x, self.kappa, self.series) if self.correlated else np.asarray(x, float)
+
+    def to_dict(self) -> dict:
+        return {"series": self.series.source if self.series is not None else None, "ar_order": self.order,
+                "partial_autocorrelations": [float(k) for k in self.kappa], "lag1_correlation": self.lag1,
+                "variance_inflation": self.inflation, "effective_samples": self.effective_samples}
+
+    def describe(self) -> str:
+        """One phrase for a report."""
+        if self.series is None:
+            return "samples taken as independent (not a time series)"
+        if self.note:
+            return f"samples taken as independent ({self.note})"
+        if not self.correlated:
+            return f"no serial correlation found (AR order 0 by AIC, series in {self.series.source})"
+        slow = (f"a slow shape sees about {self.effective_samples:.0f} independent samples of {self.n_obs}"
+                if self.inflation > 1 else "neighbouring samples anti-correlated")
+        return (f"serially correlated noise: AR({self.order}), lag-1 correlation {self.lag1:.2f}, series in "
+                f"{self.series.source}; tests on whitened residuals ({slow})")
+
+
+def _restricted_loglik(kappa, r: np.ndarray, Q: np.ndarray, series: Series) -> float:
+    """REML log likelihood (module docstring) of the AR partial autocorrelations ``kappa`` for the
+    residual ``r`` with regressors of orthonormal basis ``Q`` (up to a constant)."""
+    wr = whiten(r, kappa, series)
+    n, k = len(series.order), Q.shape[1]
+    logdet_r = 0.0
+    if len(kappa):
+        _, v = levinson(kappa)
+        logdet_r = float(np.sum(np.log(v[np.minimum(series.pos, len(kappa))])))
+    if k:
+        wq = whiten(Q, kappa, series)
+        G = wq.T @ wq
+        b = wq.T @ wr
+        w, U = np.linalg.eigh(G)
+        w = np.maximum(w, 1e-300)
+        rss = float(wr @ wr - np.sum((U.T @ b) ** 2 / w))
+        logdet_g = float(np.sum(np.log(w)))
+    else:
+        rss, logdet_g = float(wr @ wr), 0.0
+    rss = max(rss, 1e-300)
+    return -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
+
+
+def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
+             max_order: int = MAX_ORDER) -> NoiseModel:
+    """REML estimate of the AR noise model of ``residuals`` given the ``regressors`` a fit took out of
+    them (module docstring), the order chosen by AIC over ``0..max_order``.  No series: independent."""
+    r = np.asarray(residuals, float)
+    if series is None:
+        return NoiseModel((), None, len(r))
+    from .fit import orth_basis                      # local: fit imports this module's users
+    inc = series.order
+    Q = np.zeros((len(r), 0))
+    if regressors is not None and np.size(regressors):
+        X = np.asarray(regressors, float).reshape(len(r), -1)
+        Qi = orth_basis(X[inc])                      # the regressors on the observations of the series
+        Q = np.zeros((len(r), Qi.shape[1]))
+        Q[inc] = Qi
+    if len(inc) - Q.shape[1] < MIN_SAMPLES:
+        return NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation")
+    best = ((), _restricted_loglik((), r, Q, series))
+    logliks = [best[1]]
+    aic_best = -2 * best[1]
+    start = ()
+    for p in range(1, max_order + 1):
+        if p == 1:
+            sol = minimize_scalar(lambda a: -_restricted_loglik((np.tanh(a),), r, Q, series),
+                                  bounds=(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX)), method="bounded",
+                                  options={"xatol": 1e-4})
+            kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
+        else:
+            x0 = np.arctanh(np.clip(np.r_[start, 0.0], -KAPPA_MAX, KAPPA_MAX))
+            lim = np.arctanh(KAPPA_MAX)
+            sol = minimize(lambda a: -_restricted_loglik(np.tanh(a), r, Q, series), x0, method="L-BFGS-B",
+                           bounds=[(-lim, lim)] * p, options={"maxiter": 60})
+            kappa, ll = tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun)
+            ll0 = _restricted_loglik(np.r_[start, 0.0], r, Q, series)
+            if ll0 > ll:                                # never worse than the previous order
+                kappa, ll = tuple(float(k) for k in np.r_[start, 0.0]), ll0
+        logliks.append(ll)
+        start = kappa
+        aic = -2 * ll + 2 * p
+        if aic >= aic_best:
+            break                                       # forward selection: stop at the first order that
+        best, aic_best = (kappa, ll), aic              # does not lower the AIC
+    return NoiseModel(tuple(best[0]), series, len(r), tuple(logliks))
