@@ -264,6 +264,35 @@ def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
     return out
 
 
+def _structure_over(fit: Fit, noise: NoiseModel) -> list[Finding]:
+    """:func:`_structure` with each p-value the largest over the noise model's variants
+    (:meth:`navlib.workbench.serial.NoiseModel.variants`: the correlation's estimate and the ends of its
+    interval)."""
+    out = _structure(fit, noise)
+    for other in noise.variants()[1:]:
+        alt = {f.what: f for f in _structure(fit, other)}
+        for f in out:
+            if f.what in alt and alt[f.what].log_p > f.log_p:
+                f.p_value, f.log_p = alt[f.what].p_value, alt[f.what].log_p
+    return out
+
+
+def _candidate_p(fit: Fit, f1: Fit, noise: NoiseModel) -> tuple[float, float]:
+    """The nested F test of ``f1`` (= ``fit`` + a candidate): least squares for independent samples;
+    with correlated noise, generalised least squares, the p-value the largest over the noise model's
+    variants."""
+    q, df2 = f1.n_params - fit.n_params, f1.n - f1.n_params
+    if not noise.correlated:
+        return _f_test(fit.rss, f1.rss, q, df2)
+    best = (0.0, -np.inf)
+    for v in noise.variants():
+        (e0, _), (e1, _) = _gls(fit, v), _gls(f1, v)
+        p, logp = _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
+        if logp > best[1]:
+            best = (p, logp)
+    return best
+
+
 def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | None = None) -> float:
     """p of the candidate's improvement when the structure ``found`` is allowed for in both models: the
     residuals of ``fit`` and of ``f1`` (= fit + candidate) are each regressed on their model's Jacobian and
@@ -280,7 +309,10 @@ def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | 
 
     rss0, _ = rss_p(fit)
     rss1, p1 = rss_p(f1)
-    return _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
+    p = _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
+    if noise is not None and noise.correlated and noise.variants()[1:]:
+        p = max([p] + [_conditional_p(fit, f1, found, v.without_variants()) for v in noise.variants()[1:]])
+    return p
 
 
 def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:
@@ -349,13 +381,8 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
             untestable[effect] = str(err)
             continue
         fits[effect] = f1
-        q, df2 = f1.n_params - fit.n_params, f1.n - f1.n_params
         drop = max(fit.rss - f1.rss, 0.0)
-        if noise.correlated:
-            (e0, _), (e1, _) = _gls(fit, noise), _gls(f1, noise)
-            p, logp = _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
-        else:
-            p, logp = _f_test(fit.rss, f1.rss, q, df2)
+        p, logp = _candidate_p(fit, f1, noise)
         test = "F" if not noise.correlated else "F (GLS)"
         if (fit.system == "drift" and fit.n <= SMALL_SAMPLE
                 and all(e in fit.spec.catalogue for e in fit.effects + (effect,))):
@@ -364,7 +391,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
                 p, logp, test = pp, math.log(max(pp, 1e-300)), "permutation"
         cands.append(Candidate(effect, f1.rms, f1.loo_rms, drop / fit.rss if fit.rss > 0 else 0.0, p, test,
                                log_p=logp))
-    structure = _structure(fit, noise)
+    structure = _structure_over(fit, noise)
     m = len(cands) + len(structure)
     level = alpha / max(m, 1)
     for s in structure:
@@ -382,7 +409,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
             break
         f1 = fits[c.effect]
         # a candidate that brings the residual down to the numerical floor leaves no structure
-        after = {s.what: s for s in _structure(f1, noise)} if f1.rms > sc.floor else {}
+        after = {s.what: s for s in _structure_over(f1, noise)} if f1.rms > sc.floor else {}
         gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level]
         remaining = [s for s in found if s.what not in gone]
         # named only if it still matters once the structure it leaves in place is allowed for

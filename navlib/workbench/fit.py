@@ -24,6 +24,7 @@ from ..errors import InputError
 from ..sensors.ins import latitude_error_per_drift
 from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
 from .effects import COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, get_system, register_system, resolve
+from .serial import ar1_noise
 
 RAD = 180.0 / np.pi
 
@@ -430,12 +431,15 @@ for _s in SYSTEMS_BASE.values():
 
 
 # ------------------------------------------------------------------------------------- simulated data
-def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 0.0, seed=0) -> pd.DataFrame:
-    """Data from the catalogue model with the given parameters (effects absent = 0) plus white noise.
+def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 0.0, seed=0,
+             noise_correlation: float = 0.0) -> pd.DataFrame:
+    """Data from the catalogue model with the given parameters (effects absent = 0) plus noise.
 
     compass: two sweeps of 121 readings (0..360 every 3 deg, one reading every 5 s) while the carrier warms
     from 15 to 35 degC; ``noise`` is the heading noise in deg, added as field noise (so it is larger where
-    the distorted horizontal field is weaker, as on a real compass).  drift: ``n`` tests (default 16) with
+    the distorted horizontal field is weaker, as on a real compass): white, or with ``noise_correlation``
+    an AR(1) process along the readings with that lag-1 correlation
+    (:func:`navlib.workbench.serial.ar1_noise`; the drift tables are no time series: 0 only).  drift: ``n`` tests (default 16) with
     covariates spread like paper C's tables (12 h latitude error within +-0.05 deg, mean temperature
     10..65 degC, temperature change 0..30 degC); ``noise`` in deg/h."""
     rng = np.random.default_rng(seed)
@@ -444,12 +448,17 @@ def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 
         temp = np.linspace(15.0, 35.0, len(true))
         model = PlanarModel(tuple(COMPASS_EFFECTS), dict(params), float(np.mean(temp)))
         m = model._field(true, temp)
-        m = m + np.radians(noise) * rng.standard_normal(m.shape)
+        if noise_correlation:
+            m = m + np.radians(noise) * ar1_noise(rng, m.shape[::-1], 1.0, noise_correlation).T
+        else:
+            m = m + np.radians(noise) * rng.standard_normal(m.shape)
         meas = heading_deg(m[0], m[1])
         return pd.DataFrame({"true_heading_deg": true, "measured_heading_deg": meas, "temperature_c": temp,
                              "sweep": np.repeat([1, 2], 121), "time_s": 5.0 * np.arange(len(true))})
     if system != "drift":
         raise InputError(f"simulate: unknown system {system!r}; known: compass, drift")
+    if noise_correlation:
+        raise InputError("simulate: noise_correlation must be 0 for the drift tables (not a time series)")
     n = 16 if n is None else n
     frame = pd.DataFrame({"latitude_error_deg": rng.uniform(-0.05, 0.05, n),
                           "temperature_c": rng.uniform(10.0, 65.0, n),

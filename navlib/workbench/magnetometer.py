@@ -38,6 +38,7 @@ from ..data.tables import Column, read_table, where
 from ..errors import InputError
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, lstsq, user_columns, user_design
+from .serial import ar1_noise
 
 MAG = ("mag_x_ut", "mag_y_ut", "mag_z_ut")
 QUAT = ("q_w", "q_x", "q_y", "q_z")
@@ -69,6 +70,9 @@ MAGNETOMETER_EFFECTS = {
 }
 
 _PARAMS = [p for e in MAGNETOMETER_EFFECTS.values() for p in e.params]
+#: The local field of BROAD's room (pooled undisturbed trials, ../shared/realdata README), NED, uT: the
+#: simulators' default.
+BROAD_FIELD = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8}
 
 
 def quaternion_columns() -> list[Column]:
@@ -138,13 +142,15 @@ def full_params(params: dict) -> dict:
     return p
 
 
-def predict_field(params: dict, frame: pd.DataFrame, C: np.ndarray | None = None) -> np.ndarray:
-    """Model field (n, 3) in body axes for catalogued parameters ``params`` (absent = 0)."""
+def predict_field(params: dict, frame: pd.DataFrame, C: np.ndarray | None = None,
+                  w: np.ndarray | None = None) -> np.ndarray:
+    """Model field (n, 3) in body axes for catalogued parameters ``params`` (absent = 0); ``C`` and the body
+    rate ``w`` (rad/s) may be given precomputed from ``frame``."""
     p = full_params(params)
     C = body_from_nav(frame) if C is None else C
     v = C @ np.array([p[k] for k in FIELD])
     if p["time_lag_s"]:
-        w = np.radians(frame[list(GYR)].to_numpy(float))
+        w = np.radians(frame[list(GYR)].to_numpy(float)) if w is None else w
         v = v - p["time_lag_s"] * np.cross(w, v)
     return v @ _matrix(p).T + np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
 
@@ -166,9 +172,11 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
     if m.size < len(names) + 1:
         raise InputError(f"{len(m)} rows cannot determine {len(names)} model parameters")
 
+    rate = np.radians(data[list(GYR)].to_numpy(float)) if all(c in data for c in GYR) else None
+
     def model(x):
         p = dict(zip(names, x))
-        return predict_field(p, data, C).ravel() + user_columns(users, p, data, shape)
+        return predict_field(p, data, C, rate).ravel() + user_columns(users, p, data, shape)
 
     # start 2 (linearised): m = C m_n + b (+ linear user terms), all else zero -- linear least squares
     lin = [C[:, :, j].reshape(-1) for j in range(3)]          # d m / d m_n
@@ -364,20 +372,6 @@ def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, 
     return frame
 
 
-def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) -> np.ndarray:
-    """Gaussian AR(1) noise along axis 0: marginal standard deviation ``sd`` and lag-1 correlation
-    ``correlation`` (stationary from the first sample: ``e_0 ~ N(0, sd^2)``,
-    ``e_t = c e_(t-1) + sd sqrt(1 - c^2) u_t``)."""
-    shape = tuple(np.atleast_1d(shape))
-    u = rng.standard_normal(shape)
-    e = np.empty(shape)
-    e[0] = sd * u[0]
-    s = sd * np.sqrt(1.0 - correlation ** 2)
-    for t in range(1, shape[0]):
-        e[t] = correlation * e[t - 1] + s * u[t]
-    return e
-
-
 def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: float = 10.0,
                          noise_ut: float = 0.1, noise_correlation: float = 0.0, turn_rate_dps: float = 45.0,
                          turn_time_s: float = 1.0, seed=0) -> pd.DataFrame:
@@ -403,15 +397,29 @@ def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: flo
         raise InputError(f"duration_s x rate_hz = {n} samples; at least 30 are needed")
     dt = 1.0 / rate_hz
     w = ar1_noise(rng, (n, 3), turn_rate_dps, float(np.exp(-dt / turn_time_s)))   # body rate, deg/s
-    steps = Rotation.from_rotvec(np.radians(w[:-1]) * dt)
-    rots = [Rotation.random(random_state=rng)]                                  # body -> NED
-    for k in range(n - 1):
-        rots.append(rots[-1] * steps[k])
-    q = Rotation.concatenate(rots).as_quat()[:, [3, 0, 1, 2]]
+    steps = Rotation.from_rotvec(np.radians(w[:-1]) * dt).as_quat()[:, [3, 0, 1, 2]]
+    q = np.empty((n, 4))
+    q[0] = Rotation.random(random_state=rng).as_quat()[[3, 0, 1, 2]]           # body -> NED
+    for k in range(n - 1):                      # q_(k+1) = q_k (x) dq_k: the body-frame increment
+        a0, a1, a2, a3 = q[k]
+        b0, b1, b2, b3 = steps[k]
+        q[k + 1] = (a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+                    a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
     q = q * np.where(q[:, :1] < 0, -1.0, 1.0)
     frame = pd.DataFrame({"time_s": dt * np.arange(n)})
     frame[list(QUAT)] = q
     frame[list(GYR)] = w
-    p = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8, **params}
+    p = {**BROAD_FIELD, **params}
     frame[list(MAG)] = predict_field(p, frame) + ar1_noise(rng, (n, 3), noise_ut, noise_correlation)
     return frame
+
+
+def effect_rms(data: pd.DataFrame, params: dict, effect: str) -> float:
+    """RMS (uT, over rows and axes) of what ``effect`` adds to the noiseless model on ``data`` (the local
+    field from ``params``, default :data:`BROAD_FIELD`)."""
+    if effect not in MAGNETOMETER_EFFECTS:
+        raise InputError(f"unknown magnetometer effect '{effect}'; known: {', '.join(MAGNETOMETER_EFFECTS)}")
+    p = {**BROAD_FIELD, **params}
+    without = {k: v for k, v in p.items() if k not in MAGNETOMETER_EFFECTS[effect].params}
+    return float(np.sqrt(np.mean((predict_field(p, data) - predict_field(without, data)) ** 2)))

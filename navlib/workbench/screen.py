@@ -14,16 +14,17 @@ per measured column::
 consistent estimate of a normal standard deviation: Hampel 1974, JASA 69:383; Rousseeuw and Croux 1993,
 JASA 88:1273).  An observation is an outlier when ``|z| > c`` with the Bonferroni cutoff
 ``c = max(Z_MIN, t_nu^-1(1 - OUTLIER_ALPHA / (2 N)))`` over the N observations, so a file of clean Gaussian
-noise has about an ``OUTLIER_ALPHA`` chance of losing any row.  Student's t with ``nu = 0.367 (N - p)``
+noise has at most about an ``OUTLIER_ALPHA`` chance of losing any row (``Z_MIN`` = 6 keeps real sensors'
+heavier tails in).  Student's t with ``nu = 0.367 (N - p)``
 degrees of freedom rather than the normal quantile allows for the MAD's own scatter on short tables: the
 MAD has 36.7 % efficiency at the normal (Rousseeuw and Croux 1993), so it is about as precise as a variance
 from ``0.367 (N - p)`` squares (a Satterthwaite-style approximation; on a 19-row table the cutoff is about
-11, on hundreds of rows it is ``Z_MIN``).  In a time series (``time_s``, or a
+7.7, on hundreds of rows it is ``Z_MIN``).  In a time series (``time_s``, or a
 magnetometer's file order) an outlier must also stand out from its neighbours in time -- the robust z of
 ``u_t`` minus the median of the samples within :data:`ISOLATION` of it must exceed ``c`` too (a Hampel
-filter, Pearson 2002) -- and be isolated: no other flagged sample within :data:`ISOLATION` samples.  A spike
-is; a physical disturbance that lasts two samples or more (a magnet passed at close range) is not, and
-stays in the data for the structure tests.  The screen
+filter, Pearson 2002) -- and be isolated: no other sample within :data:`ISOLATION` samples has a robust
+|z| above ``c`` (nor above a tenth of its own).  A spike is; a physical disturbance that lasts two samples or
+more (a magnet passed at close range) is not, and stays in the data for the structure tests.  The screen
 is iterated (Rousseeuw and Leroy 1987, *Robust Regression and Outlier Detection*, ch. 6: reweighted least
 squares): the rows flagged whose ``|z|`` is within a factor :data:`DOMINANCE` of the largest are set aside,
 the model is refitted without them, every row (set-aside ones too) is judged again against the cleaner
@@ -59,8 +60,10 @@ from .effects import testable
 from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
 from .serial import NoiseModel, estimate, series_of
 
-#: Lowest robust |z| that flags an outlier.
-Z_MIN = 5.0
+#: Lowest robust |z| that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
+#: 2e-9; real sensor noise has heavier tails (the slow undisturbed BROAD trials reach 5.8) and stays below,
+#: while an outlier that matters to an F test (one that inflates the residual sum of squares) lies far above.
+Z_MIN = 6.0
 #: Chance that a file of clean Gaussian noise loses any row to the screen (Bonferroni over observations).
 OUTLIER_ALPHA = 0.01
 #: More than this share of the rows flagged: the data are refused.
@@ -279,23 +282,26 @@ def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
     return np.column_stack(cols) if cols else np.zeros((len(frame) * (rich.n // len(rich.data)), 0))
 
 
-def _isolated(row_flag: np.ndarray, data: pd.DataFrame, axes: int, system: str) -> np.ndarray:
-    """In a time series, the flagged rows with no other flagged row within ``ISOLATION`` samples of
-    their segment (a run of flagged samples is an event, left to the structure tests)."""
+def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system: str) -> np.ndarray:
+    """In a time series, the rows whose largest robust |z| (``size``) no other row within ``ISOLATION``
+    samples of their segment comes near: none there exceeds ``max(c, size / DOMINANCE)``.  A run of large
+    residuals is an event, left to the structure tests; the lesser residuals a huge spike causes around it
+    in a fit it distorts do not hide the spike."""
     ser = series_of(data, len(data) * axes, system)
     if ser is None:
-        return row_flag
+        return np.ones(len(data), bool)
     n = len(data)
     rows, pos = ser.order[:n] // axes, ser.pos[:n]   # axis 0: rows in time order
-    f = row_flag[rows]
+    z = size[rows]
+    bar = np.maximum(c, z / DOMINANCE)
     seg = np.cumsum(pos == 0)
     near = np.zeros(n, bool)
     for k in range(1, ISOLATION + 1):
         same = seg[k:] == seg[:-k]
-        near[k:] |= f[:-k] & same
-        near[:-k] |= f[k:] & same
+        near[k:] |= (z[:-k] > bar[k:]) & same
+        near[:-k] |= (z[k:] > bar[:-k]) & same
     out = np.zeros(n, bool)
-    out[rows] = f & ~near
+    out[rows] = ~near
     return out
 
 
@@ -346,13 +352,15 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         r = r_model = residuals_on(rich, data)
         obs = (kept[:, None] * axes + np.arange(axes)).ravel()
         if shapes_all.shape[1]:
+            # the shapes fitted to the residual clipped at Z_NOISE robust standard deviations (one Huber
+            # step), so that a spike is not smeared over its time cell
             S = shapes_all[obs]
             q = orth_basis(np.column_stack([rich.jacobian, S]))
-            rk = r[kept].ravel()
-            # rows kept: the residual of model + shapes; rows set aside: minus the shapes' prediction
-            coef = np.linalg.lstsq(S, rk, rcond=1e-10)[0]
+            rk = r[kept]
+            med = np.median(rk, axis=0)
+            half = Z_NOISE * np.maximum(MAD_SD * np.median(np.abs(rk - med), axis=0), floor)
+            coef = np.linalg.lstsq(S, np.clip(rk, med - half, med + half).ravel(), rcond=1e-10)[0]
             r = r - (shapes_all @ coef).reshape(n, axes)
-            r[kept] = (rk - q @ (q.T @ rk)).reshape(len(kept), axes)
         else:
             q = orth_basis(rich.jacobian)
         lev = np.sum(q ** 2, axis=1)
@@ -365,7 +373,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         if gap is not None:
             zg = _robust_z(gap, kept, floor)
             flagged &= np.isnan(zg) | (np.abs(zg) > c)
-            flagged &= _isolated(flagged.any(axis=1), data, axes, fit.system)[:, None]
+            flagged &= _isolated(np.abs(z).max(axis=1), c, data, axes, fit.system)[:, None]
         return r_model, z, flagged
 
     for k in range(MAX_ROUNDS):

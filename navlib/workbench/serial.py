@@ -43,7 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize, minimize_scalar
+from scipy import stats
+from scipy.optimize import brentq, minimize, minimize_scalar
 
 #: A time step more than this many times the median step starts a new segment.
 GAP_FACTOR = 2.5
@@ -53,6 +54,8 @@ MAX_ORDER = 3
 KAPPA_MAX = 0.995
 #: Fewest samples beyond the regressors for an estimate (fewer: the samples are taken as independent).
 MIN_SAMPLES = 20
+#: Coverage of the profile-likelihood interval of kappa_1 over which p-values are maximised.
+KAPPA_LEVEL = 0.9
 #: Systems whose rows are a time series in file order when the data have no ``time_s`` column.
 FILE_ORDER_SYSTEMS = {"magnetometer"}
 
@@ -114,6 +117,20 @@ def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
     return Series(order, pos, source)
 
 
+def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) -> np.ndarray:
+    """Gaussian AR(1) noise along axis 0: marginal standard deviation ``sd`` and lag-1 correlation
+    ``correlation`` (stationary from the first sample: ``e_0 ~ N(0, sd^2)``,
+    ``e_t = c e_(t-1) + sd sqrt(1 - c^2) u_t``)."""
+    shape = tuple(np.atleast_1d(shape))
+    u = rng.standard_normal(shape)
+    e = np.empty(shape)
+    e[0] = sd * u[0]
+    s = sd * np.sqrt(1.0 - correlation ** 2)
+    for t in range(1, shape[0]):
+        e[t] = correlation * e[t - 1] + s * u[t]
+    return e
+
+
 def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
     """Durbin-Levinson: from partial autocorrelations ``kappa`` (length p) the AR coefficients of every
     order, ``phi[m, 1..m]`` (row m = order m), and the prediction-error variances ``v[m]`` relative to the
@@ -139,14 +156,21 @@ def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
     if p == 0:
         return xo
     phi, v = levinson(kappa)
-    m = np.minimum(series.pos, p)
+    m = len(xo)
     out = xo.copy()
-    for j in range(1, p + 1):
-        ok = np.flatnonzero(series.pos >= j)
-        c = phi[m[ok], j]
-        out[ok] -= (c[:, None] * xo[ok - j]) if xo.ndim == 2 else c * xo[ok - j]
-    scale = 1.0 / np.sqrt(v[m])
-    return out * (scale[:, None] if xo.ndim == 2 else scale)
+    for j in range(1, p + 1):                   # the full-order filter on every sample from the p-th on
+        out[p:] -= phi[p, j] * xo[p - j:m - j]
+    out[p:] /= np.sqrt(v[p])
+    early = np.flatnonzero(series.pos < p)       # near a segment start: the filter of a lower order
+    order = series.pos[early]
+    acc = xo[early].copy()
+    for j in range(1, p):
+        use = order >= j
+        c = phi[order[use], j]
+        acc[use] -= (c[:, None] * xo[early[use] - j]) if xo.ndim == 2 else c * xo[early[use] - j]
+    scale = 1.0 / np.sqrt(v[order])
+    out[early] = acc * (scale[:, None] if xo.ndim == 2 else scale)
+    return out
 
 
 @dataclass(frozen=True)
@@ -160,6 +184,7 @@ class NoiseModel:
     n_obs: int = 0
     loglik: tuple = ()
     note: str = ""
+    bounds: tuple = ()
 
     @property
     def order(self) -> int:
@@ -193,10 +218,28 @@ class NoiseModel:
         """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent."""
         return whiten(x, self.kappa, self.series) if self.correlated else np.asarray(x, float)
 
+    def without_variants(self) -> "NoiseModel":
+        """The same model without its interval (its :meth:`variants` is itself alone)."""
+        return NoiseModel(self.kappa, self.series, self.n_obs, self.loglik, self.note)
+
+    def variants(self) -> list["NoiseModel"]:
+        """The estimate and the models with ``kappa_1`` at either end of its profile-likelihood interval
+        (:data:`KAPPA_LEVEL`): a test's p-value is taken as the largest over them (a p-value maximised over
+        a confidence set of the nuisance parameter, Berger and Boos 1994, JASA 89:1012, without their
+        correction term), so an estimate of the correlation that is a little low cannot make noise look
+        significant."""
+        out = [self]
+        if self.correlated:
+            for k1 in self.bounds:
+                out.append(NoiseModel((k1,) + tuple(self.kappa[1:]), self.series, self.n_obs, self.loglik,
+                                      self.note))
+        return out
+
     def to_dict(self) -> dict:
         return {"series": self.series.source if self.series is not None else None, "ar_order": self.order,
                 "partial_autocorrelations": [float(k) for k in self.kappa], "lag1_correlation": self.lag1,
-                "variance_inflation": self.inflation, "effective_samples": self.effective_samples}
+                "lag1_interval": [float(k) for k in self.bounds], "variance_inflation": self.inflation,
+                "effective_samples": self.effective_samples}
 
     def describe(self) -> str:
         """One phrase for a report."""
@@ -277,4 +320,21 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         if aic >= aic_best:
             break                                       # forward selection: stop at the first order that
         best, aic_best = (kappa, ll), aic              # does not lower the AIC
-    return NoiseModel(tuple(best[0]), series, len(r), tuple(logliks))
+    kappa, ll = best
+    bounds = ()
+    if kappa:
+        drop = stats.chi2.ppf(KAPPA_LEVEL, 1) / 2
+        lim = np.arctanh(KAPPA_MAX)
+        a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
+
+        def gap(a):
+            return ll - _restricted_loglik((np.tanh(a),) + tuple(kappa[1:]), r, Q, series) - drop
+
+        ends = []
+        for edge in (-lim, lim):
+            if a0 == edge or gap(edge) <= 0:
+                ends.append(float(np.tanh(edge)))
+            else:
+                ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
+        bounds = tuple(ends)
+    return NoiseModel(tuple(kappa), series, len(r), tuple(logliks), bounds=bounds)

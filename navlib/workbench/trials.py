@@ -1,7 +1,10 @@
 """Does the loop name the right effect? Simulated data with a hidden effect, and the detection and
-false-alarm rates of :func:`navlib.workbench.diagnose.diagnose` over many trials; and data with an effect
+false-alarm rates of :func:`navlib.workbench.diagnose.diagnose` over many trials; data with an effect
 *outside* the catalogue (three- and four-cycle heading errors, a step between sweeps, a drift in time),
-where the right answer names no catalogued effect and says the residuals are not noise."""
+where the right answer names no catalogued effect and says the residuals are not noise; and the same
+hidden-effect trials on time series with serially correlated (AR(1)) noise: compass sweeps read every 5 s
+and magnetometers turned by hand and sampled at 10 Hz
+(:func:`navlib.workbench.magnetometer.simulate_hand_turned`)."""
 from __future__ import annotations
 
 import math
@@ -9,18 +12,24 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
+from .. import verdicts
+from ..errors import InputError, check_param
 from .diagnose import diagnose
-from .effects import CATALOGUES
+from .effects import CATALOGUES, get_system
 from .fit import effect_rms, fit_model, simulate
+from .magnetometer import effect_rms as magnetometer_effect_rms, simulate_hand_turned
 
 #: Entropy of every trial study's seeds: a trial's seed is ``SeedSequence(TRIAL_ENTROPY, spawn_key=...)``
 #: with the trial's coordinates in its study as the spawn key (:func:`trial_seed`), so no two trials of a
 #: study share a draw and the rates' Wilson intervals rest on independent trials.
 TRIAL_ENTROPY = 0
 #: First element of the spawn key: which study the trial belongs to.
-STUDY_KEYS = {"hidden effect": 1, "out of catalogue": 2}
-SYSTEM_KEYS = {"compass": 0, "drift": 1}
+STUDY_KEYS = {"hidden effect": 1, "out of catalogue": 2, "correlated noise": 3}
+SYSTEM_KEYS = {"compass": 0, "drift": 1, "magnetometer": 2}
+#: The systems whose simulated data the hidden-effect trials can draw.
+TRIAL_SYSTEMS = ("compass", "drift", "magnetometer")
+#: Length of a simulated hand-turned magnetometer recording (s, at 10 Hz) in the trials.
+MAG_DURATION_S = 40.0
 
 
 def trial_seed(study: str, *coords: int) -> np.random.SeedSequence:
@@ -42,11 +51,24 @@ def _seed_label(seed):
     return "/".join(map(str, seed.spawn_key)) if isinstance(seed, np.random.SeedSequence) else seed
 
 
+def catalogue(system: str):
+    """The catalogue of a system the trials simulate (:data:`TRIAL_SYSTEMS`)."""
+    if system not in TRIAL_SYSTEMS:
+        raise InputError(f"trials: unknown system {system!r}; known: {', '.join(TRIAL_SYSTEMS)}")
+    return CATALOGUES.get(system) or get_system(system).catalogue
+
+
 def random_params(system: str, rng: np.random.Generator, effects) -> dict:
-    """Plausible random parameters for the given effects (used to build data with hidden effects)."""
+    """Plausible random parameters for the given effects (used to build data with hidden effects);
+    magnetometer: hard iron within +-10 uT per axis, soft iron +-0.03, misalignment +-2 deg per axis, a time
+    lag within +-30 ms."""
     p = {}
     for e in effects:
-        if system == "compass":
+        if system == "magnetometer":
+            names = catalogue("magnetometer")[e].params
+            half = {"hard_iron": 10.0, "soft_iron": 0.03, "misalignment": 2.0, "time_lag": 0.03}[e]
+            p.update(zip(names, rng.uniform(-half, half, len(names))))
+        elif system == "compass":
             if e == "misalignment":
                 p["yaw_deg"] = rng.uniform(-3, 3)
             elif e == "hard_iron":
@@ -69,10 +91,11 @@ def random_params(system: str, rng: np.random.Generator, effects) -> dict:
 
 def scale_effect(system: str, data: pd.DataFrame, params: dict, effect: str, target_rms: float) -> dict:
     """Rescale ``effect``'s parameters so that its contribution has RMS ``target_rms`` on ``data``."""
-    names = CATALOGUES[system][effect].params
+    names = catalogue(system)[effect].params
     p = dict(params)
     for _ in range(3):                       # compass: nearly linear for small effects; iterate
-        now = effect_rms(system, data, p, effect)
+        now = (magnetometer_effect_rms(data, p, effect) if system == "magnetometer"
+               else effect_rms(system, data, p, effect))
         if now == 0:
             break
         for k in names:
@@ -80,33 +103,46 @@ def scale_effect(system: str, data: pd.DataFrame, params: dict, effect: str, tar
     return p
 
 
+def _simulate(system: str, params: dict, n: int | None, noise: float, correlation: float, seed) -> pd.DataFrame:
+    """Simulated data of a trial: :func:`navlib.workbench.fit.simulate` (compass, drift; ``n`` rows of a
+    drift table) or a hand-turned magnetometer recording of :data:`MAG_DURATION_S` s (``n`` = its length
+    in s when given), with AR(1) noise of lag-1 correlation ``correlation``."""
+    if system == "magnetometer":
+        return simulate_hand_turned(params, duration_s=MAG_DURATION_S if n is None else float(n), noise_ut=noise,
+                                    noise_correlation=correlation, seed=seed)
+    return simulate(system, params, n=n, noise=noise, seed=seed, noise_correlation=correlation)
+
+
 def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: float,
-                        seed: int | np.random.SeedSequence, n: int | None = None) -> dict:
+                        seed: int | np.random.SeedSequence, n: int | None = None, correlation: float = 0.0) -> dict:
     """One trial: data from a random model, with ``hidden`` (or nothing) left out of the fitted model.
 
     With ``hidden`` set: the data contain every catalogue effect, ``hidden`` scaled so that its RMS is
     ``ratio * noise``; the model under test is the catalogue without ``hidden``.  With ``hidden=None`` the
-    data contain a random subset of the effects and the model is exactly that subset."""
-    cat = tuple(CATALOGUES[system])
+    data contain a random subset of the effects and the model is exactly that subset.  ``correlation``:
+    lag-1 correlation of AR(1) noise along the time series (compass, magnetometer; ``noise`` is its marginal
+    standard deviation)."""
+    cat = tuple(catalogue(system))
     rng = np.random.default_rng(seed)
     if hidden is None:
         k = int(rng.integers(1, len(cat)))
         present = tuple(sorted(rng.choice(len(cat), size=k, replace=False)))
         present = tuple(cat[i] for i in present)
         params = random_params(system, rng, present)
-        data = simulate(system, params, n=n, noise=noise, seed=rng)
+        data = _simulate(system, params, n, noise, correlation, rng)
         model = present
     else:
         params = random_params(system, rng, cat)
-        probe = simulate(system, params, n=n, noise=0.0, seed=np.random.default_rng(seed))
+        probe = _simulate(system, params, n, 0.0, correlation, np.random.default_rng(seed))
         params = scale_effect(system, probe, params, hidden, ratio * noise)
-        data = simulate(system, params, n=n, noise=noise, seed=np.random.default_rng(seed))
+        data = _simulate(system, params, n, noise, correlation, np.random.default_rng(seed))
         model = tuple(e for e in cat if e != hidden)
     d = diagnose(fit_model(system, data, model))
     return {"system": system, "hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise,
-            "n": len(data), "seed": _seed_label(seed), "named": d.missing or "(none)",
+            "correlation": correlation, "n": len(data), "seed": _seed_label(seed), "named": d.missing or "(none)",
             "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
-            "consistent_with_noise": d.consistent_with_noise}
+            "consistent_with_noise": d.consistent_with_noise, "ar_order": d.screening.noise.order,
+            "lag1": d.screening.noise.lag1}
 
 
 def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=range(10), n=None,
@@ -178,6 +214,49 @@ def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10
                     rows.append(out_of_catalogue_trial(kind, ratio, noise,
                                                        trial_seed("out of catalogue", i, j, r, seed)))
     return pd.DataFrame(rows)
+
+
+def correlated_noise_study(system: str, correlations=(0.0, 0.9), ratio: float = 3.0, noise: float | None = None,
+                           seeds=range(100), none_seeds=None, n: int | None = None) -> pd.DataFrame:
+    """Hidden-effect and nothing-hidden trials (:func:`hidden_effect_trial`) on time series with AR(1)
+    noise of each lag-1 correlation in ``correlations``: every catalogued effect hidden at ``ratio`` x the
+    noise, ``seeds`` trials each; nothing hidden, ``none_seeds`` trials (default: as many as ``seeds``).
+    ``noise``: marginal standard deviation (default 0.3 uT for the magnetometer, as BROAD's residuals;
+    0.1 deg for the compass).  Seeds: :func:`trial_seed` of the study "correlated noise" and the trial's
+    coordinates (system, correlation, hidden effect, seed number)."""
+    if system not in ("compass", "magnetometer"):
+        raise InputError(f"correlated_noise_study: system {system!r} is no time series; use compass or magnetometer")
+    check_param("ratio", ratio, lo=0, lo_open=True)
+    noise = {"magnetometer": 0.3, "compass": 0.1}[system] if noise is None else noise
+    check_param("noise", noise, lo=0, lo_open=True)
+    seeds = list(seeds)
+    none_seeds = list(none_seeds) if none_seeds is not None else seeds
+    rows = []
+    for j, rho in enumerate(correlations):
+        check_param("correlations", rho, lo=0, hi=1, hi_open=True)
+        for h, hidden in enumerate(catalogue(system), start=1):
+            for seed in seeds:
+                rows.append(hidden_effect_trial(system, hidden, ratio, noise,
+                                                trial_seed("correlated noise", SYSTEM_KEYS[system], j, h, seed),
+                                                n, correlation=rho))
+        for seed in none_seeds:
+            rows.append(hidden_effect_trial(system, None, 0.0, noise,
+                                            trial_seed("correlated noise", SYSTEM_KEYS[system], j, 0, seed),
+                                            n, correlation=rho))
+    return pd.DataFrame(rows)
+
+
+def correlated_noise_rates(study: pd.DataFrame) -> pd.DataFrame:
+    """Per noise correlation and hidden effect: trials, the share named correctly; nothing hidden: the
+    share ending "consistent with noise"; each with its 95 % Wilson interval (:func:`navlib.verdicts.wilson`)."""
+    rows = []
+    for (rho, hidden), g in study.groupby(["correlation", "hidden"], sort=False):
+        k = int(g.correct.astype(bool).sum())
+        e = verdicts.wilson(k, len(g))
+        rows.append({"noise correlation": rho, "hidden effect": hidden,
+                     "rate": "consistent with noise" if hidden == "(none)" else "correctly named",
+                     "trials": len(g), "value": e.value, "95% low": e.lo, "95% high": e.hi})
+    return pd.DataFrame(rows).set_index(["noise correlation", "hidden effect"])
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
