@@ -28,7 +28,7 @@ from ..workbench.fit import effect_rms, fit_model, load, simulate
 from ..workbench.loop import LoopResult, loop
 from ..workbench.magnetometer import (MAG, apply_calibration, correct_field, ellipsoid_fit, field_summary,
                                       heading_error_deg)
-from ..workbench.trials import random_params, scale_effect
+from ..workbench.trials import random_params, run_trials, scale_effect
 from .paper_a import Sweeps, compensate, error_stats, test_errors
 
 #: Where the third-party measurements live (beside the repository, never inside it).
@@ -147,6 +147,37 @@ def load_trial(name: str, row_step: int = 1, attached_only: bool = False) -> pd.
     if name in STATIONARY:
         keep &= d["moving"] == 1
     return d[keep].iloc[::int(row_step)].reset_index(drop=True)
+
+
+def undisturbed_trials() -> list[str]:
+    """The undisturbed BROAD 3-D trials (01-07 and 21), file names in order ([] if the data are absent)."""
+    return sorted(p.name for p in MAG_DIR.glob("*undisturbed*.csv")) if MAG_DIR.is_dir() else []
+
+
+def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -> dict:
+    """The loop from the local field alone on one undisturbed trial (:func:`load_trial`): what it ends
+    with -- rows used and set aside as outliers, the noise model, the effects added, the final rms, the
+    outcome and the largest unexplained structure."""
+    data = load_trial(name, row_step)
+    res = loop("magnetometer", data, [], alpha=alpha)
+    noise = res.screening.noise
+    amp = max([u["amplitude"] for u in res.unexplained] + [0.0])
+    return {"trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "), "rows": len(data),
+            "rows set aside": len(res.screening.rows_set_aside),
+            "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
+            "effects added": added(res), "final rms (uT)": res.final.rms,
+            "largest structure (uT)": amp, "outcome": res.outcome()}
+
+
+def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1) -> pd.DataFrame | None:
+    """:func:`undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data are
+    absent); ``workers`` processes."""
+    names = undisturbed_trials()
+    if not names:
+        return None
+    check_param("row_step", row_step, lo=1, integer=True)
+    rows = run_trials(undisturbed_loop, [(n, row_step, alpha) for n in names], workers)
+    return pd.DataFrame(rows).set_index("trial")
 
 
 @dataclass

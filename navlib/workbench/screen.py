@@ -174,8 +174,9 @@ def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
 def _robust_z(u: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
     """(u - median) / (1.4826 MAD) per column, median and MAD over the rows ``ref``; the scale is never
     below ``floor``."""
-    med = np.nanmedian(u[ref], axis=0)
-    mad = np.nanmedian(np.abs(u[ref] - med), axis=0)
+    median = np.nanmedian if np.isnan(u[ref]).any() else np.median
+    med = median(u[ref], axis=0)
+    mad = median(np.abs(u[ref] - med), axis=0)
     s = np.maximum(MAD_SD * mad, max(floor, 1e-300))
     return (u - med) / s
 
@@ -306,29 +307,41 @@ def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system:
 
 
 def _deletion_z(fit: Fit, data: pd.DataFrame, rich: Fit, floor: float) -> np.ndarray:
-    """Robust z of every row's deletion residual: the model refitted without the row, the row's
-    prediction error scaled by ``sqrt(1 - h)`` (its leverage in the full fit), against the median and MAD
-    of the other rows' studentised residuals in that refit.  On a short table one outlier at a
-    high-leverage point pulls the full fit towards itself and inflates everyone's residuals (masking);
-    without it, it stands out (the deletion diagnostics of Belsley, Kuh and Welsch 1980, *Regression
-    Diagnostics*, with a robust scale)."""
+    """Robust z of every row's deletion residual: the row's prediction error by the model fitted without
+    it, scaled by ``sqrt(1 - h)`` (its leverage in the full fit), against the median and MAD of the other
+    rows' studentised residuals in that fit.  On a short table one outlier at a high-leverage point pulls
+    the full fit towards itself and inflates everyone's residuals (masking); without it, it stands out.
+    The fits without each row follow from the full fit's hat matrix ``H = Q Q'`` (``Q`` an orthonormal
+    basis of the Jacobian) by the deletion formulas of Belsley, Kuh and Welsch (1980, *Regression
+    Diagnostics*, ch. 2): ``e^(i) = e + H[:, B] (I - H[B, B])^-1 e[B]`` and
+    ``h^(i) = h + diag(H[:, B] (I - H[B, B])^-1 H[B, :])`` for the observations ``B`` of row i (exact for a
+    linear model, to first order otherwise)."""
     n = len(data)
     axes = rich.n // n
-    h_full = np.clip(np.sum(orth_basis(rich.jacobian) ** 2, axis=1), 0.0, 0.99).reshape(n, axes)
+    q = orth_basis(rich.jacobian)
+    H = q @ q.T
+    e = rich.residuals
+    h = np.clip(np.diag(H), 0.0, 0.99)
     z = np.zeros((n, axes))
+    if axes == 1:                                    # every deletion at once: row i of U is the fit without i
+        g = e / (1.0 - h)
+        U = e[None, :] + H * g[:, None]
+        hU = np.clip(h[None, :] + H ** 2 / (1.0 - h)[:, None], 0.0, 0.99)
+        U = U / np.sqrt(1.0 - hU)
+        U[np.arange(n), np.arange(n)] = np.nan
+        med = np.nanmedian(U, axis=1)
+        mad = np.nanmedian(np.abs(U - med[:, None]), axis=1)
+        own = g * np.sqrt(1.0 - h)
+        return ((own - med) / np.maximum(MAD_SD * mad, max(floor, 1e-300)))[:, None]
     for i in range(n):
-        others = np.delete(np.arange(n), i)
-        try:
-            fi = fit_model(fit.spec, data.iloc[others], rich.effects, start=rich.params,
-                           user_effects=fit.user_effects)
-        except InputError:
-            continue
-        r = residuals_on(fi, data)
-        h = np.zeros((n, axes))
-        h[others] = np.clip(np.sum(orth_basis(fi.jacobian) ** 2, axis=1), 0.0, 0.99).reshape(n - 1, axes)
-        u = r / np.sqrt(1.0 - h)
-        u[i] = r[i] * np.sqrt(1.0 - h_full[i])
-        z[i] = _robust_z(u, others, floor)[i]
+        B = np.arange(i * axes, (i + 1) * axes)
+        A = np.linalg.pinv(np.eye(axes) - H[np.ix_(B, B)])
+        HB = H[:, B]
+        ei = e + HB @ (A @ e[B])
+        hi = np.clip(h + np.einsum("jb,bc,jc->j", HB, A, HB), 0.0, 0.99)
+        u = (ei / np.sqrt(1.0 - hi)).reshape(n, axes)
+        u[i] = ei[B] * np.sqrt(1.0 - h[B])
+        z[i] = _robust_z(u, np.delete(np.arange(n), i), floor)[i]
     return z
 
 

@@ -255,9 +255,54 @@ class NoiseModel:
                 f"{self.series.source}; tests on whitened residuals ({slow})")
 
 
+class _Restricted:
+    """The REML log likelihood (module docstring) of AR partial autocorrelations for a residual ``r`` with
+    regressors of orthonormal basis ``Q``, fast: with ``Z = [Q, r]`` the Gram matrix of the whitened
+    columns is ``sum_t w_t w_t'``; for the samples at least ``P = max_order`` into their segment
+    ``w_t = sum_j a_j z_(t-j) / sqrt(v_p)`` (``a_0 = 1``, ``a_j = -phi_pj``), so their part is
+    ``sum_ij a_i a_j C_ij / v_p`` with the lagged cross-products ``C_ij = sum_t z_(t-i) z_(t-j)'`` computed
+    once; the few samples nearer a segment start are whitened directly."""
+
+    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int):
+        Z = np.column_stack([Q, r])[series.order]
+        self.k, self.P, self.n = Q.shape[1], int(max_order), len(Z)
+        pos = series.pos
+        bulk = np.flatnonzero(pos >= self.P)
+        self.C = [[Z[bulk - i].T @ Z[bulk - j] for j in range(self.P + 1)] for i in range(self.P + 1)]
+        self.early = np.flatnonzero(pos < self.P)
+        self.early_pos = pos[self.early]
+        self.lags = [Z[self.early]] + [Z[np.maximum(self.early - j, 0)] for j in range(1, self.P)]
+        self.pos = pos
+
+    def __call__(self, kappa) -> float:
+        p = len(kappa)
+        if p > self.P:
+            raise ValueError("order above the cache's")
+        phi, v = levinson(kappa)
+        a = np.r_[1.0, -phi[p, 1:p + 1]] if p else np.ones(1)
+        M = sum(a[i] * a[j] * self.C[i][j] for i in range(p + 1) for j in range(p + 1)) / v[p]
+        m = np.minimum(self.early_pos, p)
+        w = self.lags[0].copy()
+        for j in range(1, min(p, self.P - 1) + 1):     # samples near a segment start: their own order
+            use = m >= j
+            w[use] -= phi[m[use], j][:, None] * self.lags[j][use]
+        w /= np.sqrt(v[m])[:, None]
+        M = M + w.T @ w
+        k = self.k
+        logdet_r = float(np.sum(np.log(v[np.minimum(self.pos, p)]))) if p else 0.0
+        if k:
+            ev, U = np.linalg.eigh(M[:k, :k])
+            ev = np.maximum(ev, 1e-300)
+            rss = float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev))
+            logdet_g = float(np.sum(np.log(ev)))
+        else:
+            rss, logdet_g = float(M[0, 0]), 0.0
+        return -0.5 * ((self.n - k) * np.log(max(rss, 1e-300)) + logdet_r + logdet_g)
+
+
 def _restricted_loglik(kappa, r: np.ndarray, Q: np.ndarray, series: Series) -> float:
-    """REML log likelihood (module docstring) of the AR partial autocorrelations ``kappa`` for the
-    residual ``r`` with regressors of orthonormal basis ``Q`` (up to a constant)."""
+    """The REML log likelihood computed directly (whitening every column): the reference
+    :class:`_Restricted` is tested against."""
     wr = whiten(r, kappa, series)
     n, k = len(series.order), Q.shape[1]
     logdet_r = 0.0
@@ -295,23 +340,24 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         Q[inc] = Qi
     if len(inc) - Q.shape[1] < MIN_SAMPLES:
         return NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation")
-    best = ((), _restricted_loglik((), r, Q, series))
+    loglik = _Restricted(r, Q, series, max_order)
+    best = ((), loglik(()))
     logliks = [best[1]]
     aic_best = -2 * best[1]
     start = ()
     for p in range(1, max_order + 1):
         if p == 1:
-            sol = minimize_scalar(lambda a: -_restricted_loglik((np.tanh(a),), r, Q, series),
+            sol = minimize_scalar(lambda a: -loglik((np.tanh(a),)),
                                   bounds=(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX)), method="bounded",
                                   options={"xatol": 1e-4})
             kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
         else:
             x0 = np.arctanh(np.clip(np.r_[start, 0.0], -KAPPA_MAX, KAPPA_MAX))
             lim = np.arctanh(KAPPA_MAX)
-            sol = minimize(lambda a: -_restricted_loglik(np.tanh(a), r, Q, series), x0, method="L-BFGS-B",
+            sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B",
                            bounds=[(-lim, lim)] * p, options={"maxiter": 60})
             kappa, ll = tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun)
-            ll0 = _restricted_loglik(np.r_[start, 0.0], r, Q, series)
+            ll0 = loglik(np.r_[start, 0.0])
             if ll0 > ll:                                # never worse than the previous order
                 kappa, ll = tuple(float(k) for k in np.r_[start, 0.0]), ll0
         logliks.append(ll)
@@ -328,7 +374,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
 
         def gap(a):
-            return ll - _restricted_loglik((np.tanh(a),) + tuple(kappa[1:]), r, Q, series) - drop
+            return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
 
         ends = []
         for edge in (-lim, lim):

@@ -145,15 +145,32 @@ def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: fl
             "lag1": d.screening.noise.lag1}
 
 
+def _batch(fn, args: list) -> list:
+    return [fn(*a) for a in args]
+
+
+def run_trials(fn, args: list, workers: int = 1) -> list:
+    """``[fn(*a) for a in args]``, in ``workers`` processes when more than one
+    (:func:`navlib.studies.parallel.run_tasks`, in batches); every trial has its own seed, so the results
+    do not depend on ``workers``."""
+    check_param("workers", workers, lo=1, integer=True)
+    if workers == 1 or len(args) < 2:
+        return _batch(fn, args)
+    from ..studies.parallel import run_tasks      # local: it imports torch, which the CLI does not need
+    chunks = [c for c in np.array_split(np.arange(len(args)), 8 * int(workers)) if len(c)]
+    parts = run_tasks(_batch, [(fn, [args[i] for i in c]) for c in chunks], int(workers))
+    return [row for part in parts for row in part]
+
+
 def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=range(10), n=None,
-                        include_none: bool = True, none_seeds=None) -> pd.DataFrame:
+                        include_none: bool = True, none_seeds=None, workers: int = 1) -> pd.DataFrame:
     """Detection and false-alarm trials over hidden effects, effect sizes, noise levels and seeds.
 
     Every trial draws its own data: its seed is :func:`trial_seed` of its coordinates (system, table size
     ``n``, noise level, hidden effect, effect size, seed number), so trials of different hidden effects,
     sizes, noise levels and table sizes are independent; nothing-hidden trials have coordinates of their
-    own (default: twice as many seeds as ``seeds``)."""
-    rows = []
+    own (default: twice as many seeds as ``seeds``).  ``workers``: processes (:func:`run_trials`)."""
+    args = []
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
     base = (SYSTEM_KEYS[system], 0 if n is None else int(n))
@@ -161,13 +178,11 @@ def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=ra
         for h, hidden in enumerate(CATALOGUES[system], start=1):
             for r, ratio in enumerate(ratios):
                 for seed in seeds:
-                    rows.append(hidden_effect_trial(system, hidden, ratio, noise,
-                                                    trial_seed("hidden effect", *base, j, h, r, seed), n))
+                    args.append((system, hidden, ratio, noise, trial_seed("hidden effect", *base, j, h, r, seed), n))
         if include_none:
             for seed in none_seeds:
-                rows.append(hidden_effect_trial(system, None, 0.0, noise,
-                                                trial_seed("hidden effect", *base, j, 0, 0, seed), n))
-    return pd.DataFrame(rows)
+                args.append((system, None, 0.0, noise, trial_seed("hidden effect", *base, j, 0, 0, seed), n))
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers))
 
 
 #: Compass errors outside the catalogue (name -> shape of unit RMS before scaling, from (data, rng)).
@@ -203,27 +218,28 @@ def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int | np
             "detected": not d.consistent_with_noise}
 
 
-def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10)) -> pd.DataFrame:
+def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10), workers: int = 1) -> pd.DataFrame:
     """:func:`out_of_catalogue_trial` over every kind, size, noise level and seed; each trial's seed is
-    :func:`trial_seed` of its coordinates (kind, noise level, size, seed number): independent draws."""
-    rows = []
+    :func:`trial_seed` of its coordinates (kind, noise level, size, seed number): independent draws.
+    ``workers``: processes (:func:`run_trials`)."""
+    args = []
     for j, noise in enumerate(noises):
         for i, kind in enumerate(OUT_OF_CATALOGUE):
             for r, ratio in enumerate(ratios):
                 for seed in seeds:
-                    rows.append(out_of_catalogue_trial(kind, ratio, noise,
-                                                       trial_seed("out of catalogue", i, j, r, seed)))
-    return pd.DataFrame(rows)
+                    args.append((kind, ratio, noise, trial_seed("out of catalogue", i, j, r, seed)))
+    return pd.DataFrame(run_trials(out_of_catalogue_trial, args, workers))
 
 
 def correlated_noise_study(system: str, correlations=(0.0, 0.9), ratio: float = 3.0, noise: float | None = None,
-                           seeds=range(100), none_seeds=None, n: int | None = None) -> pd.DataFrame:
+                           seeds=range(100), none_seeds=None, n: int | None = None, workers: int = 1) -> pd.DataFrame:
     """Hidden-effect and nothing-hidden trials (:func:`hidden_effect_trial`) on time series with AR(1)
     noise of each lag-1 correlation in ``correlations``: every catalogued effect hidden at ``ratio`` x the
     noise, ``seeds`` trials each; nothing hidden, ``none_seeds`` trials (default: as many as ``seeds``).
     ``noise``: marginal standard deviation (default 0.3 uT for the magnetometer, as BROAD's residuals;
     0.1 deg for the compass).  Seeds: :func:`trial_seed` of the study "correlated noise" and the trial's
-    coordinates (system, correlation, hidden effect, seed number)."""
+    coordinates (system, correlation, hidden effect, seed number).  ``workers``: processes
+    (:func:`run_trials`)."""
     if system not in ("compass", "magnetometer"):
         raise InputError(f"correlated_noise_study: system {system!r} is no time series; use compass or magnetometer")
     check_param("ratio", ratio, lo=0, lo_open=True)
@@ -231,19 +247,17 @@ def correlated_noise_study(system: str, correlations=(0.0, 0.9), ratio: float = 
     check_param("noise", noise, lo=0, lo_open=True)
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else seeds
-    rows = []
+    args = []
     for j, rho in enumerate(correlations):
         check_param("correlations", rho, lo=0, hi=1, hi_open=True)
         for h, hidden in enumerate(catalogue(system), start=1):
             for seed in seeds:
-                rows.append(hidden_effect_trial(system, hidden, ratio, noise,
-                                                trial_seed("correlated noise", SYSTEM_KEYS[system], j, h, seed),
-                                                n, correlation=rho))
+                args.append((system, hidden, ratio, noise,
+                             trial_seed("correlated noise", SYSTEM_KEYS[system], j, h, seed), n, rho))
         for seed in none_seeds:
-            rows.append(hidden_effect_trial(system, None, 0.0, noise,
-                                            trial_seed("correlated noise", SYSTEM_KEYS[system], j, 0, seed),
-                                            n, correlation=rho))
-    return pd.DataFrame(rows)
+            args.append((system, None, 0.0, noise, trial_seed("correlated noise", SYSTEM_KEYS[system], j, 0, seed),
+                         n, rho))
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers))
 
 
 def correlated_noise_rates(study: pd.DataFrame) -> pd.DataFrame:
