@@ -268,3 +268,13 @@ def test_the_noise_model_is_reported():
     assert "serially correlated" in res.final_diagnosis.message and res.final.effects == ("hard_iron",)
     white = loop("compass", load("compass", SWEEPS), ["misalignment"]).to_dict()["noise"]
     assert white["series"] is None and white["ar_order"] == 0       # heading bins: not a time series
+
+
+def test_a_table_too_short_to_screen_says_so(tmp_path):
+    path = tmp_path / "cold.csv"
+    drift_measurements("cold").to_csv(path, index=False)
+    for cmd in ("diagnose", "loop"):
+        r = run_cli(cmd, "drift", str(path), "--model", "earth_rate", "--json")
+        assert r.returncode == 0, r.stderr
+        out = json.loads(r.stdout)
+        assert out["outliers"] == [] and out["screen_note"].startswith("not run") and out["outlier_cutoff"] is None

@@ -65,6 +65,9 @@ SMALL_SAMPLE = 12
 # Family-wise false-alarm level. Bonferroni keeps the false-alarm rate at or below alpha; the users' target
 # is at most 5 %, so the default runs at half of it to stay under the target with margin.
 DEFAULT_ALPHA = 0.025
+# With correlated noise, fewer effective samples than this (for a slow shape) are said to leave small slow
+# effects undecided.
+FEW_EFFECTIVE = 30
 # A structure shape is "already in the model" when less than this share of its norm is left after
 # projecting it off the model's Jacobian.
 SPANNED = 0.1
@@ -77,7 +80,7 @@ class Candidate:
     loo_rms: float              # held-out (leave-one-out) RMS after adding it
     variance_explained: float   # share of the current residual sum of squares it removes
     p_value: float
-    test: str                   # 'F' or 'permutation'
+    test: str                   # 'F', 'F (GLS)' (correlated noise) or 'permutation'
     significant: bool = False
     log_p: float = field(default=0.0, repr=False)
     explains: str = ""          # the structure it removes ("" if no structure was found)
@@ -149,11 +152,8 @@ class Diagnosis:
         lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   rows: {self.n}",
                  f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
                  f"tests: {self.tests}, each at alpha/m = {self.alpha / max(self.tests, 1):.2g}"]
-        if self.screening is not None:
-            if self.screening.outliers:
-                lines.append(self.screening.outlier_line(self.unit))
-            if self.screening.noise.series is not None:
-                lines.append("noise: " + self.screening.noise.describe())
+        if self.screening is not None and self.screening.noise.series is not None:
+            lines.append("noise: " + self.screening.noise.describe())
         if self.candidates:
             lines.append("")
             lines.append(f"{'candidate':<20}{'rms after':>12}{'held-out':>12}{'var. expl.':>12}{'p':>11}  sig.")
@@ -438,6 +438,9 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
                f"at the family-wise level alpha = {alpha:g} over {m} tests")
         if fit.n <= SMALL_SAMPLE:
             msg += f" (only {fit.n} rows: small effects cannot be excluded)"
+        elif noise.correlated and noise.effective_samples < FEW_EFFECTIVE:
+            msg += (f" (the noise is so correlated that a slowly varying effect sees only about "
+                    f"{noise.effective_samples:.0f} independent samples: small slow effects cannot be excluded)")
     if missing and found:
         msg += "; structure it does not explain remains: " + "; ".join(s.what for s in found)
     if noise.correlated:

@@ -197,7 +197,7 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
         lines += ["", f"**Outliers:** {sc.outlier_line(unit)}."]
     if sc is not None and sc.noise.series is not None:
         lines += ["", f"**Noise:** {sc.noise.describe()}."]
-    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.replace("\n", "\n\n"),
+    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.split("\n")[-1],
               "", f"![the loop]({png.name})", ""]
     md.write_text("\n".join(lines))
     return png, md

@@ -5,8 +5,10 @@ and :func:`navlib.workbench.loop.loop` test on what it leaves.
 **Outliers.**  The F tests compare variances, so one wild sample inflates the noise estimate until nothing
 is significant (a 300 uT spike among 0.4 uT residuals hides every effect).  The screen fits the *richest*
 model the data can test (every testable effect, catalogued and the user's: so no missing effect, e.g. a
-time lag on the fast turns, is mistaken for outliers) and studentises its residuals with a robust scale,
-per measured column::
+time lag on the fast turns, is mistaken for outliers), takes the system's structure shapes out of its
+residuals too (fitted to the residual clipped at :data:`Z_NOISE` robust standard deviations, one Huber
+step, so that a spike is not smeared over its time cell; not on short tables, where they would absorb an
+outlier), and studentises what is left with a robust scale, per measured column::
 
     z_ij = (u_ij - med_j) / s_j,   u_ij = r_ij / sqrt(1 - h_ij),   s_j = 1.4826 MAD_j(u)
 
@@ -15,23 +17,26 @@ consistent estimate of a normal standard deviation: Hampel 1974, JASA 69:383; Ro
 JASA 88:1273).  An observation is an outlier when ``|z| > c`` with the Bonferroni cutoff
 ``c = max(Z_MIN, t_nu^-1(1 - OUTLIER_ALPHA / (2 N)))`` over the N observations, so a file of clean Gaussian
 noise has at most about an ``OUTLIER_ALPHA`` chance of losing any row (``Z_MIN`` = 6 keeps real sensors'
-heavier tails in).  Student's t with ``nu = 0.367 (N - p)``
-degrees of freedom rather than the normal quantile allows for the MAD's own scatter on short tables: the
-MAD has 36.7 % efficiency at the normal (Rousseeuw and Croux 1993), so it is about as precise as a variance
-from ``0.367 (N - p)`` squares (a Satterthwaite-style approximation; on a 19-row table the cutoff is about
-7.7, on hundreds of rows it is ``Z_MIN``).  In a time series (``time_s``, or a
-magnetometer's file order) an outlier must also stand out from its neighbours in time -- the robust z of
-``u_t`` minus the median of the samples within :data:`ISOLATION` of it must exceed ``c`` too (a Hampel
-filter, Pearson 2002) -- and be isolated: no other sample within :data:`ISOLATION` samples has a robust
-|z| above ``c`` (nor above a tenth of its own).  A spike is; a physical disturbance that lasts two samples or
-more (a magnet passed at close range) is not, and stays in the data for the structure tests.  The screen
-is iterated (Rousseeuw and Leroy 1987, *Robust Regression and Outlier Detection*, ch. 6: reweighted least
-squares): the rows flagged whose ``|z|`` is within a factor :data:`DOMINANCE` of the largest are set aside,
-the model is refitted without them, every row (set-aside ones too) is judged again against the cleaner
-fit, until the set is stable; so a huge spike that distorts the first fit cannot condemn innocent rows.
-A row with any outlying column is set aside whole.  More than :data:`MAX_OUTLIER_SHARE` of the rows (at
-least one row) flagged: the data are refused (InputError) -- a least-squares model is no description of
-them.  Fewer than :data:`MIN_DOF` residual degrees of freedom: no screen (said in the result).
+heavier tails in).  Student's t with ``nu = 0.367 (N - p)`` degrees of freedom rather than the normal
+quantile allows for the MAD's own scatter on short tables: the MAD has 36.7 % efficiency at the normal
+(Rousseeuw and Croux 1993), so it is about as precise as a variance from ``0.367 (N - p)`` squares (a
+Satterthwaite-style approximation; on a 19-row table the cutoff is about 7.7, on hundreds of rows it is
+``Z_MIN``).  On a table of at most :data:`SMALL_TABLE` rows each row is also judged by its deletion
+residual (the fit without it: one outlier at a high-leverage point otherwise pulls the fit to itself and
+inflates everyone's residuals).  In a time series (``time_s``, or a magnetometer's file order) an outlier
+must also stand out from its neighbours in time -- the robust z of ``u_t`` minus the median of the samples
+within :data:`ISOLATION` of it must exceed ``c`` too (a Hampel filter, Pearson 2002, IEEE Trans. Control
+Syst. Technol. 10:55) -- and be isolated: no other sample within :data:`ISOLATION` samples has a robust
+|z| above ``c`` (nor above a tenth of its own).  A spike is; a physical disturbance that lasts two samples
+or more (a magnet passed at close range) is not, and stays in the data for the structure tests.  The
+screen is iterated (Rousseeuw and Leroy 1987, *Robust Regression and Outlier Detection*, ch. 6:
+reweighted least squares): the rows flagged whose ``|z|`` is within a factor :data:`DOMINANCE` of the
+largest are set aside, the model is refitted without them, and every row (set-aside ones too) is judged
+again against the cleaner fit, until the set is stable; so a huge spike that distorts the first fit
+cannot condemn innocent rows.  A row with any outlying column is set aside whole.  More than
+:data:`MAX_OUTLIER_SHARE` of the rows (5 %, at least one row) outlying: the data are refused (InputError)
+-- a least-squares model is no description of them.  Fewer than :data:`MIN_DOF` residual degrees of
+freedom: no screen (said in the result).
 
 **Numerical floor.**  Residuals at the data's own precision are not evidence of anything: when the
 residual RMS is at most ``FLOOR_REL`` (1e-9) times the RMS of the measured values, the residuals are
@@ -80,8 +85,8 @@ FLOOR_REL = 1e-9
 MAX_ROUNDS = 12
 #: Tables of at most this many rows are screened with deletion residuals (and without structure shapes).
 SMALL_TABLE = 60
-#: In a time series a flagged sample is an outlier only if no other flagged sample lies within this many
-#: samples of it in its segment.
+#: In a time series an outlier stands out from the median of the samples within this many of it, and no
+#: other sample that near is outlying too.
 ISOLATION = 2
 MAD_SD = 1.482602218505602          # 1 / Phi^-1(3/4)
 #: Asymptotic efficiency of the MAD at the normal (Rousseeuw and Croux 1993).
@@ -117,7 +122,7 @@ class Screening:
     kept: np.ndarray
     n_rows: int
     outliers: list
-    cutoff: float
+    cutoff: float | None
     model: tuple
     noise: NoiseModel
     scale: float
@@ -252,7 +257,7 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     kept = np.arange(n)
     found: list[Outlier] = []
     note = ""
-    c = cutoff(rich.n, rich.n - rich.n_params) if rich is not None else float("nan")
+    c = cutoff(rich.n, rich.n - rich.n_params) if rich is not None else None
     if rich is None:
         note = f"not run: fewer than {MIN_DOF} residual degrees of freedom"
     elif not outliers:

@@ -248,11 +248,12 @@ class NoiseModel:
         if self.note:
             return f"samples taken as independent ({self.note})"
         if not self.correlated:
-            return f"no serial correlation found (AR order 0 by AIC, series in {self.series.source})"
+            return f"no serial correlation found (AR order 0 by AIC; series in {self.series.source})"
         slow = (f"a slow shape sees about {self.effective_samples:.0f} independent samples of {self.n_obs}"
                 if self.inflation > 1 else "neighbouring samples anti-correlated")
-        return (f"serially correlated noise: AR({self.order}), lag-1 correlation {self.lag1:.2f}, series in "
-                f"{self.series.source}; tests on whitened residuals ({slow})")
+        return (f"serially correlated, AR({self.order}) with lag-1 correlation {self.lag1:.2f} "
+                f"(interval {self.bounds[0]:.2f}..{self.bounds[1]:.2f}; series in {self.series.source}): tests "
+                f"on whitened residuals, {slow}")
 
 
 class _Restricted:
