@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
-from .tables import Column, read_table, require_variation
+from .tables import Column, read_table, require_variation, where
 
 # Limits: headings 0..360 deg, sweep a whole number 0..1e6, temperature -80..150 degC, time 0..1e9 s
 # (about 32 years).  The raw field and accelerometer columns are informational: no model of the compass
@@ -68,7 +68,7 @@ def load_sweeps(path, *, min_points: int = 8) -> pd.DataFrame:
         dup = pd.Series(key[~closing]).duplicated().to_numpy()
         if dup.any():
             r = int(part.index[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]])
-            raise InputError(f"{name}: column 'true_heading_deg', row {r + 1} (file line {r + 2}): heading "
+            raise InputError(f"{where(path, 'true_heading_deg', r, frame)}: heading "
                              f"{t[np.flatnonzero(~closing)[np.flatnonzero(dup)[0]]]:g} is repeated in "
                              f"sweep {sweep_id}")
     return frame

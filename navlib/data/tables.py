@@ -57,14 +57,22 @@ class Column:
 
 def where(path: str | os.PathLike, column: str, row: int, frame: pd.DataFrame | None = None) -> str:
     """The location prefix used in messages: ``file: column 'c', row r (file line l)``; ``row`` is
-    0-based over data rows.  The file line is taken from ``frame`` when it came from :func:`read_table`
-    (which records where each row starts), else assumed to be ``row + 2`` (one header line, no blank
-    lines)."""
+    0-based over data rows.  The file line is ``row + 2`` (one header line) plus the blank lines and quoted
+    line breaks before the row, which :func:`read_table` records in ``frame.attrs["line_jumps"]`` when a
+    file has any."""
     line = row + 2
-    lines = frame.attrs.get("file_lines") if frame is not None else None
-    if lines is not None and 0 <= row < len(lines):
-        line = int(lines[row])
+    for start, extra in (frame.attrs.get("line_jumps", ()) if frame is not None else ()):
+        if row >= start:
+            line = row + 2 + extra
     return f"{Path(path).name}: column '{column}', row {row + 1} (file line {line})"
+
+
+def _jumps(lines: list[int]) -> tuple[tuple[int, int], ...]:
+    """``(first row, extra lines)`` wherever the file line of a row stops being ``row + 2`` plus the
+    previous extra: a short record of the blank lines and quoted line breaks (usually empty)."""
+    extra = np.asarray(lines, dtype=np.int64) - (np.arange(len(lines)) + 2)
+    change = np.flatnonzero(np.diff(extra, prepend=0))
+    return tuple((int(r), int(extra[r])) for r in change)
 
 
 def show(text: str) -> str:
@@ -103,7 +111,7 @@ def _parse(p: Path, text: str, kind: str) -> tuple[list[str], list[list[str]], l
     try:
         for fields in reader:
             start, last = last + 1, reader.line_num
-            if not any(f.strip() for f in fields):    # blank line (or only separators)
+            if not fields or (len(fields) == 1 and not fields[0].strip()):    # a blank line
                 continue
             if header is None:
                 header = [f.strip() for f in fields]
@@ -176,8 +184,8 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     none); there are at least ``min_rows`` rows.  Optional columns that are absent are simply not in the
     result; informational columns (``checked=False``) and columns the list does not describe are not
     checked (described informational ones become floats with NaN where a cell is not a number, others stay
-    text, with any byte that is not UTF-8 replaced by U+FFFD).  The file line each row starts on is kept in
-    ``frame.attrs["file_lines"]`` (see :func:`where`).
+    text, with any byte that is not UTF-8 replaced by U+FFFD).  Where blank lines or quoted line breaks move
+    rows off ``row + 2``, ``frame.attrs["line_jumps"]`` records it (see :func:`where`).
     """
     p = Path(path)
     if not p.exists():
@@ -198,7 +206,9 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
             raise InputError(f"{p.name}: missing column '{col.name}' ({col.unit or 'no unit'}); "
                              f"found {found}{hint}")
     located = pd.DataFrame(index=pd.RangeIndex(len(rows)))
-    located.attrs["file_lines"] = np.asarray(lines, dtype=int)
+    jumps = _jumps(lines)
+    if jumps:
+        located.attrs["line_jumps"] = jumps
     cells = dict(zip(names, map(list, zip(*rows)))) if rows else {name: [] for name in names}
     described = {col.name: col for col in columns}
     out = {}
@@ -215,7 +225,8 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
             _check(p, col, text, values, located)
         out[name] = values
     frame = pd.DataFrame(out, index=pd.RangeIndex(len(rows)))
-    frame.attrs["file_lines"] = located.attrs["file_lines"]
+    if jumps:
+        frame.attrs["line_jumps"] = jumps
     if len(frame) < min_rows:
         raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
                          f"a {kind} needs at least {min_rows}")

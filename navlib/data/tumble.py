@@ -42,7 +42,7 @@ def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -
     unit = df["unit"].astype(str).str.strip()
     empty = np.flatnonzero(unit.to_numpy() == "")
     if empty.size:
-        raise InputError(f"{where(path, 'unit', int(empty[0]))}: is empty")
+        raise InputError(f"{where(path, 'unit', int(empty[0]), df)}: is empty")
     df["unit"] = unit
     q = df["position_deg"].to_numpy()
     if q.max() <= 2 * np.pi + 1e-9 and len(np.unique(q)) >= 4:
@@ -52,7 +52,7 @@ def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -
     off |= q >= 360.0
     if off.any():
         r = int(np.flatnonzero(off)[0])
-        raise InputError(f"{where(path, 'position_deg', r)}: {q[r]:g} is not on the dividing head's "
+        raise InputError(f"{where(path, 'position_deg', r, df)}: {q[r]:g} is not on the dividing head's "
                          f"{grid_deg:g} deg grid (0 <= q < 360)")
     if "set_point_c" not in df.columns:
         df["set_point_c"] = np.round(df["temperature_c"].to_numpy() * 2) / 2

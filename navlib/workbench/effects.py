@@ -303,8 +303,12 @@ def call_contribution(effect: Effect, params: Mapping[str, float], data: pd.Data
         raise UserCodeError(f"{who}: contribution returned None (a missing return?)")
     arr = np.asarray(out)
     if arr.dtype.kind not in "biuf":
-        raise UserCodeError(f"{who}: contribution returned {arr.dtype.name} values "
-                            f"({show(repr(out))[:60]}), not real numbers")
+        kind = {"U": "text", "S": "bytes", "c": "complex numbers", "M": "dates", "m": "time spans"}.get(
+            arr.dtype.kind, f"{type(arr.flat[0]).__name__ if arr.size else 'empty'} objects")
+        v = arr.flat[0] if arr.size else None
+        first = show(repr(v.item() if isinstance(v, np.generic) else v))[:40] if arr.size else ""
+        raise UserCodeError(f"{who}: contribution returned {kind}{f' ({first}, ...)' if first else ''}, "
+                            f"not real numbers")
     arr = arr.astype(float, copy=False)
     if arr.shape != tuple(shape):
         raise UserCodeError(f"{who}: contribution returned shape {arr.shape}, the measurement has shape "
@@ -320,7 +324,7 @@ def call_contribution(effect: Effect, params: Mapping[str, float], data: pd.Data
 
 def _user_line(err: BaseException, path: Path) -> str:
     """The line of ``path`` the exception came from (the deepest frame in that file), or ''."""
-    lines = [f.lineno for f in traceback.extract_tb(err.__traceback__) if Path(f.filename) == path]
+    lines = [f.lineno for f in traceback.extract_tb(err.__traceback__) if Path(f.filename).resolve() == path]
     return f"line {lines[-1]}: " if lines else ""
 
 

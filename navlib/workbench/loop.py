@@ -179,8 +179,8 @@ def check_report_folder(folder) -> tuple[Path, Path]:
         with tempfile.TemporaryFile(dir=base):
             pass
     except OSError as err:
-        raise InputError(f"{folder}: cannot write the report there ({base}: {err.strerror or type(err).__name__}); "
-                         f"choose another --report folder") from None
+        raise InputError(f"{folder}: cannot write the report there (creating a file in {base} failed: "
+                         f"{err.strerror or type(err).__name__}); choose another --report folder") from None
     return png, md
 
 
