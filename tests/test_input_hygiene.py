@@ -11,6 +11,7 @@ import sys
 import numpy as np
 import pandas as pd
 import pytest
+from scipy.spatial.transform import Rotation
 
 from navlib import cli
 from navlib.data.compass_sweeps import load_sweeps
@@ -24,7 +25,7 @@ from navlib.workbench import Effect, get_system, load_effects
 from navlib.workbench.effects import CATALOGUES
 from navlib.workbench.fit import fit_model, simulate
 from navlib.workbench.loop import check_report_folder, loop
-from navlib.workbench.magnetometer import MAG, load_magnetometer, simulate_magnetometer
+from navlib.workbench.magnetometer import GYR, MAG, QUAT, load_magnetometer, predict_field, simulate_magnetometer
 
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
 
@@ -218,6 +219,22 @@ def test_a_stuck_or_unrelated_magnetometer_is_refused(tmp_path, mag):
     shuffled = mag.copy()
     shuffled[list(MAG)] = mag[list(MAG)].to_numpy()[np.random.default_rng(3).permutation(len(mag))]
     assert "the reference attitude explains only" in refused(load_magnetometer, write(tmp_path, shuffled, "u.csv"))
+
+
+def test_gyro_rates_in_another_unit_are_named(tmp_path):
+    """A turning trajectory (a constant body rate about a fixed axis, 10 Hz): the gyro must agree with the
+    rate at which the reference attitude turns."""
+    t = 0.1 * np.arange(600)
+    w = np.array([40.0, 25.0, 60.0])
+    q = Rotation.from_rotvec(np.radians(np.outer(t, w))).as_quat()[:, [3, 0, 1, 2]]
+    f = pd.DataFrame(q, columns=list(QUAT))
+    f[list(GYR)] = w
+    f["time_s"] = t
+    f[list(MAG)] = predict_field({"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8}, f)
+    assert len(load_magnetometer(write(tmp_path, f, "deg.csv"))) == 600
+    f[list(GYR)] = np.radians(w)
+    assert "these look like rad/s (multiply by 57.2958 for deg/s)" in refused(load_magnetometer,
+                                                                             write(tmp_path, f, "rad.csv"))
 
 
 def tumble_unit(tmp_path, change=None, name="a.csv"):

@@ -106,7 +106,7 @@ def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
     fewer than ``min_rows`` rows; too few distinct orientations (fewer than 12 attitude cells of 30 deg,
     or no tilt of 10 deg) to separate the hard iron from the local field; and the plausibility checks of
     :func:`check_field` (a stuck axis, a field that does not follow the attitude, axes in another frame
-    than FRD, a unit other than uT).  Informational columns (``moving``, ``magnet_attached``,
+    than FRD, a unit other than uT) and :func:`check_rates` (gyro rates in another unit than deg/s).  Informational columns (``moving``, ``magnet_attached``,
     ``att_blur``, ``acc_*_ms2``, ``ref_*_deg``) and columns not named here are never refused."""
     frame = read_table(path, quaternion_columns(), min_rows=min_rows, kind="magnetometer file")
     q = frame[list(QUAT)].to_numpy(float)
@@ -118,7 +118,45 @@ def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
                          f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})")
     check_orientations(frame, Path(path).name)
     check_field(frame, Path(path).name)
+    check_rates(frame, Path(path).name)
     return frame
+
+
+#: Units a rate may have been written in by mistake, with the factor that converts them to deg/s.
+RATE_UNITS = (("rad/s", 180.0 / np.pi), ("mdeg/s", 1e-3), ("deg/h", 1 / 3600.0), ("rpm", 6.0))
+
+
+def check_rates(frame: pd.DataFrame, name: str = "data") -> None:
+    """Plausibility of the gyro columns (used by ``time_lag`` and the rate structure test), where the file
+    is a trajectory with times: the rate of the reference attitude between consecutive rows (rotation
+    angle over time step, rows at most 0.5 s apart; a trajectory when the median step is below 60 deg) is
+    compared with the mean ``|omega|`` of the two rows, over the rows turning faster than 5 deg/s (at
+    least 20).  The median ratio must lie within 0.5..2 (BROAD: 1.00-1.01); otherwise one line names the
+    unit that brings it there (rad/s x57.3, mdeg/s, deg/h, rpm) or says that the rates do not match."""
+    if "time_s" not in frame or not all(c in frame for c in GYR):
+        return
+    q = frame[list(QUAT)].to_numpy(float)
+    rot = Rotation.from_quat(q[:, [1, 2, 3, 0]] / np.linalg.norm(q, axis=1, keepdims=True))
+    step = np.degrees((rot[:-1].inv() * rot[1:]).magnitude())
+    dt = np.diff(frame["time_s"].to_numpy(float))
+    ok = (dt > 0) & (dt <= 0.5)
+    if ok.sum() < 20 or np.median(step[ok]) >= 60.0:
+        return
+    rate = step / np.where(ok, dt, 1.0)
+    w = np.linalg.norm(frame[list(GYR)].to_numpy(float), axis=1)
+    gyro = 0.5 * (w[:-1] + w[1:])
+    turning = ok & (rate > 5.0)
+    if turning.sum() < 20:
+        return
+    ratio = float(np.median(gyro[turning] / rate[turning]))
+    if 0.5 <= ratio <= 2.0:
+        return
+    near = [(u, f) for u, f in RATE_UNITS if 0.5 <= ratio * f <= 2.0]
+    look = (f"these look like {near[0][0]} (multiply by {near[0][1]:.6g} for deg/s)" if near else
+            "the gyro and the reference attitude disagree")
+    raise InputError(f"{name}: columns {', '.join(GYR)}: |omega| is {ratio:.3g} times the rate at which the "
+                     f"reference attitude turns (median over {int(turning.sum())} turning rows; 0.5..2 accepted): "
+                     f"{look}")
 
 
 _AXES = ("x", "y", "z")
