@@ -176,7 +176,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
                kind: str = "table") -> pd.DataFrame:
     """Read and validate a CSV table.
 
-    Checks, in order: the file exists, is text (not compressed, archived or binary) and parses as CSV; no
+    Checks, in order: the file exists, is a regular file and text (not compressed, archived or binary) and parses as CSV; no
     column name appears twice in the header; every required column is present (a near-miss name, or a
     separator other than the comma, is pointed out); every value in a described (checked) column is a
     finite number (no text, empty cell, NaN, infinity or a literal that overflows a float), whole if the
@@ -192,6 +192,8 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
         raise InputError(f"{p}: no such file")
     if p.is_dir():
         raise InputError(f"{p}: is a folder, expected a CSV {kind}")
+    if not p.is_file():                               # a device or a pipe (/dev/zero would never end)
+        raise InputError(f"{p}: is not a regular file, expected a CSV {kind}")
     header, rows, lines = _parse(p, _decode(p, kind), kind)
     names = _names(p, header)
     for col in columns:

@@ -84,6 +84,9 @@ FIELD_UNITS = (("gauss or oersted", 100.0), ("mG", 0.1), ("nT", 1e-3), ("mT", 1e
 #: The share of the field's variation the attitude must explain (through any fixed linear map of the
 #: axes, plus a constant); below it the columns are not a magnetometer turned with that attitude.
 MIN_EXPLAINED = 0.25
+#: Rows whose field is farther than this many times the median distance from the attitude fit are set aside
+#: before the checks (at most half of them; Gaussian noise reaches 5 medians with probability below 1e-9).
+TRIM = 5.0
 
 
 def quaternion_columns() -> list[Column]:
@@ -177,7 +180,9 @@ def check_field(frame: pd.DataFrame, name: str = "data") -> None:
     """Plausibility of the field columns; each failure is one line naming the columns and what they look
     like.  Method: linear least squares of the field on the reference attitude ``C = C_n^b``.
 
-    1. No axis may be constant (a stuck or unconnected axis).
+    1. No axis may be constant (a stuck or unconnected axis).  The fits below set aside rows farther than
+       ``TRIM`` (5) median distances from the fit (refitted up to four times, never more than half of the
+       rows), so that a few spikes are left to the outlier screening and not mistaken for a unit.
     2. The field must follow the attitude: ``m_j = sum_kl W_jkl C_kl + b_j`` (any fixed linear map of the
        axes, soft iron and misalignment included, plus a constant) must explain at least ``MIN_EXPLAINED``
        (25 %) of the field's variation (the undisturbed BROAD trials: more than 97 %; trial 32, with a
@@ -196,7 +201,15 @@ def check_field(frame: pd.DataFrame, name: str = "data") -> None:
     C = body_from_nav(frame)
     cols = "columns mag_x_ut, mag_y_ut, mag_z_ut"
     X = np.column_stack([C.reshape(len(m), 9), np.ones(len(m))])
-    W = np.column_stack([lstsq(X, m[:, j]) for j in range(3)])          # (10, 3)
+    keep = np.ones(len(m), bool)
+    for _ in range(4):                               # set wild rows aside (a spike must not pass for a unit)
+        W = np.column_stack([lstsq(X[keep], m[keep, j]) for j in range(3)])          # (10, 3)
+        e = np.linalg.norm(m - X @ W, axis=1)
+        inside = e <= TRIM * np.median(e[keep])
+        if np.array_equal(inside, keep) or inside.sum() < len(m) // 2:
+            break
+        keep = inside
+    m, C, X = m[keep], C[keep], X[keep]
     explained = 1.0 - float(np.sum((m - X @ W) ** 2)) / float(np.sum((m - m.mean(axis=0)) ** 2))
     if explained < MIN_EXPLAINED:
         raise InputError(f"{name}: {cols}: the reference attitude explains only {100 * max(explained, 0.0):.0f} "
