@@ -166,6 +166,8 @@ def test_files_that_are_not_csv_text(tmp_path, compass):
     gz = tmp_path / "c.csv.gz"
     gz.write_bytes(gzip.compress(p.read_bytes()))
     assert "is gzip-compressed" in refused(load_sweeps, gz)
+    if os.path.exists("/dev/zero"):
+        assert refused(load_sweeps, "/dev/zero") == "/dev/zero: is not a regular file, expected a CSV compass sweep"
     binary = tmp_path / "b.csv"
     binary.write_bytes(b"true_heading_deg\x00\x01\x02")
     assert "is a binary file" in refused(load_sweeps, binary)
@@ -219,6 +221,19 @@ def test_a_stuck_or_unrelated_magnetometer_is_refused(tmp_path, mag):
     shuffled = mag.copy()
     shuffled[list(MAG)] = mag[list(MAG)].to_numpy()[np.random.default_rng(3).permutation(len(mag))]
     assert "the reference attitude explains only" in refused(load_magnetometer, write(tmp_path, shuffled, "u.csv"))
+
+
+def test_a_few_spikes_are_not_taken_for_a_unit(tmp_path, mag):
+    """Spikes are left to the outlier screening: the plausibility fits set them aside."""
+    m = mag.copy()
+    m.loc[[3, 50, 120], "mag_x_ut"] = [1e6, -1e6, 300.0]
+    assert len(load_magnetometer(write(tmp_path, m, "spikes.csv"))) == 200
+    m[list(MAG)] /= 100
+    assert "look like gauss" in refused(load_magnetometer, write(tmp_path, m, "gauss.csv"))
+    a = read_tumble(TUMBLE_FILE)
+    a = a[(a["unit"] == "A") & (a["set_point_c"] == a["set_point_c"].iloc[0])].copy()     # 24 positions
+    a.loc[a.index[[0, 7]], "output_mg"] = -5000.0
+    assert len(get_system("accelerometer").load(write(tmp_path, a, "a.csv"))) == 24
 
 
 def test_gyro_rates_in_another_unit_are_named(tmp_path):
