@@ -801,10 +801,14 @@ def find_chromium(explicit: str | None = None) -> str | None:
     return None
 
 
+#: The tallest single screenshot (px); a taller page is written as several viewport-high tiles.
+TILE_PX = 30000
+
+
 def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str | None = None,
                 settle_s: float = 0.5) -> int:
     """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
-    relative names, ``.png``); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
+    relative names, ``.png``; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
     or tables wider than the content column, by page).  Returns 2 if Chromium is missing."""
     binary = find_chromium(chromium)
     if binary is None:
@@ -844,11 +848,22 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
                         "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
             found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
                                 session=session)["result"].get("value") or []
-            shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
-                               session=session)
             png = out_dir / rel.with_suffix(".png")
             png.parent.mkdir(parents=True, exist_ok=True)
-            png.write_bytes(base64.b64decode(shot["data"]))
+            if h <= TILE_PX:
+                shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
+                                   session=session)
+                png.write_bytes(base64.b64decode(shot["data"]))
+            else:
+                # Chromium refuses one capture taller than its texture limit ("Page is too large"): a long
+                # page (the API reference) is written as viewport-high tiles page.png, page-2.png, ...
+                chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session)
+                for k, top in enumerate(range(0, h, TILE_PX)):
+                    chrome.send("Runtime.evaluate", {"expression": f"window.scrollTo(0, {top}); new Promise("
+                                "r => setTimeout(r, 200)).then(() => 1)", "awaitPromise": True}, session=session)
+                    shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
+                    tile = png if k == 0 else png.with_name(f"{png.stem}-{k + 1}.png")
+                    tile.write_bytes(base64.b64decode(shot["data"]))
             chrome.send("Target.closeTarget", {"targetId": target})
             heights.append((str(rel), h))
             if found:

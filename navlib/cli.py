@@ -22,18 +22,24 @@ SYSTEM is compass, drift, magnetometer or accelerometer:
 --effects FILE.py adds your own effects (every navlib.workbench.effects.Effect defined in the file whose
 system matches), usable in --model and named by diagnose like catalogued ones.
 
-Bad input exits with status 2 and one line on stderr; no traceback.  ``python -m navlib --debug ...``
-shows the full traceback of any error (for bug reports).
+Bad input exits with status 2 and one line on stderr; no traceback.  That includes a broken --effects file
+(it fails at import, calls sys.exit, defines two effects with one name, or a contribution raises or
+returns text, NaN, infinity or the wrong shape: the line names the file and the effect) and a --report
+folder that exists with a report in it or cannot be written (checked before the fit).  Effects the data
+cannot test are listed ("not tested: ..." lines; "untested" in --json).  ``python -m navlib --debug ...``
+shows the full traceback of any error (for bug reports).  Output into a closed pipe (``| head -1``) ends
+quietly, with status 141 like a process stopped by SIGPIPE.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from dataclasses import replace
 
 from .data.tables import write_new_csv
-from .errors import InputError
+from .errors import InputError, UserCodeError
 from .sensors.compass import CompassErrors, simulate_train_test
 from .workbench import SYSTEMS, get_system, load_effects
 from .workbench.diagnose import diagnose
@@ -99,6 +105,7 @@ def _diagnose(args) -> int:
         out["candidates"] = [{"effect": c["effect"], "rms": c["rms"], "loo_rms": c["loo_rms"],
                               "variance_explained": c["variance_explained"], "p_value": c["p_value"],
                               "test": c["test"], "significant": c["significant"]} for c in out["candidates"]]
+        out["untested"] = [{"effect": k, "why": v} for k, v in d.untestable.items()]
         print(json.dumps(out, allow_nan=False, default=float))
     else:
         print(d.report())
@@ -118,6 +125,8 @@ def _loop(args) -> int:
         print(result.steps_table().to_string(float_format=lambda x: f"{x:.4g}"))
         print()
         print(result.final_diagnosis.message)
+        for u in result.untested:
+            print(f"not tested: {u['effect']} ({u['why']})")
         if args.report:
             print(f"report: {md} and {png}")
     return 0
@@ -126,17 +135,38 @@ def _loop(args) -> int:
 COMMANDS = {"simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop}
 
 
+#: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.
+BROKEN_PIPE = 141
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    if args.debug:                                  # let every error through with its traceback
-        return COMMANDS[args.command](args)
+    try:
+        if args.debug:                              # let every error through with its traceback
+            status = COMMANDS[args.command](args)
+        else:
+            status = _run(args)
+        sys.stdout.flush()                          # a closed pipe shows here, not at interpreter exit
+    except BrokenPipeError:
+        # the reader went away (``| head -1``): stop quietly; stdout goes to devnull so that Python's
+        # final flush does not complain again (the recipe of the Python documentation, signal module)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return BROKEN_PIPE
+    return status
+
+
+def _run(args) -> int:
     try:
         return COMMANDS[args.command](args)
-    except InputError as err:
+    except BrokenPipeError:
+        raise
+    except (InputError, UserCodeError) as err:
         print(f"navlib {args.command}: error: {err}", file=sys.stderr)
         return 2
     except OSError as err:
-        print(f"navlib {args.command}: error: {err.filename or ''}: {err.strerror}", file=sys.stderr)
+        where = f"{err.filename}: " if err.filename else ""
+        print(f"navlib {args.command}: error: {where}{err.strerror or err}", file=sys.stderr)
         return 2
     except Exception as err:                        # a bug, not bad input: one line; --debug shows the traceback
         print(f"navlib {args.command}: internal error: {type(err).__name__}: {err}".splitlines()[0]

@@ -16,6 +16,16 @@ class InputError(ValueError):
         super().__init__(" ".join(str(message).split()))
 
 
+class UserCodeError(Exception):
+    """A user's own code (an effect's ``contribution`` from an ``--effects`` file) failed or returned
+    something unusable.  ``str(err)`` is one line naming the file and the effect; the user's exception, if
+    any, is the ``__cause__``.  Deliberately not an :class:`InputError`: a fit that catches InputError to
+    mark a candidate effect untestable must not hide a broken effect (the CLI exits 2 on it)."""
+
+    def __init__(self, message: str):
+        super().__init__(" ".join(str(message).split()))
+
+
 def check_param(name: str, value: Any, *, lo: float | None = None, hi: float | None = None,
                 lo_open: bool = False, hi_open: bool = False, integer: bool = False) -> None:
     """Raise :class:`InputError` unless ``lo <= value <= hi`` (open ends when asked), finite, and whole

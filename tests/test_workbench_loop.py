@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from navlib import verdicts
-from navlib.errors import InputError
+from navlib.errors import InputError, UserCodeError
 from navlib.studies import workbench as wb
 from navlib.workbench import Effect, load_effects
 from navlib.workbench.diagnose import diagnose
@@ -97,11 +97,13 @@ def test_effect_definitions_are_checked(tmp_path):
 
 
 def test_diagnose_lets_a_bug_in_an_effect_through():
-    """Only expected errors (InputError) make a candidate untestable; a bug propagates."""
+    """Only expected errors (InputError) make a candidate untestable; a bug in a user's effect propagates,
+    named (UserCodeError, not an InputError), with the user's exception as its cause."""
     bad = Effect("broken", ("k",), ("deg",), "m", system="compass", contribution=lambda p, d: 1 / 0)
     f = fit_model("compass", simulate("compass", {"yaw_deg": 1.0}, noise=0.1), ["misalignment"], user_effects=(bad,))
-    with pytest.raises(ZeroDivisionError):
+    with pytest.raises(UserCodeError, match="effect 'broken': contribution raised ZeroDivisionError") as err:
         diagnose(f)
+    assert not isinstance(err.value, InputError) and isinstance(err.value.__cause__, ZeroDivisionError)
 
 
 def test_debug_flag_shows_the_traceback(tmp_path):

@@ -1,17 +1,27 @@
 """Reading measurement tables (CSV) with validation that names the file, column and row of every fault.
 
-A table is described by a list of :class:`Column` specs.  :func:`read_table` returns a float
-``pandas.DataFrame`` holding the described columns (plus any extra columns untouched) or raises
-:class:`navlib.errors.InputError` with a single line such as::
+A table is described by a list of :class:`Column` specs.  :func:`read_table` returns a
+``pandas.DataFrame`` holding the described columns as floats (plus any extra columns as text, untouched)
+or raises :class:`navlib.errors.InputError` with a single line such as::
 
     sweep.csv: column 'true_heading_deg', row 7 (file line 8): 'abc' is not a number
 
-Rows are counted from 1 over the data rows; the file line adds the header line.
+Rows are counted from 1 over the data rows; the file line is the line of the file the row starts on (the
+header line, blank lines and quoted line breaks counted).
+
+The header is read here, not by pandas (which renames a repeated name ``a`` to ``a.1`` and so hides it):
+a name that appears twice is refused.  The file is decoded as UTF-8 (a byte-order mark is skipped, UTF-16
+with a byte-order mark is read too); bytes that are not UTF-8 text are kept, and only refused where they
+sit in a cell of a described column.  Columns the table does not describe are never checked: a NaN, text
+or a stray byte there does not stop the reading.
 """
 from __future__ import annotations
 
+import csv
 import difflib
+import io
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,11 +30,21 @@ import pandas as pd
 
 from ..errors import InputError
 
+#: Default limit of a checked column without its own range: ``|x| <= LIMIT``.  No quantity in navlib's
+#: files comes near it in its unit, and squares and sums of values within it cannot overflow a float.
+LIMIT = 1e12
+
+_FLOAT_MAX = float(np.finfo(float).max)
+_BAD_BYTES = re.compile("[\udc80-\udcff]")          # bytes that were not UTF-8 (kept by surrogateescape)
+
 
 @dataclass(frozen=True)
 class Column:
     """One column of a table: its name, unit (for messages and the data dictionary), whether it must be
-    present, and an optional closed range ``[lo, hi]`` the values must lie in."""
+    present, and the closed range ``[lo, hi]`` its values must lie in (``-LIMIT..LIMIT`` where not given).
+
+    ``checked=False`` marks an *informational* column that the table's users read if they can but no model
+    relies on: its cells are converted to numbers where they parse (NaN elsewhere) and never refused."""
 
     name: str
     unit: str = ""
@@ -32,80 +52,218 @@ class Column:
     lo: float | None = None
     hi: float | None = None
     integer: bool = False
+    checked: bool = True
 
 
-def where(path: str | os.PathLike, column: str, row: int) -> str:
-    """The location prefix used in messages: ``file: column 'c', row r (file line r+1)``; ``row`` is
-    0-based over data rows."""
-    return f"{Path(path).name}: column '{column}', row {row + 1} (file line {row + 2})"
+def where(path: str | os.PathLike, column: str, row: int, frame: pd.DataFrame | None = None) -> str:
+    """The location prefix used in messages: ``file: column 'c', row r (file line l)``; ``row`` is
+    0-based over data rows.  The file line is ``row + 2`` (one header line) plus the blank lines and quoted
+    line breaks before the row, which :func:`read_table` records in ``frame.attrs["line_jumps"]`` when a
+    file has any."""
+    line = row + 2
+    for start, extra in (frame.attrs.get("line_jumps", ()) if frame is not None else ()):
+        if row >= start:
+            line = row + 2 + extra
+    return f"{Path(path).name}: column '{column}', row {row + 1} (file line {line})"
+
+
+def _jumps(lines: list[int]) -> tuple[tuple[int, int], ...]:
+    """``(first row, extra lines)`` wherever the file line of a row stops being ``row + 2`` plus the
+    previous extra: a short record of the blank lines and quoted line breaks (usually empty)."""
+    extra = np.asarray(lines, dtype=np.int64) - (np.arange(len(lines)) + 2)
+    change = np.flatnonzero(np.diff(extra, prepend=0))
+    return tuple((int(r), int(extra[r])) for r in change)
+
+
+def show(text: str) -> str:
+    """``text`` for a one-line message: bytes that are not UTF-8 as ``\\xNN``, control characters escaped."""
+    text = str(text).encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+
+
+def _decode(p: Path, kind: str) -> str:
+    """The file's text.  Compressed, archived or binary files are refused by name; UTF-16 with a byte-order
+    mark is decoded; otherwise UTF-8 (BOM skipped) with undecodable bytes kept as surrogates."""
+    try:
+        data = p.read_bytes()
+    except OSError as err:
+        raise InputError(f"{p}: cannot be read ({err.strerror or type(err).__name__})") from None
+    if data[:2] == b"\x1f\x8b":
+        raise InputError(f"{p.name}: is gzip-compressed; decompress it (gunzip) and give the CSV {kind}")
+    if data[:4] == b"PK\x03\x04":
+        raise InputError(f"{p.name}: is a zip archive (an Excel workbook?); save or extract it as a CSV {kind}")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as err:
+            raise InputError(f"{p.name}: starts as UTF-16 text but byte {err.start} is not UTF-16") from None
+    nul = data.find(b"\x00")
+    if nul >= 0:
+        raise InputError(f"{p.name}: is a binary file (a NUL byte at byte {nul}), not a CSV {kind}")
+    return data.decode("utf-8-sig", errors="surrogateescape")
+
+
+def _parse(p: Path, text: str, kind: str) -> tuple[list[str], list[list[str]], list[int]]:
+    """Header, data rows (each padded to the header's width) and the file line each row starts on."""
+    reader = csv.reader(io.StringIO(text, newline=""), skipinitialspace=True)
+    header, rows, lines = None, [], []
+    last = 0                                          # the line the previous record ended on
+    try:
+        for fields in reader:
+            start, last = last + 1, reader.line_num
+            if not fields or (len(fields) == 1 and not fields[0].strip()):    # a blank line
+                continue
+            if header is None:
+                header = [f.strip() for f in fields]
+                continue
+            if len(fields) > len(header):
+                if any(f.strip() for f in fields[len(header):]):
+                    raise InputError(f"{p.name}: line {start}: {len(fields)} fields, the header has "
+                                     f"{len(header)} (a separator inside a value? quote the value)")
+                fields = fields[:len(header)]
+            elif len(fields) < len(header):
+                fields = fields + [""] * (len(header) - len(fields))
+            rows.append(fields)
+            lines.append(start)
+    except csv.Error as err:
+        raise InputError(f"{p.name}: line {reader.line_num}: not a readable CSV {kind} ({err})") from None
+    if header is None:
+        raise InputError(f"{p.name}: file is empty, expected a CSV {kind} with a header line")
+    return header, rows, lines
+
+
+def _names(p: Path, header: list[str]) -> list[str]:
+    """Column names: unnamed columns become ``Unnamed: i``; a name given twice is refused."""
+    names, seen = [], {}
+    for i, name in enumerate(header):
+        if name == "":
+            names.append(f"Unnamed: {i}")
+            continue
+        if name in seen:
+            raise InputError(f"{p.name}: column '{show(name)}' appears more than once in the header "
+                             f"(columns {seen[name] + 1} and {i + 1}); remove or rename one")
+        seen[name] = i
+        names.append(name)
+    return names
+
+
+def _problem(cell: str) -> str:
+    """Why a cell that did not give a finite number was refused."""
+    if cell == "":
+        return "is empty"
+    if _BAD_BYTES.search(cell):
+        return f"'{show(cell)}' is not a number (it holds bytes that are not UTF-8 text)"
+    if cell.lower().lstrip("+-") in {"nan", "inf", "infinity"}:
+        return f"'{show(cell)}' is not a finite number"
+    try:
+        value = float(cell)
+    except ValueError:
+        return f"'{show(cell)}' is not a number"
+    if not np.isfinite(value):
+        return f"'{show(cell)}' overflows a floating-point number (beyond {_FLOAT_MAX:.3g})"
+    return f"'{show(cell)}' is not a number"
+
+
+def _numbers(cells: pd.Series) -> np.ndarray:
+    """Cells as floats (NaN where a cell is not a number; a literal beyond the float range is +-inf)."""
+    return pd.to_numeric(cells, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+
+
+_SEPARATORS = {";": "';'", "\t": "a tab", "|": "'|'"}
 
 
 def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int = 1,
                kind: str = "table") -> pd.DataFrame:
     """Read and validate a CSV table.
 
-    Checks, in order: the file exists and parses as CSV; every required column is present (a near-miss
-    name is suggested); every value in a described column is a finite number (no text, empty cell or NaN),
-    whole if the column is ``integer``, and within the column's range; there are at least ``min_rows``
-    rows.  Optional columns that are absent are simply not in the result.
+    Checks, in order: the file exists, is a regular file and text (not compressed, archived or binary) and parses as CSV; no
+    column name appears twice in the header; every required column is present (a near-miss name, or a
+    separator other than the comma, is pointed out); every value in a described (checked) column is a
+    finite number (no text, empty cell, NaN, infinity or a literal that overflows a float), whole if the
+    column is ``integer``, and within the column's range (``-LIMIT..LIMIT``, 1e12, where the column gives
+    none); there are at least ``min_rows`` rows.  Optional columns that are absent are simply not in the
+    result; informational columns (``checked=False``) and columns the list does not describe are not
+    checked (described informational ones become floats with NaN where a cell is not a number, others stay
+    text, with any byte that is not UTF-8 replaced by U+FFFD).  Where blank lines or quoted line breaks move
+    rows off ``row + 2``, ``frame.attrs["line_jumps"]`` records it (see :func:`where`).
     """
     p = Path(path)
     if not p.exists():
         raise InputError(f"{p}: no such file")
     if p.is_dir():
         raise InputError(f"{p}: is a folder, expected a CSV {kind}")
-    try:
-        raw = pd.read_csv(p, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except pd.errors.EmptyDataError:
-        raise InputError(f"{p.name}: file is empty, expected a CSV {kind} with a header line") from None
-    except (pd.errors.ParserError, UnicodeDecodeError) as err:
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise InputError(f"{p.name}: not a readable CSV {kind} ({first})") from None
-    raw.columns = [str(c).strip() for c in raw.columns]
-    dup = raw.columns[raw.columns.duplicated()].tolist()
-    if dup:
-        raise InputError(f"{p.name}: column '{dup[0]}' appears more than once in the header")
-    present = list(raw.columns)
+    if not p.is_file():                               # a device or a pipe (/dev/zero would never end)
+        raise InputError(f"{p}: is not a regular file, expected a CSV {kind}")
+    header, rows, lines = _parse(p, _decode(p, kind), kind)
+    names = _names(p, header)
     for col in columns:
-        if col.required and col.name not in present:
-            near = difflib.get_close_matches(col.name, present, n=1, cutoff=0.6)
-            hint = f"; did you mean to name '{near[0]}' '{col.name}'?" if near else ""
+        if col.required and col.name not in names:
+            near = difflib.get_close_matches(col.name, names, n=1, cutoff=0.6)
+            hint = f"; did you mean to name '{show(near[0])}' '{col.name}'?" if near else ""
+            sep = [w for s, w in _SEPARATORS.items() if len(names) == 1 and s in header[0]]
+            if sep:
+                hint += f"; the file seems to use {sep[0]} as the separator, a CSV {kind} uses commas"
+            found = ", ".join(show(n) for n in names)
+            found = found if len(found) <= 300 else found[:300] + " ..."
             raise InputError(f"{p.name}: missing column '{col.name}' ({col.unit or 'no unit'}); "
-                             f"found {', '.join(present) if present else 'no columns'}{hint}")
-    out = raw.copy()
-    for col in columns:
-        if col.name not in present:
+                             f"found {found}{hint}")
+    located = pd.DataFrame(index=pd.RangeIndex(len(rows)))
+    jumps = _jumps(lines)
+    if jumps:
+        located.attrs["line_jumps"] = jumps
+    cells = dict(zip(names, map(list, zip(*rows)))) if rows else {name: [] for name in names}
+    described = {col.name: col for col in columns}
+    out = {}
+    for name in names:
+        text = [v.strip() for v in cells[name]]
+        col = described.get(name)
+        if col is None:                               # not described: kept as text, never checked
+            if any(_BAD_BYTES.search(v) for v in text):
+                text = [v.encode("utf-8", "surrogateescape").decode("utf-8", "replace") for v in text]
+            out[name] = pd.Series(text, dtype=str)
             continue
-        text = raw[col.name].str.strip()
-        values = pd.to_numeric(text, errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            r = int(bad[0])
-            cell = text.iloc[r]
-            what = ("is empty" if cell == "" else
-                    f"'{cell}' is not a finite number" if cell.lower() in {"nan", "inf", "-inf", "+inf"}
-                    else f"'{cell}' is not a number")
-            raise InputError(f"{where(p, col.name, r)}: {what}")
-        if col.integer:
-            frac = np.flatnonzero(values != np.round(values))
-            if frac.size:
-                r = int(frac[0])
-                raise InputError(f"{where(p, col.name, r)}: {text.iloc[r]} is not a whole number")
-        outside = np.zeros(values.shape, bool)
-        if col.lo is not None:
-            outside |= values < col.lo
-        if col.hi is not None:
-            outside |= values > col.hi
-        if outside.any():
-            r = int(np.flatnonzero(outside)[0])
-            rng = f"{'' if col.lo is None else f'{col.lo:g}'}..{'' if col.hi is None else f'{col.hi:g}'}"
-            unit = f" {col.unit}" if col.unit else ""
-            raise InputError(f"{where(p, col.name, r)}: {text.iloc[r]} is outside {rng}{unit}")
-        out[col.name] = values
-    if len(out) < min_rows:
-        raise InputError(f"{p.name}: {len(out)} data row{'s' if len(out) != 1 else ''}, "
+        values = _numbers(pd.Series(text, dtype=object))
+        if col.checked:
+            _check(p, col, text, values, located)
+        out[name] = values
+    frame = pd.DataFrame(out, index=pd.RangeIndex(len(rows)))
+    if jumps:
+        frame.attrs["line_jumps"] = jumps
+    if len(frame) < min_rows:
+        raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
                          f"a {kind} needs at least {min_rows}")
-    return out
+    return frame
+
+
+def _check(p: Path, col: Column, text: list[str], values: np.ndarray, located: pd.DataFrame) -> None:
+    """A checked column's values: finite, whole if asked, within the range."""
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        r = int(bad[0])
+        raise InputError(f"{where(p, col.name, r, located)}: {_problem(text[r])}")
+    if col.integer:
+        frac = np.flatnonzero(values != np.round(values))
+        if frac.size:
+            r = int(frac[0])
+            raise InputError(f"{where(p, col.name, r, located)}: {show(text[r])} is not a whole number")
+    lo = -LIMIT if col.lo is None else col.lo
+    hi = LIMIT if col.hi is None else col.hi
+    outside = np.flatnonzero((values < lo) | (values > hi))
+    if outside.size:
+        r = int(outside[0])
+        unit = f" {col.unit}" if col.unit else ""
+        raise InputError(f"{where(p, col.name, r, located)}: {show(text[r])} is outside {lo:g}..{hi:g}{unit}")
+
+
+def require_variation(frame: pd.DataFrame, columns, path, what: str = "the model") -> None:
+    """Refuse a column that does not vary (a stuck sensor, a channel not connected, a constant written for
+    a missing one): one line naming the file, the column and its value."""
+    for c in columns:
+        if c in frame and len(frame) > 1:
+            v = frame[c].to_numpy(float)
+            if np.all(v == v[0]):
+                raise InputError(f"{Path(path).name}: column '{c}' is {v[0]:g} in all {len(v)} rows; {what} "
+                                 f"needs it to vary (a stuck sensor or an unconnected channel?)")
 
 
 def write_new_csv(frame: pd.DataFrame, path: str | os.PathLike, *, overwrite: bool = False,

@@ -28,8 +28,9 @@ COLUMNS = [Column("temperature_c", "degC", lo=-60.0, hi=130.0),
 def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -> pd.DataFrame:
     """Read and validate a tumble file.
 
-    Checks beyond :func:`navlib.data.tables.read_table`: ``position_deg`` below 360 and on the dividing
-    head's grid (a multiple of ``grid_deg`` within 1e-6 deg), ``unit`` present and non-empty.  Adds
+    Checks beyond :func:`navlib.data.tables.read_table` (limits: temperatures -60..130 degC, positions
+    0..360 deg, outputs +-5000 mg): ``position_deg`` not in radians (four or more positions all within
+    0..2 pi), below 360 and on the dividing head's grid (a multiple of ``grid_deg`` within 1e-6 deg), ``unit`` present and non-empty.  Adds
     ``set_point_c`` (the temperature rounded to 0.5 degC) when the file has none.
     """
     if not (0 < float(grid_deg) <= 180):
@@ -41,14 +42,17 @@ def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -
     unit = df["unit"].astype(str).str.strip()
     empty = np.flatnonzero(unit.to_numpy() == "")
     if empty.size:
-        raise InputError(f"{where(path, 'unit', int(empty[0]))}: is empty")
+        raise InputError(f"{where(path, 'unit', int(empty[0]), df)}: is empty")
     df["unit"] = unit
     q = df["position_deg"].to_numpy()
+    if q.max() <= 2 * np.pi + 1e-9 and len(np.unique(q)) >= 4:
+        raise InputError(f"{name}: column 'position_deg': every value is within 0..{2 * np.pi:.4f}; these look "
+                         f"like radians, the column must be in degrees")
     off = np.abs(q / grid_deg - np.round(q / grid_deg)) * grid_deg > 1e-6
     off |= q >= 360.0
     if off.any():
         r = int(np.flatnonzero(off)[0])
-        raise InputError(f"{where(path, 'position_deg', r)}: {q[r]:g} is not on the dividing head's "
+        raise InputError(f"{where(path, 'position_deg', r, df)}: {q[r]:g} is not on the dividing head's "
                          f"{grid_deg:g} deg grid (0 <= q < 360)")
     if "set_point_c" not in df.columns:
         df["set_point_c"] = np.round(df["temperature_c"].to_numpy() * 2) / 2

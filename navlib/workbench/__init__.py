@@ -20,7 +20,8 @@ the missing effect, add it, and watch the error fall.
 
 Adding a system (e.g. an accelerometer): write ``navlib/workbench/accelerometer.py`` that defines its
 catalogue (a dict of :class:`.Effect`), a loader ``load(path) -> DataFrame`` (one-line InputError naming file,
-column, row), ``fit(data, effects, start) -> Fit`` (use :func:`navlib.workbench.fit.best_least_squares`
+column, row; :func:`navlib.data.tables.read_table` with a finite range for every column the model uses, and
+plausibility checks of units and stuck sensors stated in its docstring), ``fit(data, effects, start) -> Fit`` (use :func:`navlib.workbench.fit.best_least_squares`
 from the previous parameters and a linearised start; add user effects with
 :func:`navlib.workbench.fit.user_columns`), and ``structure(fit) -> [(what, X, scale)]``; then call
 ``register_system(System(name, unit, catalogue, load, fit, structure, meaning))`` at the end of the module

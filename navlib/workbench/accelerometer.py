@@ -26,6 +26,7 @@ import os
 import numpy as np
 import pandas as pd
 
+from ..data.tables import require_variation
 from ..data.tumble import read_tumble, require_levels
 from ..errors import InputError
 from .effects import Effect, System, register_system
@@ -62,14 +63,56 @@ ACCELEROMETER_EFFECTS = {
 }
 
 
+#: The output must change by 1000 mg per g of input within this factor (paper D's units: 1001.7 and
+#: 1002.2 mg/g); outside it the output is in another unit or the input axis is reversed.
+SCALE_BAND = (0.5, 2.0)
+#: Units an output may have been written in by mistake, with the factor that converts them to mg.
+OUTPUT_UNITS = (("g", 1000.0), ("m/s^2", 1000.0 / 9.80665), ("ft/s^2", 1000.0 / 32.174), ("ug", 1e-3))
+
+
+def output_slope(df: pd.DataFrame) -> float:
+    """Least-squares slope (mg/g) of ``output_mg`` against the input ``a = cos q``, with a constant; rows
+    farther than 5 median absolute residuals from the line are set aside and the line refitted (up to four
+    times, never more than half of the rows), so that a few spikes do not pass for a unit."""
+    a = np.cos(np.deg2rad(df["position_deg"].to_numpy(float)))
+    y = df["output_mg"].to_numpy(float)
+    keep = np.ones(len(y), bool)
+    for _ in range(4):
+        coef = np.polyfit(a[keep], y[keep], 1)
+        e = np.abs(y - np.polyval(coef, a))
+        inside = e <= 5.0 * np.median(e[keep])
+        if np.array_equal(inside, keep) or inside.sum() < max(len(y) // 2, 3):
+            break
+        keep = inside
+    return float(coef[0])
+
+
 def load_accelerometer(path: str | os.PathLike) -> pd.DataFrame:
-    """A tumble file of ONE accelerometer (:func:`navlib.data.tumble.read_tumble`; at least 5 positions)."""
+    """A tumble file of ONE accelerometer (:func:`navlib.data.tumble.read_tumble`: temperature -60..130
+    degC, position on the 15-deg grid, output within +-5000 mg; at least 5 positions), with plausibility
+    checks of the output: it must vary (a stuck sensor), and its slope against the input ``a = cos q``
+    (:func:`output_slope`) must be 1000 mg/g within a factor of 2 (``SCALE_BAND``): a slope near 1 names g, near 9.8
+    m/s^2, near 31 ft/s^2, a negative one a reversed input axis."""
     df = read_tumble(path)
+    name = os.path.basename(str(path))
     units = list(dict.fromkeys(df["unit"]))
     if len(units) != 1:
-        raise InputError(f"{os.path.basename(str(path))}: column 'unit' names {len(units)} accelerometers "
+        raise InputError(f"{name}: column 'unit' names {len(units)} accelerometers "
                          f"({', '.join(units)}); the workbench fits one: give a file with one unit")
-    require_levels(df, positions=5, what="the accelerometer model", name=os.path.basename(str(path)))
+    require_levels(df, positions=5, what="the accelerometer model", name=name)
+    require_variation(df, ["output_mg"], path, "a tumble test")
+    slope = output_slope(df)
+    lo, hi = SCALE_BAND
+    if not lo * 1000.0 <= slope <= hi * 1000.0:
+        if slope < 0:
+            look = ("the output falls as the input rises: the input axis is reversed, or position_deg "
+                    "counts the other way (the input is a = cos q)")
+        else:
+            near = [(u, f) for u, f in OUTPUT_UNITS if lo * 1000.0 <= slope * f <= hi * 1000.0]
+            look = (f"the output looks like {near[0][0]} (multiply by {near[0][1]:.6g} for mg)" if near else
+                    "the output is not in mg (output divided by the nominal scale factor)")
+        raise InputError(f"{name}: column 'output_mg' changes by {slope:.4g} mg per g of input, where 1000 "
+                         f"is expected ({lo * 1000:g}..{hi * 1000:g} accepted): {look}")
     return df
 
 

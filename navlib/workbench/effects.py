@@ -43,15 +43,20 @@ top level of the file is loaded)::
 """
 from __future__ import annotations
 
+import contextlib
+import importlib.machinery
 import importlib.util
-from dataclasses import dataclass, field
+import sys
+import traceback
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
+from ..data.tables import show
+from ..errors import InputError, UserCodeError
 from ..sensors.planar import PLANAR_EFFECTS
 
 
@@ -74,7 +79,12 @@ class Effect:
     contribution : callable or None
         ``contribution(params: dict, data: DataFrame) -> ndarray``: what the effect adds to the measurement,
         in the system's unit and the measurement's shape.  Required for user effects; catalogued effects are
-        implemented by their system's model and leave it ``None``.
+        implemented by their system's model and leave it ``None``.  It is called through
+        :func:`call_contribution`: it gets a read-only copy of the data, and anything it raises or returns
+        that is not a finite array of the measurement's shape stops the run with one line naming
+        ``source`` and the effect.
+    source : str
+        Where a user effect was defined (the effects file's name, set by :func:`load_effects`), for messages.
     """
 
     name: str
@@ -85,13 +95,18 @@ class Effect:
     system: str | None = None
     contribution: Callable[[Mapping[str, float], pd.DataFrame], np.ndarray] | None = field(
         default=None, compare=False, repr=False)
+    source: str = field(default="", compare=False, repr=False)
 
     def __post_init__(self):
         if not str(self.name).isidentifier():
             raise InputError(f"effect name {self.name!r}: must be an identifier (letters, digits, _)")
-        object.__setattr__(self, "params", tuple(self.params))
-        object.__setattr__(self, "units", tuple(self.units))
-        object.__setattr__(self, "columns", tuple(self.columns))
+        for attr in ("params", "units", "columns"):          # a lone name, not its letters
+            value = getattr(self, attr)
+            object.__setattr__(self, attr, (value,) if isinstance(value, str) else tuple(value))
+            if not all(isinstance(v, str) and v for v in getattr(self, attr)):
+                raise InputError(f"effect '{self.name}': {attr} must be names (non-empty text)")
+        if len(set(self.params)) != len(self.params):
+            raise InputError(f"effect '{self.name}': a parameter is named twice in {self.params}")
         if not self.params or len(self.params) != len(self.units):
             raise InputError(f"effect '{self.name}': give one unit per parameter (got {len(self.params)} "
                              f"parameters, {len(self.units)} units)")
@@ -202,8 +217,9 @@ def catalogue_frame(effects: Mapping[str, Effect]) -> pd.DataFrame:
 
 def resolve(available: Mapping[str, Effect], names, data: pd.DataFrame | None = None,
             system: str = "") -> tuple[Effect, ...]:
-    """Validate effect names against ``available`` (unknown names, repeats, missing or constant columns) and
-    return the Effect objects in the order of ``available`` (catalogue first, then user effects)."""
+    """Validate effect names against ``available`` (unknown names, repeats, needed columns absent, not
+    numbers or constant) and return the Effect objects in the order of ``available`` (catalogue first, then
+    user effects)."""
     names = tuple(n.strip() for n in names if n and n.strip())
     for n in names:
         if n not in available:
@@ -212,49 +228,163 @@ def resolve(available: Mapping[str, Effect], names, data: pd.DataFrame | None = 
         raise InputError(f"effect listed twice in the model: {', '.join(names)}")
     if data is not None:
         for n in names:
-            for col in available[n].columns:
-                if col not in data:
-                    raise InputError(f"effect '{n}' needs the column '{col}', which the data do not have")
-                if np.ptp(data[col].to_numpy(float)) == 0:
-                    raise InputError(f"effect '{n}' needs '{col}' to vary, but it is constant in the data")
+            problem = column_problem(available[n], data)
+            if problem:
+                raise InputError(f"effect '{n}' needs {problem[1]}")
     return tuple(e for k, e in available.items() if k in names)
 
 
+def column_problem(effect: Effect, data: pd.DataFrame) -> tuple[str, str] | None:
+    """Why ``data`` cannot serve the columns ``effect`` needs, as ``(short, long)`` reasons, or None: a
+    column absent, holding something that is not a finite number in some row (an extra column no loader
+    checked), or constant."""
+    for col in effect.columns:
+        if col not in data:
+            return f"no column '{col}'", f"the column '{col}', which the data do not have"
+        values = pd.to_numeric(data[col], errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            cell = show(data[col].iloc[bad[0]])
+            return (f"'{col}' row {bad[0] + 1} is '{cell}', not a number",
+                    f"the column '{col}' to hold finite numbers, but row {bad[0] + 1} holds '{cell}'")
+        if np.ptp(values) == 0:
+            return f"'{col}' is constant", f"'{col}' to vary, but it is constant in the data"
+    return None
+
+
 def testable(available: Mapping[str, Effect], data: pd.DataFrame) -> tuple[dict, dict]:
-    """Split effects into those the data can test and those they cannot (with the reason)."""
+    """Split effects into those the data can test and those they cannot (with the reason: a needed column
+    absent, not a finite number in some row, or constant)."""
     ok, why = {}, {}
     for name, e in available.items():
-        missing = [c for c in e.columns if c not in data]
-        if missing:
-            why[name] = f"no column '{missing[0]}'"
-        elif any(np.ptp(data[c].to_numpy(float)) == 0 for c in e.columns):
-            why[name] = f"'{e.columns[0]}' is constant"
+        problem = column_problem(e, data)
+        if problem:
+            why[name] = problem[0]
         else:
             ok[name] = e
     return ok, why
 
 
+# ------------------------------------------------------------------------------------ users' own code
+def _copy_on_write() -> bool:
+    """pandas copies a frame's data before any write to a shallow copy (default from pandas 3)."""
+    return int(pd.__version__.split(".")[0]) >= 3 or pd.get_option("mode.copy_on_write") is True
+
+
+_SHALLOW = _copy_on_write()
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip()
+    return f"{type(err).__name__}: {show(text.splitlines()[0])}" if text else type(err).__name__
+
+
+def call_contribution(effect: Effect, params: Mapping[str, float], data: pd.DataFrame, shape) -> np.ndarray:
+    """``effect.contribution(params, data)`` as a float array of ``shape``, with the user's code fenced.
+
+    The contribution gets its own dictionary of parameters and a read-only copy of ``data`` (a shallow
+    copy under pandas' copy-on-write, so that assigning to it changes only the copy, and arrays taken from
+    it are read-only; a deep copy with older pandas): whatever it does to them cannot change the data the
+    fit and the other effects see.  Anything it prints goes to stderr (stdout may carry ``--json``).
+    Every failure -- an exception (``sys.exit`` included), a result that is not numbers (text, None), a
+    shape other than ``shape``, a NaN or an infinity -- raises :class:`navlib.errors.UserCodeError`, one
+    line naming the effect's file, the effect and, for a bad value, the row and the parameters."""
+    who = f"{effect.source or 'user effects'}: effect '{effect.name}'"
+    frame = data.copy(deep=not _SHALLOW)
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            out = effect.contribution(dict(params), frame)
+    except SystemExit as err:
+        raise UserCodeError(f"{who}: contribution called sys.exit({err.code!r})") from err
+    except Exception as err:                       # the user's code: any failure of it is theirs, named
+        hint = " (contributions get a read-only copy of the data)" if "read-only" in str(err) else ""
+        raise UserCodeError(f"{who}: contribution raised {_first_line(err)}{hint}") from err
+    if out is None:
+        raise UserCodeError(f"{who}: contribution returned None (a missing return?)")
+    arr = np.asarray(out)
+    if arr.dtype.kind not in "biuf":
+        kind = {"U": "text", "S": "bytes", "c": "complex numbers", "M": "dates", "m": "time spans"}.get(
+            arr.dtype.kind, f"{type(arr.flat[0]).__name__ if arr.size else 'empty'} objects")
+        v = arr.flat[0] if arr.size else None
+        first = show(repr(v.item() if isinstance(v, np.generic) else v))[:40] if arr.size else ""
+        raise UserCodeError(f"{who}: contribution returned {kind}{f' ({first}, ...)' if first else ''}, "
+                            f"not real numbers")
+    arr = arr.astype(float, copy=False)
+    if arr.shape != tuple(shape):
+        raise UserCodeError(f"{who}: contribution returned shape {arr.shape}, the measurement has shape "
+                            f"{tuple(shape)} (one value{' per axis' if len(shape) > 1 else ''} per row)")
+    bad = np.argwhere(~np.isfinite(arr))
+    if bad.size:
+        r = int(bad[0][0])
+        values = ", ".join(f"{k}={v:.6g}" for k, v in params.items())
+        raise UserCodeError(f"{who}: contribution returned {arr[tuple(bad[0])]} at row {r + 1} "
+                            f"(parameters {values})")
+    return arr
+
+
+def _user_line(err: BaseException, path: Path) -> str:
+    """The line of ``path`` the exception came from (the deepest frame in that file), or ''."""
+    lines = [f.lineno for f in traceback.extract_tb(err.__traceback__) if Path(f.filename).resolve() == path]
+    return f"line {lines[-1]}: " if lines else ""
+
+
 def load_effects(path, system: str, catalogue: Mapping[str, Effect]) -> tuple[Effect, ...]:
     """User effects from a Python file: every :class:`Effect` defined at its top level whose ``system`` is
-    ``system``.  Each needs a ``contribution``; names must not clash with the catalogue."""
+    ``system``, each with its ``source`` set to the file's name.
+
+    Refused in one line naming the file (and the effect): a file that cannot be imported (a syntax error,
+    an exception or an ImportError at import -- with the line -- or a call of ``sys.exit``); no effect for
+    ``system``; two effects with one name; a name or a parameter name already in the catalogue or in
+    another effect of the file; an effect without a ``contribution``.  Anything the file prints while it is
+    imported goes to stderr."""
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: no such effects file")
-    spec = importlib.util.spec_from_file_location(f"navlib_user_effects_{p.stem}", p)
+    module_name = "navlib_user_effects_" + "".join(c if c.isalnum() else "_" for c in p.stem)
+    loader = importlib.machinery.SourceFileLoader(module_name, str(p))
+    spec = importlib.util.spec_from_loader(module_name, loader)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module               # dataclasses and pickling look their module up
     try:
-        spec.loader.exec_module(module)
+        with contextlib.redirect_stdout(sys.stderr):
+            loader.exec_module(module)
     except SyntaxError as err:
         raise InputError(f"{p.name}: line {err.lineno}: {err.msg}") from None
-    found = tuple(v for v in vars(module).values() if isinstance(v, Effect) and v.system == system)
+    except SystemExit as err:
+        raise InputError(f"{p.name}: calls sys.exit({err.code!r}) while it is loaded; an effects file "
+                         f"should only define effects") from None
+    except Exception as err:                        # the user's file: any failure of it is theirs, named
+        raise InputError(f"{p.name}: {_user_line(err, p.resolve())}{_first_line(err)}") from err
+    finally:
+        sys.modules.pop(module_name, None)
+    named = {}                                      # each Effect object once, with its first variable name
+    for var, v in vars(module).items():
+        if isinstance(v, Effect) and id(v) not in named:
+            named[id(v)] = (var, v)
+    everything = list(named.values())
+    found = [(var, e) for var, e in everything if e.system == system]
     if not found:
-        raise InputError(f"{p.name}: defines no Effect with system='{system}'")
-    for e in found:
+        others = sorted({str(e.system) for _, e in everything})
+        what = (f"its effects are for system {', '.join(map(repr, others))}" if others
+                else "it defines no Effect at top level")
+        raise InputError(f"{p.name}: defines no Effect with system='{system}' ({what})")
+    taken = {q: f"the catalogue's '{e.name}'" for e in catalogue.values() for q in e.params}
+    names = {}
+    for var, e in found:
         if e.name in catalogue:
             raise InputError(f"{p.name}: effect '{e.name}' is already in the {system} catalogue; rename it")
+        if e.name in names:
+            raise InputError(f"{p.name}: two effects are named '{e.name}' (variables '{names[e.name]}' and "
+                             f"'{var}'); give each its own name")
+        names[e.name] = var
         if e.contribution is None:
             raise InputError(f"{p.name}: effect '{e.name}' has no contribution(params, data) function")
-    return found
+        for q in e.params:
+            if q in taken:
+                raise InputError(f"{p.name}: effect '{e.name}': parameter '{q}' is already a parameter of "
+                                 f"{taken[q]}; rename it")
+            taken[q] = f"effect '{e.name}'"
+    return tuple(replace(e, source=p.name) for _, e in found)
 
 
 #: The catalogues of the systems that have a simulator (compass, drift), by system name.

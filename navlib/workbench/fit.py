@@ -10,6 +10,7 @@ worse than the linearised model that motivated it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
@@ -19,11 +20,12 @@ from scipy.optimize import least_squares
 from ..angles import heading_deg, wrap_deg
 from ..data.compass_sweeps import load_sweeps
 from ..data.gyro_tables import USER_COLUMNS
-from ..data.tables import read_table
+from ..data.tables import read_table, require_variation
 from ..errors import InputError
 from ..sensors.ins import latitude_error_per_drift
 from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
-from .effects import COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, get_system, register_system, resolve
+from .effects import (COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, call_contribution, get_system,
+                      register_system, resolve)
 from .serial import ar1_noise
 
 RAD = 180.0 / np.pi
@@ -136,6 +138,19 @@ def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
     """Fit the named effects of ``system`` (a name or a :class:`.System`) to ``data`` (a validated frame,
     see :func:`load`); ``user_effects`` are extra effects (with a contribution) the names may refer to."""
     spec = get_system(system) if isinstance(system, str) else system
+    user_effects = tuple(user_effects)
+    taken = {q: f"effect '{e.name}'" for e in spec.catalogue.values() for q in e.params}
+    for i, e in enumerate(user_effects):
+        if e.name in spec.catalogue or any(u.name == e.name for u in user_effects[:i]):
+            raise InputError(f"{e.source or 'user effects'}: effect '{e.name}' is given twice (or is in the "
+                             f"{spec.name} catalogue); give each effect its own name")
+        if e.contribution is None:
+            raise InputError(f"{e.source or 'user effects'}: effect '{e.name}' has no contribution(params, data)")
+        for q in e.params:
+            if q in taken:
+                raise InputError(f"{e.source or 'user effects'}: effect '{e.name}': parameter '{q}' is already a "
+                                 f"parameter of {taken[q]}")
+            taken[q] = f"effect '{e.name}'"
     available = {**spec.catalogue, **{e.name: e for e in user_effects}}
     chosen = resolve(available, effects, data, spec.name)
     fit = spec.fit(data, chosen, start)
@@ -185,13 +200,12 @@ def lstsq(X: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def user_columns(effects, params: dict, data: pd.DataFrame, shape) -> np.ndarray:
-    """Sum of the user effects' contributions, flattened to the residual vector."""
+    """Sum of the user effects' contributions, flattened to the residual vector.  Each is called through
+    :func:`navlib.workbench.effects.call_contribution` (a read-only copy of the data; an exception, text,
+    NaN, infinity or a wrong shape stops the run with one line naming the effect's file and the effect)."""
     total = np.zeros(int(np.prod(shape)))
     for e in effects:
-        c = np.asarray(e.contribution({k: params[k] for k in e.params}, data), dtype=float)
-        if c.shape != tuple(shape):
-            raise InputError(f"effect '{e.name}': contribution has shape {c.shape}, the measurement {tuple(shape)}")
-        total += c.ravel()
+        total += call_contribution(e, {k: params[k] for k in e.params}, data, shape).ravel()
     return total
 
 
@@ -416,8 +430,44 @@ def drift_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     return out
 
 
+#: The earth-rate gain a drift table may show before its units are questioned (the textbook gain is 1;
+#: paper C's tests give 0.88), and the correlation above which the gain is measured well enough to judge.
+GAIN_BAND = (0.2, 5.0)
+GAIN_CORRELATION = 0.9
+#: Unit mistakes and the factor they put on the earth-rate gain.
+DRIFT_UNIT_MISTAKES = (("drift_deg_h in deg/s (multiply by 3600)", 1 / 3600.0),
+                       ("drift_deg_h in rad/h (multiply by 57.3)", np.pi / 180.0),
+                       ("latitude_error_deg in radians (multiply by 57.3)", 180.0 / np.pi),
+                       ("latitude_error_deg in arcmin (divide by 60)", 1 / 60.0))
+
+
 def load_drift(path) -> pd.DataFrame:
-    return read_table(path, USER_COLUMNS, min_rows=2, kind="drift table")
+    """A drift table (:data:`navlib.data.gyro_tables.USER_COLUMNS`: ``latitude_error_deg`` within +-1 deg,
+    ``drift_deg_h`` within +-1 deg/h, optional ``temperature_c`` -60..120 degC and ``temperature_change_c``
+    -180..180 degC; at least 2 rows), with two plausibility checks: the latitude error and the drift must
+    vary (a constant one is a stuck or missing measurement), and where the two are strongly related
+    (correlation above 0.9) the earth-rate gain ``g`` of ``drift = g dL12 / K`` (least squares with a
+    constant; 1 is the textbook relation of paper C's Table 1) must lie within 0.2..5: a gain of 1/3600,
+    1/57.3, 57.3 or 1/60 names the unit mistake, a negative one the sign convention."""
+    frame = read_table(path, USER_COLUMNS, min_rows=2, kind="drift table")
+    name = Path(path).name
+    require_variation(frame, ["latitude_error_deg", "drift_deg_h"], path, "the earth-rate model")
+    x = frame["latitude_error_deg"].to_numpy(float) / latitude_error_per_drift(12.0)
+    y = frame["drift_deg_h"].to_numpy(float)
+    if len(y) >= 4 and abs(np.corrcoef(x, y)[0, 1]) > GAIN_CORRELATION:
+        gain = float(np.polyfit(x, y, 1)[0])
+        lo, hi = GAIN_BAND
+        if gain < 0:
+            raise InputError(f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift falls as the 12 h "
+                             f"latitude error rises (earth-rate gain {gain:.3g}, textbook +1): the latitude error "
+                             f"must be indicated - true, and the drift of the same sign convention")
+        if not lo <= gain <= hi:
+            near = [what for what, f in DRIFT_UNIT_MISTAKES if 0.5 <= gain / f <= 2.0]
+            look = f"; {' or '.join(near)}?" if near else ""
+            raise InputError(f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift is {gain:.3g} times "
+                             f"what the 12 h latitude error implies (earth-rate gain; textbook 1, accepted "
+                             f"{lo:g}..{hi:g}){look}")
+    return frame
 
 
 SYSTEMS_BASE = {
@@ -439,9 +489,9 @@ def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 
     from 15 to 35 degC; ``noise`` is the heading noise in deg, added as field noise (so it is larger where
     the distorted horizontal field is weaker, as on a real compass): white, or with ``noise_correlation``
     an AR(1) process along the readings with that lag-1 correlation
-    (:func:`navlib.workbench.serial.ar1_noise`; the drift tables are no time series: 0 only).  drift: ``n`` tests (default 16) with
-    covariates spread like paper C's tables (12 h latitude error within +-0.05 deg, mean temperature
-    10..65 degC, temperature change 0..30 degC); ``noise`` in deg/h."""
+    (:func:`navlib.workbench.serial.ar1_noise`).  drift: ``n`` tests (default 16) with covariates spread like
+    paper C's tables (12 h latitude error within +-0.05 deg, mean temperature 10..65 degC, temperature
+    change 0..30 degC); ``noise`` in deg/h (no time series: ``noise_correlation`` must be 0)."""
     rng = np.random.default_rng(seed)
     if system == "compass":
         true = np.tile(np.arange(0.0, 361.0, 3.0), 2)

@@ -5,6 +5,7 @@ consistent with noise or nothing more can be named.  The CLI command ``loop`` an
 """
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -50,6 +51,18 @@ class LoopResult:
                 for s in self.final_diagnosis.structure if s.significant]
 
     @property
+    def untested(self) -> list[dict]:
+        """Effects (catalogued or the user's) the loop could not test on these data, with the reason (a
+        needed column absent, not numbers or constant; too few rows for one more parameter): every one any
+        step could not test, unless the final model holds it."""
+        why = {}
+        for d in self.diagnoses:
+            for name, reason in d.untestable.items():
+                if name not in self.final.effects:
+                    why.setdefault(name, reason)
+        return [{"effect": k, "why": v} for k, v in why.items()]
+
+    @property
     def consistent_with_noise(self) -> bool:
         return bool(self.final_diagnosis.consistent_with_noise)
 
@@ -66,9 +79,10 @@ class LoopResult:
 
     def to_dict(self) -> dict:
         """The ``--json`` schema: ``{"steps": [{"model", "rms", "loo_rms", "missing"}], "final": {"model",
-        "rms", "loo_rms", "consistent_with_noise", "unexplained"}, "outliers": [{"row", "column",
-        "residual", "robust_z"}], "rows", "rows_used", "noise": {...}, ...}`` (rms and residuals in the
-        system's unit; the screen's fields: :meth:`navlib.workbench.screen.Screening.to_dict`)."""
+        "rms", "loo_rms", "consistent_with_noise", "unexplained"}, "untested": [{"effect", "why"}],
+        "outliers": [{"row", "column", "residual", "robust_z"}], "rows", "rows_used", "noise": {...}, ...}``
+        (rms and residuals in the system's unit; ``untested``: :attr:`untested`; the screen's fields:
+        :meth:`navlib.workbench.screen.Screening.to_dict`)."""
         f = self.final
         out = {"system": f.system, "unit": f.unit,
                "steps": [{"model": list(fi.effects), "rms": fi.rms, "loo_rms": fi.loo_rms, "missing": d.missing}
@@ -76,7 +90,7 @@ class LoopResult:
                "final": {"model": list(f.effects), "rms": f.rms, "loo_rms": f.loo_rms,
                          "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
                          "message": self.final_diagnosis.message},
-               "outliers": self.outliers}
+               "untested": self.untested, "outliers": self.outliers}
         if self.screening is not None:
             extra = self.screening.to_dict()
             extra.pop("outliers")
@@ -166,14 +180,28 @@ def loop_figure(result: LoopResult):
 
 
 def check_report_folder(folder) -> tuple[Path, Path]:
-    """The report's two files in ``folder``; InputError if either exists (nothing is ever overwritten)."""
+    """The report's two files in ``folder``, checked before any work: InputError if ``folder`` (or the
+    nearest part of its path that exists) is a file, if either file exists (nothing is ever overwritten), or
+    if nothing can be written there (the nearest existing folder is tried with a temporary file, removed at
+    once; the report folder itself is created only when the report is written)."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
         raise InputError(f"{folder}: is a file, expected a folder for the report")
     png, md = folder / "loop.png", folder / "loop.md"
     for p in (png, md):
-        if p.exists():
+        if p.exists() or p.is_symlink():
             raise InputError(f"{p}: already exists; not overwritten (choose another --report folder)")
+    base = folder
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(f"{folder}: cannot be created, '{base}' is a file (choose another --report folder)")
+    try:
+        with tempfile.TemporaryFile(dir=base):
+            pass
+    except OSError as err:
+        raise InputError(f"{folder}: cannot write the report there (creating a file in {base} failed: "
+                         f"{err.strerror or type(err).__name__}); choose another --report folder") from None
     return png, md
 
 
@@ -192,6 +220,7 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     for i, (f, d) in enumerate(zip(result.fits, result.diagnoses)):
         lines.append(f"| {i} | {' + '.join(f.effects) or '(none)'} | {f.rms:.4g} | {f.loo_rms:.4g} | "
                      f"{d.missing or '-'} |")
+    lines += [""] + [f"Not tested: {u['effect']} ({u['why']})." for u in result.untested]
     sc = result.screening
     if sc is not None and sc.outliers:
         lines += ["", f"**Outliers:** {sc.outlier_line(unit)}."]

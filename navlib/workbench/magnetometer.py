@@ -34,7 +34,7 @@ import pandas as pd
 from scipy.spatial.transform import Rotation
 
 from ..angles import wrap_deg
-from ..data.tables import Column, read_table, where
+from ..data.tables import Column, read_table, require_variation, where
 from ..errors import InputError
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, lstsq, user_columns, user_design
@@ -75,32 +75,179 @@ _PARAMS = [p for e in MAGNETOMETER_EFFECTS.values() for p in e.params]
 BROAD_FIELD = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8}
 
 
+# Limits of the checked columns (a value outside is refused in one line naming file, column and row):
+# field +-1e6 uT (1 T, beyond any magnetometer's range; a file in nT still passes, so that the unit check
+# can name the unit), quaternion components +-1.5, rates +-1e5 deg/s, positions +-1e7 m, time +-1e10 s.
+# The other columns BROAD's files carry are informational (never refused).
+MAG_LIMIT_UT = 1e6
+#: The intensity of the field that follows the reference attitude must be within this band (uT): the
+#: Earth's field is 22-67 uT at the surface; a building changes it by a few tens of per cent.
+FIELD_BAND_UT = (10.0, 150.0)
+#: Units a field may have been written in by mistake, with the factor that converts them to uT.
+FIELD_UNITS = (("gauss or oersted", 100.0), ("mG", 0.1), ("nT", 1e-3), ("mT", 1e3), ("T", 1e6))
+#: The share of the field's variation the attitude must explain (through any fixed linear map of the
+#: axes, plus a constant); below it the columns are not a magnetometer turned with that attitude.
+MIN_EXPLAINED = 0.25
+#: Rows whose field is farther than this many times the median distance from the attitude fit are set aside
+#: before the checks (at most half of them; Gaussian noise reaches 5 medians with probability below 1e-9).
+TRIM = 5.0
+
+
 def quaternion_columns() -> list[Column]:
-    return ([Column(c, "uT") for c in MAG] + [Column(c, "", lo=-1.5, hi=1.5) for c in QUAT]
-            + [Column(c, "deg/s", required=False) for c in GYR] + [Column(c, "m", required=False) for c in POS]
-            + [Column("time_s", "s", required=False), Column("moving", "", required=False),
-               Column("magnet_attached", "", required=False), Column("att_blur", "", required=False)]
-            + [Column(c, "", required=False) for c in ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2", "ref_roll_deg",
-                                                        "ref_pitch_deg", "ref_heading_deg")])
+    return ([Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT) for c in MAG]
+            + [Column(c, "", lo=-1.5, hi=1.5) for c in QUAT]
+            + [Column(c, "deg/s", required=False, lo=-1e5, hi=1e5) for c in GYR]
+            + [Column(c, "m", required=False, lo=-1e7, hi=1e7) for c in POS]
+            + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10)]
+            + [Column(c, "", required=False, checked=False)
+               for c in ("moving", "magnet_attached", "att_blur", "acc_x_ms2", "acc_y_ms2", "acc_z_ms2",
+                         "ref_roll_deg", "ref_pitch_deg", "ref_heading_deg")])
 
 
 def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
     """Load and validate a 3-D magnetometer file with reference attitude.
 
-    One-line errors naming file, column and row: missing field or attitude columns; empty cells, text or
-    NaN; a quaternion whose norm is farther than 0.01 from 1; fewer than ``min_rows`` rows; too few
-    distinct orientations (fewer than 12 attitude cells of 30 deg, or no tilt of 10 deg) to separate the
-    hard iron from the local field."""
+    One-line errors naming file, column and row: missing field or attitude columns; empty cells, text,
+    NaN or infinity; a value outside its limits (field +-1e6 uT, quaternion components +-1.5, gyro
+    +-1e5 deg/s, position +-1e7 m, time +-1e10 s); a quaternion whose norm is farther than 0.01 from 1;
+    fewer than ``min_rows`` rows; too few distinct orientations (fewer than 12 attitude cells of 30 deg,
+    or no tilt of 10 deg) to separate the hard iron from the local field; and the plausibility checks of
+    :func:`check_field` (a stuck axis, a field that does not follow the attitude, axes in another frame
+    than FRD, a unit other than uT) and :func:`check_rates` (gyro rates in another unit than deg/s).  Informational columns (``moving``, ``magnet_attached``,
+    ``att_blur``, ``acc_*_ms2``, ``ref_*_deg``) and columns not named here are never refused."""
     frame = read_table(path, quaternion_columns(), min_rows=min_rows, kind="magnetometer file")
     q = frame[list(QUAT)].to_numpy(float)
     norm = np.linalg.norm(q, axis=1)
     bad = np.flatnonzero(np.abs(norm - 1.0) > QUAT_TOL)
     if bad.size:
         r = int(bad[0])
-        raise InputError(f"{where(path, 'q_w..q_z', r)}: quaternion norm "
+        raise InputError(f"{where(path, 'q_w..q_z', r, frame)}: quaternion norm "
                          f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})")
     check_orientations(frame, Path(path).name)
+    check_field(frame, Path(path).name)
+    check_rates(frame, Path(path).name)
     return frame
+
+
+#: Units a rate may have been written in by mistake, with the factor that converts them to deg/s.
+RATE_UNITS = (("rad/s", 180.0 / np.pi), ("mdeg/s", 1e-3), ("deg/h", 1 / 3600.0), ("rpm", 6.0))
+
+
+def check_rates(frame: pd.DataFrame, name: str = "data") -> None:
+    """Plausibility of the gyro columns (used by ``time_lag`` and the rate structure test), where the file
+    is a trajectory with times: the rate of the reference attitude between consecutive rows (rotation
+    angle over time step, rows at most 0.5 s apart; a trajectory when the median step is below 60 deg) is
+    compared with the mean ``|omega|`` of the two rows, over the rows turning faster than 5 deg/s (at
+    least 20).  The median ratio must lie within 0.5..2 (BROAD: 1.00-1.01); otherwise one line names the
+    unit that brings it there (rad/s x57.3, mdeg/s, deg/h, rpm) or says that the rates do not match."""
+    if "time_s" not in frame or not all(c in frame for c in GYR):
+        return
+    q = frame[list(QUAT)].to_numpy(float)
+    rot = Rotation.from_quat(q[:, [1, 2, 3, 0]] / np.linalg.norm(q, axis=1, keepdims=True))
+    step = np.degrees((rot[:-1].inv() * rot[1:]).magnitude())
+    dt = np.diff(frame["time_s"].to_numpy(float))
+    ok = (dt > 0) & (dt <= 0.5)
+    if ok.sum() < 20 or np.median(step[ok]) >= 60.0:
+        return
+    rate = step / np.where(ok, dt, 1.0)
+    w = np.linalg.norm(frame[list(GYR)].to_numpy(float), axis=1)
+    gyro = 0.5 * (w[:-1] + w[1:])
+    turning = ok & (rate > 5.0)
+    if turning.sum() < 20:
+        return
+    ratio = float(np.median(gyro[turning] / rate[turning]))
+    if 0.5 <= ratio <= 2.0:
+        return
+    near = [(u, f) for u, f in RATE_UNITS if 0.5 <= ratio * f <= 2.0]
+    look = (f"these look like {near[0][0]} (multiply by {near[0][1]:.6g} for deg/s)" if near else
+            "the gyro and the reference attitude disagree")
+    raise InputError(f"{name}: columns {', '.join(GYR)}: |omega| is {ratio:.3g} times the rate at which the "
+                     f"reference attitude turns (median over {int(turning.sum())} turning rows; 0.5..2 accepted): "
+                     f"{look}")
+
+
+_AXES = ("x", "y", "z")
+
+
+def _signed_permutation(M: np.ndarray) -> np.ndarray | None:
+    """The signed permutation matrix nearest to ``M`` (each row's largest entry), or None if the rows do
+    not pick three different axes."""
+    k = np.argmax(np.abs(M), axis=1)
+    if len(set(k.tolist())) != 3:
+        return None
+    P = np.zeros((3, 3))
+    P[np.arange(3), k] = np.sign(M[np.arange(3), k])
+    return P
+
+
+def check_field(frame: pd.DataFrame, name: str = "data") -> None:
+    """Plausibility of the field columns; each failure is one line naming the columns and what they look
+    like.  Method: linear least squares of the field on the reference attitude ``C = C_n^b``.
+
+    1. No axis may be constant (a stuck or unconnected axis).  The fits below set aside rows farther than
+       ``TRIM`` (5) median distances from the fit (refitted up to four times, never more than half of the
+       rows), so that a few spikes are left to the outlier screening and not mistaken for a unit.
+    2. The field must follow the attitude: ``m_j = sum_kl W_jkl C_kl + b_j`` (any fixed linear map of the
+       axes, soft iron and misalignment included, plus a constant) must explain at least ``MIN_EXPLAINED``
+       (25 %) of the field's variation (the undisturbed BROAD trials: more than 97 %; trial 32, with a
+       magnet attached and removed during the recording: 57 %).
+    3. The axes must be FRD: ``W_jkl = M_jk n_l`` is factorised (the leading singular pair; ``n`` taken
+       with a northward component); if the signed permutation nearest to ``M`` is not the identity and
+       ``M`` is within 0.5 of it (Frobenius), the axes are in another frame (FLU, swapped or reversed axes)
+       and the message says how each axis reads.
+    4. The unit must be uT: the intensity ``|m_n|`` of the field that follows the attitude
+       (``m = C m_n + b``) must lie in ``FIELD_BAND_UT`` (10-150 uT; the Earth's field is 22-67 uT, BROAD's
+       room 43-55 uT); outside it the message names the unit that brings it into the band (gauss or
+       oersted x100, mG x0.1, nT x0.001, mT x1000, T x1e6) and the median ``|m|``.
+    """
+    require_variation(frame, MAG, name, "a magnetometer turned through many attitudes")
+    m = frame[list(MAG)].to_numpy(float)
+    C = body_from_nav(frame)
+    cols = "columns mag_x_ut, mag_y_ut, mag_z_ut"
+    X = np.column_stack([C.reshape(len(m), 9), np.ones(len(m))])
+    keep = np.ones(len(m), bool)
+    for _ in range(4):                               # set wild rows aside (a spike must not pass for a unit)
+        W = np.column_stack([lstsq(X[keep], m[keep, j]) for j in range(3)])          # (10, 3)
+        e = np.linalg.norm(m - X @ W, axis=1)
+        inside = e <= TRIM * np.median(e[keep])
+        if np.array_equal(inside, keep) or inside.sum() < len(m) // 2:
+            break
+        keep = inside
+    m, C, X = m[keep], C[keep], X[keep]
+    explained = 1.0 - float(np.sum((m - X @ W) ** 2)) / float(np.sum((m - m.mean(axis=0)) ** 2))
+    if explained < MIN_EXPLAINED:
+        raise InputError(f"{name}: {cols}: the reference attitude explains only {100 * max(explained, 0.0):.0f} "
+                         f"% of the field's variation (a magnetometer turned with it: more than "
+                         f"{100 * MIN_EXPLAINED:.0f} %); a stuck or disconnected sensor, or the attitude of "
+                         f"another body or time?")
+    # W[k*3 + l, j] = M_jk n_l: rows (j, k), columns l
+    G = W[:9].T.reshape(3, 3, 3).reshape(9, 3)
+    u, s, vt = np.linalg.svd(G, full_matrices=False)
+    M, n = u[:, 0].reshape(3, 3) * np.sqrt(3.0), vt[0] * s[0] / np.sqrt(3.0)
+    if n[0] < 0:
+        M, n = -M, -n
+    P = _signed_permutation(M)
+    if (P is not None and not np.array_equal(P, np.eye(3)) and np.linalg.norm(M - P) < 0.5
+            and n[0] > 0.2 * np.linalg.norm(n)):
+        k = np.argmax(np.abs(P), axis=1)
+        said = " and ".join(f"{MAG[j]} holds {'-' if P[j, k[j]] < 0 else ''}{_AXES[k[j]]}" for j in range(3)
+                            if not (k[j] == j and P[j, k[j]] > 0))
+        hint = (" (FLU: y left, z up; multiply y and z by -1)"
+                if np.array_equal(P, np.diag([1.0, -1.0, -1.0])) else "")
+        raise InputError(f"{name}: {cols}: the axes are not FRD (x forward, y right, z down): the field "
+                         f"follows the attitude only if {said}{hint}; convert the axes to FRD")
+    Xf = np.column_stack([C[:, :, j].reshape(-1) for j in range(3)]
+                         + [np.tile(np.eye(3)[j], len(m)) for j in range(3)])
+    intensity = float(np.linalg.norm(lstsq(Xf, m.ravel())[:3]))
+    lo, hi = FIELD_BAND_UT
+    if not lo <= intensity <= hi:
+        median = float(np.median(np.linalg.norm(m, axis=1)))
+        units = [(unit, f) for unit, f in FIELD_UNITS if lo <= intensity * f <= hi]
+        look = (f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)" if units
+                else "this is not a field in uT")
+        raise InputError(f"{name}: {cols}: the field that follows the attitude has an intensity of "
+                         f"{intensity:.4g} (median |m| {median:.4g}), where the Earth's field is 22-67 uT "
+                         f"and {lo:g}-{hi:g} uT is accepted: {look}")
 
 
 def body_from_nav(frame: pd.DataFrame) -> np.ndarray:
@@ -166,6 +313,10 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
     cat = tuple(e.name for e in effects if e.contribution is None)
     users = tuple(e for e in effects if e.contribution is not None)
     names = list(FIELD) + [p for e in cat for p in MAGNETOMETER_EFFECTS[e].params] + [p for e in users for p in e.params]
+    clash = sorted({n for n in names if names.count(n) > 1})
+    if clash:
+        raise InputError(f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
+                         f"not be named like the local field {', '.join(FIELD)})")
     m = data[list(MAG)].to_numpy(float)
     C = body_from_nav(data)
     shape = m.shape
