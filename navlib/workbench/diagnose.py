@@ -31,8 +31,11 @@ serial correlation is modelled (AR(p) by restricted maximum likelihood, :mod:`na
 With correlated noise every F test above -- candidates, structure, conditional -- is computed by
 generalised least squares: on the whitened residual ``W r``, whitened Jacobians ``W J`` and whitened
 shapes ``W X``, with each model's residual first freed of what its whitened Jacobian can absorb (one
-Gauss-Newton step of the GLS fit from the least-squares solution; exact for a linear model).  Independent
-samples (``W = I``) give the least-squares tests unchanged.
+Gauss-Newton step of the GLS fit from the least-squares solution; exact for a linear model), and each
+p-value is the largest over the estimated correlation and the two ends of its 90 % profile-likelihood
+interval (:meth:`navlib.workbench.serial.NoiseModel.variants`; a p-value maximised over a confidence set of
+the nuisance parameter, Berger and Boos 1994), because the F statistic of a slow shape is very sensitive to
+a correlation near 1.  Independent samples (``W = I``) give the least-squares tests unchanged.
 
 The effect to add (``missing``) is the significant candidate with the strongest evidence (smallest p) that
 also improves the held-out RMS *and* explains what it claims.  If the residual shows significant structure,

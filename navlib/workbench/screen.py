@@ -252,16 +252,15 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     n = len(data)
     scale = measurement_scale(fit, data)
     floor = FLOOR_REL * scale
-    models = _richest(fit)
-    rich = _fit_rich(fit, data, models)
+    rich = _fit_rich(fit, data, _richest(fit)) if outliers or serial else None
     kept = np.arange(n)
     found: list[Outlier] = []
     note = ""
     c = cutoff(rich.n, rich.n - rich.n_params) if rich is not None else None
-    if rich is None:
-        note = f"not run: fewer than {MIN_DOF} residual degrees of freedom"
-    elif not outliers:
+    if not outliers:
         note = "not run"
+    elif rich is None:
+        note = f"not run: fewer than {MIN_DOF} residual degrees of freedom"
     elif fit.system not in MEASURED:
         note = f"not run: system '{fit.system}' names no measured columns"
     zk = None
