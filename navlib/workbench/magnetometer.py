@@ -532,7 +532,7 @@ def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: flo
     shape, changes slowly from sample to sample, as in BROAD's hand-held trials); the field follows the
     model of the module docstring with ``params`` (plus the local field, default BROAD's room) and AR(1)
     noise of marginal standard deviation ``noise_ut`` and lag-1 correlation ``noise_correlation``
-    (:func:`ar1_noise`, the same process on each axis, independent between axes).  Columns as a BROAD
+    (:func:`navlib.workbench.serial.ar1_noise`, the same process on each axis, independent between axes).  Columns as a BROAD
     3-D file: ``time_s``, quaternion, gyro, field."""
     for name, value, lo in (("duration_s", duration_s, 0.0), ("rate_hz", rate_hz, 0.0),
                             ("turn_rate_dps", turn_rate_dps, 0.0), ("turn_time_s", turn_time_s, 0.0)):

@@ -27,7 +27,7 @@ inflates everyone's residuals).  In a time series (``time_s``, or a magnetometer
 must also stand out from its neighbours in time -- the robust z of ``u_t`` minus the median of the samples
 within :data:`ISOLATION` of it must exceed ``c`` too (a Hampel filter, Pearson 2002, IEEE Trans. Control
 Syst. Technol. 10:55) -- and be isolated: no other sample within :data:`ISOLATION` samples has a robust
-|z| above ``c`` (nor above a tenth of its own).  A spike is; a physical disturbance that lasts two samples
+``|z|`` above ``c`` (nor above a tenth of its own).  A spike is; a physical disturbance that lasts two samples
 or more (a magnet passed at close range) is not, and stays in the data for the structure tests.  The
 screen is iterated (Rousseeuw and Leroy 1987, *Robust Regression and Outlier Detection*, ch. 6:
 reweighted least squares): the rows flagged whose ``|z|`` is within a factor :data:`DOMINANCE` of the
@@ -46,7 +46,7 @@ called noise without a test (round-off of float arithmetic is ~1e-16 of the valu
 **Serial correlation.**  :mod:`navlib.workbench.serial`: an AR(p) model of the noise estimated by REML from
 the richest model's residuals with the model's Jacobian *and the system's structure shapes* as regressors
 (so a slow structure outside the catalogue is not mistaken for correlated noise, and stays testable), and
-without the observations whose robust |z| exceeds :data:`Z_NOISE` (3.5, the "potential outlier" cutoff of
+without the observations whose robust ``|z|`` exceeds :data:`Z_NOISE` (3.5, the "potential outlier" cutoff of
 Iglewicz and Hoaglin 1993, *How to Detect and Handle Outliers*): the noise model describes the bulk of
 the data, so a localised disturbance (a magnet passed at close range) is not taken for strongly
 correlated noise that would then hide it.
@@ -65,7 +65,7 @@ from .effects import testable
 from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
 from .serial import NoiseModel, estimate, series_of
 
-#: Lowest robust |z| that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
+#: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
 #: 2e-9; real sensor noise has heavier tails (the slow undisturbed BROAD trials reach 5.8) and stays below,
 #: while an outlier that matters to an F test (one that inflates the residual sum of squares) lies far above.
 Z_MIN = 6.0
@@ -75,9 +75,9 @@ OUTLIER_ALPHA = 0.01
 MAX_OUTLIER_SHARE = 0.05
 #: Fewest residual degrees of freedom of the screening model for the screen to run.
 MIN_DOF = 10
-#: Each round sets aside the flagged rows whose |z| is at least the largest |z| divided by this.
+#: Each round sets aside the flagged rows whose ``|z|`` is at least the largest ``|z|`` divided by this.
 DOMINANCE = 10.0
-#: Observations with a robust |z| above this are left out of the noise model's estimate (they are what the
+#: Observations with a robust ``|z|`` above this are left out of the noise model's estimate (they are what the
 #: tests look at, not the noise; 3.5 is Iglewicz and Hoaglin's cutoff for a potential outlier).
 Z_NOISE = 3.5
 #: Residuals whose RMS is at most this share of the RMS of the measured values are noise.
@@ -105,6 +105,7 @@ class Outlier:
     z: float
 
     def to_dict(self) -> dict:
+        """``{"row", "column", "residual", "robust_z"}``."""
         return {"row": self.row, "column": self.column, "residual": self.residual, "robust_z": self.z}
 
 
@@ -113,7 +114,7 @@ class Screening:
     """What :func:`screen` found on one data set.
 
     ``data``: the rows kept (original index); ``kept``: their 0-based positions in the data screened;
-    ``outliers``: the observations set aside; ``cutoff``: the |z| that flags one; ``model``: the effects
+    ``outliers``: the observations set aside; ``cutoff``: the ``|z|`` that flags one; ``model``: the effects
     of the screening (richest) model; ``noise``: the serial-correlation model the tests whiten with;
     ``scale``, ``floor``: RMS of the measured values and the numerical floor (``FLOOR_REL * scale``);
     ``note``: why the screen did not run, if it did not; ``rich``: the richest model fitted to ``data``."""
@@ -132,6 +133,7 @@ class Screening:
 
     @property
     def rows_set_aside(self) -> list[int]:
+        """The rows set aside (1-based, sorted)."""
         return sorted({o.row for o in self.outliers})
 
     def refit(self, fit: Fit) -> Fit:
@@ -153,6 +155,9 @@ class Screening:
                 f"{shown}{more}")
 
     def to_dict(self) -> dict:
+        """The screen in ``--json``: ``rows`` (given), ``rows_used``, ``outliers``, ``outlier_cutoff`` (None if
+        the screen did not run), ``screening_model``, ``numerical_floor``, ``noise``
+        (:meth:`navlib.workbench.serial.NoiseModel.to_dict`), ``screen_note``."""
         return {"rows": self.n_rows, "rows_used": int(len(self.kept)),
                 "outliers": [o.to_dict() for o in self.outliers], "outlier_cutoff": self.cutoff,
                 "screening_model": list(self.model), "numerical_floor": self.floor,
@@ -160,7 +165,7 @@ class Screening:
 
 
 def cutoff(n_obs: int, dof: int) -> float:
-    """The robust |z| above which one of ``n_obs`` observations with ``dof`` residual degrees of freedom
+    """The robust ``|z|`` above which one of ``n_obs`` observations with ``dof`` residual degrees of freedom
     is an outlier (module docstring)."""
     nu = max(MAD_EFFICIENCY * dof, 1.0)
     return float(max(Z_MIN, stats.t.isf(OUTLIER_ALPHA / (2 * max(n_obs, 1)), nu)))
@@ -288,7 +293,7 @@ def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
 
 
 def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system: str) -> np.ndarray:
-    """In a time series, the rows whose largest robust |z| (``size``) no other row within ``ISOLATION``
+    """In a time series, the rows whose largest robust ``|z|`` (``size``) no other row within ``ISOLATION``
     samples of their segment comes near: none there exceeds ``max(c, size / DOMINANCE)``.  A run of large
     residuals is an event, left to the structure tests; the lesser residuals a huge spike causes around it
     in a fit it distorts do not hide the spike."""

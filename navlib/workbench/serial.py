@@ -236,6 +236,9 @@ class NoiseModel:
         return out
 
     def to_dict(self) -> dict:
+        """The noise model in ``--json``: what ordered the series (``time_s``, ``file order`` or None), AR
+        order, partial autocorrelations, lag-1 correlation and its interval, the variance inflation of a
+        slow shape and the effective number of samples."""
         return {"series": self.series.source if self.series is not None else None, "ar_order": self.order,
                 "partial_autocorrelations": [float(k) for k in self.kappa], "lag1_correlation": self.lag1,
                 "lag1_interval": [float(k) for k in self.bounds], "variance_inflation": self.inflation,
