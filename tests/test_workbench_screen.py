@@ -278,3 +278,40 @@ def test_a_table_too_short_to_screen_says_so(tmp_path):
         assert r.returncode == 0, r.stderr
         out = json.loads(r.stdout)
         assert out["outliers"] == [] and out["screen_note"].startswith("not run") and out["outlier_cutoff"] is None
+
+
+def _ar_correlation(kappa, n):
+    """The correlation matrix of a stationary AR process with partial autocorrelations ``kappa``."""
+    phi, v = serial.levinson(kappa)
+    p = len(kappa)
+    rho = np.zeros(n)
+    rho[0] = 1.0
+    for k in range(1, p + 1):                     # Durbin-Levinson backwards: rho from the order-k coefficients
+        rho[k] = sum(phi[k - 1, j] * rho[k - j] for j in range(1, k)) + kappa[k - 1] * v[k - 1]
+    for k in range(p + 1, n):
+        rho[k] = sum(phi[p, j] * rho[k - j] for j in range(1, p + 1))
+    return np.array([[rho[abs(i - j)] for j in range(n)] for i in range(n)])
+
+
+@pytest.mark.parametrize("kappa", [(0.7,), (0.9, -0.4), (0.5, 0.3, -0.2)])
+def test_whitening_is_the_inverse_cholesky_factor_on_every_segment(kappa):
+    """``whiten`` against the textbook: on each segment ``W = L^-1`` with ``L L' = R`` the AR correlation."""
+    t = np.r_[0.1 * np.arange(7), 10.0 + 0.1 * np.arange(12)]               # two segments, 7 and 12 samples
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), len(t), "magnetometer")
+    x = np.random.default_rng(1).standard_normal((len(t), 2))
+    w = serial.whiten(x, kappa, ser)
+    for a, b in ((0, 7), (7, 19)):
+        L = np.linalg.cholesky(_ar_correlation(kappa, b - a))
+        assert np.allclose(w[a:b], np.linalg.solve(L, x[a:b]))
+
+
+def test_the_fast_restricted_likelihood_equals_the_direct_one():
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], 200))
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(rng.random(600) < 0.03)
+    Q = np.linalg.qr(rng.standard_normal((600, 6)))[0]
+    r = rng.standard_normal(600)
+    for order in (1, 2, 3):
+        fast = serial._Restricted(r, Q, ser, order)
+        for kappa in ((), (0.6,), (0.8, -0.3), (0.2, 0.3, -0.4))[:order + 1]:
+            assert fast(kappa) == pytest.approx(serial._restricted_loglik(kappa, r, Q, ser), rel=1e-10)
