@@ -126,6 +126,7 @@ def load_cold_test(path=None) -> pd.DataFrame:
     return load_table(5, path)
 
 
+#: The columns of a user's drift table (what ``python -m navlib loop drift FILE`` reads), with their limits.
 USER_COLUMNS = [
     Column("latitude_error_deg", "deg", lo=-1.0, hi=1.0),
     Column("drift_deg_h", "deg/h", lo=-1.0, hi=1.0),
