@@ -194,6 +194,16 @@ def exact(value: float) -> Estimate:
     return Estimate(v, v, v, "exact", 1)
 
 
+def attempt(fn: Callable[..., Estimate], *args) -> tuple[Estimate | None, str]:
+    """``(fn(*args), "")``, or ``(None, reason)`` when ``fn`` refuses its data (too few runs for a 95 %
+    interval, pairs from different runs): the claim built on it then has no statistic, cannot be judged,
+    and says why."""
+    try:
+        return fn(*args), ""
+    except InputError as err:
+        return None, f"no 95 % interval: {err}"
+
+
 # ------------------------------------------------------------------------------------------ the rule
 @dataclass(frozen=True)
 class Floor:

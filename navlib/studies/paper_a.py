@@ -581,14 +581,20 @@ def paired_by_seed(a: pd.Series, b: pd.Series) -> tuple[np.ndarray, np.ndarray]:
     return a.loc[common].to_numpy(float), b.loc[common].to_numpy(float)
 
 
-def paired_rms_difference(runs: pd.DataFrame, worse: str, better: str, col: str = "rms_deg") -> verdicts.Estimate:
-    """"``better`` beats ``worse``" as a statistic: the median over seeds of ``col(worse) - col(better)``
-    (the RMS by default) with its 95 % interval, paired by seed (:func:`paired_by_seed`); positive when
-    ``better`` has the smaller error.  Two deterministic methods give their exact difference."""
-    w, b = paired_by_seed(per_seed(runs, worse, col), per_seed(runs, better, col))
+def paired_seed_difference(worse: pd.Series, better: pd.Series) -> verdicts.Estimate:
+    """The median over seeds of ``worse - better`` with its 95 % interval, two per-seed series paired by
+    :func:`paired_by_seed`; two deterministic runs (one pair) give their exact difference."""
+    w, b = paired_by_seed(worse, better)
     if w.size == 1:
         return verdicts.exact(w[0] - b[0])
     return verdicts.paired_difference(w, b)
+
+
+def paired_rms_difference(runs: pd.DataFrame, worse: str, better: str, col: str = "rms_deg") -> verdicts.Estimate:
+    """"``better`` beats ``worse``" as a statistic: the median over seeds of ``col(worse) - col(better)``
+    (the RMS by default) with its 95 % interval, paired by seed (:func:`paired_seed_difference`); positive
+    when ``better`` has the smaller error."""
+    return paired_seed_difference(per_seed(runs, worse, col), per_seed(runs, better, col))
 
 
 def ordering_rate(runs: pd.DataFrame, ls: str, bp: str, de: str, ade: str) -> verdicts.Estimate:
@@ -613,15 +619,6 @@ def width_estimate(runs: pd.DataFrame, method: str) -> verdicts.Estimate:
     95 % interval, or the exact value of a deterministic method on the fixed sweeps."""
     w = per_seed(runs, method, "width_deg")
     return verdicts.exact(w.iloc[0]) if list(w.index) == [-1] else verdicts.median_ci(w.to_numpy())
-
-
-def _estimate(fn, *args) -> tuple[verdicts.Estimate | None, str]:
-    """``(fn(*args), "")``, or ``(None, reason)`` when the runs are too few for a 95 % interval (the claim
-    then cannot be judged, and says why)."""
-    try:
-        return fn(*args), ""
-    except InputError as err:
-        return None, f"too few runs for a 95 % interval ({err})"
 
 
 def _rng(r) -> str:
@@ -660,7 +657,7 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
                  ("BP beats 8-position LS", bp, ls, "BP network", "8-position least squares", "bp_ls"),
                  ("ADE-BP beats 8-position LS", ade, ls, "ADE-BP", "8-position least squares", "ade_ls")]
         for text, better, worse, pb, pw, key in pairs:
-            est, short = _estimate(paired_rms_difference, runs, worse, better)
+            est, short = verdicts.attempt(paired_rms_difference, runs, worse, better)
             rb, rw = per_seed(runs, better), per_seed(runs, worse)
             dec = (how, TRAINING_ONLY) + (("our compass: hard iron a third of the horizontal field limits "
                                             "the 8-position LS's five coefficients",) if worse == ls else ())
@@ -696,7 +693,7 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
                 p_ = pr.loc[prow]
                 width = float(p_.error_max_deg - p_.error_min_deg)
                 g = frame[frame.method == mid]
-                est, short = _estimate(width_estimate, frame, mid)
+                est, short = verdicts.attempt(width_estimate, frame, mid)
                 fl = _floor(phys, width, noise, floor)
                 out.append(Claim(f"{name} error within the paper's range, {level_name} noise{nz}",
                                  _rng(p_) + " deg", reading=reading, source="paper",

@@ -461,14 +461,6 @@ def improvement_pct(bp, kf) -> verdicts.Estimate:
     return verdicts.Estimate(100 * (1 - r.value), 100 * (1 - r.hi), 100 * (1 - r.lo), r.rule, r.n)
 
 
-def _try(fn, *args) -> tuple[verdicts.Estimate | None, str]:
-    """``fn(*args)`` and no reason, or None and the reason there is no interval (e.g. too few runs)."""
-    try:
-        return fn(*args), ""
-    except InputError as err:
-        return None, f"no 95 % interval: {err}"
-
-
 def claims(data: StudyData) -> list[report.Claim]:
     """The paper's claims and the book's own, each judged by the one rule of :mod:`navlib.verdicts`.
 
@@ -498,7 +490,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     for case, feats, tag in (("level_raw45", "45 gains", "45"), ("level_qr6", "6 QR", "6")):
         for mode in ("held-out", "same run"):
             held = mode == "held-out"
-            est, why = _try(improvement_pct, *_paired(per_run(data, case, mode, "BPKF"),
+            est, why = verdicts.attempt(improvement_pct, *_paired(per_run(data, case, mode, "BPKF"),
                                                       per_run(data, case, mode, "KF")))
             out.append(report.Claim(
                 f"BPKF beats KF by > {thr:g} % (level, {feats})", f"> {thr:g} % (with and without QR)",
@@ -511,7 +503,7 @@ def claims(data: StudyData) -> list[report.Claim]:
                 why=why, key=f"cel_imp{tag}_{'held' if held else 'same'}"))
 
     t45, t6 = timing_pairs(data)
-    est, why = _try(verdicts.paired_ratio, t45, t6)
+    est, why = verdicts.attempt(verdicts.paired_ratio, t45, t6)
     if est is not None:
         ten, _ = verdicts.decide(est.interval, 10.0, "above")
         why = (f"the paper calls its {ratio_p:.1f}x an order of magnitude; against 10x: "
@@ -528,7 +520,7 @@ def claims(data: StudyData) -> list[report.Claim]:
                     "this machine and its load during the build"),
         why=why, key="cel_time", volatile=True))
 
-    est, why = _try(verdicts.paired_difference, *_paired(per_run(data, "level_raw45", "held-out", "BPKF"),
+    est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "level_raw45", "held-out", "BPKF"),
                                                         per_run(data, "level_qr6", "held-out", "BPKF")))
     out.append(report.Claim(
         "6 QR features no less accurate than 45 raw gains", "not worse, slightly better",
@@ -537,7 +529,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         estimate=est, boundary=0.0, holds_when="above", unit="arcsec", decided_by=(device, trainer),
         why=why, key="cel_qr"))
 
-    est, why = _try(verdicts.paired_difference, *_paired(per_run(data, "sturn_qr6", "held-out", "BPKF", "yaw"),
+    est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "sturn_qr6", "held-out", "BPKF", "yaw"),
                                                         per_run(data, "sturn_qr6_rate", "held-out", "BPKF", "yaw")))
     out.append(report.Claim(
         "Angular-rate inputs improve yaw in S-manoeuvres", "yaw error drops (Figs 6-9)",
@@ -551,12 +543,12 @@ def claims(data: StudyData) -> list[report.Claim]:
     worst = "median over held-out runs (too few runs for a high quantile) of the per-run largest per-angle RMS (1 sigma), arcsec"
     w9 = per_run(data, "sturn_qr6_rate", "held-out", "BPKF", "worst")
     wkf = per_run(data, "sturn_qr6_rate", "held-out", "KF", "worst")
-    est_kf, why_kf = _try(verdicts.median_ci, wkf.to_numpy())
+    est_kf, why_kf = verdicts.attempt(verdicts.median_ci, wkf.to_numpy())
     kf_claim = report.Claim(
         f"The plain KF (no network) is within {bound:g} arcsec too", "(not in the paper)", source="book",
         reading="held-out S-turn runs, our device", statistic=worst, estimate=est_kf, boundary=bound,
         holds_when="below", unit="arcsec", decided_by=(device, star), why=why_kf, key="cel_kf_within")
-    est, why = _try(verdicts.median_ci, w9.to_numpy())
+    est, why = verdicts.attempt(verdicts.median_ci, w9.to_numpy())
     out.append(report.Claim(
         f"With rates, attitude error within {bound:g} arcsec (1 sigma)", f"<= {bound:g} arcsec (1 sigma)",
         reading="held-out runs, our device", statistic=worst, estimate=est, boundary=bound, holds_when="below",
@@ -577,7 +569,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         ours=f"{k}/{n} runs", decided_by=(f"gyro scale factor {sp.gyro_scale_ppm:g} ppm", f"yaw S-manoeuvre "
                                            f"+-{sp.yaw_amplitude_deg:g} deg", star),
         key="cel_innov"))
-    est, why = _try(verdicts.paired_difference,
+    est, why = verdicts.attempt(verdicts.paired_difference,
                     *_paired(per_run(data, "sturn_qr6_rate", "held-out", "BPKF"),
                              per_run(data, "sturn_qr6_rate", "held-out", "augmented KF")))
     out.append(report.Claim(

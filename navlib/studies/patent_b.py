@@ -23,7 +23,7 @@ from ..sensors.planar import fit_planar_model
 from .. import verdicts
 from ..report import Claim
 from .paper_a import (ELM_METHODS, METHODS, TRAINING_ONLY, StudyParams, Sweeps, fit_method, method_id,
-                      paired_by_seed, per_seed, rms_deg)
+                      paired_seed_difference, per_seed, rms_deg)
 
 # ----------------------------------------------------------------------------------------------------------
 # Patent B: test error against hidden-node count
@@ -304,15 +304,11 @@ def _series(frame: pd.DataFrame, col: str) -> pd.Series:
 
 
 def _paired(worse: pd.Series, better: pd.Series, name: str) -> tuple[verdicts.Estimate | None, str]:
-    """The paired difference ``worse - better`` over the same seeds (:func:`navlib.studies.paper_a.paired_by_seed`),
-    or None and the reason when the runs are too few for a 95 % interval."""
-    w, b = paired_by_seed(worse.rename(f"{name} (first)"), better.rename(f"{name} (second)"))
-    if w.size == 1:
-        return verdicts.exact(w[0] - b[0]), ""
-    try:
-        return verdicts.paired_difference(w, b), ""
-    except InputError as err:
-        return None, f"too few runs for a 95 % interval ({err})"
+    """The paired difference ``worse - better`` over the same seeds
+    (:func:`navlib.studies.paper_a.paired_seed_difference`), or None and the reason when there is no 95 %
+    interval."""
+    return verdicts.attempt(paired_seed_difference, worse.rename(f"{name} (first)"),
+                            better.rename(f"{name} (second)"))
 
 
 def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, small: pd.DataFrame,

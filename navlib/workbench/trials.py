@@ -7,8 +7,6 @@ and magnetometers turned by hand and sampled at 10 Hz
 (:func:`navlib.workbench.magnetometer.simulate_hand_turned`)."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
@@ -273,14 +271,13 @@ def correlated_noise_rates(study: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index(["noise correlation", "hidden effect"])
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95 % Wilson score interval of a rate k/n."""
+def wilson(k: int, n: int) -> tuple[float, float]:
+    """95 % Wilson score interval ``(low, high)`` of a rate k/n (:func:`navlib.verdicts.wilson`, the
+    interval the book's verdicts use); NaNs for no trials."""
     if n == 0:
         return (np.nan, np.nan)
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (c - h, c + h)
+    e = verdicts.wilson(int(k), int(n))
+    return (e.lo, e.hi)
 
 
 def out_of_catalogue_rates(study: pd.DataFrame) -> pd.DataFrame:
