@@ -315,3 +315,41 @@ def test_the_fast_restricted_likelihood_equals_the_direct_one():
         fast = serial._Restricted(r, Q, ser, order)
         for kappa in ((), (0.6,), (0.8, -0.3), (0.2, 0.3, -0.4))[:order + 1]:
             assert fast(kappa) == pytest.approx(serial._restricted_loglik(kappa, r, Q, ser), rel=1e-10)
+
+
+@pytest.mark.parametrize("kappa", [(), (0.9,), (0.8, -0.3), (0.5, 0.2, 0.4)])
+def test_colouring_is_the_inverse_of_whitening(kappa):
+    """``colour`` makes the AR process ``whiten`` undoes, on segments of every length (shorter than the
+    order too), one column or many; and its samples have the AR correlation."""
+    t = np.r_[0.1 * np.arange(2), 10.0 + 0.1 * np.arange(25), 30.0 + 0.1 * np.arange(9)]
+    ser = serial.series_of(pd.DataFrame({"time_s": t[::-1]}), len(t), "magnetometer")
+    u = np.random.default_rng(2).standard_normal((len(t), 3))
+    x = serial.colour(u, kappa, ser, len(t))
+    assert np.allclose(serial.whiten(x, kappa, ser), u)
+    assert np.allclose(serial.colour(u[:, 1], kappa, ser, len(t)), x[:, 1])
+    if kappa:
+        ser1 = serial.series_of(_frame(4000), 4000, "magnetometer")
+        x = serial.colour(np.random.default_rng(3).standard_normal(4000), kappa, ser1, 4000)
+        rho1 = _ar_correlation(kappa, len(kappa) + 2)[0, 1]
+        assert np.corrcoef(x[1:], x[:-1])[0, 1] == pytest.approx(rho1, abs=0.05)
+        assert np.var(x) == pytest.approx(1.0, rel=0.15)
+
+
+def test_the_noise_model_is_chosen_around_the_regressors_the_likelihood_prefers():
+    """AR(1) noise around smooth regressors: without a structure the model's Jacobian alone (the tighter
+    estimate); with a three-cycle sinusoid in white noise the structure shapes, so the sinusoid is not taken
+    for correlated noise."""
+    n = 240
+    ser = serial.series_of(_frame(n), n, "magnetometer")
+    J = np.column_stack([np.ones(n), np.linspace(-1, 1, n)])
+    k = np.arange(n)
+    S = np.column_stack([np.cos(2 * np.pi * h * k / 120) for h in (1, 2, 3)]
+                        + [np.sin(2 * np.pi * h * k / 120) for h in (1, 2, 3)])
+    picks = [serial.select(serial.ar1_noise(np.random.default_rng(s), n, 1.0, 0.9), J, S, ser).around
+             for s in range(10)]
+    assert picks.count("model") >= 8, picks
+    rng = np.random.default_rng(7)
+    y = 3.0 * np.sin(2 * np.pi * 3 * k / 120) + rng.standard_normal(n)
+    m = serial.select(y, J, S, ser)
+    assert m.around == "model and structure shapes" and abs(m.lag1) < 0.3, m
+    assert serial.estimate(y, J, ser).lag1 > 0.5                  # what the Jacobian alone would have said

@@ -19,9 +19,10 @@
    projected off the model's Jacobian (what the model can already absorb is not structure); what remains
    is F-tested against the residual.  The *amplitude* reported is computed on the residual itself (least
    squares of the residual on ``X``), so it can never exceed what the residual allows;
-3. controls false alarms over the whole family of tests with Bonferroni: each test is run at
-   ``alpha / m`` (m = number of tests), so data with nothing missing are called "consistent with noise" with
-   probability at least ``1 - alpha``.
+3. controls false alarms over the whole family of tests: on independent samples with Bonferroni (each
+   test at ``alpha / m``, m = number of tests), on serially correlated noise with a parametric bootstrap of
+   the family's smallest p-value (below), so data with nothing missing are called "consistent with noise"
+   with probability at least about ``1 - alpha``.
 
 Before any test the data are screened once (:func:`navlib.workbench.screen.screen`): outlying rows are
 set aside (robust, MAD-studentised residuals of the richest model the data can test; listed in
@@ -31,11 +32,18 @@ serial correlation is modelled (AR(p) by restricted maximum likelihood, :mod:`na
 With correlated noise every F test above -- candidates, structure, conditional -- is computed by
 generalised least squares: on the whitened residual ``W r``, whitened Jacobians ``W J`` and whitened
 shapes ``W X``, with each model's residual first freed of what its whitened Jacobian can absorb (one
-Gauss-Newton step of the GLS fit from the least-squares solution; exact for a linear model), and each
-p-value is the largest over the estimated correlation and the two ends of its 90 % profile-likelihood
-interval (:meth:`navlib.workbench.serial.NoiseModel.variants`; a p-value maximised over a confidence set of
-the nuisance parameter, Berger and Boos 1994), because the F statistic of a slow shape is very sensitive to
-a correlation near 1.  Independent samples (``W = I``) give the least-squares tests unchanged.
+Gauss-Newton step of the GLS fit from the least-squares solution; exact for a linear model), with the
+estimated noise model plugged in.  Plugged-in p-values are too small: the correlation is estimated from
+the same data, an estimate a little low makes a slow shape look significant, and Bonferroni cannot allow
+for that.  The family is therefore calibrated by a **parametric bootstrap of its smallest p-value**
+(:func:`_bootstrap_level`; single-step minP, Westfall and Young 1993): noise from the estimated AR model
+is simulated on the same series, the noise model re-estimated on it as the screen does, and every test of
+the family re-run with the re-estimated model; a test is significant when its plugged-in p lies below the
+level that the replicates' smallest p-values reach in a share ``alpha`` of replicates.  This keeps the
+family-wise false-alarm rate near ``alpha`` including the uncertainty of the correlation, without the
+power lost by maximising each p-value over an interval of the correlation (the F statistic of a constant
+offset at a correlation near 1 says almost nothing).  Independent samples (``W = I``) keep the
+least-squares tests and Bonferroni.
 
 The effect to add (``missing``) is the significant candidate with the strongest evidence (smallest p) that
 also improves the held-out RMS *and* explains what it claims.  If the residual shows significant structure,
@@ -74,6 +82,11 @@ FEW_EFFECTIVE = 30
 # A structure shape is "already in the model" when less than this share of its norm is left after
 # projecting it off the model's Jacobian.
 SPANNED = 0.1
+#: Parametric-bootstrap replicates of the family's smallest p-value on correlated noise (at least
+#: ``2.5 / alpha - 1``: :func:`bootstrap_replicates`).
+REPLICATES = 99
+# The bootstrap's random stream: spawn key under the diagnosis seed (the permutation test uses the seed itself).
+_BOOTSTRAP_KEY = 1
 
 
 @dataclass
@@ -115,6 +128,7 @@ class Diagnosis:
     tests: int
     message: str
     screening: Screening | None = field(default=None, repr=False, compare=False)
+    calibration: "Calibration | None" = field(default=None, repr=False, compare=False)
 
     @property
     def outliers(self) -> list[dict]:
@@ -133,6 +147,8 @@ class Diagnosis:
             s.pop("log_p")
         d.update({"untestable": dict(self.untestable), "alpha": self.alpha, "tests": self.tests,
                   "message": self.message, "outliers": self.outliers})
+        if self.calibration is not None:
+            d["calibration"] = self.calibration.to_dict()
         if self.screening is not None:
             extra = self.screening.to_dict()
             extra.pop("outliers")
@@ -150,11 +166,19 @@ class Diagnosis:
                  "significant": s.significant} for s in self.structure]
         return pd.DataFrame(rows).set_index("structure") if rows else pd.DataFrame()
 
+    def _level_line(self) -> str:
+        cal = self.calibration
+        if cal is None or cal.method == "Bonferroni":
+            return f"tests: {self.tests}, each at alpha/m = {self.alpha / max(self.tests, 1):.2g}"
+        return (f"tests: {self.tests}, family-wise alpha = {self.alpha:g}: significant below p = {cal.level:.2g} "
+                f"(parametric bootstrap of the smallest p, {cal.replicates} replicates"
+                f"{', stopped early' if cal.stopped_early else ''})")
+
     def report(self) -> str:
         """A readable multi-line report (the CLI's output without --json)."""
         lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   rows: {self.n}",
                  f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
-                 f"tests: {self.tests}, each at alpha/m = {self.alpha / max(self.tests, 1):.2g}"]
+                 self._level_line()]
         if self.screening is not None and self.screening.noise.series is not None:
             lines.append("noise: " + self.screening.noise.describe())
         if self.candidates:
@@ -231,22 +255,26 @@ def _gls(fit: Fit, noise: NoiseModel | None) -> tuple[np.ndarray, np.ndarray]:
     """The residual of ``fit`` as the tests see it and the orthonormal basis of its Jacobian: with
     correlated noise, ``W r`` freed of what ``W J`` absorbs (the GLS residual, to first order) and the
     basis of ``W J``; otherwise ``r`` and the basis of ``J``."""
+    return _gls_of(fit.residuals, fit.jacobian, noise)
+
+
+def _gls_of(r: np.ndarray, J: np.ndarray, noise: NoiseModel | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_gls` of a residual ``r`` and a Jacobian ``J``."""
     if noise is None or not noise.correlated:
-        return fit.residuals, _projector(fit.jacobian)
-    e = noise.whiten(fit.residuals)
-    Q = _projector(noise.whiten(fit.jacobian))
+        return r, _projector(J)
+    e = noise.whiten(r)
+    Q = _projector(noise.whiten(J))
     return e - Q @ (Q.T @ e), Q
 
 
-def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
-    """The system's structure tests on the residuals of ``fit`` (module docstring, point 2); generalised
-    least squares with the whitening of ``noise`` when it is correlated."""
-    r = fit.residuals
-    e, Q = _gls(fit, noise)
+def _shape_tests(e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel | None,
+                 n: int) -> list[tuple[int, float, float]]:
+    """F tests of structure shapes ``X0`` against the (whitened, projected) residual ``e`` of a model with
+    (whitened) Jacobian basis ``Q``: ``(index, p, log p)`` of each shape the model does not already span."""
     white = noise is not None and noise.correlated
     out = []
-    for what, X0, scale in fit.spec.structure(fit):
-        X0 = np.asarray(X0, float)
+    rss = float(e @ e)
+    for i, X0 in enumerate(shapes):
         X = noise.whiten(X0) if white else X0
         X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
         Xp = X - Q @ (Q.T @ X)
@@ -255,45 +283,39 @@ def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
         w, V = np.linalg.eigh(Xp.T @ Xp)
         keep = w > SPANNED ** 2
         q = int(np.sum(keep))
-        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
-        df2 = len(r) - Q.shape[1] - q
+        df2 = n - Q.shape[1] - q
         if q == 0 or df2 < 3:
             continue                                   # the model already spans this shape, or too few rows
+        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
         drop = float(np.sum((u.T @ e) ** 2))
-        p, logp = _f_test(float(np.sum(e ** 2)), float(np.sum(e ** 2)) - drop, q, df2)
+        p, logp = _f_test(rss, rss - drop, q, df2)
+        out.append((i, p, logp))
+    return out
+
+
+def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
+    """The system's structure tests on the residuals of ``fit`` (module docstring, point 2); generalised
+    least squares with the whitening of ``noise`` when it is correlated."""
+    r = fit.residuals
+    e, Q = _gls(fit, noise)
+    spec = [(what, np.asarray(X0, float), scale) for what, X0, scale in fit.spec.structure(fit)]
+    out = []
+    for i, p, logp in _shape_tests(e, Q, [X0 for _, X0, _ in spec], noise, len(r)):
+        what, X0, scale = spec[i]
         qx = orth_basis(X0)                             # amplitude: the shape fitted to the residual itself
         amp = scale * float(np.sqrt(np.mean((qx @ (qx.T @ r)) ** 2)))
         out.append(Finding(what, amp, p, log_p=logp))
     return out
 
 
-def _structure_over(fit: Fit, noise: NoiseModel) -> list[Finding]:
-    """:func:`_structure` with each p-value the largest over the noise model's variants
-    (:meth:`navlib.workbench.serial.NoiseModel.variants`: the correlation's estimate and the ends of its
-    interval)."""
-    out = _structure(fit, noise)
-    for other in noise.variants()[1:]:
-        alt = {f.what: f for f in _structure(fit, other)}
-        for f in out:
-            if f.what in alt and alt[f.what].log_p > f.log_p:
-                f.p_value, f.log_p = alt[f.what].p_value, alt[f.what].log_p
-    return out
-
-
 def _candidate_p(fit: Fit, f1: Fit, noise: NoiseModel) -> tuple[float, float]:
     """The nested F test of ``f1`` (= ``fit`` + a candidate): least squares for independent samples;
-    with correlated noise, generalised least squares, the p-value the largest over the noise model's
-    variants."""
+    with correlated noise, generalised least squares with the estimated noise model."""
     q, df2 = f1.n_params - fit.n_params, f1.n - f1.n_params
     if not noise.correlated:
         return _f_test(fit.rss, f1.rss, q, df2)
-    best = (0.0, -np.inf)
-    for v in noise.variants():
-        (e0, _), (e1, _) = _gls(fit, v), _gls(f1, v)
-        p, logp = _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
-        if logp > best[1]:
-            best = (p, logp)
-    return best
+    (e0, _), (e1, _) = _gls(fit, noise), _gls(f1, noise)
+    return _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
 
 
 def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | None = None) -> float:
@@ -312,10 +334,71 @@ def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | 
 
     rss0, _ = rss_p(fit)
     rss1, p1 = rss_p(f1)
-    p = _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
-    if noise is not None and noise.correlated and noise.variants()[1:]:
-        p = max([p] + [_conditional_p(fit, f1, found, v.without_variants()) for v in noise.variants()[1:]])
-    return p
+    return _f_test(rss0, rss1, f1.n_params - fit.n_params, f1.n - p1)[0]
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """The per-test critical p-value of a family of tests (a test is significant when its p is below
+    ``level``) and how it was found: ``method`` "Bonferroni" (``alpha / m``) or "parametric bootstrap"
+    (``replicates`` simulated, ``exceed`` of them with a family minimum below the smallest observed p)."""
+
+    level: float
+    method: str
+    replicates: int = 0
+    stopped_early: bool = False
+
+    def to_dict(self) -> dict:
+        return {"level": self.level, "method": self.method, "replicates": self.replicates,
+                "stopped_early": self.stopped_early}
+
+
+def bootstrap_replicates(alpha: float) -> int:
+    """Replicates of the parametric bootstrap: :data:`REPLICATES`, or more when ``alpha`` needs them (at
+    least ``2.5 / alpha - 1``, so that one replicate may reach the observed p and the test still be
+    significant)."""
+    return max(REPLICATES, int(math.ceil(2.5 / alpha)) - 1)
+
+
+def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: float,
+                     seed: int) -> Calibration:
+    """The family-wise critical p-value on correlated noise, by a parametric bootstrap of the smallest
+    plug-in p-value of the family (Westfall and Young 1993, *Resampling-Based Multiple Testing*, single-step
+    minP; module docstring).  Each replicate: AR noise with the estimated partial autocorrelations on the
+    same series (:func:`navlib.workbench.serial.colour`), the noise model re-estimated on it as the screen
+    does (:func:`navlib.workbench.serial.select`: same regressors, REML; the AR order fixed at the
+    data's), then every test of the family -- each candidate's
+    nested GLS F test and each structure shape's -- with that re-estimated model; the replicate's smallest p
+    is kept.  A test is significant when ``(1 + #{replicates whose minimum <= p}) / (B + 1) < alpha``,
+    i.e. ``p`` below the K-th smallest replicate minimum, ``K = ceil(alpha (B + 1) - 1)``.  The replicates
+    stop early once K minima fall at or below the smallest observed p (nothing can then be significant;
+    Besag and Clifford 1991, Biometrika 78:301)."""
+    from .serial import colour, select, select_bases
+    noise = sc.noise
+    B = bootstrap_replicates(alpha)
+    K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))
+    if K < 1:
+        return Calibration(0.0, "parametric bootstrap", 0)
+    J0 = fit.jacobian
+    cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
+    shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
+    ser = noise.series
+    bases = select_bases(*sc.regressors, ser, fit.n)
+    minima = []
+    for b in range(B):
+        e = colour(rng.standard_normal(len(ser.order)), noise.kappa, ser, fit.n)
+        nb = select(e, *sc.regressors, ser, order=noise.order, interval=False, bases=bases)
+        e0, Q0 = _gls_of(e, J0, nb)
+        ps = [p for _, p, _ in _shape_tests(e0, Q0, shapes, nb, fit.n)]
+        rss0 = float(e0 @ e0)
+        for J1, q, df2 in cands:
+            e1, _ = _gls_of(e, J1, nb)
+            ps.append(_f_test(rss0, float(e1 @ e1), q, df2)[0])
+        minima.append(min(ps) if ps else 1.0)
+        if sum(m <= p_min for m in minima) >= K:
+            return Calibration(float(sorted(minima)[K - 1]), "parametric bootstrap", b + 1, True)
+    return Calibration(float(sorted(minima)[K - 1]), "parametric bootstrap", B)
 
 
 def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:
@@ -369,7 +452,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
                f"numerical precision (at most {sc.floor / sc.scale:.0e} of the measured values' rms "
                f"{_fmt(sc.scale)} {unit}); nothing to test")
         return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, None, True,
-                                 [], [], untestable, alpha, 0, msg, sc))
+                                 [], [], untestable, alpha, 0, msg, sc, Calibration(alpha, "Bonferroni")))
     cands = []
     fits = {}
     for effect in ok:
@@ -394,9 +477,14 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
                 p, logp, test = pp, math.log(max(pp, 1e-300)), "permutation"
         cands.append(Candidate(effect, f1.rms, f1.loo_rms, drop / fit.rss if fit.rss > 0 else 0.0, p, test,
                                log_p=logp))
-    structure = _structure_over(fit, noise)
+    structure = _structure(fit, noise)
     m = len(cands) + len(structure)
-    level = alpha / max(m, 1)
+    if noise.correlated and sc.regressors is not None and m:
+        p_min = min([c.p_value for c in cands] + [s.p_value for s in structure])
+        cal = _bootstrap_level(fit, fits, sc, alpha, p_min, seed)
+    else:
+        cal = Calibration(alpha / max(m, 1), "Bonferroni")
+    level = cal.level
     for s in structure:
         s.significant = bool(s.p_value < level)
     found = [s for s in structure if s.significant]
@@ -412,7 +500,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
             break
         f1 = fits[c.effect]
         # a candidate that brings the residual down to the numerical floor leaves no structure
-        after = {s.what: s for s in _structure_over(f1, noise)} if f1.rms > sc.floor else {}
+        after = {s.what: s for s in _structure(f1, noise)} if f1.rms > sc.floor else {}
         gone = [s.what for s in found if s.what not in after or after[s.what].p_value >= level]
         remaining = [s for s in found if s.what not in gone]
         # named only if it still matters once the structure it leaves in place is allowed for
@@ -450,7 +538,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
         msg += (f" [serially correlated noise, AR({noise.order}) with lag-1 correlation {noise.lag1:.2f}: "
                 f"tests on whitened residuals]")
     return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
-                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc))
+                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc, cal))
 
 
 def _finish(d: Diagnosis) -> Diagnosis:

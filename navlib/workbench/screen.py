@@ -44,12 +44,14 @@ called noise without a test (round-off of float arithmetic is ~1e-16 of the valu
 1e-9 of its range).  The robust scale is never taken below this floor either.
 
 **Serial correlation.**  :mod:`navlib.workbench.serial`: an AR(p) model of the noise estimated by REML from
-the richest model's residuals with the model's Jacobian *and the system's structure shapes* as regressors
-(so a slow structure outside the catalogue is not mistaken for correlated noise, and stays testable), and
-without the observations whose robust ``|z|`` exceeds :data:`Z_NOISE` (3.5, the "potential outlier" cutoff of
-Iglewicz and Hoaglin 1993, *How to Detect and Handle Outliers*): the noise model describes the bulk of
-the data, so a localised disturbance (a magnet passed at close range) is not taken for strongly
-correlated noise that would then hide it.
+the richest model's residuals, without the observations whose robust ``|z|`` exceeds :data:`Z_NOISE` (3.5,
+the "potential outlier" cutoff of Iglewicz and Hoaglin 1993, *How to Detect and Handle Outliers*): the noise
+model describes the bulk of the data, so a localised disturbance (a magnet passed at close range) is not
+taken for strongly correlated noise that would then hide it.  The regressors are chosen by the likelihood
+(:func:`navlib.workbench.serial.select`): the model's Jacobian alone, or with the system's structure shapes
+as well when they fit the data better by AIC -- so a slow structure outside the catalogue is not mistaken
+for correlated noise and stays testable, while on data without one the correlation keeps the precision
+that the slow shapes would take from it.
 """
 from __future__ import annotations
 
@@ -63,7 +65,7 @@ from scipy import stats
 from ..errors import InputError
 from .effects import testable
 from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
-from .serial import NoiseModel, estimate, series_of
+from .serial import NoiseModel, select, series_of
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
 #: 2e-9; real sensor noise has heavier tails (the slow undisturbed BROAD trials reach 5.8) and stays below,
@@ -117,7 +119,10 @@ class Screening:
     ``outliers``: the observations set aside; ``cutoff``: the ``|z|`` that flags one; ``model``: the effects
     of the screening (richest) model; ``noise``: the serial-correlation model the tests whiten with;
     ``scale``, ``floor``: RMS of the measured values and the numerical floor (``FLOOR_REL * scale``);
-    ``note``: why the screen did not run, if it did not; ``rich``: the richest model fitted to ``data``."""
+    ``note``: why the screen did not run, if it did not; ``rich``: the richest model fitted to ``data``;
+    ``regressors``: ``(jacobian, shapes)``, the columns the noise model was chosen around
+    (:func:`navlib.workbench.serial.select`: the rich model's Jacobian, and its structure shapes or None;
+    None when no noise model was estimated)."""
 
     data: pd.DataFrame
     kept: np.ndarray
@@ -130,6 +135,7 @@ class Screening:
     floor: float
     note: str = ""
     rich: Fit | None = field(default=None, repr=False)
+    regressors: tuple | None = field(default=None, repr=False)
 
     @property
     def rows_set_aside(self) -> list[int]:
@@ -274,15 +280,17 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     if rich is not None and len(kept) < n:
         data = data.iloc[kept]
     noise = NoiseModel(n_obs=fit.n)
+    regressors = None
     if serial and rich is not None and rich.rms > floor:
         ser = series_of(rich.data, rich.n, rich.system)
         if ser is not None:
             if zk is not None:                         # the noise model describes the bulk of the data
                 ser = ser.without(np.abs(zk.ravel()) > Z_NOISE)
             shapes = [np.asarray(X, float) for _, X, _ in rich.spec.structure(rich)]
-            noise = estimate(rich.residuals, np.column_stack([rich.jacobian] + shapes), ser)
+            regressors = (rich.jacobian, np.column_stack(shapes) if shapes else None)
+            noise = select(rich.residuals, *regressors, ser)
     return Screening(data, kept, n, found, c, rich.effects if rich is not None else tuple(fit.effects), noise,
-                     scale, floor, note, rich)
+                     scale, floor, note, rich, regressors)
 
 
 def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
