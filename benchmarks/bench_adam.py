@@ -31,7 +31,7 @@ import navlib.methods.bpnet as bpnet
 from navlib.data.compass_sweeps import load_sweeps, split_sweeps
 from navlib.methods.bpnet import AdamParams, train_adam_many
 from navlib.methods.seeding import generators
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 from navlib.studies import paper_a
 from navlib.studies.paper_a import StudyParams, Sweeps
 
@@ -73,7 +73,7 @@ def main(argv=None):
     ap.add_argument("--study", action="store_true",
                     help="also time the seed study (slow: the former code takes about a minute per run)")
     a = ap.parse_args(argv)
-    sw = Sweeps(*split_sweeps(load_sweeps(DATA_DIR / "compass_sweeps.csv")))
+    sw = Sweeps(*split_sweeps(load_sweeps(data_path("compass_sweeps.csv"))))
     params = AdamParams(epochs=a.epochs)
     ratios = []
     print(f"ms per epoch, best of {a.repeats} runs of {a.epochs} epochs; torch default threads "

@@ -36,7 +36,7 @@ from navlib.data.compass_sweeps import load_sweeps, split_sweeps  # noqa: E402
 from navlib.studies.paper_a import Sweeps  # noqa: E402
 from navlib.methods.de import DEParams, evolve, evolve_many  # noqa: E402
 from navlib.methods.seeding import generators  # noqa: E402
-from navlib.paths import DATA_DIR  # noqa: E402
+from navlib.paths import data_path  # noqa: E402
 
 
 def main() -> None:
@@ -45,7 +45,7 @@ def main() -> None:
     ap.add_argument("--generations", type=int, default=3000)
     ap.add_argument("--seeds", type=int, default=20)
     args = ap.parse_args()
-    sw = Sweeps(*split_sweeps(load_sweeps(DATA_DIR / "compass_sweeps.csv")))
+    sw = Sweeps(*split_sweeps(load_sweeps(data_path("compass_sweeps.csv"))))
     objective, _, _ = sse_objective(sw.x_train, sw.t_train, 6)
     exact, _, _ = sse_objective(sw.x_train, sw.t_train, 6, np.float64)
     dim, gens = n_params(6), args.generations

@@ -39,7 +39,7 @@ from navlib.data.compass_sweeps import load_sweeps, split_sweeps  # noqa: E402
 from navlib.methods.elm import ELMParams, _back_tune, fit_elm, fit_incremental_elm  # noqa: E402
 from navlib.methods.scaling import MinMax  # noqa: E402
 from navlib.methods.seeding import generators  # noqa: E402
-from navlib.paths import DATA_DIR  # noqa: E402
+from navlib.paths import data_path  # noqa: E402
 from navlib.sensors.compass import CompassErrors, SweepConfig, simulate_train_test  # noqa: E402
 from navlib.studies import paper_a, patent_b  # noqa: E402
 from navlib.studies.paper_a import StudyParams, Sweeps  # noqa: E402
@@ -61,7 +61,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="time the studies with the compiled kernels only")
     args = ap.parse_args()
     R = args.repeats
-    sw = Sweeps(*split_sweeps(load_sweeps(DATA_DIR / "compass_sweeps.csv")))
+    sw = Sweeps(*split_sweeps(load_sweeps(data_path("compass_sweeps.csv"))))
     params = StudyParams()
     target = params.target.target(sw.x_train, sw.t_train)
     X = MinMax.fit(sw.x_train).transform(sw.x_train)[:, None]

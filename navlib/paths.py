@@ -1,6 +1,45 @@
-"""Where the project's folders are, independent of the caller's working directory."""
+"""Where navlib's files are, independent of the caller's working directory.
+
+- :func:`data_path` -- a data file shipped with navlib: the checkout's top-level ``data/`` folder, installed
+  as the package ``navlib._data`` and read through ``importlib.resources`` (so the loaders work from
+  site-packages, an editable install or a checkout alike).  Every read of a shipped data file goes through
+  it.
+- ``ROOT``, ``NOTEBOOK_DIR`` -- the source checkout and its notebooks; meaningful only when navlib
+  runs from a checkout (tests, benchmarks, the book's build), never used by the library to find data.
+
+Results files go where the caller says (:func:`navlib.report.results_dir`), never into the package.
+"""
+from __future__ import annotations
+
+import importlib.resources
+import os
+from functools import lru_cache
 from pathlib import Path
 
+# (no doc comments on the paths: the API page would print this machine's folders)
 ROOT = Path(__file__).resolve().parent.parent
-DATA_DIR = ROOT / "data"
 NOTEBOOK_DIR = ROOT / "notebooks"
+#: The package the data files are installed as (pyproject.toml maps it to the checkout's ``data/``).
+DATA_PACKAGE = "navlib._data"
+
+
+@lru_cache(maxsize=None)
+def data_dir() -> Path:
+    """The folder of navlib's data files: the package ``navlib._data`` (installed or editable), or, when
+    navlib is imported from a checkout that was never installed (``PYTHONPATH=checkout``), its ``data/``."""
+    try:
+        folder = importlib.resources.files(DATA_PACKAGE)
+    except ModuleNotFoundError as err:
+        if err.name not in (DATA_PACKAGE, "navlib"):
+            raise
+        return ROOT / "data"
+    return Path(os.fspath(folder))      # a folder on disk: navlib is installed unzipped (zip-safe = false)
+
+
+def data_path(name: str) -> Path:
+    """The path of the shipped data file ``name`` (e.g. ``"compass_sweeps.csv"``; see ``data/README.md``)."""
+    return data_dir() / name
+
+
+# the folder data_path reads from (kept for notebooks that name files in it)
+DATA_DIR = data_dir()

@@ -37,10 +37,9 @@ import pandas as pd
 
 from . import verdicts
 from .errors import InputError
-from .paths import ROOT
 
-#: Where each chapter's headline results are written during a build (git-ignored).
-RESULTS_DIR = ROOT / "book" / "_generated" / "results"
+#: The environment variable that says where results files go (the book's build sets it to its own folder).
+RESULTS_ENV = "NAVBOOK_RESULTS_DIR"
 #: Plain-text rendering width in characters; a stored output line longer than this would be cut on the page.
 PLAIN_WIDTH = 92
 METHOD_KEYS = ("median_rms", "p10_rms", "p90_rms", "median_min", "median_max")
@@ -51,9 +50,11 @@ _CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflo
 
 
 def results_dir() -> Path:
-    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if set, else :data:`RESULTS_DIR`."""
-    env = os.environ.get("NAVBOOK_RESULTS_DIR")
-    return Path(env) if env else RESULTS_DIR
+    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if set (``make book`` and ``make test`` set it,
+    so the build's files land in ``book/_generated/results``), else ``results/`` in the current directory
+    (library use; never inside the installed package)."""
+    env = os.environ.get(RESULTS_ENV)
+    return Path(env) if env else Path.cwd() / "results"
 
 
 # ----------------------------------------------------------------------------------------------- numbers
@@ -439,8 +440,9 @@ def method_stats(rms, min_err=None, max_err=None) -> dict:
 
 def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = None,
                   methods: Mapping[str, Mapping[str, Any]] | None = None,
-                  extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None) -> Path:
-    """Write ``<results dir>/<chapter>.json``::
+                  extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
+                  overwrite: bool = False) -> Path:
+    """Write ``<folder>/<chapter>.json`` (``folder`` defaults to :func:`results_dir`)::
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
          "p90_rms_<unit>", "median_min_<unit>", "median_max_<unit>", "n_seeds"}},
@@ -448,9 +450,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
 
     ``methods`` maps a display label to :func:`method_stats`-style keys (without unit suffix); the unit
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
-    significant digits.  Returns the path written (this is a build output; it is rewritten each run); it
-    displays as ``results written: <chapter>.json``, the same in every run, so a notebook cell that ends
-    with this call shows no run-specific folder."""
+    significant digits.  An existing file (an earlier run's) is never replaced unless ``overwrite=True``:
+    the call stops with one line naming it.  Returns the path written; it displays as ``results written:
+    <chapter>.json``, the same in every run, so a notebook cell that ends with this call shows no
+    run-specific folder."""
     if not chapter.isidentifier():
         raise InputError(f"chapter name {chapter!r}: use letters, digits and underscores")
     out: dict[str, Any] = {"chapter": chapter}
@@ -479,9 +482,20 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}
     d = Path(folder) if folder is not None else results_dir()
-    d.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
     path = d / f"{chapter}.json"
-    path.write_text(json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n", encoding="utf-8")
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise InputError(f"{d}: cannot create the results folder ({err.strerror})") from None
+    try:
+        with open(path, "w" if overwrite else "x", encoding="utf-8") as fh:   # "x": never over a file
+            fh.write(text)
+    except FileExistsError:
+        raise InputError(f"{path}: a results file is already there (an earlier run's); remove it, write "
+                         f"elsewhere (folder=... or ${RESULTS_ENV}) or pass overwrite=True") from None
+    except OSError as err:
+        raise InputError(f"{path}: cannot write the results file ({err.strerror})") from None
     return _WrittenPath(path)
 
 

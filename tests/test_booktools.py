@@ -241,8 +241,13 @@ def test_check_results_fails_for_a_notebook_that_writes_no_results(tmp_path, cap
     assert "writes no results file" in capsys.readouterr().err
 
 
-def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path):
+def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, monkeypatch):
     from navlib.booktools import execute
+
+    cwd = tmp_path / "elsewhere"
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)                     # the library default (./results) must not be written either
+    monkeypatch.delenv("NAVBOOK_RESULTS_DIR", raising=False)
 
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell(
@@ -255,8 +260,9 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path):
     assert execute([path], None, in_place=True) == 0
     stored = json.loads((tmp_path / "results" / "demo_chapter.json").read_text())
     assert stored["claims"][0]["reproduced"] is True
-    from navlib.report import RESULTS_DIR
-    assert not (RESULTS_DIR / "demo_chapter.json").exists()   # the book's folder is not touched
+    from navlib.paths import ROOT
+    assert not (ROOT / "book" / "_generated" / "results" / "demo_chapter.json").exists()  # the book's folder
+    assert not (cwd / "results").exists()                                                 # nor ./results
 
 
 def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):

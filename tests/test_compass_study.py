@@ -24,7 +24,7 @@ from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, 
     node_count_curve, nodes_to_goal_runs, prepare_patent_data, small_sample_study, small_sample_summary)
 from navlib.studies.patent_b import claims as patent_b_claims
 from navlib.errors import InputError
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +73,7 @@ def test_claims_and_verdict_table(sw):
     p = StudyParams(de=DEParams(max_generations=100), lm=replace(StudyParams().lm, epochs=50))
     ids = sorted({i for r in READINGS.values() for i in r} | {"physical"})
     runs = seed_study(sw, p, seeds=range(6), methods=ids)
-    paper = pd.read_csv(DATA_DIR / "paper_a_error_ranges.csv")
+    paper = pd.read_csv(data_path("paper_a_error_ranges.csv"))
     cl = claims(runs, paper, default_ut=0.04, floor=floor_curve(grid_ut=np.linspace(0.01, 0.05, 5)))
     assert {c.reading for c in cl} == set(READINGS)
     assert all(c.source == "paper" and c.estimate is not None for c in cl)
@@ -142,7 +142,7 @@ def test_comparisons_are_paired_by_seed_not_by_row():
 
 
 def test_claims_sides_boundaries_and_floor():
-    paper = pd.read_csv(DATA_DIR / "paper_a_error_ranges.csv")
+    paper = pd.read_csv(data_path("paper_a_error_ranges.csv"))
     pr = paper.set_index("method")
     # ADE-BP better than DE-BP in every seed; BP worse than LS; widths: BP 0.5 (< 0.80), DE-BP 0.7 (> 0.56)
     rms = _rms_all(ade_bp_pure=0.5, de_bp_pure=np.linspace(0.8, 0.9, 8), bp_matlab=2.0, ls8=1.0)

@@ -12,7 +12,7 @@ from navlib.workbench.diagnose import diagnose
 from navlib.workbench.trials import detection_rates, hidden_effect_study, hidden_effect_trial
 from navlib.workbench.fit import fit_model, simulate
 from navlib.data.gyro_tables import drift_measurements
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 
 
 @pytest.mark.parametrize("system,noises,n", [("compass", (0.05, 0.3), None), ("drift", (1e-4, 4e-4), 16),
@@ -94,7 +94,7 @@ def test_cli_diagnose_compass_json(tmp_path):
 
 
 def test_cli_diagnose_drift_table_and_json():
-    path = str(DATA_DIR / "gyro_drift_measurements.csv")
+    path = str(data_path("gyro_drift_measurements.csv"))
     r = run_cli("diagnose", "drift", path, "--model", "earth_rate", "--json")
     out = json.loads(r.stdout)
     assert out["missing"] == "temperature_change" and out["unit"] == "deg/h"
@@ -107,7 +107,7 @@ def test_cli_diagnose_drift_table_and_json():
     (["--model", "earth_rate", "--alpha", "2"], "alpha"),
 ])
 def test_cli_bad_arguments_exit_2(args, expect):
-    r = run_cli("diagnose", "drift", str(DATA_DIR / "gyro_drift_measurements.csv"), *args)
+    r = run_cli("diagnose", "drift", str(data_path("gyro_drift_measurements.csv")), *args)
     assert r.returncode == 2 and expect in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
 

@@ -9,7 +9,7 @@ from navlib.workbench.effects import CATALOGUES, catalogue_table, check_effects
 from navlib.workbench.fit import compare, effect_rms, fit_model, load, simulate
 from navlib.errors import InputError
 from navlib.data.gyro_tables import drift_measurements
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 
 
 @pytest.mark.parametrize("system", ["compass", "drift"])
@@ -127,7 +127,7 @@ def test_effect_validation():
 
 
 def test_stored_drift_file_is_generated_by_code():
-    stored = load("drift", DATA_DIR / "gyro_drift_measurements.csv")
+    stored = load("drift", data_path("gyro_drift_measurements.csv"))
     fresh = drift_measurements()
     assert len(stored) == 25 == len(fresh)
     for col in ("latitude_error_deg", "drift_deg_h", "temperature_c", "temperature_change_c"):

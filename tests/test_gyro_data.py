@@ -9,7 +9,7 @@ from navlib.errors import InputError
 from navlib.data.gyro_tables import (COLUMNS, TABLE_FILES, load_cold_test, load_cold_train, load_hot_test,
     load_hot_train, load_table, load_user_drift)
 from navlib.sensors.ins import LOCAL_LATITUDE_DEG
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 
 
 def test_row_counts():
@@ -56,11 +56,11 @@ def test_exact_values_tables4_5():
 
 
 def test_data_dictionary_documents_every_column_with_units():
-    md = (DATA_DIR / "gyro_tables.md").read_text(encoding="utf-8")
+    md = data_path("gyro_tables.md").read_text(encoding="utf-8")
     assert "28.222" in md and "true - identified" in md
     for n, fname in TABLE_FILES.items():
         assert fname in md
-        header = pd.read_csv(DATA_DIR / fname, nrows=0).columns
+        header = pd.read_csv(data_path(fname), nrows=0).columns
         assert [c.name for c in COLUMNS[n]] == list(header)        # every CSV column is validated
         for col in COLUMNS[n]:
             assert f"`{col.name}`" in md, col.name
@@ -77,7 +77,7 @@ def _write(tmp_path, name, text):
 
 
 def _table2_with(tmp_path, row7):
-    lines = (DATA_DIR / TABLE_FILES[2]).read_text().splitlines()
+    lines = data_path(TABLE_FILES[2]).read_text().splitlines()
     lines[7] = row7
     return _write(tmp_path, "t2.csv", "\n".join(lines) + "\n")
 
@@ -97,7 +97,7 @@ def test_table2_typos_are_caught(tmp_path, row7, pattern):
 
 
 def test_table4_inconsistent_temperature_change(tmp_path):
-    lines = (DATA_DIR / TABLE_FILES[4]).read_text().splitlines()
+    lines = data_path(TABLE_FILES[4]).read_text().splitlines()
     lines[2] = lines[2].replace("42,54,12,", "42,54,13,")
     p = _write(tmp_path, "t4.csv", "\n".join(lines) + "\n")
     with pytest.raises(InputError, match=r"t4\.csv: column 'align_temp_change_c', row 2 .*not align_temp_max_c"):

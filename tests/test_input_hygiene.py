@@ -19,7 +19,7 @@ from navlib.data.gyro_tables import drift_measurements
 from navlib.data.tables import Column, read_table
 from navlib.data.tumble import TUMBLE_FILE, read_tumble
 from navlib.errors import InputError, UserCodeError
-from navlib.paths import DATA_DIR, ROOT
+from navlib.paths import ROOT, data_path
 from navlib.studies.workbench import REALDATA
 from navlib.workbench import Effect, get_system, load_effects
 from navlib.workbench.effects import CATALOGUES
@@ -301,7 +301,7 @@ def test_drift_units_are_checked(tmp_path, change, expect):
 
 
 def real_files():
-    files = [("compass", DATA_DIR / "compass_sweeps.csv"), ("drift", DATA_DIR / "gyro_drift_measurements.csv")]
+    files = [("compass", data_path("compass_sweeps.csv")), ("drift", data_path("gyro_drift_measurements.csv"))]
     files += [("compass", p) for p in sorted((REALDATA / "broad" / "level").glob("*.csv"))]
     files += [("magnetometer", p) for p in sorted((REALDATA / "broad" / "3d").glob("*.csv"))]
     return files

@@ -7,7 +7,7 @@ import pytest
 
 from navlib import verdicts
 from navlib.errors import InputError
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 from navlib.report import Claim
 from navlib.sensors import ins
 from navlib.studies import paper_c as pc
@@ -36,13 +36,13 @@ def test_paper_facts_match_their_quotes_and_the_simulator():
     assert (pc.fact("align_h"), pc.fact("identify_h"), pc.fact("navigate_h")) == (p.align_h, p.identify_h,
                                                                                   p.navigate_h)
     assert set(f["kind"]) == {"claim", "setting"}
-    assert "paper_c_facts.csv" in (DATA_DIR / "README.md").read_text(encoding="utf-8")
+    assert "paper_c_facts.csv" in data_path("README.md").read_text(encoding="utf-8")
     with pytest.raises(InputError, match="no such fact"):
         pc.fact("accuracy")
 
 
 def test_paper_facts_reject_a_missing_or_duplicated_key(tmp_path):
-    lines = (DATA_DIR / pc.FACTS_FILE).read_text(encoding="utf-8").splitlines()
+    lines = data_path(pc.FACTS_FILE).read_text(encoding="utf-8").splitlines()
     p = tmp_path / "facts.csv"
     p.write_text("\n".join(ln for ln in lines if not ln.startswith("spread,")) + "\n", encoding="utf-8")
     with pytest.raises(InputError, match="facts.csv: no row for key 'spread'"):

@@ -113,6 +113,30 @@ def test_write_results_refuses_bad_input(tmp_path):
         report.write_results("compass", claims=[claim, claim], folder=tmp_path)
 
 
+def test_results_go_where_the_caller_says_and_never_over_an_earlier_run(tmp_path, monkeypatch):
+    claim = _claim((1.5, 2.0))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("NAVBOOK_RESULTS_DIR", raising=False)
+    assert report.results_dir() == tmp_path / "results"                 # library use: ./results
+    first = report.write_results("compass", claims=[claim])
+    assert first == tmp_path / "results" / "compass.json"
+    before = first.read_text()
+    with pytest.raises(InputError, match="compass.json: a results file is already there") as err:
+        report.write_results("compass", claims=[_claim((0.1, 0.2))])
+    assert "\n" not in str(err.value) and "overwrite=True" in str(err.value)
+    assert first.read_text() == before                                   # the earlier run's file is intact
+    report.write_results("compass", claims=[_claim((0.1, 0.2))], overwrite=True)
+    assert json.loads(first.read_text())["claims"][0]["interval"] == [0.1, 0.2]
+    book = tmp_path / "book_results"
+    monkeypatch.setenv("NAVBOOK_RESULTS_DIR", str(book))                 # the build says where
+    assert report.results_dir() == book
+    assert report.write_results("compass", claims=[claim]) == book / "compass.json"
+    assert set(report.read_results()) == {"compass"}
+    (tmp_path / "a_file").write_text("x")
+    with pytest.raises(InputError, match="cannot create the results folder"):
+        report.write_results("compass", claims=[claim], folder=tmp_path / "a_file" / "sub")
+
+
 def test_claims_summary_counts_per_chapter_source_and_reading():
     res = {"a": {"claims": [{"reproduced": True, "reading": "r1", "source": "paper"},
                             {"reproduced": False, "reading": "r1", "source": "paper"},

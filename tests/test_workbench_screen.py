@@ -10,7 +10,7 @@ import pytest
 
 from navlib.data.gyro_tables import drift_measurements
 from navlib.errors import InputError
-from navlib.paths import DATA_DIR
+from navlib.paths import data_path
 from navlib.studies import workbench as wb
 from navlib.workbench import serial
 from navlib.workbench.diagnose import diagnose
@@ -21,7 +21,7 @@ from navlib.workbench.screen import MAX_OUTLIER_SHARE, screen
 from navlib.workbench.trials import TRIAL_SYSTEMS, catalogue, random_params, trial_seed
 
 REAL = pytest.mark.skipif(not wb.MAG_DIR.is_dir(), reason="../shared/realdata absent")
-SWEEPS = DATA_DIR / "compass_sweeps.csv"
+SWEEPS = data_path("compass_sweeps.csv")
 
 
 def run_cli(*args):

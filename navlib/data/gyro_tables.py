@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
-from ..paths import DATA_DIR
+from ..paths import data_path
 from ..sensors.ins import LOCAL_LATITUDE_DEG
 from .tables import Column, read_table, where
 
@@ -87,7 +87,7 @@ def load_table(number: int, path: str | os.PathLike | None = None) -> pd.DataFra
     """Load and validate paper C's Table ``number`` (2, 3, 4 or 5) from ``data/`` (or ``path``)."""
     if number not in TABLE_FILES:
         raise InputError(f"parameter table={number!r}: paper C has drift tables 2, 3, 4 and 5")
-    p = Path(path) if path is not None else DATA_DIR / TABLE_FILES[number]
+    p = Path(path) if path is not None else data_path(TABLE_FILES[number])
     df = read_table(p, COLUMNS[number], min_rows=MIN_ROWS[number], kind=KIND[number])
     key = "sample" if number in (2, 4) else "test"
     _check_unique(p, df, key)

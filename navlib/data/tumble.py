@@ -14,10 +14,10 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
-from ..paths import DATA_DIR
+from ..paths import data_path
 from .tables import Column, read_table, where
 
-TUMBLE_FILE = DATA_DIR / "accel_tumble.csv"
+TUMBLE_FILE = data_path("accel_tumble.csv")
 COLUMNS = [Column("temperature_c", "degC", lo=-60.0, hi=130.0),
            Column("position_deg", "deg", lo=0.0, hi=360.0),
            Column("output_mg", "mg", lo=-5000.0, hi=5000.0),

@@ -31,15 +31,17 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
-import torch
 from scipy.optimize import least_squares
-from torch.optim.adam import adam as adam_step
 
+from .._optional import require
 from ..errors import InputError, check_choice, check_param
 from .de import DEParams, DEResult, evolve_many
 from .jit import LM_STOPS, lm_1m1, logsig_sse
 from .lm import LMParams, LMResult, dividerand, levenberg_marquardt
 from .scaling import MinMax
+
+torch = require("torch", __name__)      # the [nets] extra
+from torch.optim.adam import adam as adam_step  # noqa: E402
 
 Activation = Literal["logsig", "tansig"]
 ACTIVATIONS = ("logsig", "tansig")

@@ -24,9 +24,11 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-import torch
 
+from .._optional import require
 from ..errors import InputError, check_param
+
+torch = require("torch", __name__)      # the [nets] extra
 
 _CHOICES = {"hidden": ("tansig", "logsig"), "trainer": ("lbfgs", "adam"),
             "scaling": ("mapminmax", "standardize"), "init": ("nguyen_widrow", "torch")}

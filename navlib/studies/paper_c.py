@@ -58,7 +58,7 @@ from ..data.gyro_tables import TABLE_FILES, load_cold_test, load_cold_train, loa
 from ..data.tables import Column, read_table
 from ..errors import InputError, check_param
 from ..methods.rbf import InputScaler, RBFNet, leave_one_out, newrb
-from ..paths import DATA_DIR
+from ..paths import data_path
 from ..report import Claim, method_stats
 from ..sensors import ins
 
@@ -90,7 +90,7 @@ def paper_facts(path=None) -> pd.DataFrame:
     pandas.DataFrame
         One row per fact.
     """
-    p = DATA_DIR / FACTS_FILE if path is None else path
+    p = data_path(FACTS_FILE) if path is None else path
     df = read_table(p, [Column("value", lo=-1e6, hi=1e6)], kind="facts table")
     for c in ("key", "unit", "kind", "source", "quote"):
         if c not in df:
@@ -1219,7 +1219,7 @@ def _printed(table: int, column: str) -> list[str]:
     ``0.0020``)."""
     if table not in TABLE_FILES:
         raise InputError(f"parameter table={table!r}: paper C's measured tables are 2, 3, 4 and 5")
-    raw = pd.read_csv(DATA_DIR / TABLE_FILES[table], dtype=str)
+    raw = pd.read_csv(data_path(TABLE_FILES[table]), dtype=str)
     if column not in raw:
         raise InputError(f"{TABLE_FILES[table]}: no column '{column}'")
     return [v.strip() for v in raw[column]]

@@ -36,7 +36,7 @@ from ..methods.anfis import AnfisOptions, anfis
 from ..methods.fish_swarm import FishSwarmParams, minimise
 from ..methods.mlp import MLPParams, train_mlp
 from ..methods.subclust import SubclustOptions, SugenoFIS, genfis2, solve_consequents, subclust
-from ..paths import DATA_DIR
+from ..paths import data_path
 from ..sensors.accelerometer import (AccelCoefficients, TumbleExperiment, T_REF_C, bias_test, paper_units,
                                      tumble_coefficients)
 
@@ -46,7 +46,7 @@ METHODS = ("ANN", "FIS", "ANFIS", "IAFSA-SCM-ANFIS", "physical (poly K0, K1, K2)
 ORDER_OF_MAGNITUDE = 10.0
 #: The 95 % median interval over seeds needs at least this many seeds (:func:`navlib.verdicts.median_ci`).
 MIN_SEEDS_FOR_CLAIMS = 6
-PAPER_FILE = DATA_DIR / "paper_d_results.csv"
+PAPER_FILE = data_path("paper_d_results.csv")
 
 
 @dataclass(frozen=True)

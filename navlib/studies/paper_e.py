@@ -32,7 +32,7 @@ from ..data.tables import Column, read_table
 from ..errors import InputError, check_param
 from ..methods import kalman as km
 from ..methods.mlp import MLPParams, train_mlp
-from ..paths import DATA_DIR
+from ..paths import data_path
 from ..sensors.strapdown import ImuSpec, InitialError, StarSensorSpec, strapdown
 from ..sensors.trajectory import FlightProfile, generate
 
@@ -305,7 +305,7 @@ def _trace(rows, t, case, method, err):
 # ------------------------------------------------------------------------------------------- tables
 def paper_numbers() -> pd.DataFrame:
     """Paper E's four surviving numbers, ``data/paper_e_numbers.csv`` (indexed by quantity)."""
-    df = read_table(DATA_DIR / "paper_e_numbers.csv", [Column("value", lo=0)], kind="table of paper numbers")
+    df = read_table(data_path("paper_e_numbers.csv"), [Column("value", lo=0)], kind="table of paper numbers")
     need = {"train_time_45_s", "train_time_6_s", "improvement_min_pct", "attitude_error_max_arcsec"}
     if "quantity" not in df.columns or not need <= set(df["quantity"].str.strip()):
         raise InputError(f"paper_e_numbers.csv: column 'quantity' must list {', '.join(sorted(need))}")
