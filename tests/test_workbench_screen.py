@@ -353,3 +353,48 @@ def test_the_noise_model_is_chosen_around_the_regressors_the_likelihood_prefers(
     m = serial.select(y, J, S, ser)
     assert m.around == "model and structure shapes" and abs(m.lag1) < 0.3, m
     assert serial.estimate(y, J, ser).lag1 > 0.5                  # what the Jacobian alone would have said
+
+
+def test_the_report_counts_rows_not_observations():
+    """A magnetometer row holds three observations (x, y, z): the text report says rows, and the
+    observations beside them; a compass row is one observation."""
+    data = simulate_hand_turned({"hard_x_ut": 5.0}, duration_s=20, noise_ut=0.3, seed=4)
+    d = diagnose(fit_model("magnetometer", data, ["hard_iron"]))
+    first = d.report().splitlines()[0]
+    assert f"rows: {len(data)} ({3 * len(data)} observations)" in first, first
+    c = diagnose(fit_model("compass", load("compass", data_path("compass_sweeps.csv")), ["misalignment"]))
+    assert c.report().splitlines()[0].endswith(f"rows: {c.n}")
+
+
+def test_the_bootstrap_level_of_correlated_noise_is_reported_and_reproducible():
+    """On correlated noise the family is calibrated by the parametric bootstrap: its level is stored, the
+    same seed gives the same level, and the text report states it."""
+    data = simulate_hand_turned({"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=5)
+    f = fit_model("magnetometer", data, ["hard_iron"])
+    a, b = diagnose(f), diagnose(f)
+    cal = a.to_dict()["calibration"]
+    assert cal["method"] == "parametric bootstrap" and cal["replicates"] >= 1
+    assert cal == b.to_dict()["calibration"]
+    assert "parametric bootstrap" in a.report().splitlines()[2]
+    assert 0 < cal["level"] < a.alpha
+
+
+def test_the_vectorised_ar1_likelihoods_equal_the_fast_ones_and_pick_the_same_correlation():
+    """``ar1_grid`` (many residual vectors at once) against ``_Restricted`` at order 1 on a series with gaps
+    and left-out samples; ``select_ar1_many`` against ``select`` at order 1, to the grid's resolution."""
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], 200))
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(rng.random(600) < 0.03)
+    X = rng.standard_normal((600, 4))
+    S = rng.standard_normal((600, 3))
+    E = serial.colour(rng.standard_normal((len(ser.order), 4)), (0.8,), ser, 600)
+    Q = serial.basis_on(X, ser, 600)
+    reml, ml = serial.ar1_grid(E, Q, ser)
+    for g in (5, 120, 230):
+        fast = serial._Restricted(E[:, 2], Q, ser, 1)
+        assert reml[g, 2] == pytest.approx(fast((serial.AR1_GRID[g],)), rel=1e-10)
+        assert ml[g, 2] == pytest.approx(fast.ml((serial.AR1_GRID[g],)), rel=1e-10)
+    many = serial.select_ar1_many(E, serial.select_bases(X, S, ser, 600), ser)
+    for b in range(4):
+        one = serial.select(E[:, b], X, S, ser, order=1, interval=False)
+        assert many[b] == pytest.approx(one.lag1, abs=0.01)

@@ -87,6 +87,8 @@ SPANNED = 0.1
 REPLICATES = 99
 # The bootstrap's random stream: spawn key under the diagnosis seed (the permutation test uses the seed itself).
 _BOOTSTRAP_KEY = 1
+# Replicates simulated at once (the early stop is checked after each batch; fixed, so results never depend on it).
+_BATCH = 20
 
 
 @dataclass
@@ -176,7 +178,10 @@ class Diagnosis:
 
     def report(self) -> str:
         """A readable multi-line report (the CLI's output without --json)."""
-        lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   rows: {self.n}",
+        used = len(self.screening.kept) if self.screening is not None else None
+        size = (f"rows: {used}" + (f" ({self.n} observations)" if self.n != used else "")
+                if used else f"observations: {self.n}")
+        lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   {size}",
                  f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
                  self._level_line()]
         if self.screening is not None and self.screening.noise.series is not None:
@@ -373,32 +378,89 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     i.e. ``p`` below the K-th smallest replicate minimum, ``K = ceil(alpha (B + 1) - 1)``.  The replicates
     stop early once K minima fall at or below the smallest observed p (nothing can then be significant;
     Besag and Clifford 1991, Biometrika 78:301)."""
-    from .serial import colour, select, select_bases
+    from .serial import colour, select_bases
     noise = sc.noise
     B = bootstrap_replicates(alpha)
     K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))
     if K < 1:
         return Calibration(0.0, "parametric bootstrap", 0)
-    J0 = fit.jacobian
-    cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
-    shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
+    family = _Family(fit, fits)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
     ser = noise.series
     bases = select_bases(*sc.regressors, ser, fit.n)
-    minima = []
-    for b in range(B):
-        e = colour(rng.standard_normal(len(ser.order)), noise.kappa, ser, fit.n)
-        nb = select(e, *sc.regressors, ser, order=noise.order, interval=False, bases=bases)
-        e0, Q0 = _gls_of(e, J0, nb)
-        ps = [p for _, p, _ in _shape_tests(e0, Q0, shapes, nb, fit.n)]
-        rss0 = float(e0 @ e0)
-        for J1, q, df2 in cands:
-            e1, _ = _gls_of(e, J1, nb)
-            ps.append(_f_test(rss0, float(e1 @ e1), q, df2)[0])
-        minima.append(min(ps) if ps else 1.0)
-        if sum(m <= p_min for m in minima) >= K:
-            return Calibration(float(sorted(minima)[K - 1]), "parametric bootstrap", b + 1, True)
-    return Calibration(float(sorted(minima)[K - 1]), "parametric bootstrap", B)
+    U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
+    minima = np.empty(0)
+    for start in range(0, B, _BATCH):
+        E = colour(U[:, start:start + _BATCH], noise.kappa, ser, fit.n)
+        minima = np.r_[minima, family.minima(E, bases, noise, sc.regressors)]
+        if np.sum(minima <= p_min) >= K:
+            return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", len(minima), True)
+    return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", B)
+
+
+class _Family:
+    """The tests of one diagnosis, re-run on simulated residual vectors: each candidate's nested GLS F test
+    and each structure shape's, with the noise model each vector's own estimate."""
+
+    def __init__(self, fit: Fit, fits: dict):
+        self.n = fit.n
+        self.J0 = fit.jacobian
+        self.cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
+        self.shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
+
+    def minima(self, E: np.ndarray, bases: tuple, noise: NoiseModel, regressors: tuple) -> np.ndarray:
+        """The smallest p of the family on each column of ``E`` (residual vectors in observation order), the
+        noise model of each chosen as the screen chose the data's (:func:`navlib.workbench.serial.select`
+        around ``regressors``, whose orthonormal ``bases`` are given; the AR order fixed at the data's)."""
+        from .serial import select, select_ar1_many
+        out = np.ones(E.shape[1])
+        if noise.order == 1:
+            # AR(1): every vector's correlation on the grid at once; vectors with the same one share the
+            # whitened Jacobians and shapes
+            k1 = select_ar1_many(E, bases, noise.series)
+            for k in np.unique(k1):
+                cols = np.flatnonzero(k1 == k)
+                out[cols] = self._min_p(E[:, cols], NoiseModel((float(k),), noise.series, self.n))
+            return out
+        for b in range(E.shape[1]):
+            nb = select(E[:, b], *regressors, noise.series, order=noise.order, interval=False, bases=bases)
+            out[b] = self._min_p(E[:, [b]], nb)[0]
+        return out
+
+    def _min_p(self, E: np.ndarray, nm: NoiseModel) -> np.ndarray:
+        W = nm.whiten(E) if nm.correlated else E
+        Q0 = _projector(nm.whiten(self.J0))
+        e0 = W - Q0 @ (Q0.T @ W)
+        rss0 = np.einsum("ij,ij->j", e0, e0)
+        best = np.ones(E.shape[1])
+        for J1, q, df2 in self.cands:
+            if q <= 0 or df2 <= 0:
+                continue
+            Q1 = _projector(nm.whiten(J1))
+            e1 = W - Q1 @ (Q1.T @ W)
+            rss1 = np.einsum("ij,ij->j", e1, e1)
+            best = np.minimum(best, _f_p(rss0 - rss1, rss1, q, df2))
+        for X0 in self.shapes:
+            X = nm.whiten(X0) if nm.correlated else X0
+            X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
+            Xp = X - Q0 @ (Q0.T @ X)
+            w, V = np.linalg.eigh(Xp.T @ Xp)
+            keep = w > SPANNED ** 2
+            q = int(np.sum(keep))
+            df2 = self.n - Q0.shape[1] - q
+            if q == 0 or df2 < 3:
+                continue
+            u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
+            drop = np.sum((u.T @ e0) ** 2, axis=0)
+            best = np.minimum(best, _f_p(drop, rss0 - drop, q, df2))
+        return best
+
+
+def _f_p(drop: np.ndarray, rss1: np.ndarray, q: int, df2: int) -> np.ndarray:
+    """p of the nested F test (:func:`_f_test`), vectorised: ``F = (drop / q) / (rss1 / df2)``."""
+    from scipy.special import fdtrc
+    f = np.maximum(drop / q, 0.0) / np.maximum(rss1 / df2, 1e-300)
+    return np.where(rss1 > 0, fdtrc(q, df2, f), np.where(drop > 0, 0.0, 1.0))
 
 
 def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:

@@ -55,7 +55,7 @@ MAX_ORDER = 3
 KAPPA_MAX = 0.995
 #: Fewest samples beyond the regressors for an estimate (fewer: the samples are taken as independent).
 MIN_SAMPLES = 20
-#: Coverage of the profile-likelihood interval of kappa_1 over which p-values are maximised.
+#: Coverage of the profile-likelihood interval of kappa_1 reported with the noise model (``lag1_interval``).
 KAPPA_LEVEL = 0.9
 #: Penalty per parameter of the criterion that chooses the noise model's regressors (:func:`select`), as a
 #: function of the number of observations: BIC's ``log N`` (Schwarz 1978, Ann. Stat. 6:461).
@@ -259,24 +259,6 @@ class NoiseModel:
     def whiten(self, x: np.ndarray) -> np.ndarray:
         """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent."""
         return whiten(x, self.kappa, self.series) if self.correlated else np.asarray(x, float)
-
-    def without_variants(self) -> "NoiseModel":
-        """The same model without its interval (its :meth:`variants` is itself alone)."""
-        return NoiseModel(self.kappa, self.series, self.n_obs, self.loglik, self.note, (), self.ml, self.regressors,
-                          self.around)
-
-    def variants(self) -> list["NoiseModel"]:
-        """The estimate and the models with ``kappa_1`` at either end of its profile-likelihood interval
-        (:data:`KAPPA_LEVEL`): a test's p-value is taken as the largest over them (a p-value maximised over
-        a confidence set of the nuisance parameter, Berger and Boos 1994, JASA 89:1012, without their
-        correction term), so an estimate of the correlation that is a little low cannot make noise look
-        significant."""
-        out = [self]
-        if self.correlated:
-            for k1 in self.bounds:
-                out.append(NoiseModel((k1,) + tuple(self.kappa[1:]), self.series, self.n_obs, self.loglik,
-                                      self.note))
-        return out
 
     def to_dict(self) -> dict:
         """The noise model in ``--json``: what ordered the series (``time_s``, ``file order`` or None), AR
@@ -503,3 +485,63 @@ def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_o
     qb = basis_on(base, series, n_obs)
     qe = basis_on(np.column_stack([base, extra]), series, n_obs) if extra is not None and np.size(extra) else None
     return qb, qe
+
+
+#: The grid of lag-1 correlations on which :func:`ar1_grid` evaluates the likelihoods: uniform in
+#: ``atanh(kappa)`` over ``+-atanh(KAPPA_MAX)`` (spacing 0.025, so 0.005 in ``kappa`` near 0.9).
+AR1_GRID = np.tanh(np.linspace(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX), 241))
+
+
+def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray = AR1_GRID) -> tuple:
+    """REML and plain log likelihoods of AR(1) noise (module docstring) for many residual vectors at once,
+    on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
+    (:func:`basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
+    :class:`_Restricted` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
+    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix."""
+    Zq, Ze = basis[series.order], np.asarray(E, float)[series.order]
+    pos = series.pos
+    bulk, early = np.flatnonzero(pos >= 1), np.flatnonzero(pos == 0)
+    q0, q1, e0, e1 = Zq[bulk], Zq[bulk - 1], Ze[bulk], Ze[bulk - 1]
+    Cqq = (q0.T @ q0, q0.T @ q1 + q1.T @ q0, q1.T @ q1)
+    Cqe = (q0.T @ e0, q0.T @ e1 + q1.T @ e0, q1.T @ e1)
+    Cee = (np.einsum("ij,ij->j", e0, e0), 2 * np.einsum("ij,ij->j", e0, e1), np.einsum("ij,ij->j", e1, e1))
+    qe, ee = Zq[early], Ze[early]
+    Eqq, Eqe, Eee = qe.T @ qe, qe.T @ ee, np.einsum("ij,ij->j", ee, ee)
+    n, k = len(Zq), Zq.shape[1]
+    reml = np.empty((len(grid), Ze.shape[1]))
+    ml = np.empty_like(reml)
+    for g, phi in enumerate(grid):
+        v = 1.0 - phi * phi
+        mee = (Cee[0] - phi * Cee[1] + phi * phi * Cee[2]) / v + Eee
+        logdet_r = len(bulk) * np.log(v)
+        if k:
+            mqq = (Cqq[0] - phi * Cqq[1] + phi * phi * Cqq[2]) / v + Eqq
+            mqe = (Cqe[0] - phi * Cqe[1] + phi * phi * Cqe[2]) / v + Eqe
+            L = np.linalg.cholesky(mqq)
+            z = dtrtrs(L, mqe, lower=1)[0]
+            rss = mee - np.einsum("ij,ij->j", z, z)
+            logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
+        else:
+            rss, logdet_g = mee, 0.0
+        rss = np.maximum(rss, 1e-300)
+        reml[g] = -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
+        ml[g] = -0.5 * (n * np.log(rss / n) + logdet_r)
+    return reml, ml
+
+
+def select_ar1_many(E: np.ndarray, bases: tuple, series: Series, grid: np.ndarray = AR1_GRID) -> np.ndarray:
+    """:func:`select` at AR order 1 for many residual vectors at once (the columns of ``E``), the
+    correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
+    correlation of each vector."""
+    qb, qe = bases
+    rb, mb = ar1_grid(E, qb, series, grid)
+    ib = np.argmax(rb, axis=0)
+    cols = np.arange(E.shape[1])
+    if qe is None:
+        return grid[ib]
+    re_, me = ar1_grid(E, qe, series, grid)
+    ie = np.argmax(re_, axis=0)
+    pen = SELECT_PENALTY(len(series.order))
+    ic_b = -2 * mb[ib, cols] + pen * (qb.shape[1] + 1)
+    ic_e = -2 * me[ie, cols] + pen * (qe.shape[1] + 1)
+    return np.where(ic_e < ic_b, grid[ie], grid[ib])
