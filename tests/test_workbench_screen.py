@@ -313,8 +313,10 @@ def test_the_fast_restricted_likelihood_equals_the_direct_one():
     r = rng.standard_normal(600)
     for order in (1, 2, 3):
         fast = serial._Restricted(r, Q, ser, order)
+        shared = serial._Restricted(r, Q, ser, order, serial._Prepared(Q, ser, order))   # parts shared by a bootstrap
         for kappa in ((), (0.6,), (0.8, -0.3), (0.2, 0.3, -0.4))[:order + 1]:
             assert fast(kappa) == pytest.approx(serial._restricted_loglik(kappa, r, Q, ser), rel=1e-10)
+            assert shared(kappa) == pytest.approx(fast(kappa), rel=1e-12)
 
 
 @pytest.mark.parametrize("kappa", [(), (0.9,), (0.8, -0.3), (0.5, 0.2, 0.4)])

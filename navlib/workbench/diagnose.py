@@ -387,7 +387,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     family = _Family(fit, fits)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
     ser = noise.series
-    bases = select_bases(*sc.regressors, ser, fit.n)
+    bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order if noise.order > 1 else None)
     U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
     minima = np.empty(0)
     for start in range(0, B, _BATCH):
@@ -423,7 +423,8 @@ class _Family:
                 out[cols] = self._min_p(E[:, cols], NoiseModel((float(k),), noise.series, self.n))
             return out
         for b in range(E.shape[1]):
-            nb = select(E[:, b], *regressors, noise.series, order=noise.order, interval=False, bases=bases)
+            nb = select(E[:, b], *regressors, noise.series, order=noise.order, interval=False, bases=bases,
+                        start_at=noise.kappa)
             out[b] = self._min_p(E[:, [b]], nb)[0]
         return out
 

@@ -285,6 +285,22 @@ class NoiseModel:
                 f"on whitened residuals, {slow}")
 
 
+class _Prepared:
+    """The parts of :class:`_Restricted` that depend only on the regressors' basis ``Q`` and the series (not
+    on the residual): computed once when many residual vectors share them (a bootstrap)."""
+
+    def __init__(self, Q: np.ndarray, series: Series, max_order: int):
+        Zq = np.asarray(Q, float)[series.order]
+        self.k, self.P, self.n = Zq.shape[1], int(max_order), len(Zq)
+        self.pos = series.pos
+        self.bulk = np.flatnonzero(self.pos >= self.P)
+        self.lq = [Zq[self.bulk - i] for i in range(self.P + 1)]
+        self.C = [[self.lq[i].T @ self.lq[j] for j in range(self.P + 1)] for i in range(self.P + 1)]
+        self.early = np.flatnonzero(self.pos < self.P)
+        self.early_pos = self.pos[self.early]
+        self.elags = [Zq[self.early]] + [Zq[np.maximum(self.early - j, 0)] for j in range(1, self.P)]
+
+
 class _Restricted:
     """The REML log likelihood (module docstring) of AR partial autocorrelations for a residual ``r`` with
     regressors of orthonormal basis ``Q``, fast: with ``Z = [Q, r]`` the Gram matrix of the whitened
@@ -293,16 +309,28 @@ class _Restricted:
     ``sum_ij a_i a_j C_ij / v_p`` with the lagged cross-products ``C_ij = sum_t z_(t-i) z_(t-j)'`` computed
     once; the few samples nearer a segment start are whitened directly."""
 
-    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int):
-        Z = np.column_stack([Q, r])[series.order]
-        self.k, self.P, self.n = Q.shape[1], int(max_order), len(Z)
-        pos = series.pos
-        bulk = np.flatnonzero(pos >= self.P)
-        self.C = [[Z[bulk - i].T @ Z[bulk - j] for j in range(self.P + 1)] for i in range(self.P + 1)]
-        self.early = np.flatnonzero(pos < self.P)
-        self.early_pos = pos[self.early]
-        self.lags = [Z[self.early]] + [Z[np.maximum(self.early - j, 0)] for j in range(1, self.P)]
-        self.pos = pos
+    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int,
+                 prepared: "_Prepared | None" = None):
+        pre = prepared if prepared is not None and prepared.P >= int(max_order) else \
+            _Prepared(Q, series, int(max_order))
+        self.k, self.P, self.n = pre.k, pre.P, pre.n
+        ro = np.asarray(r, float)[series.order]
+        rl = [ro[pre.bulk - i] for i in range(self.P + 1)]
+        k = self.k
+        self.C = []
+        for i in range(self.P + 1):
+            row = []
+            for j in range(self.P + 1):
+                c = np.empty((k + 1, k + 1))
+                c[:k, :k] = pre.C[i][j]
+                c[:k, k] = pre.lq[i].T @ rl[j]
+                c[k, :k] = rl[i] @ pre.lq[j]
+                c[k, k] = rl[i] @ rl[j]
+                row.append(c)
+            self.C.append(row)
+        self.early, self.early_pos, self.pos = pre.early, pre.early_pos, pre.pos
+        self.lags = [np.column_stack([pre.elags[0], ro[self.early]])] + \
+            [np.column_stack([pre.elags[j], ro[np.maximum(self.early - j, 0)]]) for j in range(1, self.P)]
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -388,11 +416,14 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
 
 def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
              max_order: int = MAX_ORDER, *, order: int | None = None, interval: bool = True,
-             basis: np.ndarray | None = None) -> NoiseModel:
+             basis: np.ndarray | None = None, prepared: _Prepared | None = None,
+             start_at: tuple | None = None) -> NoiseModel:
     """REML estimate of the AR noise model of ``residuals`` given the ``regressors`` a fit took out of
     them (module docstring), the order chosen by AIC over ``0..max_order``, or fixed at ``order``.
     ``interval``: also the profile-likelihood interval of ``kappa_1`` (``bounds``).  No series:
-    independent.  ``basis``: :func:`basis_on` of the regressors, if already computed."""
+    independent.  ``basis``: :func:`basis_on` of the regressors, if already computed; ``prepared``: its
+    residual-free likelihood parts (:class:`_Prepared`), likewise; ``start_at``: with a fixed ``order`` of 2
+    or more, optimise that order only, from these partial autocorrelations."""
     r = np.asarray(residuals, float)
     if series is None:
         return NoiseModel((), None, len(r))
@@ -402,11 +433,20 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         return NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation")
     if order is not None:
         max_order = int(order)
-    loglik = _Restricted(r, Q, series, max(max_order, 1))
+    loglik = _Restricted(r, Q, series, max(max_order, 1), prepared)
     best = ((), loglik(()))
     logliks = [best[1]]
     aic_best = -2 * best[1] if order is None else np.inf
     start = ()
+    if order is not None and order >= 2 and start_at is not None:
+        # a fixed order from a given start (a bootstrap replicate starts at the data's estimate): that order only
+        lim = np.arctanh(KAPPA_MAX)
+        x0 = np.arctanh(np.clip(np.asarray(start_at, float)[:order], -KAPPA_MAX, KAPPA_MAX))
+        sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
+                       options={"maxiter": 60})
+        best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
+        logliks.append(best[1])
+        max_order = 0                                  # skip the forward search
     for p in range(1, max_order + 1):
         if p == 1:
             sol = minimize_scalar(lambda a: -loglik((np.tanh(a),)),
@@ -453,7 +493,8 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
 
 
 def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series | None, *,
-           order: int | None = None, interval: bool = True, bases: tuple | None = None) -> NoiseModel:
+           order: int | None = None, interval: bool = True, bases: tuple | None = None,
+           start_at: tuple | None = None) -> NoiseModel:
     """The noise model around the better of two sets of regressors: ``base`` (the model's Jacobian) or
     ``base`` and ``extra`` (the structure shapes).  Each set gets its REML estimate (:func:`estimate`);
     the set with the lower AIC of the plain likelihood, ``-2 l_ML + 2 (regressors + AR order)``, is used.
@@ -465,12 +506,13 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     out, is taken for correlated noise and hidden by it.  The likelihood decides which is the case.
     ``around`` in the result says which set was used; ``bases``: :func:`select_bases` of the regressors,
     if already computed (a bootstrap re-estimates on many residual vectors)."""
-    qb, qe = bases if bases is not None else (None, None)
-    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb)
+    qb, qe = bases[:2] if bases is not None else (None, None)
+    pb, pe = bases[2:4] if bases is not None and len(bases) > 2 else (None, None)
+    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at)
     if extra is None or not np.size(extra) or series is None:
         return replace(mb, around="model")
     me = estimate(residuals, None if qe is not None else np.column_stack([base, extra]), series, order=order,
-                  interval=interval, basis=qe)
+                  interval=interval, basis=qe, prepared=pe, start_at=start_at)
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
         return replace(me, around="model and structure shapes")
     pen = SELECT_PENALTY(len(series.order))
@@ -479,12 +521,17 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     return replace(me, around="model and structure shapes") if ic_e < ic_b else replace(mb, around="model")
 
 
-def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_obs: int) -> tuple:
+def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_obs: int,
+                 order: int | None = None) -> tuple:
     """The two orthonormal bases :func:`select` compares (:func:`basis_on` of ``base`` and of ``base`` with
-    ``extra``; the second None without ``extra``)."""
+    ``extra``; the second None without ``extra``); with ``order``, also their likelihood parts for that AR
+    order (:class:`_Prepared`), for many residual vectors."""
     qb = basis_on(base, series, n_obs)
     qe = basis_on(np.column_stack([base, extra]), series, n_obs) if extra is not None and np.size(extra) else None
-    return qb, qe
+    if order is None:
+        return qb, qe
+    P = max(int(order), 1)
+    return qb, qe, _Prepared(qb, series, P), (_Prepared(qe, series, P) if qe is not None else None)
 
 
 #: The grid of lag-1 correlations on which :func:`ar1_grid` evaluates the likelihoods: uniform in
@@ -533,7 +580,7 @@ def select_ar1_many(E: np.ndarray, bases: tuple, series: Series, grid: np.ndarra
     """:func:`select` at AR order 1 for many residual vectors at once (the columns of ``E``), the
     correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
     correlation of each vector."""
-    qb, qe = bases
+    qb, qe = bases[:2]
     rb, mb = ar1_grid(E, qb, series, grid)
     ib = np.argmax(rb, axis=0)
     cols = np.arange(E.shape[1])
