@@ -59,6 +59,7 @@ CONNECT_TIMEOUT_S = 10.0
 _ADDRESS = re.compile(r"^(tcp|tls|ws|wss|inproc|ucx)://\S+$")
 _CLIENTS: dict[tuple, Any] = {}          # ("local", n) or ("remote", address) -> Client
 _CLUSTERS: dict[tuple, Any] = {}         # ("local", n) -> LocalCluster
+_PRELOADS: list = []                     # futures of start()'s imports (a released future is cancelled)
 
 
 # ------------------------------------------------------------------------------------------ where
@@ -172,6 +173,7 @@ def _close(key) -> None:
 
 def shutdown() -> None:
     """Close every client and stop every local cluster this process started (also done at exit)."""
+    _PRELOADS.clear()
     for key in list(_CLIENTS) + list(_CLUSTERS):
         _close(key)
 
@@ -193,9 +195,10 @@ def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str]
     c = client(workers, scheduler)
     if c is None or not preload:
         return
+    _PRELOADS[:] = [f for f in _PRELOADS if not f.done()]
     for addr in c.scheduler_info(n_workers=-1)["workers"]:
-        c.submit(_import, tuple(preload), workers=[addr], pure=False, allow_other_workers=False,
-                 key=f"navlib-preload-{uuid.uuid4().hex[:8]}")
+        _PRELOADS.append(c.submit(_import, tuple(preload), workers=[addr], pure=False, allow_other_workers=False,
+                                  priority=10**9, key=f"navlib-preload-{uuid.uuid4().hex[:8]}"))
 
 
 # ------------------------------------------------------------------------------------------ running

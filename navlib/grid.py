@@ -27,11 +27,14 @@ Needs papermill (the book's tooling: ``pip install 'navlib[book]'``).
 from __future__ import annotations
 
 import ast
+import contextlib
 import csv
 import itertools
 import json
+import logging
 import math
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -191,6 +194,22 @@ def _papermill():
     return papermill
 
 
+@contextlib.contextmanager
+def _stderr_to(path: Path):
+    """File descriptor 2 (this process's and the kernels' it starts) into ``path`` while a run executes:
+    the kernel's and papermill's warnings belong to the run, not to the terminal of the grid."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(path, "ab") as f:
+            os.dup2(f.fileno(), 2)
+        yield
+    finally:
+        sys.stderr.flush()
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
 def run_point(notebook_json: str, name: str, parameters: dict, cwd: str) -> dict:
     """One run of the grid (a task of :mod:`navlib.engine`, in a worker process): execute the notebook
     ``notebook_json`` (its text) with ``parameters`` in ``cwd`` (a temporary folder where ``cwd`` does not
@@ -206,15 +225,21 @@ def run_point(notebook_json: str, name: str, parameters: dict, cwd: str) -> dict
         os.environ["NAVBOOK_RESULTS_DIR"] = str(res)            # the kernel inherits the environment
         os.environ.pop(engine.ENV_SCHEDULER, None)
         os.environ[engine.ENV_PROGRESS] = "0"
+        quiet = logging.getLogger("papermill")
+        level = quiet.level
+        quiet.setLevel(logging.ERROR)       # "Passed unknown parameter" when it cannot parse a commented line
         try:
-            pm.execute_notebook(str(src), str(dst), parameters=parameters, cwd=cwd if Path(cwd).is_dir() else tmp,
-                                kernel_name="python3", progress_bar=False, log_output=False)
+            with _stderr_to(Path(tmp) / "stderr.log"):
+                pm.execute_notebook(str(src), str(dst), parameters=parameters,
+                                    cwd=cwd if Path(cwd).is_dir() else tmp, kernel_name="python3",
+                                    progress_bar=False, log_output=False)
         except pm.PapermillExecutionError as err:
             lines = [ln for ln in str(err).strip().splitlines() if ln.strip()]
             error = f"cell {err.exec_count}: {lines[-1] if lines else err.ename}"
         except (RuntimeError, OSError, TimeoutError) as err:        # kernel died, could not start ...
             error = f"{type(err).__name__}: {str(err).strip().splitlines()[0] if str(err).strip() else ''}"
         finally:
+            quiet.setLevel(level)
             for k, v in saved.items():
                 if v is None:
                     os.environ.pop(k, None)
