@@ -153,7 +153,10 @@ def parse_grid(specs: list[str], parameters: dict[str, Any], notebook: str = "th
             raise InputError(f"grid: parameter {name!r} is not in the parameters cell of {notebook} "
                              f"(its parameters: {known})")
         default = parameters[name]
-        raws = [values] if isinstance(default, (list, tuple)) else next(csv.reader([values], skipinitialspace=True), [""])
+        if isinstance(default, (list, tuple)):
+            raws = [values]
+        else:                                        # comma-separated; "a,b" in double quotes is one value
+            raws = next(csv.reader([values], skipinitialspace=True), [])
         if not raws or any(not r.strip() for r in raws):
             raise InputError(f"grid: parameter {name}={values!r}: an empty value")
         for r in raws:

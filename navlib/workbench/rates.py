@@ -77,7 +77,8 @@ class Rates:
                  "", "false alarms (nothing hidden; anything but 'consistent with noise'):",
                  self.false_alarms.to_string(index=False, formatters=fmt)]
         if self.out_of_catalogue is not None:
-            f2 = dict(fmt, **{c: "{:.3f}".format for c in self.out_of_catalogue.columns if c.endswith(("rate", "low", "high"))})
+            f2 = dict(fmt, **{c: "{:.3f}".format for c in self.out_of_catalogue.columns
+                              if c.endswith(("rate", "low", "high"))})
             parts += ["", "errors outside the catalogue (quiet: no catalogued effect named; detected: not noise):",
                       self.out_of_catalogue.to_string(index=False, formatters=f2)]
         return "\n".join(parts)
