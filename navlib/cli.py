@@ -10,6 +10,19 @@ Commands:
       the whole loop: diagnose, add the named effect, repeat until the residuals are consistent with noise
       or nothing more can be named.  --json prints {"steps": [...], "final": {...}}; --report DIR writes
       loop.png and loop.md (never over existing files).
+  rates SYSTEM [--trials N] [--noise X,X] [--ratio R,R] [--workers N] [--scheduler ADDR] [--json]
+      how far to trust the loop on your set-up: the share of simulated trials in which a hidden effect of
+      each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
+      compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
+      --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
+  grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
+      one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
+      file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
+      statistics, claim verdicts).  Needs papermill.
+
+rates and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
+cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
+variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.
 
 SYSTEM is compass, drift, magnetometer or accelerometer:
   compass columns: true_heading_deg, measured_heading_deg; optional temperature_c, time_s, sweep.
@@ -38,6 +51,7 @@ import os
 import sys
 from dataclasses import replace
 
+from . import engine
 from .data.tables import write_new_csv
 from .errors import InputError, UserCodeError
 from .sensors.compass import CompassErrors, simulate_train_test
@@ -46,6 +60,7 @@ from .workbench.diagnose import diagnose
 from .workbench.effects import resolve
 from .workbench.fit import fit_model
 from .workbench.loop import check_report_folder, loop, write_report
+from .workbench.rates import DEFAULT_RATIOS, RATE_SYSTEMS, rates
 
 
 class _Parser(argparse.ArgumentParser):
@@ -74,6 +89,31 @@ def build_parser() -> argparse.ArgumentParser:
         cmd.add_argument("--alpha", type=float, default=None, help="family-wise false-alarm level (default 0.025)")
         if name == "loop":
             cmd.add_argument("--report", default=None, help="folder for loop.png and loop.md (never overwritten)")
+    rates = sub.add_parser("rates", help="detection, false-alarm and out-of-catalogue rates of the loop",
+                           description="detection, false-alarm and out-of-catalogue rates of the workbench's loop "
+                                       "on simulated data at your noise level and effect sizes (95 % Wilson "
+                                       "intervals)")
+    rates.add_argument("system", choices=sorted(RATE_SYSTEMS))
+    rates.add_argument("--trials", type=int, default=20, help="trials per hidden effect, size and noise (default 20)")
+    rates.add_argument("--noise", default=None,
+                       help="noise levels (1 sigma, comma-separated) in the system's unit (compass deg, drift deg/h, "
+                            "magnetometer uT, accelerometer mg)")
+    rates.add_argument("--ratio", default=None, help="effect sizes as multiples of the noise (default 3,10)")
+    rates.add_argument("--null-trials", type=int, default=None,
+                       help="nothing-hidden trials per noise level (default twice --trials)")
+    grid = sub.add_parser("grid", help="run a chapter notebook over a grid of its parameters",
+                          description="one papermill run of NOTEBOOK per point of the grid, each with its own "
+                                      "results file; DIR gets the executed notebooks and grid.csv")
+    grid.add_argument("notebook", help="a notebook with a cell tagged 'parameters'")
+    grid.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2",
+                      help="a parameter and its values (repeat for more parameters)")
+    grid.add_argument("--out", required=True, help="new or empty folder for the outputs")
+    for cmd in (rates, grid):
+        cmd.add_argument("--workers", type=int, default=None,
+                         help="local worker processes (default: the cores of this machine; 1 = this process)")
+        cmd.add_argument("--scheduler", default=None,
+                         help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
+    rates.add_argument("--json", action="store_true", help="print one JSON object")
     return ap
 
 
@@ -132,7 +172,45 @@ def _loop(args) -> int:
     return 0
 
 
-COMMANDS = {"simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop}
+def _numbers(option: str, text: str | None, default):
+    if text is None:
+        return default
+    out = []
+    for part in text.split(","):
+        try:
+            out.append(float(part))
+        except ValueError:
+            raise InputError(f"parameter {option}={part.strip()!r}: not a number") from None
+    return tuple(out)
+
+
+def _workers(args) -> int:
+    return engine.default_workers() if args.workers is None else args.workers
+
+
+def _rates(args) -> int:
+    r = rates(args.system, trials=args.trials, noises=_numbers("--noise", args.noise, None),
+              ratios=_numbers("--ratio", args.ratio, DEFAULT_RATIOS), null_trials=args.null_trials,
+              workers=_workers(args), scheduler=args.scheduler)
+    if args.json:
+        print(json.dumps(r.to_dict(), allow_nan=False, default=float))
+    else:
+        print(r.text())
+    return 0
+
+
+def _grid(args) -> int:
+    from .grid import run_grid                      # papermill and the notebook machinery: only here
+    rows = run_grid(args.notebook, args.param, args.out, workers=_workers(args), scheduler=args.scheduler)
+    failed = [r for r in rows if r["status"].startswith("failed")]
+    print(f"{len(rows)} runs, {len(rows) - len(failed)} ok; {os.path.join(args.out, 'grid.csv')}")
+    for r in failed:
+        print(f"run {r['run']}: {r['status']}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+COMMANDS = {"simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
+            "grid": _grid}
 
 
 #: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.

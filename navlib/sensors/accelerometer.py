@@ -178,13 +178,19 @@ def sensor_temperatures_c(exp: TumbleExperiment) -> np.ndarray:
     return out
 
 
-def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int, unit: str = "A") -> pd.DataFrame:
+def _sequence(seed: int | np.random.SeedSequence) -> np.random.SeedSequence:
+    return seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+
+
+def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence,
+                    unit: str = "A") -> pd.DataFrame:
     """One unit's multi-position full-temperature test: a tidy frame with ``set_point_c``, ``temperature_c``
     (the sensor's, lagged), ``position_deg``, ``output_mg`` (noisy), ``true_output_mg`` (noise-free) and
-    ``unit``; 552 rows for the paper's experiment.  Noise from ``np.random.SeedSequence(seed)``."""
+    ``unit``; 552 rows for the paper's experiment.  Noise from ``np.random.SeedSequence(seed)`` (or from
+    ``seed`` itself when it is a ``SeedSequence``)."""
     if not str(unit).strip():
         raise InputError("parameter unit='': give the unit a name")
-    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    rng = np.random.default_rng(_sequence(seed))
     temps = sensor_temperatures_c(exp)
     pos = np.broadcast_to(exp.positions_deg, temps.shape)
     sp = np.broadcast_to(exp.set_points_c[:, None], temps.shape)
@@ -195,11 +201,12 @@ def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int, u
                          "true_output_mg": true.ravel(), "unit": str(unit)})
 
 
-def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int) -> pd.DataFrame:
+def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence) -> pd.DataFrame:
     """The 0/180 deg bias test at each set point: ``(U(0) + U(180))/2 = K0 + K1 K2`` (the second-order term
     stays in: this is what the paper's bias test measures).  Columns ``set_point_c``, ``temperature_c``,
-    ``bias_mg`` (measured), ``true_bias_mg`` (the same test without noise)."""
-    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    ``bias_mg`` (measured), ``true_bias_mg`` (the same test without noise).  ``seed``: an integer entropy
+    or a ``SeedSequence``."""
+    rng = np.random.default_rng(_sequence(seed))
     temps = sensor_temperatures_c(exp)[:, 0]
     u = coef.output_mg(temps[:, None], np.array([0.0, 180.0])[None, :])
     noisy = u + 1e-3 * exp.noise_ug * rng.standard_normal(u.shape)

@@ -426,8 +426,11 @@ class ProcedureResult:
 def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors = ImuErrors(),
                   initial: InitialErrors = InitialErrors(), earth: Earth = Earth(),
                   rotation: Rotation = Rotation(), procedure: Procedure = Procedure(),
-                  cold: ColdStart | None = None, seed: int = 0) -> ProcedureResult:
+                  cold: ColdStart | None = None, seed: int | np.random.SeedSequence | None = 0) -> ProcedureResult:
     """Run align -> identify -> compensate -> navigate.
+
+    ``seed`` (an integer entropy or a ``numpy.random.SeedSequence``) draws the noise of the identification
+    run; the navigation runs draw theirs from the child with spawn key ``seed.spawn_key + (1,)``.
 
     ``identify(latitude_error_12h_deg) -> drift_deg_h`` is the identification method (a network, the
     Table 1 inverse...); ``None`` means the Table 1 inverse.  In cold mode the axial drift follows
@@ -450,7 +453,8 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
     x_reset = run1.states[-1].copy()
     x_reset[3:] = 0.0                                                      # velocity and position known
     t1 = t0 + p.identify_h * 3600.0
-    seed2 = None if seed is None else seed + 7919
+    # the navigation stage draws its own noise: part 1 of the run's seed (SeedSequence spawn key, no arithmetic)
+    seed2 = None if seed is None else _part(seed, 1)
 
     def nav(drift):
         return simulate(p.navigate_h, earth=earth, imu=replace(imu, axial_drift_deg_h=drift),
@@ -474,6 +478,12 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
     return ProcedureResult(identify_run=run1, latitude_error_12h_deg=lat12,
                            final_drift_deg_h=imu.axial_drift_deg_h, identified_drift_deg_h=est, after=after,
                            before=before, best_drift_deg_h=best, unit_response=unit)
+
+
+def _part(seed: int | np.random.SeedSequence, k: int) -> np.random.SeedSequence:
+    """Part ``k`` of a seed: the SeedSequence with the same entropy and ``k`` appended to its spawn key."""
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(int(seed))
+    return np.random.SeedSequence(ss.entropy, spawn_key=tuple(ss.spawn_key) + (int(k),))
 
 
 def random_test(rng: np.random.Generator, *, axial_drift_deg_h: float, gyro_bias_sd_deg_h: float = 0.002,
@@ -500,15 +510,18 @@ def simulated_tests(axial_drifts_deg_h, *, seed: int, identify: Callable[[float]
                     rotation: Rotation = Rotation(), procedure: Procedure = Procedure(),
                     **error_sd) -> list[ProcedureResult]:
     """Run the procedure once per axial drift, each test with its own residual sensor errors and alignment
-    outcome drawn by :func:`random_test` from ``numpy.random.default_rng([seed, i])`` (``error_sd``: its
-    standard deviations); ``cold[i]`` optionally gives test i a cold-start temperature history."""
+    outcome drawn by :func:`random_test` (``error_sd``: its standard deviations); ``cold[i]`` optionally
+    gives test i a cold-start temperature history.  Test ``i`` draws its errors from
+    ``SeedSequence(seed, spawn_key=(i, 0))`` and its noise from ``SeedSequence(seed, spawn_key=(i, 1))``:
+    every test and every part of it has its own stream."""
     drifts = np.atleast_1d(np.asarray(axial_drifts_deg_h, float))
     if cold is not None and len(cold) != drifts.size:
         raise InputError(f"{len(cold)} cold-start histories for {drifts.size} tests")
     out = []
     for i, d in enumerate(drifts):
-        imu, init = random_test(np.random.default_rng([seed, i]), axial_drift_deg_h=float(d), **error_sd)
+        errors = np.random.SeedSequence(int(seed), spawn_key=(i, 0))
+        imu, init = random_test(np.random.default_rng(errors), axial_drift_deg_h=float(d), **error_sd)
         out.append(run_procedure(identify, imu=imu, initial=init, earth=earth, rotation=rotation,
                                  procedure=procedure, cold=None if cold is None else cold[i],
-                                 seed=seed * 1000 + i))
+                                 seed=np.random.SeedSequence(int(seed), spawn_key=(i, 1))))
     return out

@@ -44,7 +44,7 @@ from ..report import Claim, method_stats
 from ..sensors.compass import CompassErrors, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
 from ..sensors.planar import fit_planar_model
-from .parallel import run_tasks
+from .. import engine
 
 
 @dataclass(frozen=True)
@@ -352,42 +352,50 @@ def _method_runs(sw: Sweeps, params: StudyParams, mid: str, seeds: list, base_se
     return rows
 
 
-def _tasks(sw, params, seeds, methods, base_seed, keep_errors, workers):
-    """One task per method, the seeds of a stochastic method cut into ``workers`` batches when parallel."""
+#: Runs of a stochastic method per task (a fixed size: the batches, and so the numbers, never depend on the
+#: number of workers).
+SEED_BATCH = 4
+
+
+def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
+    """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one,
+    with its estimated cost (CPU seconds)."""
     tasks, cost = [], []
     for m in methods:
         mid = method_id(m)
-        chunks = [seeds]
-        if METHODS[mid].stochastic and workers > 1 and len(seeds) >= 2 * workers:
-            chunks = [list(c) for c in np.array_split(np.asarray(seeds), workers)]
+        stochastic = METHODS[mid].stochastic
+        chunks = [seeds[i:i + SEED_BATCH] for i in range(0, len(seeds), SEED_BATCH)] if stochastic else [seeds]
         for c in chunks:
             tasks.append((sw, params, mid, [int(v) for v in c], base_seed, keep_errors))
             cost.append(RUN_COST_S.get(mid, 0.001) * len(c) * params.de.max_generations / 3000
-                        if METHODS[mid].stochastic else 0.001)
+                        if stochastic else 0.001)
     return tasks, cost
 
 
 def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20), methods=MAIN_METHODS,
-               base_seed: int = 0, keep_errors: bool = False, workers: int = 1) -> pd.DataFrame:
+               base_seed: int = 0, keep_errors: bool = False, workers: int = 1,
+               scheduler: str | None = None) -> pd.DataFrame:
     """One row per (method, seed): ``method`` (id), ``label``, test-sweep error ``min_deg``, ``max_deg``,
     ``rms_deg``, ``train_time_s`` (per run; runs of one batch train together), ``n_nodes`` (ELMs),
     ``epochs`` and ``stop`` (``trainlm``), and with ``keep_errors`` the error curve ``error_deg`` (an
     array over the test sweep) and the training ``history``.  Deterministic methods get one row with
-    seed -1.  ``workers`` > 1 runs the methods (and batches of seeds) in that many processes
-    (:mod:`navlib.studies.parallel`); the numbers do not depend on it."""
-    return seed_studies([(sw, params, seeds, methods)], base_seed, keep_errors, workers)[0]
+    seed -1.  The runs go to :mod:`navlib.engine` (``workers`` local processes, or the cluster at
+    ``scheduler``) in batches of :data:`SEED_BATCH` seeds; the numbers do not depend on where they ran."""
+    return seed_studies([(sw, params, seeds, methods)], base_seed, keep_errors, workers, scheduler)[0]
 
 
-def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers: int = 1) -> list[pd.DataFrame]:
+def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers: int = 1,
+                 scheduler: str | None = None) -> list[pd.DataFrame]:
     """Several :func:`seed_study` at once, ``studies`` a list of ``(sweeps, params, seeds, methods)``: all
-    their tasks share the worker processes (the expensive ones start first), one frame per study."""
+    their tasks share the engine's workers (the expensive ones start first), one frame per study."""
     tasks, cost, owner = [], [], []
     for k, (sw, params, seeds, methods) in enumerate(studies):
-        t, c = _tasks(sw, params, [int(v) for v in seeds], methods, base_seed, keep_errors, workers)
+        t, c = _tasks(sw, params, [int(v) for v in seeds], methods, base_seed, keep_errors)
         tasks += t
         cost += c
         owner += [k] * len(t)
-    parts = run_tasks(_method_runs, tasks, workers, cost)
+    parts = engine.run(_method_runs, tasks, workers=workers, scheduler=scheduler, cost=cost,
+                       label="seed study", weight=[len(t[3]) for t in tasks])
     return [pd.DataFrame([row for o, part in zip(owner, parts) if o == k for row in part])
             for k in range(len(studies))]
 
@@ -512,12 +520,13 @@ def implied_noise_ut(paper_min_deg: float, paper_max_deg: float, errors: Compass
 
 def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), methods=MAIN_METHODS,
                 errors: CompassErrors = CompassErrors(), sim_seed: int = 2024, workers: int = 1,
-                seeds_at: Mapping[float, Iterable[int]] | None = None) -> pd.DataFrame:
+                seeds_at: Mapping[float, Iterable[int]] | None = None, scheduler: str | None = None) -> pd.DataFrame:
     """:func:`seed_study` on sweeps simulated with each magnetometer noise in ``levels_ut`` (the same
     compass and simulation seed, only the noise changes); one row per (noise_ut, method, seed).
     ``seeds_at`` maps a level to its own seeds (e.g. more runs at the level whose claims are judged, so
-    that their median has a 95 % interval: at least 6 runs).  With ``workers`` > 1 the (level, method)
-    tasks run in that many processes (results identical: every run has its own generator)."""
+    that their median has a 95 % interval: at least 6 runs).  Every (level, method, batch of seeds) is a
+    task of :mod:`navlib.engine` (``workers``, ``scheduler``; results identical: every run has its own
+    generator)."""
     levels = [float(v) for v in levels_ut]
     for noise in levels:
         check_param("noise level", noise, lo=0)
@@ -532,7 +541,7 @@ def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), 
 
     studies = [(Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), seed=sim_seed))),
                 params, level_seeds(noise), methods) for noise in levels]
-    frames = seed_studies(studies, workers=workers)
+    frames = seed_studies(studies, workers=workers, scheduler=scheduler)
     return pd.concat([f.assign(noise_ut=noise) for noise, f in zip(levels, frames)], ignore_index=True)
 
 

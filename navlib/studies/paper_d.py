@@ -29,7 +29,7 @@ import pandas as pd
 
 from scipy import optimize, stats
 
-from .. import report, verdicts
+from .. import engine, report, verdicts
 from ..errors import InputError, check_param
 from ..data.tables import Column, read_table
 from ..methods.anfis import AnfisOptions, anfis
@@ -47,6 +47,12 @@ ORDER_OF_MAGNITUDE = 10.0
 #: The 95 % median interval over seeds needs at least this many seeds (:func:`navlib.verdicts.median_ci`).
 MIN_SEEDS_FOR_CLAIMS = 6
 PAPER_FILE = data_path("paper_d_results.csv")
+#: Entropy of the chapter's simulated draws: seed ``s`` draws unit A's noise from
+#: ``SeedSequence(SIM_ENTROPY, spawn_key=(s, 0))``, unit B's from ``(s, 1)`` and the bias test's from
+#: ``(s, 2)`` (spawn keys, no arithmetic: no two seeds or parts share a draw).
+SIM_ENTROPY = 1000
+#: Parts of a seed's draws (the second element of the spawn key).
+SIM_PARTS = {"noise_a": 0, "noise_b": 1, "bias_test": 2}
 
 
 @dataclass(frozen=True)
@@ -106,11 +112,18 @@ class PaperDParams:
 
 
 # ------------------------------------------------------------------------------------------------ data
+def sim_seed(seed: int, part: str) -> np.random.SeedSequence:
+    """The draw of one part (:data:`SIM_PARTS`) of seed ``seed``: ``SeedSequence(SIM_ENTROPY,
+    spawn_key=(seed, part))``."""
+    check_param("seed", seed, lo=0, integer=True)
+    return np.random.SeedSequence(SIM_ENTROPY, spawn_key=(int(seed), SIM_PARTS[part]))
+
+
 def simulate(params: PaperDParams, seed: int) -> pd.DataFrame:
-    """Both units' tumble tests for one seed (noise of unit A and B; unit B's coefficients stay those of
-    the stored data set so that seeds vary the noise, not the second unit)."""
+    """Both units' tumble tests for one seed (noise of unit A and B, :func:`sim_seed`; unit B's
+    coefficients stay those of the stored data set so that seeds vary the noise, not the second unit)."""
     return paper_units(params.experiment, params.coefficients, params.batch_spread_rel,
-                       seeds={"noise_a": 1000 + 2 * seed, "noise_b": 1001 + 2 * seed})
+                       seeds={"noise_a": sim_seed(seed, "noise_a"), "noise_b": sim_seed(seed, "noise_b")})
 
 
 def samples(df: pd.DataFrame, unit: str = "A", reference_c: float = T_REF_C) -> pd.DataFrame:
@@ -278,9 +291,12 @@ def run_seed(params: PaperDParams, seed: int, df: pd.DataFrame | None = None) ->
     return Run(seed, a, b, ra, sq, n_rules, res.history, models)
 
 
-def run_study(params: PaperDParams = PaperDParams()) -> list[Run]:
-    """One :class:`Run` per seed in ``params.seeds``."""
-    return [run_seed(params, s) for s in params.seeds]
+def run_study(params: PaperDParams = PaperDParams(), workers: int = 1, scheduler: str | None = None) -> list[Run]:
+    """One :class:`Run` per seed in ``params.seeds``, each a task of :mod:`navlib.engine` (``workers``
+    local processes, or the cluster at ``scheduler``); every seed draws its own data and starts, so the
+    runs do not depend on where they ran."""
+    return engine.run(run_seed, [(params, s) for s in params.seeds], workers=workers, scheduler=scheduler,
+                      label="paper D seeds")
 
 
 # ----------------------------------------------------------------------------------------- metrics
@@ -452,7 +468,7 @@ def fig2_output_drift(df: pd.DataFrame, unit: str = "A", reference_c: float = T_
 
 def fig3_bias(params: PaperDParams, seed: int = 0) -> pd.DataFrame:
     """Fig 3: the 0/180 deg bias test (mg) and its drift against 55 degC, measured and model K0."""
-    bt = bias_test(params.coefficients, params.experiment, seed=5000 + seed)
+    bt = bias_test(params.coefficients, params.experiment, seed=sim_seed(seed, "bias_test"))
     ref = bt.loc[np.isclose(bt["set_point_c"], params.experiment.reference_c)]
     bt["bias_drift_mg"] = bt["bias_mg"] - float(ref["bias_mg"].iloc[0])
     bt["true_bias_drift_mg"] = bt["true_bias_mg"] - float(ref["true_bias_mg"].iloc[0])

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 import pandas as pd
 
-from .. import report, verdicts
+from .. import engine, report, verdicts
 from ..data.tables import Column, read_table
 from ..errors import InputError, check_param
 from ..methods import kalman as km
@@ -168,35 +168,49 @@ def _score_rows(rows, rep, case, mode, method, err, mask, first_run=0):
                          "axis": ax, "rms_arcsec": float(r[i, a])})
 
 
+#: Parts of a repeat's draws (spawn-key elements after the repeat; see :func:`seed_of`).
+SEED_PARTS = {"noise": 0, "manoeuvre": 1, "network": 2, "timing": 3}
+KINDS = ("level", "s_turns")
+
+
+def seed_of(spec: StudySpec, rep: int, part: str, *key: int) -> int:
+    """The integer seed of one draw of the study: from ``SeedSequence(spec.seed, spawn_key=(rep, part,
+    *key))``, ``part`` one of :data:`SEED_PARTS` (noise of the runs of a simulation kind, the manoeuvre of a
+    run, the networks' start, a timing repetition).  Spawn keys, no arithmetic: no two draws share a seed."""
+    ss = np.random.SeedSequence(int(spec.seed), spawn_key=(int(rep), SEED_PARTS[part]) + tuple(int(k) for k in key))
+    return int(ss.generate_state(1)[0])
+
+
 def _paired_timings(spec: StudySpec, f_train) -> list[dict]:
     """Time per training pass of the 45-input and the 6-input net on the same training set, both in each of
     ``n_timings`` repetitions (alternating which goes first), after one untimed warm-up of each."""
     x = {45: km.gain_features(f_train, "raw45"), 6: km.gain_features(f_train, "qr6")}
     y = f_train.att_err_arcsec
     for n_in in (45, 6):
-        train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs), seed=spec.seed)
+        train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs), seed=seed_of(spec, 0, "timing", 0))
     rows = []
     for j in range(spec.n_timings):
         for n_in in ((45, 6) if j % 2 == 0 else (6, 45)):
-            net = train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs), seed=spec.seed + j)
+            net = train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs),
+                            seed=seed_of(spec, 0, "timing", j))
             rows.append({"timing": j, "n_in": n_in, "seconds_per_pass": net.seconds_per_pass})
     return rows
 
 
 def _runs(spec: StudySpec, kind: str, rep: int):
     """Training and test runs of one repeat.  Level flight: one path, different noise seeds.  S-turns: each
-    training run flies its own manoeuvre sequence, the test runs share another one."""
-    ss = np.random.SeedSequence([spec.seed, rep])
-    seeds = ss.generate_state(spec.n_train_runs + spec.n_test_runs).astype(int).tolist()
+    training run flies its own manoeuvre sequence, the test runs share another one.  Every run's noise and
+    every manoeuvre has its own seed (:func:`seed_of`)."""
+    k = KINDS.index(kind)
+    seeds = [seed_of(spec, rep, "noise", k, i) for i in range(spec.n_train_runs + spec.n_test_runs)]
     init = InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec)
-    base = (spec.seed * 1000 + rep) * (spec.n_train_runs + 1)
     if kind == "level":
         tr = generate(spec.profile(kind, 0))
         both = strapdown(tr, seeds, spec.imu, spec.star, init)
         return _subset(both, slice(0, spec.n_train_runs)), _subset(both, slice(spec.n_train_runs, None)), tr
-    train = _concat([strapdown(generate(spec.profile(kind, base + 1 + i)), [seeds[i]], spec.imu, spec.star, init)
-                     for i in range(spec.n_train_runs)])
-    tr_test = generate(spec.profile(kind, base))
+    train = _concat([strapdown(generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 1 + i))), [seeds[i]],
+                               spec.imu, spec.star, init) for i in range(spec.n_train_runs)])
+    tr_test = generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 0)))
     test = strapdown(tr_test, seeds[spec.n_train_runs:], spec.imu, spec.star, init)
     return train, test, tr_test
 
@@ -214,86 +228,102 @@ def _subset(run, sl):
     return replace(run, **arrays)
 
 
-def simulate(spec: StudySpec = StudySpec()) -> StudyData:
+def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
+    """One repeat of one simulation kind (a task of :func:`simulate`): its rows of every table."""
+    out = {k: [] for k in ("score", "trace", "time", "glr", "glr_run", "corr", "timing")}
+    out["yaw"] = None
+    secs = {"simulate_filter": 0.0, "train": 0.0, "timing": 0.0}
+    score_rows, trace_rows, time_rows = out["score"], out["trace"], out["time"]
+    t0 = time.perf_counter()
+    train, test, tr_test = _runs(spec, kind, rep)
+    f_train = km.run_filter(train, spec.filter)
+    f_test = km.run_filter(test, spec.filter)
+    t = f_test.t_s
+    mask = t >= spec.settle_s
+    _score_rows(score_rows, rep, kind, "held-out", "KF", f_test.att_err_arcsec, mask)
+    _score_rows(score_rows, rep, kind, "same run", "KF", f_test.att_err_arcsec, mask)
+    if rep == 0:
+        _trace(trace_rows, t, kind, "KF", f_test.att_err_arcsec[0])
+    if kind == "s_turns":
+        aug = km.run_filter(test, replace(spec.filter, scale_states=True))
+        _score_rows(score_rows, rep, kind, "held-out", "augmented KF", aug.att_err_arcsec, mask)
+        _score_rows(score_rows, rep, kind, "same run", "augmented KF", aug.att_err_arcsec, mask)
+        if rep == 0:
+            _trace(trace_rows, t, kind, "augmented KF", aug.att_err_arcsec[0])
+            out["yaw"] = pd.DataFrame({"t_s": tr_test.t_s, "yaw_deg": np.degrees(tr_test.att[:, 2]),
+                                       "rate_deg_s": np.degrees(np.r_[tr_test.rate_b[0, 2], tr_test.rate_b[:, 2]])})
+    g = km.innovation_glr(train, f_train)
+    for row in g.table.itertuples():
+        out["glr"].append({"repeat": rep, "kind": kind, "candidate": row.candidate, "chi2": row.chi2,
+                           "p_bonferroni": row.p_bonferroni, "significant": bool(row.significant),
+                           "named": g.named or "none"})
+    for part, (rr, ff) in (("train", (train, f_train)), ("test", (test, f_test))):
+        for i, gi in enumerate(km.innovation_glr_per_run(rr, ff)):
+            out["glr_run"].append({"repeat": rep, "kind": kind, "runs": part, "run": i, "named": gi.named or "none"})
+    r, p = km.rate_correlation(f_train)
+    out["corr"].append({"repeat": rep, "kind": kind, "r": r, "p": p})
+    secs["simulate_filter"] += time.perf_counter() - t0
+    t0 = time.perf_counter()
+    net_seed = seed_of(spec, rep, "network")
+    for case, (ck, feats) in CASES.items():
+        if ck != kind:
+            continue
+        x_tr, x_te = km.gain_features(f_train, feats), km.gain_features(f_test, feats)
+        mspec = bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs)
+        net = train_mlp(x_tr, f_train.att_err_arcsec, mspec, seed=net_seed)
+        bp = f_test.att_err_arcsec - net.predict(x_te)
+        _score_rows(score_rows, rep, case, "held-out", "BPKF", bp, mask)
+        time_rows.append({"repeat": rep, "case": case, "n_in": mspec.n_in,
+                          "seconds_per_pass": net.seconds_per_pass,
+                          "seconds_total": net.seconds_per_pass * spec.epochs})
+        for i in range(spec.n_test_runs):
+            one = slice(i, i + 1)
+            same = train_mlp(x_te[one], f_test.att_err_arcsec[one], mspec, seed=net_seed)
+            bp_same = f_test.att_err_arcsec[one] - same.predict(x_te[one])
+            _score_rows(score_rows, rep, case, "same run", "BPKF", bp_same, mask, first_run=i)
+            if rep == 0 and i == 0:
+                _trace(trace_rows, t, case, "BPKF (held-out)", bp[0])
+                _trace(trace_rows, t, case, "BPKF (same run)", bp_same[0])
+    secs["train"] += time.perf_counter() - t0
+    if rep == 0 and kind == "level":
+        t0 = time.perf_counter()
+        out["timing"] = _paired_timings(spec, f_train)
+        secs["timing"] += time.perf_counter() - t0
+    out["secs"] = secs
+    return out
+
+
+def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | None = None) -> StudyData:
     """Fly, filter and train for every repeat (see the module docstring); returns :class:`StudyData`.
 
     Per repeat and simulation: KF on training and test runs; networks for every case of ``CASES``
     trained on the training runs (held-out) and on each test run alone (same run); for the S-turns also the
     augmented 18-state KF (gyro scale-factor states); the innovation GLR test of the 15-state KF pooled
     over the training runs and on each run alone; in the first repeat of the level flight the paired
-    training-time repetitions."""
-    score_rows, trace_rows, time_rows, glr_rows, corr_rows, glr_run_rows = [], [], [], [], [], []
-    timing_rows: list[dict] = []
-    yaw_profile = None
-    secs = {"simulate_filter": 0.0, "train": 0.0, "timing": 0.0}
-    for rep in range(spec.n_repeats):
-        for kind in ("level", "s_turns"):
-            t0 = time.perf_counter()
-            train, test, tr_test = _runs(spec, kind, rep)
-            f_train = km.run_filter(train, spec.filter)
-            f_test = km.run_filter(test, spec.filter)
-            t = f_test.t_s
-            mask = t >= spec.settle_s
-            _score_rows(score_rows, rep, kind, "held-out", "KF", f_test.att_err_arcsec, mask)
-            _score_rows(score_rows, rep, kind, "same run", "KF", f_test.att_err_arcsec, mask)
-            if rep == 0:
-                _trace(trace_rows, t, kind, "KF", f_test.att_err_arcsec[0])
-            if kind == "s_turns":
-                aug = km.run_filter(test, replace(spec.filter, scale_states=True))
-                _score_rows(score_rows, rep, kind, "held-out", "augmented KF", aug.att_err_arcsec, mask)
-                _score_rows(score_rows, rep, kind, "same run", "augmented KF", aug.att_err_arcsec, mask)
-                if rep == 0:
-                    _trace(trace_rows, t, kind, "augmented KF", aug.att_err_arcsec[0])
-                    yaw_profile = pd.DataFrame({"t_s": tr_test.t_s, "yaw_deg": np.degrees(tr_test.att[:, 2]),
-                                                "rate_deg_s": np.degrees(np.r_[tr_test.rate_b[0, 2],
-                                                                                tr_test.rate_b[:, 2]])})
-            g = km.innovation_glr(train, f_train)
-            for row in g.table.itertuples():
-                glr_rows.append({"repeat": rep, "kind": kind, "candidate": row.candidate, "chi2": row.chi2,
-                                 "p_bonferroni": row.p_bonferroni, "significant": bool(row.significant),
-                                 "named": g.named or "none"})
-            for part, (rr, ff) in (("train", (train, f_train)), ("test", (test, f_test))):
-                for i, gi in enumerate(km.innovation_glr_per_run(rr, ff)):
-                    glr_run_rows.append({"repeat": rep, "kind": kind, "runs": part, "run": i,
-                                         "named": gi.named or "none"})
-            r, p = km.rate_correlation(f_train)
-            corr_rows.append({"repeat": rep, "kind": kind, "r": r, "p": p})
-            secs["simulate_filter"] += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            for case, (ck, feats) in CASES.items():
-                if ck != kind:
-                    continue
-                x_tr, x_te = km.gain_features(f_train, feats), km.gain_features(f_test, feats)
-                mspec = bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs)
-                net = train_mlp(x_tr, f_train.att_err_arcsec, mspec, seed=spec.seed * 1000 + rep)
-                bp = f_test.att_err_arcsec - net.predict(x_te)
-                _score_rows(score_rows, rep, case, "held-out", "BPKF", bp, mask)
-                time_rows.append({"repeat": rep, "case": case, "n_in": mspec.n_in,
-                                  "seconds_per_pass": net.seconds_per_pass,
-                                  "seconds_total": net.seconds_per_pass * spec.epochs})
-                for i in range(spec.n_test_runs):
-                    one = slice(i, i + 1)
-                    same = train_mlp(x_te[one], f_test.att_err_arcsec[one], mspec, seed=spec.seed * 1000 + rep)
-                    bp_same = f_test.att_err_arcsec[one] - same.predict(x_te[one])
-                    _score_rows(score_rows, rep, case, "same run", "BPKF", bp_same, mask, first_run=i)
-                    if rep == 0 and i == 0:
-                        _trace(trace_rows, t, case, "BPKF (held-out)", bp[0])
-                        _trace(trace_rows, t, case, "BPKF (same run)", bp_same[0])
-            secs["train"] += time.perf_counter() - t0
-            if rep == 0 and kind == "level":
-                t0 = time.perf_counter()
-                timing_rows = _paired_timings(spec, f_train)
-                secs["timing"] += time.perf_counter() - t0
-    scores = pd.DataFrame(score_rows)
+    training-time repetitions.  Every (repeat, simulation) is a task of :mod:`navlib.engine` (``workers``
+    local processes, or the cluster at ``scheduler``; the one with the timings starts first); the draws of
+    each come from :func:`seed_of`, so the numbers (not the timings) do not depend on where they ran."""
+    tasks = [(spec, rep, kind) for rep in range(spec.n_repeats) for kind in KINDS]
+    cost = [(3.0 if kind == "s_turns" else 2.0) + (2.0 * spec.n_timings * spec.timing_epochs / spec.epochs
+                                                     if rep == 0 and kind == "level" else 0.0)
+            for _, rep, kind in tasks]
+    parts = engine.run(_repeat, tasks, workers=workers, scheduler=scheduler, cost=cost, label="paper E repeats")
+
+    def rows(key):
+        return [r for part in parts for r in part[key]]
+
+    secs = {k: sum(part["secs"][k] for part in parts) for k in ("simulate_filter", "train", "timing")}
+    yaw_profile = next((part["yaw"] for part in parts if part["yaw"] is not None), None)
+    scores = pd.DataFrame(rows("score"))
     # the KF rows belong to both cases of their simulation
     kf = scores[scores["case"].isin(["level", "s_turns"])]
-    parts = [scores[~scores["case"].isin(["level", "s_turns"])]]
+    parts_ = [scores[~scores["case"].isin(["level", "s_turns"])]]
     for case, (ck, _) in CASES.items():
-        parts.append(kf[kf["case"] == ck].assign(case=case))
-    scores = pd.concat(parts, ignore_index=True)
-    traces = pd.concat(trace_rows, ignore_index=True)
-    return StudyData(spec, scores, traces, pd.DataFrame(time_rows), pd.DataFrame(glr_rows),
-                     pd.DataFrame(glr_run_rows), pd.DataFrame(timing_rows), pd.DataFrame(corr_rows),
+        parts_.append(kf[kf["case"] == ck].assign(case=case))
+    scores = pd.concat(parts_, ignore_index=True)
+    traces = pd.concat(rows("trace"), ignore_index=True)
+    return StudyData(spec, scores, traces, pd.DataFrame(rows("time")), pd.DataFrame(rows("glr")),
+                     pd.DataFrame(rows("glr_run")), pd.DataFrame(rows("timing")), pd.DataFrame(rows("corr")),
                      yaw_profile, secs)
 
 

@@ -20,7 +20,7 @@ from ..methods.scaling import MinMax
 from ..methods.seeding import generators
 from ..sensors.compass import heading_from_field
 from ..sensors.planar import fit_planar_model
-from .. import verdicts
+from .. import engine, verdicts
 from ..report import Claim
 from .paper_a import (ELM_METHODS, METHODS, TRAINING_ONLY, StudyParams, Sweeps, fit_method, method_id,
                       paired_seed_difference, per_seed, rms_deg)
@@ -29,7 +29,7 @@ from .paper_a import (ELM_METHODS, METHODS, TRAINING_ONLY, StudyParams, Sweeps, 
 # Patent B: test error against hidden-node count
 
 def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
-                     max_nodes: int = 40) -> pd.DataFrame:
+                     max_nodes: int = 40, workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
     """Test-sweep RMS error (deg) against the hidden-node count, one row per (method, seed, n_nodes):
 
     - ``ELM``: a plain ELM fitted afresh with n = 1..max_nodes random nodes (seed ``seed``);
@@ -38,7 +38,8 @@ def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=rang
       each ELM stage (the history's ``val_loss``, evaluated on the test sweep).
 
     The error is the de-normalised network output minus the true heading without wrapping (the same as
-    the wrapped error wherever it is below 180 deg), in both cases computed the same way."""
+    the wrapped error wherever it is below 180 deg), in both cases computed the same way.  Every seed is a
+    task of :mod:`navlib.engine` (``workers``, ``scheduler``; the numbers do not depend on them)."""
     check_param("max_nodes", max_nodes, lo=1, integer=True)
     tg = params.target
     target, t_val = tg.target(sw.x_train, sw.t_train), tg.target(sw.x_test, sw.t_test)
@@ -46,19 +47,24 @@ def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=rang
     xn, tn = xs.transform(sw.x_train), ts.transform(target)
     xv, tv = xs.transform(sw.x_test), ts.transform(t_val)
     span = float(ts.span[0])
-    rows = []
-    for seed in seeds:
-        for n in range(1, int(max_nodes) + 1):      # the same stream for every n: run `seed`'s generator
-            model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=generators([seed])[0])
-            rows.append(("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)),
-                         span * np.sqrt(model.loss(xv, tv))))
-        ip = replace(params.incremental_params(span), loss_goal=0.0, max_nodes=int(max_nodes),
-                     max_iter=2 * int(max_nodes))
-        _, hist = fit_incremental_elm(xn, tn, ip, rng=generators([seed])[0], x_val=xv, t_val=tv)
-        tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
-        for n, row in tuned.iterrows():
-            rows.append(("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss)))
+    parts = engine.run(_node_count_seed, [(xn, tn, xv, tv, span, params, int(seed), int(max_nodes)) for seed in seeds],
+                       workers=workers, scheduler=scheduler, label="ELM node counts")
+    rows = [r for part in parts for r in part]
     return pd.DataFrame(rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg"])
+
+
+def _node_count_seed(xn, tn, xv, tv, span, params, seed, max_nodes) -> list[tuple]:
+    """The rows of :func:`node_count_curve` for one seed (a task)."""
+    rows = []
+    for n in range(1, max_nodes + 1):      # the same stream for every n: run `seed`'s generator
+        model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=generators([seed])[0])
+        rows.append(("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)), span * np.sqrt(model.loss(xv, tv))))
+    ip = replace(params.incremental_params(span), loss_goal=0.0, max_nodes=max_nodes, max_iter=2 * max_nodes)
+    _, hist = fit_incremental_elm(xn, tn, ip, rng=generators([seed])[0], x_val=xv, t_val=tv)
+    tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
+    for n, row in tuned.iterrows():
+        rows.append(("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss)))
+    return rows
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -169,25 +175,36 @@ def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: St
 
 def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = StudyParams(),
                  seeds=range(20), *, method: str = "elm_backtuned", window: int = 3,
-                 threshold: float = 4.0, frac: float = 0.9) -> pd.DataFrame:
+                 threshold: float = 4.0, frac: float = 0.9, workers: int = 1,
+                 scheduler: str | None = None) -> pd.DataFrame:
     """What patent B's data preparation buys on a training sweep with glitches: for each variant of
     ``GLITCH_VARIANTS`` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
     sweep (a compensation cannot repair a reading hit by a spike).
 
     One row per (variant, seed): ``test_rms_deg`` (test sweep), ``check_rms_deg`` (the patent's own
     held-out part of the training sweep), ``n_rejected``, ``glitches_rejected`` (rejected readings that
-    were glitches, from the training sweep's ``glitch`` column), ``n_nodes``."""
+    were glitches, from the training sweep's ``glitch`` column), ``n_nodes``.  The runs are tasks of
+    :mod:`navlib.engine` (``workers``, ``scheduler``; every run has its own seeds)."""
+    if method_id(method) not in ELM_METHODS:
+        raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
+    items = [(train, test, variant, params, int(seed), method, window, threshold, frac)
+             for variant in GLITCH_VARIANTS for seed in seeds]
+    return pd.DataFrame(engine.run_batches(_glitch_row, items, GLITCH_BATCH, workers=workers, scheduler=scheduler,
+                                           label="glitch study"))
+
+
+#: Runs of :func:`glitch_study` per engine task.
+GLITCH_BATCH = 5
+
+
+def _glitch_row(train, test, variant, params, seed, method, window, threshold, frac) -> dict:
+    """One row of :func:`glitch_study` (a task)."""
     glitch = train["glitch"].to_numpy(bool) if "glitch" in train else np.zeros(len(train), bool)
-    rows = []
-    for variant in GLITCH_VARIANTS:
-        for seed in seeds:
-            err, clean, d, info = glitch_run(train, test, variant, params, seed, method=method,
-                                             window=window, threshold=threshold, frac=frac)
-            rows.append({"variant": variant, "seed": seed,
-                         "test_rms_deg": float(np.sqrt(np.mean(err[clean] ** 2))),
-                         "check_rms_deg": info["check_rms_deg"], "n_rejected": d.n_rejected,
-                         "glitches_rejected": int(np.sum(glitch & ~d.keep)), "n_nodes": info["n_nodes"]})
-    return pd.DataFrame(rows)
+    err, clean, d, info = glitch_run(train, test, variant, params, seed, method=method, window=window,
+                                     threshold=threshold, frac=frac)
+    return {"variant": variant, "seed": seed, "test_rms_deg": float(np.sqrt(np.mean(err[clean] ** 2))),
+            "check_rms_deg": info["check_rms_deg"], "n_rejected": d.n_rejected,
+            "glitches_rejected": int(np.sum(glitch & ~d.keep)), "n_nodes": info["n_nodes"]}
 
 
 # ----------------------------------------------------------------------------------------------------------
@@ -206,7 +223,8 @@ def big_net_labels(big_hidden: int) -> tuple[str, str]:
 
 
 def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = StudyParams(),
-                       seeds=range(20), big_hidden: int = 50) -> pd.DataFrame:
+                       seeds=range(20), big_hidden: int = 50, workers: int = 1,
+                       scheduler: str | None = None) -> pd.DataFrame:
     """Patent B's claim that its ELM overfits less than a large network on small samples: train on ``n``
     evenly spread readings of the training sweep (:func:`even_indices`) and score on the whole test sweep.
 
@@ -224,34 +242,43 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
     - ``physical model`` (five parameters; seed -1).
 
     One row per (n_train, method, seed): ``train_rms_deg`` (on the n readings), ``test_rms_deg``,
-    ``n_nodes`` (hidden nodes; NaN for the physical model)."""
+    ``n_nodes`` (hidden nodes; NaN for the physical model).  Every size is a task of :mod:`navlib.engine`
+    (``workers``, ``scheduler``), its seeds in one batch as above: the numbers do not depend on them."""
     check_param("big_hidden", big_hidden, lo=1, integer=True)
-    seeds = list(seeds)
+    seeds = [int(s) for s in seeds]
+    for n in sizes:
+        check_param("n", n, lo=2, hi=sw.t_train.size, integer=True)
+    parts = engine.run(_small_sample_size, [(sw, int(n), params, seeds, int(big_hidden)) for n in sizes],
+                       workers=workers, scheduler=scheduler, cost=[float(n) for n in sizes], label="small samples")
+    return pd.DataFrame([r for part in parts for r in part])
+
+
+def _small_sample_size(sw: Sweeps, n: int, params: StudyParams, seeds: list, big_hidden: int) -> list[dict]:
+    """The rows of :func:`small_sample_study` for one training size (a task)."""
     adam, lm = big_net_labels(big_hidden)
     tg = params.target
     rows = []
-    for n in sizes:
-        sub = sw.subset(even_indices(sw.t_train.size, n))
-        xtr, ttr, xte = sub.x_train, sub.t_train, sub.x_test
+    sub = sw.subset(even_indices(sw.t_train.size, n))
+    xtr, ttr, xte = sub.x_train, sub.t_train, sub.x_test
 
-        def add(method, seed, comp, n_nodes):
-            rows.append({"n_train": int(n), "method": method, "seed": seed,
-                         "train_rms_deg": rms_deg(comp.correct(xtr), ttr),
-                         "test_rms_deg": rms_deg(comp.correct(xte), sub.t_test), "n_nodes": n_nodes})
+    def add(method, seed, comp, n_nodes):
+        rows.append({"n_train": int(n), "method": method, "seed": seed,
+                     "train_rms_deg": rms_deg(comp.correct(xtr), ttr),
+                     "test_rms_deg": rms_deg(comp.correct(xte), sub.t_test), "n_nodes": n_nodes})
 
-        for method in ELM_METHODS[::-1]:
-            for seed, comp in zip(seeds, fit_method(method, xtr, ttr, params, seeds)):
-                add(METHODS[method].label, seed, comp, comp.info["n_nodes"])
-        target = tg.target(xtr, ttr)
-        for label, nets in ((adam, train_adam_many(xtr, target, int(big_hidden), params.adam, generators(seeds))),
-                            (lm, train_matlab_bp_many(xtr, target, int(big_hidden), generators(seeds), params.lm))):
-            for seed, net in zip(seeds, nets):
-                add(label, seed, NetworkCompensator(net, tg), int(big_hidden))
-        phys = fit_planar_model(sub.t_train, sub.m_train)
-        rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
-                     "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
-                     "test_rms_deg": rms_deg(phys.correct(sub.m_test), sub.t_test), "n_nodes": np.nan})
-    return pd.DataFrame(rows)
+    for method in ELM_METHODS[::-1]:
+        for seed, comp in zip(seeds, fit_method(method, xtr, ttr, params, seeds)):
+            add(METHODS[method].label, seed, comp, comp.info["n_nodes"])
+    target = tg.target(xtr, ttr)
+    for label, nets in ((adam, train_adam_many(xtr, target, big_hidden, params.adam, generators(seeds))),
+                        (lm, train_matlab_bp_many(xtr, target, big_hidden, generators(seeds), params.lm))):
+        for seed, net in zip(seeds, nets):
+            add(label, seed, NetworkCompensator(net, tg), big_hidden)
+    phys = fit_planar_model(sub.t_train, sub.m_train)
+    rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
+                 "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
+                 "test_rms_deg": rms_deg(phys.correct(sub.m_test), sub.t_test), "n_nodes": np.nan})
+    return rows
 
 
 # ----------------------------------------------------------------------------------------------------------

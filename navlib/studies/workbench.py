@@ -20,7 +20,7 @@ from ..angles import wrap_deg
 from ..errors import InputError, check_param
 from ..data.gyro_tables import drift_measurements
 from ..paths import ROOT
-from .. import verdicts
+from .. import engine, verdicts
 from ..report import Claim
 from ..workbench.diagnose import DEFAULT_ALPHA, diagnose
 from ..workbench.effects import CATALOGUES
@@ -28,7 +28,7 @@ from ..workbench.fit import effect_rms, fit_model, load, simulate
 from ..workbench.loop import LoopResult, loop
 from ..workbench.magnetometer import (MAG, apply_calibration, correct_field, ellipsoid_fit, field_summary,
                                       heading_error_deg)
-from ..workbench.trials import random_params, run_trials, scale_effect
+from ..workbench.trials import random_params, scale_effect
 from .paper_a import Sweeps, compensate, error_stats, test_errors
 
 #: Where the third-party measurements live (beside the repository, never inside it).
@@ -169,14 +169,17 @@ def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -
             "largest structure (uT)": amp, "outcome": res.outcome()}
 
 
-def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1) -> pd.DataFrame | None:
+def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1,
+                      scheduler: str | None = None) -> pd.DataFrame | None:
     """:func:`undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data are
-    absent); ``workers`` processes."""
+    absent); ``workers``, ``scheduler``: where they run (:mod:`navlib.engine`; the workers read the files,
+    so a remote cluster needs them at the same path)."""
     names = undisturbed_trials()
     if not names:
         return None
     check_param("row_step", row_step, lo=1, integer=True)
-    rows = run_trials(undisturbed_loop, [(n, row_step, alpha) for n in names], workers)
+    rows = engine.run(undisturbed_loop, [(n, row_step, alpha) for n in names], workers=workers,
+                      scheduler=scheduler, label="BROAD loops")
     return pd.DataFrame(rows).set_index("trial")
 
 

@@ -32,7 +32,7 @@ from ..errors import InputError
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, fit_linear, fit_model, user_columns
 from .diagnose import diagnose
-from .trials import wilson
+from .trials import SYSTEM_KEYS, _seed_label, run_trials, trial_seed, wilson
 
 ACCELEROMETER_EFFECTS = {
     "bias": Effect("bias", ("k0_mg",), ("mg",),
@@ -200,13 +200,14 @@ PARAM_SCALE = {"k0_mg": 1.0, "k1_mg_g": 1.0, "bias_t1_mg_c": 0.015, "bias_t2_mg_
                "kip_mg_g2": 0.03, "delta_o_mg": 0.2}
 
 
-def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float, seed: int) -> dict:
+def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float,
+                        seed: int | np.random.SeedSequence) -> dict:
     """One trial: with ``hidden`` set, data contain every effect (random, ``hidden`` rescaled so that its
     RMS is ``ratio`` x noise) and the model is the catalogue without ``hidden``; with ``None`` the data
     contain a random subset and the model is exactly that subset (a correct answer is "consistent with
-    noise")."""
+    noise").  ``seed``: an integer entropy or a ``numpy.random.SeedSequence``."""
     cat = tuple(ACCELEROMETER_EFFECTS)
-    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    rng = np.random.default_rng(seed)
     if hidden is None:
         k = int(rng.integers(1, len(cat)))
         present = tuple(cat[i] for i in sorted(rng.choice(len(cat), size=k, replace=False)))
@@ -227,21 +228,31 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float, seed:
         model = present
     data = simulate_catalogue(params, noise_ug=noise_ug, seed=rng)
     d = diagnose(fit_model("accelerometer", data, model))
-    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise_ug": noise_ug, "seed": seed,
+    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise_ug": noise_ug,
+            "seed": _seed_label(seed),
             "named": d.missing or "(none)",
             "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
             "consistent_with_noise": d.consistent_with_noise}
 
 
-def hidden_effect_study(ratios=(3.0, 10.0), noise_ug: float = 3.0, seeds=range(10), none_seeds=None) -> pd.DataFrame:
+def hidden_effect_study(ratios=(3.0, 10.0), noise_ug=3.0, seeds=range(10), none_seeds=None,
+                        workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
     """Detection trials for every hidden effect, size and seed, plus nothing-hidden trials (false alarms;
-    default twice as many seeds)."""
+    default twice as many seeds), at the noise ``noise_ug`` (ug, one level or a sequence of levels).  Each
+    trial's seed is :func:`navlib.workbench.trials.trial_seed` of its coordinates (the accelerometer, noise
+    level, hidden effect, size, seed number; nothing hidden: effect 0), as in
+    :func:`navlib.workbench.trials.hidden_effect_study`: every trial draws its own data.  ``workers``,
+    ``scheduler``: where the trials run (:func:`navlib.workbench.trials.run_trials`)."""
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
-    rows = [hidden_effect_trial(h, r, noise_ug, 1000 * i + 100 * int(r) + s)
-            for i, h in enumerate(ACCELEROMETER_EFFECTS) for r in ratios for s in seeds]
-    rows += [hidden_effect_trial(None, 0.0, noise_ug, 90_000 + s) for s in none_seeds]
-    return pd.DataFrame(rows)
+    noises = [float(noise_ug)] if np.ndim(noise_ug) == 0 else [float(v) for v in noise_ug]
+    base = (SYSTEM_KEYS[SYSTEM.name], 0)            # system, table size (the fixed grid)
+    args = []
+    for k, noise in enumerate(noises):
+        args += [(h, r, noise, trial_seed("hidden effect", *base, k, i, j, s))
+                 for i, h in enumerate(ACCELEROMETER_EFFECTS, start=1) for j, r in enumerate(ratios) for s in seeds]
+        args += [(None, 0.0, noise, trial_seed("hidden effect", *base, k, 0, 0, s)) for s in none_seeds]
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "accelerometer trials"))
 
 
 def detection_table(study: pd.DataFrame) -> pd.DataFrame:

@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .. import verdicts
+from .. import engine, verdicts
 from ..errors import InputError, check_param
+from ..methods.seeding import child, sequence
 from .diagnose import diagnose
 from .effects import CATALOGUES, get_system
 from .fit import effect_rms, fit_model, simulate
@@ -23,7 +24,7 @@ from .magnetometer import effect_rms as magnetometer_effect_rms, simulate_hand_t
 TRIAL_ENTROPY = 0
 #: First element of the spawn key: which study the trial belongs to.
 STUDY_KEYS = {"hidden effect": 1, "out of catalogue": 2, "correlated noise": 3}
-SYSTEM_KEYS = {"compass": 0, "drift": 1, "magnetometer": 2}
+SYSTEM_KEYS = {"compass": 0, "drift": 1, "magnetometer": 2, "accelerometer": 3}
 #: The systems whose simulated data the hidden-effect trials can draw.
 TRIAL_SYSTEMS = ("compass", "drift", "magnetometer")
 #: Length of a simulated hand-turned magnetometer recording (s, at 10 Hz) in the trials.
@@ -40,7 +41,7 @@ def trial_seed(study: str, *coords: int) -> np.random.SeedSequence:
     key = tuple(int(c) for c in coords)
     if any(c < 0 for c in key):
         raise InputError(f"trial_seed: coordinates must be whole numbers >= 0, got {coords!r}")
-    return np.random.SeedSequence(TRIAL_ENTROPY, spawn_key=(STUDY_KEYS[study],) + key)
+    return sequence(TRIAL_ENTROPY, STUDY_KEYS[study], *key)
 
 
 def _seed_label(seed):
@@ -130,10 +131,12 @@ def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: fl
         data = _simulate(system, params, n, noise, correlation, rng)
         model = present
     else:
-        params = random_params(system, rng, cat)
-        probe = _simulate(system, params, n, 0.0, correlation, np.random.default_rng(seed))
+        # parameters and data from streams of their own (child 0, child 1): the noise-free probe that scales
+        # the hidden effect sees the same rows (the same hand-turned motion) as the data
+        params = random_params(system, np.random.default_rng(child(seed, 0)), cat)
+        probe = _simulate(system, params, n, 0.0, correlation, np.random.default_rng(child(seed, 1)))
         params = scale_effect(system, probe, params, hidden, ratio * noise)
-        data = _simulate(system, params, n, noise, correlation, np.random.default_rng(seed))
+        data = _simulate(system, params, n, noise, correlation, np.random.default_rng(child(seed, 1)))
         model = tuple(e for e in cat if e != hidden)
     d = diagnose(fit_model(system, data, model))
     return {"system": system, "hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise,
@@ -143,31 +146,27 @@ def hidden_effect_trial(system: str, hidden: str | None, ratio: float, noise: fl
             "lag1": d.screening.noise.lag1}
 
 
-def _batch(fn, args: list) -> list:
-    return [fn(*a) for a in args]
+#: Trials per engine task (fixed, so the batches never depend on the number of workers).
+TRIAL_BATCH = 8
 
 
-def run_trials(fn, args: list, workers: int = 1) -> list:
-    """``[fn(*a) for a in args]``, in ``workers`` processes when more than one
-    (:func:`navlib.studies.parallel.run_tasks`, in batches); every trial has its own seed, so the results
-    do not depend on ``workers``."""
-    check_param("workers", workers, lo=1, integer=True)
-    if workers == 1 or len(args) < 2:
-        return _batch(fn, args)
-    from ..studies.parallel import run_tasks      # local: it imports torch, which the CLI does not need
-    chunks = [c for c in np.array_split(np.arange(len(args)), 8 * int(workers)) if len(c)]
-    parts = run_tasks(_batch, [(fn, [args[i] for i in c]) for c in chunks], int(workers))
-    return [row for part in parts for row in part]
+def run_trials(fn, args: list, workers: int = 1, scheduler: str | None = None, label: str = "trials") -> list:
+    """``[fn(*a) for a in args]`` on :mod:`navlib.engine` (``workers`` local processes, or the cluster at
+    ``scheduler``), in batches of :data:`TRIAL_BATCH` trials; every trial carries its own seed, so the
+    results do not depend on where they ran."""
+    return engine.run_batches(fn, args, TRIAL_BATCH, workers=workers, scheduler=scheduler, label=label)
 
 
 def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=range(10), n=None,
-                        include_none: bool = True, none_seeds=None, workers: int = 1) -> pd.DataFrame:
+                        include_none: bool = True, none_seeds=None, workers: int = 1,
+                        scheduler: str | None = None) -> pd.DataFrame:
     """Detection and false-alarm trials over hidden effects, effect sizes, noise levels and seeds.
 
     Every trial draws its own data: its seed is :func:`trial_seed` of its coordinates (system, table size
     ``n``, noise level, hidden effect, effect size, seed number), so trials of different hidden effects,
     sizes, noise levels and table sizes are independent; nothing-hidden trials have coordinates of their
-    own (default: twice as many seeds as ``seeds``).  ``workers``: processes (:func:`run_trials`)."""
+    own (default: twice as many seeds as ``seeds``).  ``workers``, ``scheduler``: where the trials run
+    (:func:`run_trials`)."""
     args = []
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
@@ -180,7 +179,7 @@ def hidden_effect_study(system: str, ratios=(3.0, 10.0), noises=(0.1,), seeds=ra
         if include_none:
             for seed in none_seeds:
                 args.append((system, None, 0.0, noise, trial_seed("hidden effect", *base, j, 0, 0, seed), n))
-    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers))
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "hidden-effect trials"))
 
 
 #: Compass errors outside the catalogue (name -> shape of unit RMS before scaling, from (data, rng)).
@@ -216,28 +215,30 @@ def out_of_catalogue_trial(kind: str, ratio: float, noise: float, seed: int | np
             "detected": not d.consistent_with_noise}
 
 
-def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10), workers: int = 1) -> pd.DataFrame:
+def out_of_catalogue_study(ratios=(5.0, 8.0), noises=(0.05, 0.2), seeds=range(10), workers: int = 1,
+                           scheduler: str | None = None) -> pd.DataFrame:
     """:func:`out_of_catalogue_trial` over every kind, size, noise level and seed; each trial's seed is
     :func:`trial_seed` of its coordinates (kind, noise level, size, seed number): independent draws.
-    ``workers``: processes (:func:`run_trials`)."""
+    ``workers``, ``scheduler``: where the trials run (:func:`run_trials`)."""
     args = []
     for j, noise in enumerate(noises):
         for i, kind in enumerate(OUT_OF_CATALOGUE):
             for r, ratio in enumerate(ratios):
                 for seed in seeds:
                     args.append((kind, ratio, noise, trial_seed("out of catalogue", i, j, r, seed)))
-    return pd.DataFrame(run_trials(out_of_catalogue_trial, args, workers))
+    return pd.DataFrame(run_trials(out_of_catalogue_trial, args, workers, scheduler, "out-of-catalogue trials"))
 
 
 def correlated_noise_study(system: str, correlations=(0.0, 0.9), ratio: float = 3.0, noise: float | None = None,
-                           seeds=range(100), none_seeds=None, n: int | None = None, workers: int = 1) -> pd.DataFrame:
+                           seeds=range(100), none_seeds=None, n: int | None = None, workers: int = 1,
+                           scheduler: str | None = None) -> pd.DataFrame:
     """Hidden-effect and nothing-hidden trials (:func:`hidden_effect_trial`) on time series with AR(1)
     noise of each lag-1 correlation in ``correlations``: every catalogued effect hidden at ``ratio`` x the
     noise, ``seeds`` trials each; nothing hidden, ``none_seeds`` trials (default: as many as ``seeds``).
     ``noise``: marginal standard deviation (default 0.3 uT for the magnetometer, as BROAD's residuals;
     0.1 deg for the compass).  Seeds: :func:`trial_seed` of the study "correlated noise" and the trial's
-    coordinates (system, correlation, hidden effect, seed number).  ``workers``: processes
-    (:func:`run_trials`)."""
+    coordinates (system, correlation, hidden effect, seed number).  ``workers``, ``scheduler``: where the
+    trials run (:func:`run_trials`)."""
     if system not in ("compass", "magnetometer"):
         raise InputError(f"correlated_noise_study: system {system!r} is no time series; use compass or magnetometer")
     check_param("ratio", ratio, lo=0, lo_open=True)
@@ -255,7 +256,7 @@ def correlated_noise_study(system: str, correlations=(0.0, 0.9), ratio: float = 
         for seed in none_seeds:
             args.append((system, None, 0.0, noise, trial_seed("correlated noise", SYSTEM_KEYS[system], j, 0, seed),
                          n, rho))
-    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers))
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "correlated-noise trials"))
 
 
 def correlated_noise_rates(study: pd.DataFrame) -> pd.DataFrame:

@@ -1,0 +1,337 @@
+"""The one engine of navlib's Monte Carlo work (seed studies, rate trials, notebook grids): dask.distributed.
+
+A study is a list of independent tasks ``fn(*args)``; :func:`run` returns ``[fn(*a) for a in tasks]`` in
+task order, wherever the tasks ran:
+
+- ``workers=1`` and no scheduler: in this process, in order (dask is not even imported, so a plain
+  ``pip install navlib`` without the ``dist`` extra runs every study);
+- ``workers=N`` > 1: a ``dask.distributed.LocalCluster`` of ``N`` single-threaded worker processes
+  (OpenBLAS, OpenMP, MKL and torch on one thread each), started on first use and reused by every later
+  study of this process (:func:`start` starts it early, and lets the workers import the modules a chapter
+  needs while it goes on);
+- a scheduler address (``scheduler="tcp://host:8786"``, or the environment variable ``NAVLIB_SCHEDULER``)
+  sends the same tasks to an existing cluster (``dask scheduler`` and ``dask worker`` processes started by
+  the user, on this machine or others; ``workers`` is then ignored).
+
+Numbers never depend on where a task ran: every task carries its own seed (a ``numpy.random.SeedSequence``
+spawn key of its coordinates in its study, see :mod:`navlib.methods.seeding`), and tasks are cut into
+batches of a fixed size (:func:`run_batches`), never into one batch per worker.  So 1 worker, N workers
+and a remote cluster give identical results (tested).
+
+Scheduling: tasks with a ``cost`` estimate get dask priorities, the most expensive first (longest
+processing time first), so no worker idles at the end while another still runs a long task.  A worker
+that dies (killed, out of memory) is restarted by its nanny and the scheduler re-runs its tasks on
+another worker (up to :data:`ALLOWED_FAILURES` deaths per task); an exception raised by a task (bad
+input) is not retried: it reaches the caller as raised.
+
+Progress: a tqdm bar on stderr for studies that run longer than :data:`PROGRESS_DELAY_S`, only when stderr
+is a terminal (never in a notebook's stored outputs) unless ``NAVLIB_PROGRESS=1`` asks for it (``0``
+turns it off everywhere).
+"""
+from __future__ import annotations
+
+import atexit
+import importlib
+import importlib.util
+import logging
+import os
+import re
+import sys
+import uuid
+from typing import Any, Callable, Iterable, Sequence
+
+from .errors import InputError, check_param
+
+#: Environment variable holding a scheduler address (``tcp://host:port``) every study sends its tasks to.
+ENV_SCHEDULER = "NAVLIB_SCHEDULER"
+#: Environment variable forcing the progress bar on (``1``) or off (``0``).
+ENV_PROGRESS = "NAVLIB_PROGRESS"
+#: The progress bar appears only for studies still running after this many seconds.
+PROGRESS_DELAY_S = 3.0
+#: How many worker deaths a task may see before the scheduler gives up on it (dask's ``allowed-failures``).
+ALLOWED_FAILURES = 3
+#: Environment of every local worker process: one thread for every numerical library.
+WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
+#: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
+#: samples every worker's stack every 10 ms) and slower housekeeping loops; dask's defaults cost an idle
+#: 2-worker cluster about 12 % of a core, these 1 %.
+LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+                "distributed.worker.profile.enabled": False,
+                "distributed.admin.tick.interval": "1s",
+                "distributed.admin.system-monitor.interval": "2s",
+                "distributed.worker.memory.monitor-interval": "1s"}
+#: Seconds to wait for a scheduler at an address before giving up.
+CONNECT_TIMEOUT_S = 10.0
+
+_ADDRESS = re.compile(r"^(tcp|tls|ws|wss|inproc|ucx)://\S+$")
+_CLIENTS: dict[tuple, Any] = {}          # ("local", n) or ("remote", address) -> Client
+_CLUSTERS: dict[tuple, Any] = {}         # ("local", n) -> LocalCluster
+_PRELOADS: list = []                     # futures of start()'s imports (a released future is cancelled)
+
+
+# ------------------------------------------------------------------------------------------ where
+def scheduler_address(scheduler: str | None = None) -> str | None:
+    """The scheduler address tasks go to: ``scheduler``, else ``$NAVLIB_SCHEDULER``, else None (local).
+    ``host:port`` is read as ``tcp://host:port``; anything else that is not an address is refused."""
+    addr = scheduler if scheduler is not None else os.environ.get(ENV_SCHEDULER) or None
+    if addr is None:
+        return None
+    if not isinstance(addr, str) or not addr.strip():
+        raise InputError(f"scheduler {addr!r}: give an address such as tcp://127.0.0.1:8786")
+    given = addr.strip()
+    addr = given if "://" in given else "tcp://" + given
+    if not _ADDRESS.match(addr) or (addr.startswith("tcp://") and not re.search(r":\d+$", addr)):
+        raise InputError(f"scheduler {given!r}: give an address such as tcp://127.0.0.1:8786 (host and port)")
+    return addr
+
+
+def dask_available() -> bool:
+    """True when dask.distributed can be imported (``pip install navlib[dist]``)."""
+    return importlib.util.find_spec("distributed") is not None
+
+
+def default_workers() -> int:
+    """Worker processes a command uses when not told: the cores this process may run on, or 1 when
+    dask.distributed is not installed."""
+    if not dask_available():
+        return 1
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                       # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _need_dask(why: str):
+    if not dask_available():
+        raise InputError(f"{why} needs dask.distributed, which is not installed: pip install 'navlib[dist]' "
+                         f"(or run with workers=1)")
+
+
+def _one_thread() -> None:
+    """One thread for torch in this process when torch is already loaded (never imports it)."""
+    torch = sys.modules.get("torch")
+    if torch is not None and torch.get_num_threads() != 1:
+        torch.set_num_threads(1)
+
+
+def _worker_plugin():
+    from distributed import WorkerPlugin
+
+    class OneThread(WorkerPlugin):
+        """Every worker: numerical libraries on one thread (the environment before they load; torch's
+        own setting when it is importable)."""
+
+        def setup(self, worker):
+            for k, v in WORKER_ENV.items():     # read by OpenMP (torch) and BLAS when they load later
+                os.environ.setdefault(k, v)
+            _one_thread()                      # torch already loaded: its own setting
+
+    return OneThread()
+
+
+def client(workers: int = 1, scheduler: str | None = None):
+    """The ``dask.distributed.Client`` tasks go to, or None when they run in this process (``workers=1``
+    and no scheduler address).  Clients and local clusters are made once per process and reused."""
+    check_param("workers", workers, lo=1, integer=True)
+    addr = scheduler_address(scheduler)
+    if addr is None and int(workers) == 1:
+        return None
+    key = ("remote", addr) if addr else ("local", int(workers))
+    c = _CLIENTS.get(key)
+    if c is not None and c.status == "running":
+        return c
+    _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
+    import dask
+    from distributed import Client, LocalCluster
+
+    if addr:
+        try:
+            c = Client(addr, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
+        except (OSError, TimeoutError) as err:
+            raise InputError(f"scheduler {addr}: cannot connect ({type(err).__name__}: "
+                             f"{str(err).splitlines()[0] if str(err) else 'no answer'})") from None
+    else:
+        for other in [k for k in _CLUSTERS if k[0] == "local"]:       # one local cluster at a time
+            _close(other)
+        with dask.config.set(LOCAL_CONFIG):
+            cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                                   host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR,
+                                   scheduler_kwargs={"dashboard_address": ":0"},   # no dashboard; no fixed port
+                                   env=dict(WORKER_ENV))
+        _CLUSTERS[key] = cluster
+        c = Client(cluster, set_as_default=False)
+    c.register_plugin(_worker_plugin(), name="navlib-one-thread")
+    _CLIENTS[key] = c
+    return c
+
+
+def _close(key) -> None:
+    c = _CLIENTS.pop(key, None)
+    cluster = _CLUSTERS.pop(key, None)
+    for obj in (c, cluster):
+        if obj is not None:
+            try:
+                obj.close()
+            except (OSError, RuntimeError, TimeoutError):   # already gone (interpreter exit, dead loop)
+                pass
+
+
+def shutdown() -> None:
+    """Close every client and stop every local cluster this process started (also done at exit)."""
+    _PRELOADS.clear()
+    for key in list(_CLIENTS) + list(_CLUSTERS):
+        _close(key)
+
+
+atexit.register(shutdown)
+
+
+def _import(modules: Sequence[str]) -> bool:
+    for m in modules:
+        importlib.import_module(m)
+    _one_thread()
+    return True
+
+
+def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str] = ()) -> None:
+    """Start the local cluster (or connect to the scheduler) now, and let every worker import the modules
+    ``preload`` in the background (a chapter pays its workers' start-up while it loads its data).  Nothing
+    happens for ``workers=1`` without a scheduler."""
+    c = client(workers, scheduler)
+    if c is None or not preload:
+        return
+    _PRELOADS[:] = [f for f in _PRELOADS if not f.done()]
+    for addr in c.scheduler_info(n_workers=-1)["workers"]:
+        _PRELOADS.append(c.submit(_import, tuple(preload), workers=[addr], pure=False, allow_other_workers=False,
+                                  priority=10**9, key=f"navlib-preload-{uuid.uuid4().hex[:8]}"))
+
+
+# ------------------------------------------------------------------------------------------ running
+def _show_progress(progress: bool | None) -> bool:
+    if progress is not None:
+        return bool(progress)
+    env = os.environ.get(ENV_PROGRESS)
+    if env is not None and env.strip():
+        return env.strip().lower() not in ("0", "false", "no", "off")
+    return sys.stderr is not None and hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
+
+
+def _bar(total: int, label: str, show: bool):
+    if not show:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,
+                dynamic_ncols=True)
+
+
+def _call(fn: Callable, args: tuple):
+    _one_thread()
+    return fn(*args)
+
+
+def _batch(fn: Callable, batch: list) -> list:
+    _one_thread()
+    return [fn(*a) for a in batch]
+
+
+def run(fn: Callable, tasks: Iterable[tuple], *, workers: int = 1, scheduler: str | None = None,
+        cost: Sequence[float] | None = None, label: str = "", progress: bool | None = None,
+        weight: Sequence[int] | None = None, on_result: Callable[[int, Any], None] | None = None) -> list:
+    """``[fn(*args) for args in tasks]`` on the engine (see the module docstring), results in task order.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level function (it is sent to worker processes by reference).
+    tasks : iterable of tuple
+        The arguments of each call.
+    workers : int
+        Worker processes of the local cluster; 1 runs in this process.
+    scheduler : str, optional
+        Address of an existing dask scheduler (default ``$NAVLIB_SCHEDULER``); overrides ``workers``.
+    cost : sequence of float, optional
+        Estimated cost of each task: the most expensive start first (dask priorities).
+    label : str
+        Name shown on the progress bar.
+    progress : bool, optional
+        Force the progress bar on or off (default: see the module docstring).
+    weight : sequence of int, optional
+        What each task counts for on the progress bar (e.g. the trials in a batch).
+    on_result : callable, optional
+        ``on_result(i, result)`` is called in this process as soon as task ``i`` is done (e.g. to write
+        its output while the others still run).
+
+    Returns
+    -------
+    list
+        One result per task, in the order of ``tasks``.  The first exception a task raised is raised here
+        (the other tasks are cancelled).
+    """
+    tasks = [tuple(t) for t in tasks]
+    if cost is not None and len(cost) != len(tasks):
+        raise InputError(f"engine.run: {len(cost)} costs for {len(tasks)} tasks")
+    weight = [1] * len(tasks) if weight is None else [int(w) for w in weight]
+    addr = scheduler_address(scheduler)
+    check_param("workers", workers, lo=1, integer=True)
+    bar = _bar(sum(weight), label, _show_progress(progress))
+    try:
+        if addr is None and (int(workers) == 1 or len(tasks) <= 1):
+            out = []
+            for i, (t, w) in enumerate(zip(tasks, weight)):
+                out.append(_call(fn, t))
+                if on_result is not None:
+                    on_result(i, out[-1])
+                if bar is not None:
+                    bar.update(w)
+            return out
+        return _run_dask(client(workers, addr), fn, tasks, cost, label, bar, weight, on_result)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _run_dask(c, fn, tasks, cost, label, bar, weight, on_result) -> list:
+    from distributed import as_completed
+
+    n = len(tasks)
+    order = sorted(range(n), key=lambda i: -cost[i]) if cost is not None else list(range(n))
+    priority = {i: n - rank for rank, i in enumerate(order)}      # higher runs first
+    tag = re.sub(r"[^A-Za-z0-9_]+", "_", label or getattr(fn, "__name__", "task"))[:40]
+    run_id = uuid.uuid4().hex[:10]
+    futures = [None] * n
+    for i in order:
+        futures[i] = c.submit(_call, fn, tasks[i], priority=priority[i], retries=0, pure=False,
+                              key=f"navlib-{tag}-{run_id}-{i}")
+    index = {f.key: i for i, f in enumerate(futures)}
+    try:
+        for f in as_completed(futures, loop=c.loop):
+            if f.status == "error":
+                f.result()                       # raises the task's exception here
+            if on_result is not None:
+                on_result(index[f.key], f.result())
+            if bar is not None:
+                bar.update(weight[index[f.key]])
+        return c.gather(futures)
+    finally:
+        pending = [f for f in futures if f is not None and not f.done()]
+        if pending:
+            c.cancel(pending)
+
+
+def run_batches(fn: Callable, items: Sequence[tuple], batch_size: int, *, workers: int = 1,
+                scheduler: str | None = None, cost: Sequence[float] | None = None, label: str = "",
+                progress: bool | None = None) -> list:
+    """``[fn(*args) for args in items]``, sent in batches of ``batch_size`` consecutive items (one task
+    each; the batches depend on ``batch_size`` only, never on the number of workers).  ``cost``: per
+    item; a batch costs the sum of its items."""
+    check_param("batch_size", batch_size, lo=1, integer=True)
+    items = [tuple(a) for a in items]
+    if cost is not None and len(cost) != len(items):
+        raise InputError(f"engine.run_batches: {len(cost)} costs for {len(items)} items")
+    bounds = [(s, min(s + int(batch_size), len(items))) for s in range(0, len(items), int(batch_size))]
+    batches = [(fn, items[a:b]) for a, b in bounds]
+    bcost = None if cost is None else [float(sum(cost[a:b])) for a, b in bounds]
+    parts = run(_batch, batches, workers=workers, scheduler=scheduler, cost=bcost, label=label or
+                getattr(fn, "__name__", ""), progress=progress, weight=[b - a for a, b in bounds])
+    return [r for part in parts for r in part]
