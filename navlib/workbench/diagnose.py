@@ -36,7 +36,7 @@ Gauss-Newton step of the GLS fit from the least-squares solution; exact for a li
 estimated noise model plugged in.  Plugged-in p-values are too small: the correlation is estimated from
 the same data, an estimate a little low makes a slow shape look significant, and Bonferroni cannot allow
 for that.  The family is therefore calibrated by a **parametric bootstrap of its smallest p-value**
-(:func:`_bootstrap_level`; single-step minP, Westfall and Young 1993): noise from the estimated AR model
+(``_bootstrap_level``; single-step minP, Westfall and Young 1993): noise from the estimated AR model
 is simulated on the same series, the noise model re-estimated on it as the screen does, and every test of
 the family re-run with the re-estimated model; a test is significant when its plugged-in p lies below the
 level that the replicates' smallest p-values reach in a share ``alpha`` of replicates.  This keeps the

@@ -183,7 +183,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     variance on each segment, returned in observation order (``n_obs`` rows; observations outside the
     series are 0).  ``whiten(colour(u)) == u``: the first samples of a segment are built with the
     Durbin-Levinson coefficients of their own order, the rest by the recursion of order p
-    (:func:`scipy.signal.lfilter`, its state carried over from the start-up)."""
+    (``scipy.signal.lfilter``, its state carried over from the start-up)."""
     from scipy.signal import lfilter
     u = np.asarray(u, float)
     p = len(kappa)
