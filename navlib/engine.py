@@ -7,8 +7,9 @@ task order, wherever the tasks ran:
   ``pip install navlib`` without the ``dist`` extra runs every study);
 - ``workers=N`` > 1: a ``dask.distributed.LocalCluster`` of ``N`` single-threaded worker processes
   (OpenBLAS, OpenMP, MKL and torch on one thread each), started on first use and reused by every later
-  study of this process (:func:`start` starts it early, and lets the workers import the modules a chapter
-  needs while it goes on);
+  study of this process (:func:`start` starts it in the background, and lets the workers import the
+  modules a chapter needs while the chapter goes on); a script that asks for it runs under
+  ``if __name__ == "__main__":`` (the workers are spawned processes);
 - a scheduler address (``scheduler="tcp://host:8786"``, or the environment variable ``NAVLIB_SCHEDULER``)
   sends the same tasks to an existing cluster (``dask scheduler`` and ``dask worker`` processes started by
   the user, on this machine or others; ``workers`` is then ignored).
@@ -56,13 +57,17 @@ ALLOWED_FAILURES = 3
 WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
               "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
-#: samples every worker's stack every 10 ms) and slower housekeeping loops; dask's defaults cost an idle
-#: 2-worker cluster about 12 % of a core, these 1 %.
+#: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
+#: 2-worker cluster about 12 % of a core, these 1 %); glibc's malloc as in this process.
 LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
                 "distributed.worker.profile.enabled": False,
                 "distributed.admin.tick.interval": "1s",
                 "distributed.admin.system-monitor.interval": "2s",
-                "distributed.worker.memory.monitor-interval": "1s"}
+                "distributed.worker.memory.monitor-interval": "1s",
+                # dask's workers start with MALLOC_TRIM_THRESHOLD_=65536, which also fixes glibc's mmap threshold
+                # at 128 kB: every numpy temporary above it is mmap'ed and zeroed afresh (paper E's filter ran 1.4x
+                # slower in a worker than in this process); the workers keep glibc's adaptive defaults
+                "distributed.nanny.pre-spawn-environ": dict(WORKER_ENV)}
 #: Seconds to wait for a scheduler at an address before giving up.
 CONNECT_TIMEOUT_S = 10.0
 
