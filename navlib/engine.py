@@ -7,8 +7,9 @@ task order, wherever the tasks ran:
   ``pip install navlib`` without the ``dist`` extra runs every study);
 - ``workers=N`` > 1: a ``dask.distributed.LocalCluster`` of ``N`` single-threaded worker processes
   (OpenBLAS, OpenMP, MKL and torch on one thread each), started on first use and reused by every later
-  study of this process (:func:`start` starts it early, and lets the workers import the modules a chapter
-  needs while it goes on);
+  study of this process (:func:`start` starts it in the background, and lets the workers import the
+  modules a chapter needs while the chapter goes on); a script that asks for it runs under
+  ``if __name__ == "__main__":`` (the workers are spawned processes);
 - a scheduler address (``scheduler="tcp://host:8786"``, or the environment variable ``NAVLIB_SCHEDULER``)
   sends the same tasks to an existing cluster (``dask scheduler`` and ``dask worker`` processes started by
   the user, on this machine or others; ``workers`` is then ignored).
@@ -37,7 +38,9 @@ import logging
 import os
 import re
 import sys
+import threading
 import uuid
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
 
 from .errors import InputError, check_param
@@ -54,13 +57,17 @@ ALLOWED_FAILURES = 3
 WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
               "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
-#: samples every worker's stack every 10 ms) and slower housekeeping loops; dask's defaults cost an idle
-#: 2-worker cluster about 12 % of a core, these 1 %.
+#: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
+#: 2-worker cluster about 12 % of a core, these 1 %); glibc's malloc as in this process.
 LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
                 "distributed.worker.profile.enabled": False,
                 "distributed.admin.tick.interval": "1s",
                 "distributed.admin.system-monitor.interval": "2s",
-                "distributed.worker.memory.monitor-interval": "1s"}
+                "distributed.worker.memory.monitor-interval": "1s",
+                # dask's workers start with MALLOC_TRIM_THRESHOLD_=65536, which also fixes glibc's mmap threshold
+                # at 128 kB: every numpy temporary above it is mmap'ed and zeroed afresh (paper E's filter ran 1.4x
+                # slower in a worker than in this process); the workers keep glibc's adaptive defaults
+                "distributed.nanny.pre-spawn-environ": dict(WORKER_ENV)}
 #: Seconds to wait for a scheduler at an address before giving up.
 CONNECT_TIMEOUT_S = 10.0
 
@@ -68,6 +75,8 @@ _ADDRESS = re.compile(r"^(tcp|tls|ws|wss|inproc|ucx)://\S+$")
 _CLIENTS: dict[tuple, Any] = {}          # ("local", n) or ("remote", address) -> Client
 _CLUSTERS: dict[tuple, Any] = {}         # ("local", n) -> LocalCluster
 _PRELOADS: list = []                     # futures of start()'s imports (a released future is cancelled)
+_STARTING: dict[tuple, Any] = {}         # key -> concurrent.futures.Future of a start() in the background
+_LOCK = threading.RLock()
 
 
 # ------------------------------------------------------------------------------------------ where
@@ -132,16 +141,25 @@ def _worker_plugin():
 
 def client(workers: int = 1, scheduler: str | None = None):
     """The ``dask.distributed.Client`` tasks go to, or None when they run in this process (``workers=1``
-    and no scheduler address).  Clients and local clusters are made once per process and reused."""
+    and no scheduler address).  Clients and local clusters are made once per process and reused (a
+    cluster :func:`start` is still starting is waited for)."""
     check_param("workers", workers, lo=1, integer=True)
     addr = scheduler_address(scheduler)
     if addr is None and int(workers) == 1:
         return None
     key = ("remote", addr) if addr else ("local", int(workers))
-    c = _CLIENTS.get(key)
-    if c is not None and c.status == "running":
-        return c
-    _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
+    starting = _STARTING.pop(key, None)
+    if starting is not None:
+        starting.result()                        # raises what the start raised
+    with _LOCK:
+        c = _CLIENTS.get(key)
+        if c is not None and c.status == "running":
+            return c
+        _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
+        return _new_client(key, addr, int(workers))
+
+
+def _new_client(key, addr, workers):
     import dask
     from distributed import Client, LocalCluster
 
@@ -155,7 +173,7 @@ def client(workers: int = 1, scheduler: str | None = None):
         for other in [k for k in _CLUSTERS if k[0] == "local"]:       # one local cluster at a time
             _close(other)
         with dask.config.set(LOCAL_CONFIG):
-            cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR,
                                    scheduler_kwargs={"dashboard_address": ":0"},   # no dashboard; no fixed port
                                    env=dict(WORKER_ENV))
@@ -179,6 +197,12 @@ def _close(key) -> None:
 
 def shutdown() -> None:
     """Close every client and stop every local cluster this process started (also done at exit)."""
+    for f in list(_STARTING.values()):
+        try:
+            f.result()
+        except (InputError, OSError, RuntimeError, TimeoutError):     # reported by client(), if ever asked
+            pass
+    _STARTING.clear()
     _PRELOADS.clear()
     for key in list(_CLIENTS) + list(_CLUSTERS):
         _close(key)
@@ -194,17 +218,38 @@ def _import(modules: Sequence[str]) -> bool:
     return True
 
 
-def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str] = ()) -> None:
-    """Start the local cluster (or connect to the scheduler) now, and let every worker import the modules
-    ``preload`` in the background (a chapter pays its workers' start-up while it loads its data).  Nothing
-    happens for ``workers=1`` without a scheduler."""
-    c = client(workers, scheduler)
-    if c is None or not preload:
+def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str] = (), wait: bool = False) -> None:
+    """Start the local cluster (or connect to the scheduler) in the background and let every worker import
+    the modules ``preload`` once it is up: a chapter goes on loading its data meanwhile, and its first
+    study waits for the cluster only if it is not up yet.  ``workers`` and the address are checked here;
+    a cluster that then fails to start (or a scheduler that does not answer) raises at the first study
+    (or here with ``wait=True``).  Nothing happens for ``workers=1`` without a scheduler."""
+    check_param("workers", workers, lo=1, integer=True)
+    addr = scheduler_address(scheduler)
+    if addr is None and int(workers) == 1:
         return
-    _PRELOADS[:] = [f for f in _PRELOADS if not f.done()]
-    for addr in c.scheduler_info(n_workers=-1)["workers"]:
-        _PRELOADS.append(c.submit(_import, tuple(preload), workers=[addr], pure=False, allow_other_workers=False,
-                                  priority=10**9, key=f"navlib-preload-{uuid.uuid4().hex[:8]}"))
+    _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
+    key = ("remote", addr) if addr else ("local", int(workers))
+    if key in _STARTING or (key in _CLIENTS and _CLIENTS[key].status == "running"):
+        return
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="navlib-engine-start")
+    _STARTING[key] = pool.submit(_start, int(workers), addr, tuple(preload))
+    pool.shutdown(wait=False)
+    if wait:
+        client(workers, addr)
+
+
+def _start(workers: int, addr: str | None, preload: tuple) -> None:
+    with _LOCK:
+        key = ("remote", addr) if addr else ("local", workers)
+        c = _CLIENTS.get(key)
+        if c is None or c.status != "running":
+            c = _new_client(key, addr, workers)
+    if preload:
+        _PRELOADS[:] = [f for f in _PRELOADS if not f.done()]
+        for w in c.scheduler_info(n_workers=-1)["workers"]:
+            _PRELOADS.append(c.submit(_import, preload, workers=[w], pure=False, allow_other_workers=False,
+                                      priority=10**9, key=f"navlib-preload-{uuid.uuid4().hex[:8]}"))
 
 
 # ------------------------------------------------------------------------------------------ running

@@ -304,22 +304,22 @@ def test_cli_grid_refuses_a_folder_with_files_and_says_papermill_is_missing(tmp_
 
 def test_cli_grid_runs_a_chapter_on_the_cluster(remote, tmp_path):
     out = tmp_path / "grid"
-    r = run_cli("grid", GYRO, "--param", "n_seeds=2,3", "--param", "input_unit=arcmin,deg", "--out", out,
+    r = run_cli("grid", GYRO, "--param", "input_unit=arcmin,deg", "--param", "n_seeds=2", "--out", out,
                 "--scheduler", remote)
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""                                                 # the kernels' chatter stays in the runs
     rows = pd.read_csv(out / "grid.csv")
-    assert list(rows["run"]) == [1, 2, 3, 4] and (rows["status"] == "ok").all(), rows["status"]
-    assert list(zip(rows.n_seeds, rows.input_unit)) == [(2, "arcmin"), (2, "deg"), (3, "arcmin"), (3, "deg")]
-    for k in range(1, 5):
+    assert list(rows["run"]) == [1, 2] and (rows["status"] == "ok").all(), rows["status"]
+    assert list(zip(rows.input_unit, rows.n_seeds)) == [("arcmin", 2), ("deg", 2)]
+    for k in (1, 2):
         assert (out / f"gyro_{k:03d}.ipynb").is_file() and (out / "results" / f"gyro_{k:03d}" / "gyro.json").is_file()
     verdict_cols = [c for c in rows if c.endswith(": verdict")]
     stat_cols = [c for c in rows if ": median_rms_" in c]
     assert verdict_cols and stat_cols and rows[verdict_cols].notna().all().all()
     # each run wrote its own results with its own parameters: the input unit changes verdicts
     assert rows.loc[0, verdict_cols].tolist() != rows.loc[1, verdict_cols].tolist()
-    nb = json.loads((out / "gyro_004.ipynb").read_text())
+    nb = json.loads((out / "gyro_002.ipynb").read_text())
     injected = next(c for c in nb["cells"] if "injected-parameters" in c["metadata"].get("tags", []))
-    assert 'input_unit = "deg"' in "".join(injected["source"]) and "n_seeds = 3" in "".join(injected["source"])
-    r2 = run_cli("grid", GYRO, "--param", "n_seeds=1", "--out", out, "--scheduler", remote)
+    assert 'input_unit = "deg"' in "".join(injected["source"]) and "n_seeds = 2" in "".join(injected["source"])
+    r2 = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", out, "--scheduler", remote)
     assert r2.returncode == 2 and "not empty" in r2.stderr                # never writes over earlier outputs

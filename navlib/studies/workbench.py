@@ -172,14 +172,15 @@ def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -
 def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1,
                       scheduler: str | None = None) -> pd.DataFrame | None:
     """:func:`undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data are
-    absent); ``workers``, ``scheduler``: where they run (:mod:`navlib.engine`; the workers read the files,
-    so a remote cluster needs them at the same path)."""
+    absent); ``workers``, ``scheduler``: where they run (:mod:`navlib.engine`, the largest files first; the
+    workers read the files, so a remote cluster needs them at the same path)."""
     names = undisturbed_trials()
     if not names:
         return None
     check_param("row_step", row_step, lo=1, integer=True)
     rows = engine.run(undisturbed_loop, [(n, row_step, alpha) for n in names], workers=workers,
-                      scheduler=scheduler, label="BROAD loops")
+                      scheduler=scheduler, label="BROAD loops",
+                      cost=[float((MAG_DIR / n).stat().st_size) for n in names])     # the longest recordings first
     return pd.DataFrame(rows).set_index("trial")
 
 
