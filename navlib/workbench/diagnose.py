@@ -272,13 +272,14 @@ def _gls_of(r: np.ndarray, J: np.ndarray, noise: NoiseModel | None) -> tuple[np.
     return e - Q @ (Q.T @ e), Q
 
 
-def _shape_tests(e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel | None,
-                 n: int) -> list[tuple[int, float, float]]:
-    """F tests of structure shapes ``X0`` against the (whitened, projected) residual ``e`` of a model with
-    (whitened) Jacobian basis ``Q``: ``(index, p, log p)`` of each shape the model does not already span."""
+def _shape_bases(Q: np.ndarray, shapes: list, noise: NoiseModel | None,
+                 n: int) -> list[tuple[int, np.ndarray, int, int]]:
+    """For each structure shape ``X0`` the part the model of (whitened) Jacobian basis ``Q`` cannot absorb:
+    ``(index, u, q, df2)`` with ``u`` an orthonormal basis of it (q columns) and ``df2`` the F test's
+    denominator degrees of freedom; shapes the model already spans, or with too few rows left, are
+    skipped."""
     white = noise is not None and noise.correlated
     out = []
-    rss = float(e @ e)
     for i, X0 in enumerate(shapes):
         X = noise.whiten(X0) if white else X0
         X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
@@ -291,7 +292,17 @@ def _shape_tests(e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel |
         df2 = n - Q.shape[1] - q
         if q == 0 or df2 < 3:
             continue                                   # the model already spans this shape, or too few rows
-        u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
+        out.append((i, (Xp @ V[:, keep]) / np.sqrt(w[keep]), q, df2))
+    return out
+
+
+def _shape_tests(e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel | None,
+                 n: int) -> list[tuple[int, float, float]]:
+    """F tests of structure shapes ``X0`` against the (whitened, projected) residual ``e`` of a model with
+    (whitened) Jacobian basis ``Q``: ``(index, p, log p)`` of each shape the model does not already span."""
+    rss = float(e @ e)
+    out = []
+    for i, u, q, df2 in _shape_bases(Q, shapes, noise, n):
         drop = float(np.sum((u.T @ e) ** 2))
         p, logp = _f_test(rss, rss - drop, q, df2)
         out.append((i, p, logp))
@@ -346,7 +357,7 @@ def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | 
 class Calibration:
     """The per-test critical p-value of a family of tests (a test is significant when its p is below
     ``level``) and how it was found: ``method`` "Bonferroni" (``alpha / m``) or "parametric bootstrap"
-    (``replicates`` simulated, ``exceed`` of them with a family minimum below the smallest observed p)."""
+    (``replicates`` simulated; ``stopped_early`` when enough of them reached the smallest observed p)."""
 
     level: float
     method: str
@@ -381,9 +392,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     from .serial import colour, select_bases
     noise = sc.noise
     B = bootstrap_replicates(alpha)
-    K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))
-    if K < 1:
-        return Calibration(0.0, "parametric bootstrap", 0)
+    K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))     # >= 2: B >= 2.5 / alpha - 1
     family = _Family(fit, fits)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
     ser = noise.series
@@ -408,7 +417,7 @@ class _Family:
         self.cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
         self.shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
 
-    def minima(self, E: np.ndarray, bases: tuple, noise: NoiseModel, regressors: tuple) -> np.ndarray:
+    def minima(self, E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> np.ndarray:
         """The smallest p of the family on each column of ``E`` (residual vectors in observation order), the
         noise model of each chosen as the screen chose the data's (:func:`navlib.workbench.serial.select`
         around ``regressors``, whose orthonormal ``bases`` are given; the AR order fixed at the data's)."""
@@ -441,17 +450,7 @@ class _Family:
             e1 = W - Q1 @ (Q1.T @ W)
             rss1 = np.einsum("ij,ij->j", e1, e1)
             best = np.minimum(best, _f_p(rss0 - rss1, rss1, q, df2))
-        for X0 in self.shapes:
-            X = nm.whiten(X0) if nm.correlated else X0
-            X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
-            Xp = X - Q0 @ (Q0.T @ X)
-            w, V = np.linalg.eigh(Xp.T @ Xp)
-            keep = w > SPANNED ** 2
-            q = int(np.sum(keep))
-            df2 = self.n - Q0.shape[1] - q
-            if q == 0 or df2 < 3:
-                continue
-            u = (Xp @ V[:, keep]) / np.sqrt(w[keep])
+        for _, u, q, df2 in _shape_bases(Q0, self.shapes, nm, self.n):
             drop = np.sum((u.T @ e0) ** 2, axis=0)
             best = np.minimum(best, _f_p(drop, rss0 - drop, q, df2))
         return best

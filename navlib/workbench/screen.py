@@ -49,7 +49,7 @@ the "potential outlier" cutoff of Iglewicz and Hoaglin 1993, *How to Detect and 
 model describes the bulk of the data, so a localised disturbance (a magnet passed at close range) is not
 taken for strongly correlated noise that would then hide it.  The regressors are chosen by the likelihood
 (:func:`navlib.workbench.serial.select`): the model's Jacobian alone, or with the system's structure shapes
-as well when they fit the data better by AIC -- so a slow structure outside the catalogue is not mistaken
+as well when they fit the data better by BIC -- so a slow structure outside the catalogue is not mistaken
 for correlated noise and stays testable, while on data without one the correlation keeps the precision
 that the slow shapes would take from it.
 """

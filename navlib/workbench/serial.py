@@ -40,6 +40,7 @@ removes most of that bias for AR errors in regression (Cheang and Reinsel 2000, 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -493,11 +494,11 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
 
 
 def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series | None, *,
-           order: int | None = None, interval: bool = True, bases: tuple | None = None,
+           order: int | None = None, interval: bool = True, bases: Bases | None = None,
            start_at: tuple | None = None) -> NoiseModel:
     """The noise model around the better of two sets of regressors: ``base`` (the model's Jacobian) or
     ``base`` and ``extra`` (the structure shapes).  Each set gets its REML estimate (:func:`estimate`);
-    the set with the lower AIC of the plain likelihood, ``-2 l_ML + 2 (regressors + AR order)``, is used.
+    the set with the lower BIC of the plain likelihood (:func:`criterion`) is used.
 
     Why: slow shapes among the regressors (a trend, offsets per sweep, harmonics of a heading that turns
     with time) soak up the low frequencies where an AR process of high correlation lives, and the
@@ -506,8 +507,7 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     out, is taken for correlated noise and hidden by it.  The likelihood decides which is the case.
     ``around`` in the result says which set was used; ``bases``: :func:`select_bases` of the regressors,
     if already computed (a bootstrap re-estimates on many residual vectors)."""
-    qb, qe = bases[:2] if bases is not None else (None, None)
-    pb, pe = bases[2:4] if bases is not None and len(bases) > 2 else (None, None)
+    qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
     mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at)
     if extra is None or not np.size(extra) or series is None:
         return replace(mb, around="model")
@@ -515,23 +515,38 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
                   interval=interval, basis=qe, prepared=pe, start_at=start_at)
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
         return replace(me, around="model and structure shapes")
-    pen = SELECT_PENALTY(len(series.order))
-    ic_b = -2 * mb.ml + pen * (mb.regressors + mb.order)
-    ic_e = -2 * me.ml + pen * (me.regressors + me.order)
-    return replace(me, around="model and structure shapes") if ic_e < ic_b else replace(mb, around="model")
+    n = len(series.order)
+    better = criterion(me.ml, me.regressors + me.order, n) < criterion(mb.ml, mb.regressors + mb.order, n)
+    return replace(me, around="model and structure shapes") if better else replace(mb, around="model")
+
+
+def criterion(ml, parameters: int, n: int):
+    """The information criterion :func:`select` compares: ``-2 l_ML + SELECT_PENALTY(n) * parameters``
+    (regressors and AR coefficients)."""
+    return -2 * ml + SELECT_PENALTY(n) * parameters
+
+
+class Bases(NamedTuple):
+    """What :func:`select` needs of its two regressor sets, computed once for many residual vectors: the
+    orthonormal bases (:func:`basis_on`) of ``base`` and of ``base`` with ``extra`` (None without
+    ``extra``), and optionally their likelihood parts for one AR order (:class:`_Prepared`)."""
+
+    base: np.ndarray | None
+    extra: np.ndarray | None
+    prepared_base: "_Prepared | None" = None
+    prepared_extra: "_Prepared | None" = None
 
 
 def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_obs: int,
-                 order: int | None = None) -> tuple:
-    """The two orthonormal bases :func:`select` compares (:func:`basis_on` of ``base`` and of ``base`` with
-    ``extra``; the second None without ``extra``); with ``order``, also their likelihood parts for that AR
-    order (:class:`_Prepared`), for many residual vectors."""
+                 order: int | None = None) -> Bases:
+    """The :class:`Bases` of :func:`select`'s regressors on ``series``; with ``order``, also their
+    likelihood parts for that AR order."""
     qb = basis_on(base, series, n_obs)
     qe = basis_on(np.column_stack([base, extra]), series, n_obs) if extra is not None and np.size(extra) else None
     if order is None:
-        return qb, qe
+        return Bases(qb, qe)
     P = max(int(order), 1)
-    return qb, qe, _Prepared(qb, series, P), (_Prepared(qe, series, P) if qe is not None else None)
+    return Bases(qb, qe, _Prepared(qb, series, P), _Prepared(qe, series, P) if qe is not None else None)
 
 
 #: The grid of lag-1 correlations on which :func:`ar1_grid` evaluates the likelihoods: uniform in
@@ -576,11 +591,11 @@ def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray 
     return reml, ml
 
 
-def select_ar1_many(E: np.ndarray, bases: tuple, series: Series, grid: np.ndarray = AR1_GRID) -> np.ndarray:
+def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarray = AR1_GRID) -> np.ndarray:
     """:func:`select` at AR order 1 for many residual vectors at once (the columns of ``E``), the
     correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
     correlation of each vector."""
-    qb, qe = bases[:2]
+    qb, qe = bases.base, bases.extra
     rb, mb = ar1_grid(E, qb, series, grid)
     ib = np.argmax(rb, axis=0)
     cols = np.arange(E.shape[1])
@@ -588,7 +603,6 @@ def select_ar1_many(E: np.ndarray, bases: tuple, series: Series, grid: np.ndarra
         return grid[ib]
     re_, me = ar1_grid(E, qe, series, grid)
     ie = np.argmax(re_, axis=0)
-    pen = SELECT_PENALTY(len(series.order))
-    ic_b = -2 * mb[ib, cols] + pen * (qb.shape[1] + 1)
-    ic_e = -2 * me[ie, cols] + pen * (qe.shape[1] + 1)
-    return np.where(ic_e < ic_b, grid[ie], grid[ib])
+    n = len(series.order)
+    better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(mb[ib, cols], qb.shape[1] + 1, n)
+    return np.where(better, grid[ie], grid[ib])
