@@ -43,6 +43,7 @@ import uuid
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
 
+from .__main__ import ONE_THREAD
 from .errors import InputError, check_param
 
 #: Environment variable holding a scheduler address (``tcp://host:port``) every study sends its tasks to.
@@ -54,8 +55,7 @@ PROGRESS_DELAY_S = 3.0
 #: How many worker deaths a task may see before the scheduler gives up on it (dask's ``allowed-failures``).
 ALLOWED_FAILURES = 3
 #: Environment of every local worker process: one thread for every numerical library.
-WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
+WORKER_ENV = dict(ONE_THREAD)
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
 #: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
 #: 2-worker cluster about 12 % of a core, these 1 %); glibc's malloc as in this process.

@@ -153,3 +153,22 @@ def test_stored_sweeps_are_what_the_simulator_produces():
     np.testing.assert_allclose(stored.to_numpy(float), fresh.to_numpy(float), rtol=0, atol=1e-6)
     other = simulate_train_test(seed=2025)
     assert not np.allclose(stored.measured_heading_deg, other.measured_heading_deg, atol=1e-6)
+
+
+def test_the_planar_jacobian_equals_central_differences():
+    """``PlanarModel.jacobian`` (exact derivatives of the measured heading) against central differences of
+    ``predict_measured``, every parameter, away from zero, with a temperature drift."""
+    from navlib.sensors.planar import PLANAR_EFFECTS, PlanarModel
+    rng = np.random.default_rng(np.random.SeedSequence(18, spawn_key=(7,)))
+    effects = tuple(PLANAR_EFFECTS)
+    names = [n for e in effects for n in PLANAR_EFFECTS[e]]
+    p0 = dict(zip(names, [3.0, 0.3, -0.2, 0.1, -0.05, 0.01, -0.02]))
+    true = rng.uniform(0, 360, 200)
+    temp = rng.uniform(-10, 40, 200)
+    J = PlanarModel(effects, p0, 15.0).jacobian(true, names, temp)
+    for j, name in enumerate(names):
+        h = 1e-6
+        up = PlanarModel(effects, {**p0, name: p0[name] + h}, 15.0).predict_measured(true, temp)
+        dn = PlanarModel(effects, {**p0, name: p0[name] - h}, 15.0).predict_measured(true, temp)
+        fd = wrap_deg(up - dn) / (2 * h)
+        np.testing.assert_allclose(J[:, j], fd, rtol=1e-5, atol=1e-7, err_msg=name)

@@ -79,6 +79,24 @@ class PlanarModel:
         m = self._field(true_deg, temperature_c)
         return heading_deg(m[0], m[1])
 
+    def jacobian(self, true_deg, names, temperature_c=None) -> np.ndarray:
+        """d(measured heading)/d(parameter), deg per unit parameter, (N x len(names)), exact: with
+        ``v = S r + h + k (T - T_ref)`` the heading is ``atan2(-v_y, v_x) + yaw``, so
+        ``d psi_m / d p = (v_y dv_x/dp - v_x dv_y/dp) / |v|^2`` (rad) and ``d psi_m / d yaw = 1``."""
+        p = self.full_params()
+        t = np.radians(np.atleast_1d(np.asarray(true_deg, dtype=float)))
+        r0, r1 = np.cos(t), -np.sin(t)
+        S = np.array([[1 + p["soft_e"], p["soft_f"]], [p["soft_f"], 1 - p["soft_e"]]])
+        v = S @ np.stack([r0, r1]) + self._offset(p, len(t), temperature_c)
+        k = np.degrees(1.0) / np.sum(v * v, axis=0)
+        one, zero = np.ones_like(t), np.zeros_like(t)
+        dt = (np.asarray(temperature_c, dtype=float) - self.reference_temperature_c
+              if temperature_c is not None else zero)
+        dv = {"soft_e": (r0, -r1), "soft_f": (r1, r0), "hard_x": (one, zero), "hard_y": (zero, one),
+              "temp_x_per_c": (dt, zero), "temp_y_per_c": (zero, dt)}
+        cols = [one if n == "yaw_deg" else k * (v[1] * dv[n][0] - v[0] * dv[n][1]) for n in names]
+        return np.column_stack(cols) if cols else np.zeros((len(t), 0))
+
     def predict_error(self, true_deg, temperature_c=None) -> np.ndarray:
         return wrap_deg(self.predict_measured(true_deg, temperature_c) - np.asarray(true_deg, dtype=float))
 

@@ -376,6 +376,10 @@ def bootstrap_replicates(alpha: float) -> int:
     return max(REPLICATES, int(math.ceil(2.5 / alpha)) - 1)
 
 
+#: Noise models whose whitened bases one bootstrap keeps (replicates share the grid's correlations).
+_KEEP_BASES = 4
+
+
 def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: float,
                      seed: int) -> Calibration:
     """The family-wise critical p-value on correlated noise, by a parametric bootstrap of the smallest
@@ -396,7 +400,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     family = _Family(fit, fits)
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
     ser = noise.series
-    bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order if noise.order > 1 else None)
+    bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order)   # with the basis-only blocks
     U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
     minima = np.empty(0)
     for start in range(0, B, _BATCH):
@@ -416,6 +420,7 @@ class _Family:
         self.J0 = fit.jacobian
         self.cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
         self.shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
+        self._cache: dict = {}
 
     def minima(self, E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> np.ndarray:
         """The smallest p of the family on each column of ``E`` (residual vectors in observation order), the
@@ -437,20 +442,29 @@ class _Family:
             out[b] = self._min_p(E[:, [b]], nb)[0]
         return out
 
+    def _bases(self, nm: NoiseModel) -> tuple:
+        """The whitened model's and candidates' orthonormal bases and the shapes' (:func:`_shape_bases`)
+        under the noise model ``nm``; the last few are kept, since replicates share grid correlations."""
+        key = tuple(nm.kappa)
+        if key not in self._cache:
+            Q0 = _projector(nm.whiten(self.J0))
+            Q1s = [(_projector(nm.whiten(J1)), q, df2) for J1, q, df2 in self.cands if q > 0 and df2 > 0]
+            if len(self._cache) >= _KEEP_BASES:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = (Q0, Q1s, _shape_bases(Q0, self.shapes, nm, self.n))
+        return self._cache[key]
+
     def _min_p(self, E: np.ndarray, nm: NoiseModel) -> np.ndarray:
         W = nm.whiten(E) if nm.correlated else E
-        Q0 = _projector(nm.whiten(self.J0))
+        Q0, Q1s, shape_bases = self._bases(nm)
         e0 = W - Q0 @ (Q0.T @ W)
         rss0 = np.einsum("ij,ij->j", e0, e0)
         best = np.ones(E.shape[1])
-        for J1, q, df2 in self.cands:
-            if q <= 0 or df2 <= 0:
-                continue
-            Q1 = _projector(nm.whiten(J1))
+        for Q1, q, df2 in Q1s:
             e1 = W - Q1 @ (Q1.T @ W)
             rss1 = np.einsum("ij,ij->j", e1, e1)
             best = np.minimum(best, _f_p(rss0 - rss1, rss1, q, df2))
-        for _, u, q, df2 in _shape_bases(Q0, self.shapes, nm, self.n):
+        for _, u, q, df2 in shape_bases:
             drop = np.sum((u.T @ e0) ** 2, axis=0)
             best = np.minimum(best, _f_p(drop, rss0 - drop, q, df2))
         return best

@@ -285,7 +285,11 @@ def _fit_compass(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     # start 2: the linearised (harmonic) model fitted by linear least squares
     X = np.column_stack([compass_linear_design(data, pnames, t_ref), user_design(users, data, shape)])
     x2 = lstsq(X, wrap_deg(meas - true))
-    sol = best_least_squares(resid, [x1, x2], lo, hi)
+    jac = "2-point"
+    if not users:                                   # the planar model's exact derivatives
+        def jac(x):
+            return PlanarModel(planar, dict(zip(names, x)), t_ref).jacobian(true, names, temp)
+    sol = best_least_squares(resid, [x1, x2], lo, hi, jac=jac)
     params = dict(zip(names, map(float, sol.x)))
     pm = PlanarModel(planar, {k: params[k] for k in pnames}, t_ref)
     r = wrap_deg(meas - model(sol.x))

@@ -9,7 +9,6 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
@@ -142,6 +141,7 @@ def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effe
 def loop_figure(result: LoopResult):
     """Three panels: measurement against the start and final models, residuals at each step, the error
     falling (rms and held-out rms per step)."""
+    import matplotlib.pyplot as plt                 # only for the picture: the CLI's loop runs without it
     fits, unit = result.fits, result.final.unit
     fig, axes = plt.subplots(1, 3, figsize=(12, 4))
     ax = axes[0]

@@ -554,22 +554,24 @@ def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_o
 AR1_GRID = np.tanh(np.linspace(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX), 241))
 
 
-def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray = AR1_GRID) -> tuple:
+def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray = AR1_GRID,
+             prepared: _Prepared | None = None) -> tuple:
     """REML and plain log likelihoods of AR(1) noise (module docstring) for many residual vectors at once,
     on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
     (:func:`basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
     :class:`_Restricted` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
-    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix."""
-    Zq, Ze = basis[series.order], np.asarray(E, float)[series.order]
-    pos = series.pos
-    bulk, early = np.flatnonzero(pos >= 1), np.flatnonzero(pos == 0)
-    q0, q1, e0, e1 = Zq[bulk], Zq[bulk - 1], Ze[bulk], Ze[bulk - 1]
-    Cqq = (q0.T @ q0, q0.T @ q1 + q1.T @ q0, q1.T @ q1)
+    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix.  ``prepared``: the
+    basis's own blocks (:class:`_Prepared` of order 1), when many calls share the basis."""
+    pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
+    Ze = np.asarray(E, float)[series.order]
+    bulk, early = pre.bulk, pre.early
+    q0, q1, e0, e1 = pre.lq[0], pre.lq[1], Ze[bulk], Ze[bulk - 1]
+    Cqq = (pre.C[0][0], pre.C[0][1] + pre.C[1][0], pre.C[1][1])
     Cqe = (q0.T @ e0, q0.T @ e1 + q1.T @ e0, q1.T @ e1)
     Cee = (np.einsum("ij,ij->j", e0, e0), 2 * np.einsum("ij,ij->j", e0, e1), np.einsum("ij,ij->j", e1, e1))
-    qe, ee = Zq[early], Ze[early]
+    qe, ee = pre.elags[0], Ze[early]
     Eqq, Eqe, Eee = qe.T @ qe, qe.T @ ee, np.einsum("ij,ij->j", ee, ee)
-    n, k = len(Zq), Zq.shape[1]
+    n, k = pre.n, pre.k
     reml = np.empty((len(grid), Ze.shape[1]))
     ml = np.empty_like(reml)
     for g, phi in enumerate(grid):
@@ -596,12 +598,12 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
     correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
     correlation of each vector."""
     qb, qe = bases.base, bases.extra
-    rb, mb = ar1_grid(E, qb, series, grid)
+    rb, mb = ar1_grid(E, qb, series, grid, bases.prepared_base)
     ib = np.argmax(rb, axis=0)
     cols = np.arange(E.shape[1])
     if qe is None:
         return grid[ib]
-    re_, me = ar1_grid(E, qe, series, grid)
+    re_, me = ar1_grid(E, qe, series, grid, bases.prepared_extra)
     ie = np.argmax(re_, axis=0)
     n = len(series.order)
     better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(mb[ib, cols], qb.shape[1] + 1, n)
