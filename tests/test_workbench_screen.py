@@ -38,10 +38,21 @@ def trial05():
     return wb.load_trial(wb.CALIBRATION_TRIAL, 3)
 
 
+WILD_ROW = 40
+
+
+@pytest.fixture(scope="module")
+def trial05_clean_loops(trial05):
+    """The loop on the clean file without the spiked row, and on the whole clean file (shared by the
+    spike values)."""
+    return loop("magnetometer", trial05.drop(index=WILD_ROW), []), loop("magnetometer", trial05, [])
+
+
 @REAL
 @pytest.mark.parametrize("value", [300.0, 1e6, 1e10])
-def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_clean_answer(trial05, value):
-    row = 40
+def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_clean_answer(
+        trial05, trial05_clean_loops, value):
+    row = WILD_ROW
     spiked = trial05.copy()
     spiked.loc[row, "mag_x_ut"] = value
     # without the screen the spike inflates the noise estimate until nothing is significant (issue 18)
@@ -49,8 +60,7 @@ def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_
     res = loop("magnetometer", spiked, [])
     assert [(o["row"], o["column"]) for o in res.outliers] == [(row + 1, "mag_x_ut")]
     assert res.outliers[0]["residual"] == pytest.approx(value - trial05.loc[row, "mag_x_ut"], rel=0.01, abs=2.0)
-    without = loop("magnetometer", trial05.drop(index=row), [])      # the clean file without that row
-    clean = loop("magnetometer", trial05, [])
+    without, clean = trial05_clean_loops          # the clean file without that row; the clean file
     assert steps(res) == steps(without) == steps(clean)
     assert res.final.rms == pytest.approx(without.final.rms, rel=1e-9)
     assert res.final.rms == pytest.approx(clean.final.rms, rel=0.01)
