@@ -27,7 +27,7 @@ input) is not retried: it reaches the caller as raised.
 
 Progress: a tqdm bar on stderr for studies that run longer than :data:`PROGRESS_DELAY_S`, only when stderr
 is a terminal (never in a notebook's stored outputs) unless ``NAVLIB_PROGRESS=1`` asks for it (``0``
-turns it off everywhere).
+turns it off everywhere); no bar, and no error, when tqdm is not installed (it is not a core dependency).
 """
 from __future__ import annotations
 
@@ -263,7 +263,7 @@ def _show_progress(progress: bool | None) -> bool:
 
 
 def _bar(total: int, label: str, show: bool):
-    if not show:
+    if not show or importlib.util.find_spec("tqdm") is None:     # tqdm is not a core dependency: no bar
         return None
     from tqdm.auto import tqdm
     return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,

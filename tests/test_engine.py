@@ -91,6 +91,16 @@ def test_one_worker_runs_here_and_bad_settings_are_named():
             engine.run(_pid, [(0,)], scheduler=bad)
 
 
+def test_without_tqdm_a_forced_progress_bar_is_quietly_left_out(monkeypatch):
+    """tqdm is not a core dependency: ``NAVLIB_PROGRESS=1`` in a plain install must not stop a study."""
+    monkeypatch.setitem(sys.modules, "tqdm", None)                       # import tqdm fails, find_spec is None
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    monkeypatch.setenv(engine.ENV_PROGRESS, "1")
+    assert engine._show_progress(None)
+    assert engine.run(np.sqrt, [(float(k),) for k in range(5)], workers=1) == [np.sqrt(float(k)) for k in range(5)]
+    assert engine.run_batches(_pid, [(k,) for k in range(5)], 2, workers=1) == [os.getpid()] * 5
+
+
 def _raise_input_error(k):
     if k == 3:
         raise InputError("parameter k=3: refused")
