@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import atexit
 import importlib
-import importlib.util
 import logging
 import os
 import re
@@ -44,6 +43,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
 
 from .__main__ import ONE_THREAD
+from ._optional import installed, need
 from .errors import InputError, check_param
 
 #: Environment variable holding a scheduler address (``tcp://host:port``) every study sends its tasks to.
@@ -97,7 +97,7 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
 
 def dask_available() -> bool:
     """True when dask.distributed can be imported (``pip install navlib[dist]``)."""
-    return importlib.util.find_spec("distributed") is not None
+    return installed("distributed")
 
 
 def default_workers() -> int:
@@ -112,9 +112,7 @@ def default_workers() -> int:
 
 
 def _need_dask(why: str):
-    if not dask_available():
-        raise InputError(f"{why} needs dask.distributed, which is not installed: pip install 'navlib[dist]' "
-                         f"(or run with workers=1)")
+    need("distributed", why, alternative="run with workers=1")
 
 
 def _one_thread() -> None:
@@ -263,7 +261,7 @@ def _show_progress(progress: bool | None) -> bool:
 
 
 def _bar(total: int, label: str, show: bool):
-    if not show or importlib.util.find_spec("tqdm") is None:     # tqdm is not a core dependency: no bar
+    if not show or not installed("tqdm"):            # tqdm is not a core dependency: no bar
         return None
     from tqdm.auto import tqdm
     return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,

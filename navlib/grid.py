@@ -41,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from . import engine
+from ._optional import require
 from .errors import InputError
 from .report import RESULTS_ENV
 
@@ -190,12 +191,7 @@ def check_out_dir(out: str | os.PathLike) -> Path:
 
 
 def _papermill():
-    try:
-        import papermill
-    except ImportError:
-        raise InputError("grid needs papermill (the book's tooling), which is not installed: "
-                         "pip install 'navlib[book]' (or pip install papermill ipykernel)") from None
-    return papermill
+    return require("papermill", "grid", alternative="pip install papermill ipykernel")
 
 
 @contextlib.contextmanager

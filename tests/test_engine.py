@@ -101,6 +101,26 @@ def test_without_tqdm_a_forced_progress_bar_is_quietly_left_out(monkeypatch):
     assert engine.run_batches(_pid, [(k,) for k in range(5)], 2, workers=1) == [os.getpid()] * 5
 
 
+def test_a_missing_optional_package_is_one_line_naming_the_extra(monkeypatch):
+    """dask.distributed, papermill and torch: one message, an InputError (and a ModuleNotFoundError)."""
+    from navlib import _optional, grid
+    for module in ("distributed", "papermill", "torch"):
+        monkeypatch.setitem(sys.modules, module, None)
+    with pytest.raises(InputError) as err:
+        engine.start(workers=3)                                          # checked before any cluster starts
+    assert str(err.value) == ("workers=3 needs distributed, which is not installed: pip install 'navlib[dist]' "
+                              "(or run with workers=1)")
+    assert not engine.dask_available() and engine.default_workers() == 1
+    with pytest.raises(InputError) as err:
+        grid._papermill()
+    assert str(err.value) == ("grid needs papermill, which is not installed: pip install 'navlib[book]' "
+                              "(or pip install papermill ipykernel)")
+    with pytest.raises(ModuleNotFoundError) as err:
+        _optional.require("torch", "navlib.methods.mlp")
+    assert isinstance(err.value, InputError) and err.value.name == "torch"
+    assert str(err.value) == "navlib.methods.mlp needs torch, which is not installed: pip install 'navlib[nets]'"
+
+
 def _raise_input_error(k):
     if k == 3:
         raise InputError("parameter k=3: refused")
