@@ -137,6 +137,11 @@ def _worker_plugin():
     return OneThread()
 
 
+def _key(workers: int, addr: str | None) -> tuple:
+    """The cache key of a client: ``("remote", address)``, or ``("local", workers)`` without an address."""
+    return ("remote", addr) if addr else ("local", int(workers))
+
+
 def client(workers: int = 1, scheduler: str | None = None):
     """The ``dask.distributed.Client`` tasks go to, or None when they run in this process (``workers=1``
     and no scheduler address).  Clients and local clusters are made once per process and reused (a
@@ -145,7 +150,7 @@ def client(workers: int = 1, scheduler: str | None = None):
     addr = scheduler_address(scheduler)
     if addr is None and int(workers) == 1:
         return None
-    key = ("remote", addr) if addr else ("local", int(workers))
+    key = _key(workers, addr)
     starting = _STARTING.pop(key, None)
     if starting is not None:
         starting.result()                        # raises what the start raised
@@ -227,7 +232,7 @@ def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str]
     if addr is None and int(workers) == 1:
         return
     _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
-    key = ("remote", addr) if addr else ("local", int(workers))
+    key = _key(workers, addr)
     if key in _STARTING or (key in _CLIENTS and _CLIENTS[key].status == "running"):
         return
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="navlib-engine-start")
@@ -239,7 +244,7 @@ def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str]
 
 def _start(workers: int, addr: str | None, preload: tuple) -> None:
     with _LOCK:
-        key = ("remote", addr) if addr else ("local", workers)
+        key = _key(workers, addr)
         c = _CLIENTS.get(key)
         if c is None or c.status != "running":
             c = _new_client(key, addr, workers)
@@ -274,8 +279,7 @@ def _call(fn: Callable, args: tuple):
 
 
 def _batch(fn: Callable, batch: list) -> list:
-    _one_thread()
-    return [fn(*a) for a in batch]
+    return [fn(*a) for a in batch]                # a task of run(): _call has set the threads
 
 
 def run(fn: Callable, tasks: Iterable[tuple], *, workers: int = 1, scheduler: str | None = None,
