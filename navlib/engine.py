@@ -54,7 +54,10 @@ ENV_PROGRESS = "NAVLIB_PROGRESS"
 PROGRESS_DELAY_S = 3.0
 #: How many worker deaths a task may see before the scheduler gives up on it (dask's ``allowed-failures``).
 ALLOWED_FAILURES = 3
-#: Environment of every local worker process: one thread for every numerical library.
+#: Environment of every local worker process: one thread for every numerical library.  Set by the nannies
+#: before they spawn a worker (``distributed.nanny.pre-spawn-environ`` in :data:`LOCAL_CONFIG`), so BLAS and
+#: OpenMP read it when they load; a value the caller's environment already has wins (dask's rule, as in
+#: ``python -m navlib``).
 WORKER_ENV = dict(ONE_THREAD)
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
 #: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
@@ -178,8 +181,7 @@ def _new_client(key, addr, workers):
         with dask.config.set(LOCAL_CONFIG):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR,
-                                   scheduler_kwargs={"dashboard_address": ":0"},   # no dashboard; no fixed port
-                                   env=dict(WORKER_ENV))
+                                   scheduler_kwargs={"dashboard_address": ":0"})   # no dashboard; no fixed port
         _CLUSTERS[key] = cluster
         c = Client(cluster, set_as_default=False)
     c.register_plugin(_worker_plugin(), name="navlib-one-thread")

@@ -5,6 +5,7 @@ processes and on a cluster started here as separate ``dask scheduler`` and ``das
 127.0.0.1; a worker killed in the middle of a study is replaced and the study completes with the same
 numbers; every trial of every study has its own seed.
 """
+import ast
 import json
 import os
 import signal
@@ -119,6 +120,45 @@ def test_a_missing_optional_package_is_one_line_naming_the_extra(monkeypatch):
         _optional.require("torch", "navlib.methods.mlp")
     assert isinstance(err.value, InputError) and err.value.name == "torch"
     assert str(err.value) == "navlib.methods.mlp needs torch, which is not installed: pip install 'navlib[nets]'"
+
+
+BLAS_PROBE = """
+import ctypes, os, sys
+from navlib import engine
+
+def threads():
+    import numpy  # noqa: F401  (loads OpenBLAS, as any task does)
+    libs = sorted({ln.split()[-1] for ln in open("/proc/self/maps") if "openblas" in ln.lower() and ".so" in ln})
+    n = None
+    for path in libs:
+        lib = ctypes.CDLL(path)
+        f = next((getattr(lib, s) for s in ("scipy_openblas_get_num_threads64_", "openblas_get_num_threads64_",
+                                            "openblas_get_num_threads") if hasattr(lib, s)), None)
+        n = int(f()) if f is not None else n
+    with open("/proc/self/environ", "rb") as f:          # the environment the process started with
+        start = dict(v.decode().partition("=")[::2] for v in f.read().split(b"\\0") if v)
+    return os.getpid(), {k: start.get(k) for k in engine.WORKER_ENV}, n
+
+if __name__ == "__main__":
+    print((os.getpid(), engine.run(threads, [()] * 4, workers=2, progress=False)))
+"""
+
+
+def test_local_workers_start_with_one_blas_thread(tmp_path):
+    """The one-thread variables reach a local worker before numpy loads in it: they are in the environment
+    its process started with (the nannies' pre-spawn environment), so a caller whose environment sets none
+    of them gets workers whose OpenBLAS runs one thread."""
+    script = tmp_path / "probe.py"
+    script.write_text(BLAS_PROBE)
+    env = {k: v for k, v in os.environ.items() if k not in engine.WORKER_ENV and k != engine.ENV_SCHEDULER}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    main, rows = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+    assert main not in {r[0] for r in rows}                                # ran in the workers
+    assert all(r[1] == engine.WORKER_ENV for r in rows), rows
+    if rows[0][2] is not None:                                           # OpenBLAS's own count, where it says
+        assert {r[2] for r in rows} == {1}, rows
 
 
 def _raise_input_error(k):
