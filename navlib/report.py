@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from . import verdicts
+from .data.tables import write_new
 from .errors import InputError
 
 #: The environment variable that says where results files go (the book's build sets it to its own folder).
@@ -489,11 +490,9 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     except OSError as err:
         raise InputError(f"{d}: cannot create the results folder ({err.strerror})") from None
     try:
-        with open(path, "w" if overwrite else "x", encoding="utf-8") as fh:   # "x": never over a file
-            fh.write(text)
-    except FileExistsError:
-        raise InputError(f"{path}: a results file is already there (an earlier run's); remove it, write "
-                         f"elsewhere (folder=... or ${RESULTS_ENV}) or pass overwrite=True") from None
+        write_new(path, lambda fh: fh.write(text), overwrite=overwrite,
+                  exists=f"a results file is already there (an earlier run's); remove it, write elsewhere "
+                         f"(folder=... or ${RESULTS_ENV}) or pass overwrite=True")
     except OSError as err:
         raise InputError(f"{path}: cannot write the results file ({err.strerror})") from None
     return _WrittenPath(path)
