@@ -51,9 +51,11 @@ _CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflo
 
 
 def results_dir() -> Path:
-    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if set (``make book`` and ``make test`` set it,
-    so the build's files land in ``book/_generated/results``), else ``results/`` in the current directory
-    (library use; never inside the installed package)."""
+    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if it is set and not empty, else ``results/``
+    in the current directory (library use; never a folder of the installed package).  ``make test``
+    sets the variable to ``book/_generated/results``; ``python -m navlib.booktools execute`` (``make book``,
+    ``make notebooks``) sets it to a temporary folder for each notebook and copies the files written there
+    to ``book/_generated/results`` (or ``notebooks/results``)."""
     env = os.environ.get(RESULTS_ENV)
     return Path(env) if env else Path.cwd() / "results"
 
