@@ -48,7 +48,7 @@ from pathlib import Path
 
 from . import verdicts
 from .errors import InputError
-from .report import claims_summary, read_results
+from .report import RESULTS_ENV, claims_summary, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
@@ -114,11 +114,11 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
         target.parent.mkdir(parents=True, exist_ok=True)
         print(f"[{i}/{len(notebooks)}] executing {nb_path.name} -> {target}", flush=True)
         t0 = time.perf_counter()
-        old_env = os.environ.get("NAVBOOK_RESULTS_DIR")
+        old_env = os.environ.get(RESULTS_ENV)
         with tempfile.TemporaryDirectory() as tmp:
             tmp_out = Path(tmp) / nb_path.name
             tmp_results = Path(tmp) / "results"
-            os.environ["NAVBOOK_RESULTS_DIR"] = str(tmp_results)   # the kernel inherits the environment
+            os.environ[RESULTS_ENV] = str(tmp_results)   # the kernel inherits the environment
             try:
                 pm.execute_notebook(str(nb_path), str(tmp_out), cwd=str(nb_path.parent),
                                     parameters=parameters or {}, kernel_name="python3",
@@ -130,9 +130,9 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
                 return 1
             finally:
                 if old_env is None:
-                    os.environ.pop("NAVBOOK_RESULTS_DIR", None)
+                    os.environ.pop(RESULTS_ENV, None)
                 else:
-                    os.environ["NAVBOOK_RESULTS_DIR"] = old_env
+                    os.environ[RESULTS_ENV] = old_env
             nb = nbformat.read(tmp_out, as_version=4)
             missing = missing_figures(nb)
             if missing:

@@ -27,13 +27,12 @@ input) is not retried: it reaches the caller as raised.
 
 Progress: a tqdm bar on stderr for studies that run longer than :data:`PROGRESS_DELAY_S`, only when stderr
 is a terminal (never in a notebook's stored outputs) unless ``NAVLIB_PROGRESS=1`` asks for it (``0``
-turns it off everywhere).
+turns it off everywhere); no bar, and no error, when tqdm is not installed (it is not a core dependency).
 """
 from __future__ import annotations
 
 import atexit
 import importlib
-import importlib.util
 import logging
 import os
 import re
@@ -44,6 +43,7 @@ from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
 
 from .__main__ import ONE_THREAD
+from ._optional import installed, need
 from .errors import InputError, check_param
 
 #: Environment variable holding a scheduler address (``tcp://host:port``) every study sends its tasks to.
@@ -54,7 +54,10 @@ ENV_PROGRESS = "NAVLIB_PROGRESS"
 PROGRESS_DELAY_S = 3.0
 #: How many worker deaths a task may see before the scheduler gives up on it (dask's ``allowed-failures``).
 ALLOWED_FAILURES = 3
-#: Environment of every local worker process: one thread for every numerical library.
+#: Environment of every local worker process: one thread for every numerical library.  Set by the nannies
+#: before they spawn a worker (``distributed.nanny.pre-spawn-environ`` in :data:`LOCAL_CONFIG`), so BLAS and
+#: OpenMP read it when they load; a value the caller's environment already has wins (dask's rule, as in
+#: ``python -m navlib``).
 WORKER_ENV = dict(ONE_THREAD)
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
 #: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
@@ -97,7 +100,7 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
 
 def dask_available() -> bool:
     """True when dask.distributed can be imported (``pip install navlib[dist]``)."""
-    return importlib.util.find_spec("distributed") is not None
+    return installed("distributed")
 
 
 def default_workers() -> int:
@@ -112,9 +115,7 @@ def default_workers() -> int:
 
 
 def _need_dask(why: str):
-    if not dask_available():
-        raise InputError(f"{why} needs dask.distributed, which is not installed: pip install 'navlib[dist]' "
-                         f"(or run with workers=1)")
+    need("distributed", why, alternative="run with workers=1")
 
 
 def _one_thread() -> None:
@@ -139,6 +140,11 @@ def _worker_plugin():
     return OneThread()
 
 
+def _key(workers: int, addr: str | None) -> tuple:
+    """The cache key of a client: ``("remote", address)``, or ``("local", workers)`` without an address."""
+    return ("remote", addr) if addr else ("local", int(workers))
+
+
 def client(workers: int = 1, scheduler: str | None = None):
     """The ``dask.distributed.Client`` tasks go to, or None when they run in this process (``workers=1``
     and no scheduler address).  Clients and local clusters are made once per process and reused (a
@@ -147,7 +153,7 @@ def client(workers: int = 1, scheduler: str | None = None):
     addr = scheduler_address(scheduler)
     if addr is None and int(workers) == 1:
         return None
-    key = ("remote", addr) if addr else ("local", int(workers))
+    key = _key(workers, addr)
     starting = _STARTING.pop(key, None)
     if starting is not None:
         starting.result()                        # raises what the start raised
@@ -175,8 +181,7 @@ def _new_client(key, addr, workers):
         with dask.config.set(LOCAL_CONFIG):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR,
-                                   scheduler_kwargs={"dashboard_address": ":0"},   # no dashboard; no fixed port
-                                   env=dict(WORKER_ENV))
+                                   scheduler_kwargs={"dashboard_address": ":0"})   # no dashboard; no fixed port
         _CLUSTERS[key] = cluster
         c = Client(cluster, set_as_default=False)
     c.register_plugin(_worker_plugin(), name="navlib-one-thread")
@@ -229,7 +234,7 @@ def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str]
     if addr is None and int(workers) == 1:
         return
     _need_dask(f"scheduler {addr}" if addr else f"workers={workers}")
-    key = ("remote", addr) if addr else ("local", int(workers))
+    key = _key(workers, addr)
     if key in _STARTING or (key in _CLIENTS and _CLIENTS[key].status == "running"):
         return
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="navlib-engine-start")
@@ -241,7 +246,7 @@ def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str]
 
 def _start(workers: int, addr: str | None, preload: tuple) -> None:
     with _LOCK:
-        key = ("remote", addr) if addr else ("local", workers)
+        key = _key(workers, addr)
         c = _CLIENTS.get(key)
         if c is None or c.status != "running":
             c = _new_client(key, addr, workers)
@@ -263,7 +268,7 @@ def _show_progress(progress: bool | None) -> bool:
 
 
 def _bar(total: int, label: str, show: bool):
-    if not show:
+    if not show or not installed("tqdm"):            # tqdm is not a core dependency: no bar
         return None
     from tqdm.auto import tqdm
     return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,
@@ -276,8 +281,7 @@ def _call(fn: Callable, args: tuple):
 
 
 def _batch(fn: Callable, batch: list) -> list:
-    _one_thread()
-    return [fn(*a) for a in batch]
+    return [fn(*a) for a in batch]                # a task of run(): _call has set the threads
 
 
 def run(fn: Callable, tasks: Iterable[tuple], *, workers: int = 1, scheduler: str | None = None,

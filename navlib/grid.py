@@ -41,7 +41,9 @@ from pathlib import Path
 from typing import Any
 
 from . import engine
+from ._optional import require
 from .errors import InputError
+from .report import RESULTS_ENV
 
 #: Parameters a grid sets in every run unless the user sets them (notebooks that have them).
 RUN_DEFAULTS = {"n_workers": 1}
@@ -189,12 +191,7 @@ def check_out_dir(out: str | os.PathLike) -> Path:
 
 
 def _papermill():
-    try:
-        import papermill
-    except ImportError:
-        raise InputError("grid needs papermill (the book's tooling), which is not installed: "
-                         "pip install 'navlib[book]' (or pip install papermill ipykernel)") from None
-    return papermill
+    return require("papermill", "grid", alternative="pip install papermill ipykernel")
 
 
 @contextlib.contextmanager
@@ -220,12 +217,12 @@ def run_point(notebook_json: str, name: str, parameters: dict, cwd: str) -> dict
     None, "seconds": wall time}``; a failing run is reported, not raised."""
     pm = _papermill()
     t0 = time.perf_counter()
-    saved = {k: os.environ.get(k) for k in ("NAVBOOK_RESULTS_DIR", engine.ENV_SCHEDULER, engine.ENV_PROGRESS)}
+    saved = {k: os.environ.get(k) for k in (RESULTS_ENV, engine.ENV_SCHEDULER, engine.ENV_PROGRESS)}
     with tempfile.TemporaryDirectory(prefix="navlib-grid-") as tmp:
         src, dst, res = Path(tmp) / f"{name}_in.ipynb", Path(tmp) / f"{name}.ipynb", Path(tmp) / "results"
         src.write_text(notebook_json, encoding="utf-8")
         error = None
-        os.environ["NAVBOOK_RESULTS_DIR"] = str(res)            # the kernel inherits the environment
+        os.environ[RESULTS_ENV] = str(res)            # the kernel inherits the environment
         os.environ.pop(engine.ENV_SCHEDULER, None)
         os.environ[engine.ENV_PROGRESS] = "0"
         quiet = logging.getLogger("papermill")

@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from . import verdicts
+from .data.tables import write_new
 from .errors import InputError
 
 #: The environment variable that says where results files go (the book's build sets it to its own folder).
@@ -50,9 +51,11 @@ _CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflo
 
 
 def results_dir() -> Path:
-    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if set (``make book`` and ``make test`` set it,
-    so the build's files land in ``book/_generated/results``), else ``results/`` in the current directory
-    (library use; never inside the installed package)."""
+    """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if it is set and not empty, else ``results/``
+    in the current directory (library use; never a folder of the installed package).  ``make test``
+    sets the variable to ``book/_generated/results``; ``python -m navlib.booktools execute`` (``make book``,
+    ``make notebooks``) sets it to a temporary folder for each notebook and copies the files written there
+    to ``book/_generated/results`` (or ``notebooks/results``)."""
     env = os.environ.get(RESULTS_ENV)
     return Path(env) if env else Path.cwd() / "results"
 
@@ -489,11 +492,9 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     except OSError as err:
         raise InputError(f"{d}: cannot create the results folder ({err.strerror})") from None
     try:
-        with open(path, "w" if overwrite else "x", encoding="utf-8") as fh:   # "x": never over a file
-            fh.write(text)
-    except FileExistsError:
-        raise InputError(f"{path}: a results file is already there (an earlier run's); remove it, write "
-                         f"elsewhere (folder=... or ${RESULTS_ENV}) or pass overwrite=True") from None
+        write_new(path, lambda fh: fh.write(text), overwrite=overwrite,
+                  exists=f"a results file is already there (an earlier run's); remove it, write elsewhere "
+                         f"(folder=... or ${RESULTS_ENV}) or pass overwrite=True")
     except OSError as err:
         raise InputError(f"{path}: cannot write the results file ({err.strerror})") from None
     return _WrittenPath(path)

@@ -125,6 +125,25 @@ def test_write_never_overwrites(tmp_path, good):
     assert p.read_bytes() == before
 
 
+def test_csv_and_results_writers_share_one_overwrite_rule(tmp_path, good):
+    """write_new_csv and report.write_results both create their file through tables.write_new: an existing
+    path, even a symbolic link to a file not there yet, is refused with each writer's own one line."""
+    from navlib import report, verdicts
+    claim = report.Claim("c", "p", statistic="x, deg", estimate=verdicts.exact(0.5), boundary=1.0,
+                         holds_when="below")
+    for name, call, says in [
+            ("s.csv", lambda f: write_new_csv(good, f), "already exists; not overwritten"),
+            ("demo.json", lambda f: report.write_results("demo", claims=[claim], folder=f.parent),
+             "a results file is already there")]:
+        link, target = tmp_path / name, tmp_path / f"target_of_{name}"
+        link.symlink_to(target)                                       # dangling: target does not exist
+        with pytest.raises(InputError, match=says) as err:
+            call(link)
+        assert str(err.value).startswith(str(link)) and not target.exists()
+        link.unlink()
+        assert call(link) == link and link.stat().st_size > 0         # a new file is written
+
+
 @pytest.mark.parametrize("make,name", [
     (lambda: StudyParams(de=DEParams(pop_size=3)), "NP"), (lambda: DEParams(f=0), "F"),
     (lambda: DEParams(f=2.1), "F"), (lambda: DEParams(f_max=3), "F"), (lambda: DEParams(cr=-0.1), "CR"),

@@ -1,4 +1,6 @@
 import json
+import os
+from pathlib import Path
 
 import nbformat
 import pytest
@@ -242,27 +244,32 @@ def test_check_results_fails_for_a_notebook_that_writes_no_results(tmp_path, cap
 
 
 def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, monkeypatch):
+    """The kernel writes its results file where execute tells it (a temporary folder in
+    $NAVBOOK_RESULTS_DIR, not a library default such as the notebook folder's ./results or the book's
+    folder); execute copies it beside the notebook and restores the caller's environment."""
     from navlib.booktools import execute
+    from navlib.report import RESULTS_ENV
 
-    cwd = tmp_path / "elsewhere"
-    cwd.mkdir()
-    monkeypatch.chdir(cwd)                     # the library default (./results) must not be written either
-    monkeypatch.delenv("NAVBOOK_RESULTS_DIR", raising=False)
-
+    monkeypatch.delenv(RESULTS_ENV, raising=False)
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell(
+        "import os\n"
         "from navlib import report\n"
         "from navlib import verdicts\n"
-        "report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
-        "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])"))
+        "p = report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
+        "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])\n"
+        f"print(os.environ.get({RESULTS_ENV!r}))\n"
+        "print(p.resolve())"))
     path = tmp_path / "demo.ipynb"
     nbformat.write(nb, path)
     assert execute([path], None, in_place=True) == 0
     stored = json.loads((tmp_path / "results" / "demo_chapter.json").read_text())
     assert stored["claims"][0]["reproduced"] is True
-    from navlib.paths import ROOT
-    assert not (ROOT / "book" / "_generated" / "results" / "demo_chapter.json").exists()  # the book's folder
-    assert not (cwd / "results").exists()                                                 # nor ./results
+    told, wrote = nbformat.read(path, as_version=4).cells[0].outputs[0]["text"].split()
+    assert told != "None" and Path(wrote) == Path(told).resolve() / "demo_chapter.json"   # where it was told
+    assert Path(told).resolve() != (tmp_path / "results").resolve()                       # not its ./results
+    assert not Path(told).exists()                                                        # a temporary folder
+    assert RESULTS_ENV not in os.environ                                                  # restored
 
 
 def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):

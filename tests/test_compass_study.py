@@ -303,6 +303,10 @@ def test_prepare_patent_data_bad_input(frames):
         prepare_patent_data(train, window=4)
     with pytest.raises(InputError, match="unknown preparation"):
         glitch_run(train, test, "magic")
+    for call in (lambda: glitch_run(train, test, "no preparation", method="ls8"),
+                 lambda: glitch_study(train, test, seeds=(), method="ls8")):    # refused before any run
+        with pytest.raises(InputError, match="glitch study method 'ls8': one of elm, elm_backtuned"):
+            call()
 
 
 def test_glitch_study_preparation_helps():

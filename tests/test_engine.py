@@ -5,6 +5,7 @@ processes and on a cluster started here as separate ``dask scheduler`` and ``das
 127.0.0.1; a worker killed in the middle of a study is replaced and the study completes with the same
 numbers; every trial of every study has its own seed.
 """
+import ast
 import json
 import os
 import signal
@@ -89,6 +90,75 @@ def test_one_worker_runs_here_and_bad_settings_are_named():
     for bad in ("not an address", "tcp://127.0.0.1", "http://x:1 y"):
         with pytest.raises(InputError, match="scheduler"):
             engine.run(_pid, [(0,)], scheduler=bad)
+
+
+def test_without_tqdm_a_forced_progress_bar_is_quietly_left_out(monkeypatch):
+    """tqdm is not a core dependency: ``NAVLIB_PROGRESS=1`` in a plain install must not stop a study."""
+    monkeypatch.setitem(sys.modules, "tqdm", None)                       # import tqdm fails, find_spec is None
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    monkeypatch.setenv(engine.ENV_PROGRESS, "1")
+    assert engine._show_progress(None)
+    assert engine.run(np.sqrt, [(float(k),) for k in range(5)], workers=1) == [np.sqrt(float(k)) for k in range(5)]
+    assert engine.run_batches(_pid, [(k,) for k in range(5)], 2, workers=1) == [os.getpid()] * 5
+
+
+def test_a_missing_optional_package_is_one_line_naming_the_extra(monkeypatch):
+    """dask.distributed, papermill and torch: one message, an InputError (and a ModuleNotFoundError)."""
+    from navlib import _optional, grid
+    for module in ("distributed", "papermill", "torch"):
+        monkeypatch.setitem(sys.modules, module, None)
+    with pytest.raises(InputError) as err:
+        engine.start(workers=3)                                          # checked before any cluster starts
+    assert str(err.value) == ("workers=3 needs distributed, which is not installed: pip install 'navlib[dist]' "
+                              "(or run with workers=1)")
+    assert not engine.dask_available() and engine.default_workers() == 1
+    with pytest.raises(InputError) as err:
+        grid._papermill()
+    assert str(err.value) == ("grid needs papermill, which is not installed: pip install 'navlib[book]' "
+                              "(or pip install papermill ipykernel)")
+    with pytest.raises(ModuleNotFoundError) as err:
+        _optional.require("torch", "navlib.methods.mlp")
+    assert isinstance(err.value, InputError) and err.value.name == "torch"
+    assert str(err.value) == "navlib.methods.mlp needs torch, which is not installed: pip install 'navlib[nets]'"
+
+
+BLAS_PROBE = """
+import ctypes, os, sys
+from navlib import engine
+
+def threads():
+    import numpy  # noqa: F401  (loads OpenBLAS, as any task does)
+    libs = sorted({ln.split()[-1] for ln in open("/proc/self/maps") if "openblas" in ln.lower() and ".so" in ln})
+    n = None
+    for path in libs:
+        lib = ctypes.CDLL(path)
+        f = next((getattr(lib, s) for s in ("scipy_openblas_get_num_threads64_", "openblas_get_num_threads64_",
+                                            "openblas_get_num_threads") if hasattr(lib, s)), None)
+        n = int(f()) if f is not None else n
+    with open("/proc/self/environ", "rb") as f:          # the environment the process started with
+        start = dict(v.decode().partition("=")[::2] for v in f.read().split(b"\\0") if v)
+    return os.getpid(), {k: start.get(k) for k in engine.WORKER_ENV}, n
+
+if __name__ == "__main__":
+    print((os.getpid(), engine.run(threads, [()] * 4, workers=2, progress=False)))
+"""
+
+
+def test_local_workers_start_with_one_blas_thread(tmp_path):
+    """The one-thread variables reach a local worker before numpy loads in it: they are in the environment
+    its process started with (the nannies' pre-spawn environment), so a caller whose environment sets none
+    of them gets workers whose OpenBLAS runs one thread."""
+    script = tmp_path / "probe.py"
+    script.write_text(BLAS_PROBE)
+    env = {k: v for k, v in os.environ.items() if k not in engine.WORKER_ENV and k != engine.ENV_SCHEDULER}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    main, rows = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+    assert main not in {r[0] for r in rows}                                # ran in the workers
+    assert all(r[1] == engine.WORKER_ENV for r in rows), rows
+    if rows[0][2] is not None:                                           # OpenBLAS's own count, where it says
+        assert {r[2] for r in rows} == {1}, rows
 
 
 def _raise_input_error(k):

@@ -26,6 +26,7 @@ import pytest
 from packaging.markers import Marker
 from packaging.requirements import Requirement
 from packaging.utils import canonicalize_name
+from packaging.version import Version
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ("pyproject.toml", "README.md", "navlib", "data")     # what the wheel is built from
@@ -266,8 +267,9 @@ def test_the_editable_install_finds_the_data_files_through_importlib_resources(t
 
 
 def test_pyproject_lower_bounds_are_the_locked_versions():
-    """Every requirement of pyproject.toml that environment.lock pins is satisfied by the pinned version;
-    the core and [nets] are pinned."""
+    """Every requirement of pyproject.toml that environment.lock pins has one lower bound (``>=``), and it is
+    the pinned version (its base: 2.13.0 for the lock's 2.13.0+cpu, 1.0.4 for 1.0.4.post1), which the whole
+    specifier admits; the core and [nets] are pinned."""
     import tomllib
 
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
@@ -284,5 +286,8 @@ def test_pyproject_lower_bounds_are_the_locked_versions():
         key = canonicalize_name(r.name)
         if key in lock:
             assert r.specifier.contains(lock[key], prereleases=True), f"{r} vs the lock's {lock[key]}"
+            lower = [s.version for s in r.specifier if s.operator == ">="]
+            assert len(lower) == 1 and Version(lower[0]) == Version(Version(lock[key]).base_version), \
+                f"{r}: the lower bound must be the lock's {lock[key]}"
         else:
             assert key not in must, f"{r.name} is not pinned in environment.lock"

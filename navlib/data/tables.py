@@ -24,6 +24,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable, TextIO
 
 import numpy as np
 import pandas as pd
@@ -266,13 +267,45 @@ def require_variation(frame: pd.DataFrame, columns, path, what: str = "the model
                                  f"needs it to vary (a stuck sensor or an unconnected channel?)")
 
 
+def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, overwrite: bool = False,
+              exists: str = "already exists; not overwritten", newline: str | None = None) -> Path:
+    """The one overwrite rule of navlib: create ``path`` (and its folder) and let ``write(fh)`` fill it,
+    never replacing an existing file unless ``overwrite`` is set; user data and earlier outputs are not
+    overwritten by accident.  The check and the creation are one step (``open(path, "x")``), so no file
+    that appears in between is replaced, nor one a symbolic link points to.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write.
+    write : callable
+        Writes the content to the open text file (UTF-8) it is given.
+    overwrite : bool
+        Replace an existing file.
+    exists : str
+        What the one-line :class:`~navlib.errors.InputError` says after the path when the file exists.
+    newline : str, optional
+        Passed to ``open`` (``""`` for a CSV writer that ends its own lines).
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        with open(p, "w" if overwrite else "x", encoding="utf-8", newline=newline) as fh:
+            write(fh)
+    except FileExistsError:
+        raise InputError(f"{p}: {exists}") from None
+    return p
+
+
 def write_new_csv(frame: pd.DataFrame, path: str | os.PathLike, *, overwrite: bool = False,
                   float_format: str = "%.10g") -> Path:
-    """Write ``frame`` to ``path`` but never replace an existing file unless ``overwrite`` is set:
-    user data and earlier outputs are not overwritten by accident."""
-    p = Path(path)
-    if p.exists() and not overwrite:
-        raise InputError(f"{p}: already exists; not overwritten (choose another name or pass overwrite)")
-    p.parent.mkdir(parents=True, exist_ok=True)
-    frame.to_csv(p, index=False, float_format=float_format)
-    return p
+    """Write ``frame`` to ``path`` but never replace an existing file unless ``overwrite`` is set
+    (:func:`write_new`): user data and earlier outputs are not overwritten by accident."""
+    return write_new(path, lambda fh: frame.to_csv(fh, index=False, float_format=float_format),
+                     overwrite=overwrite, newline="",
+                     exists="already exists; not overwritten (choose another name or pass overwrite)")

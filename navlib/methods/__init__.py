@@ -9,7 +9,7 @@
 - :mod:`navlib.methods.preprocess` -- the patent's median filter and field-gravity screen (B);
 - :mod:`navlib.methods.rbf` -- MATLAB-compatible ``newrb``/``newrbe`` RBF networks (C);
 - :mod:`navlib.methods.scaling` -- explicit min-max scaling (also MATLAB's ``mapminmax``);
-- :mod:`navlib.methods.seeding` -- the one seeding convention (``SeedSequence(base).spawn``);
+- :mod:`navlib.methods.seeding` -- the one seeding convention (``SeedSequence(base).spawn``; :mod:`navlib.seeding`);
 - :mod:`navlib.methods.arrays` -- shared input checks;
 - :mod:`navlib.methods.kalman` -- the INS/star-sensor Kalman filter, QR gain features, innovation GLR test (E);
 - :mod:`navlib.methods.subclust` -- MATLAB ``subclust``/``genfis2`` and first-order Sugeno inference (D);

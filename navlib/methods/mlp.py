@@ -27,6 +27,7 @@ import numpy as np
 
 from .._optional import require
 from ..errors import InputError, check_param
+from .seeding import as_int
 
 torch = require("torch", __name__)      # the [nets] extra
 
@@ -119,7 +120,7 @@ class MLP:
 
 def _initial_weights(p: MLPParams, seed: int) -> dict:
     if p.init == "torch":
-        torch.manual_seed(int(np.random.SeedSequence(seed).generate_state(1)[0]))
+        torch.manual_seed(as_int(np.random.SeedSequence(seed)))
         l1 = torch.nn.Linear(p.n_in, p.n_hidden, dtype=torch.float64)
         l2 = torch.nn.Linear(p.n_hidden, p.n_out, dtype=torch.float64)
         return {k: v.detach().numpy().copy() for k, v in

@@ -45,6 +45,7 @@ import pandas as pd
 
 from ..data.tables import write_new_csv
 from ..errors import InputError, check_param
+from ..seeding import child
 
 #: The paper's reference (normal operating) temperature, degC.
 T_REF_C = 55.0
@@ -178,10 +179,6 @@ def sensor_temperatures_c(exp: TumbleExperiment) -> np.ndarray:
     return out
 
 
-def _sequence(seed: int | np.random.SeedSequence) -> np.random.SeedSequence:
-    return seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-
-
 def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence,
                     unit: str = "A") -> pd.DataFrame:
     """One unit's multi-position full-temperature test: a tidy frame with ``set_point_c``, ``temperature_c``
@@ -190,7 +187,7 @@ def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | 
     ``seed`` itself when it is a ``SeedSequence``)."""
     if not str(unit).strip():
         raise InputError("parameter unit='': give the unit a name")
-    rng = np.random.default_rng(_sequence(seed))
+    rng = np.random.default_rng(child(seed))
     temps = sensor_temperatures_c(exp)
     pos = np.broadcast_to(exp.positions_deg, temps.shape)
     sp = np.broadcast_to(exp.set_points_c[:, None], temps.shape)
@@ -206,7 +203,7 @@ def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.ran
     stays in: this is what the paper's bias test measures).  Columns ``set_point_c``, ``temperature_c``,
     ``bias_mg`` (measured), ``true_bias_mg`` (the same test without noise).  ``seed``: an integer entropy
     or a ``SeedSequence``."""
-    rng = np.random.default_rng(_sequence(seed))
+    rng = np.random.default_rng(child(seed))
     temps = sensor_temperatures_c(exp)[:, 0]
     u = coef.output_mg(temps[:, None], np.array([0.0, 180.0])[None, :])
     noisy = u + 1e-3 * exp.noise_ug * rng.standard_normal(u.shape)

@@ -47,6 +47,7 @@ from scipy.optimize import minimize_scalar
 
 from ..angles import ARCSEC, DEG
 from ..errors import InputError, check_param
+from ..seeding import child, sequence
 
 DEG_H = DEG / 3600.0            # 1 deg/h in rad/s
 UG = 9.80665e-6                 # 1 micro-g in m/s^2
@@ -454,7 +455,7 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
     x_reset[3:] = 0.0                                                      # velocity and position known
     t1 = t0 + p.identify_h * 3600.0
     # the navigation stage draws its own noise: part 1 of the run's seed (SeedSequence spawn key, no arithmetic)
-    seed2 = None if seed is None else _part(seed, 1)
+    seed2 = None if seed is None else child(seed, 1)
 
     def nav(drift):
         return simulate(p.navigate_h, earth=earth, imu=replace(imu, axial_drift_deg_h=drift),
@@ -478,12 +479,6 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
     return ProcedureResult(identify_run=run1, latitude_error_12h_deg=lat12,
                            final_drift_deg_h=imu.axial_drift_deg_h, identified_drift_deg_h=est, after=after,
                            before=before, best_drift_deg_h=best, unit_response=unit)
-
-
-def _part(seed: int | np.random.SeedSequence, k: int) -> np.random.SeedSequence:
-    """Part ``k`` of a seed: the SeedSequence with the same entropy and ``k`` appended to its spawn key."""
-    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(int(seed))
-    return np.random.SeedSequence(ss.entropy, spawn_key=tuple(ss.spawn_key) + (int(k),))
 
 
 def random_test(rng: np.random.Generator, *, axial_drift_deg_h: float, gyro_bias_sd_deg_h: float = 0.002,
@@ -519,9 +514,9 @@ def simulated_tests(axial_drifts_deg_h, *, seed: int, identify: Callable[[float]
         raise InputError(f"{len(cold)} cold-start histories for {drifts.size} tests")
     out = []
     for i, d in enumerate(drifts):
-        errors = np.random.SeedSequence(int(seed), spawn_key=(i, 0))
+        errors = sequence(seed, i, 0)
         imu, init = random_test(np.random.default_rng(errors), axial_drift_deg_h=float(d), **error_sd)
         out.append(run_procedure(identify, imu=imu, initial=init, earth=earth, rotation=rotation,
                                  procedure=procedure, cold=None if cold is None else cold[i],
-                                 seed=np.random.SeedSequence(int(seed), spawn_key=(i, 1))))
+                                 seed=sequence(seed, i, 1)))
     return out

@@ -37,6 +37,7 @@ from ..methods.fish_swarm import FishSwarmParams, minimise
 from ..methods.mlp import MLPParams, train_mlp
 from ..methods.subclust import SubclustOptions, SugenoFIS, genfis2, solve_consequents, subclust
 from ..paths import data_path
+from ..seeding import sequence
 from ..sensors.accelerometer import (AccelCoefficients, TumbleExperiment, T_REF_C, bias_test, paper_units,
                                      tumble_coefficients)
 
@@ -116,7 +117,7 @@ def sim_seed(seed: int, part: str) -> np.random.SeedSequence:
     """The draw of one part (:data:`SIM_PARTS`) of seed ``seed``: ``SeedSequence(SIM_ENTROPY,
     spawn_key=(seed, part))``."""
     check_param("seed", seed, lo=0, integer=True)
-    return np.random.SeedSequence(SIM_ENTROPY, spawn_key=(int(seed), SIM_PARTS[part]))
+    return sequence(SIM_ENTROPY, seed, SIM_PARTS[part])
 
 
 def simulate(params: PaperDParams, seed: int) -> pd.DataFrame:

@@ -33,6 +33,7 @@ from ..errors import InputError, check_param
 from ..methods import kalman as km
 from ..methods.mlp import MLPParams, train_mlp
 from ..paths import data_path
+from ..seeding import as_int, sequence
 from ..sensors.strapdown import ImuSpec, InitialError, StarSensorSpec, strapdown
 from ..sensors.trajectory import FlightProfile, generate
 
@@ -177,8 +178,7 @@ def seed_of(spec: StudySpec, rep: int, part: str, *key: int) -> int:
     """The integer seed of one draw of the study: from ``SeedSequence(spec.seed, spawn_key=(rep, part,
     *key))``, ``part`` one of :data:`SEED_PARTS` (noise of the runs of a simulation kind, the manoeuvre of a
     run, the networks' start, a timing repetition).  Spawn keys, no arithmetic: no two draws share a seed."""
-    ss = np.random.SeedSequence(int(spec.seed), spawn_key=(int(rep), SEED_PARTS[part]) + tuple(int(k) for k in key))
-    return int(ss.generate_state(1)[0])
+    return as_int(sequence(spec.seed, rep, SEED_PARTS[part], *key))
 
 
 def _paired_timings(spec: StudySpec, f_train) -> list[dict]:

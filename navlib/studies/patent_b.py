@@ -148,6 +148,12 @@ GLITCH_VARIANTS = {
 }
 
 
+def _check_elm(method: str) -> None:
+    """The glitch study trains ELMs only: refuse any other method (one message for the study and a run)."""
+    if method_id(method) not in ELM_METHODS:
+        raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
+
+
 def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: StudyParams = StudyParams(),
                seed: int = 0, *, method: str = "elm_backtuned", window: int = 3, threshold: float = 4.0,
                frac: float = 0.9):
@@ -159,8 +165,7 @@ def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: St
     part)."""
     if variant not in GLITCH_VARIANTS:
         raise InputError(f"unknown preparation {variant!r}; known: {', '.join(GLITCH_VARIANTS)}")
-    if method_id(method) not in ELM_METHODS:
-        raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
+    _check_elm(method)
     d = prepare_patent_data(train, window=window, threshold=threshold, frac=frac,
                             rng=generators([seed], base=1)[0], **GLITCH_VARIANTS[variant])
     tr, ck = d.train_idx, d.test_idx
@@ -185,8 +190,7 @@ def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = 
     held-out part of the training sweep), ``n_rejected``, ``glitches_rejected`` (rejected readings that
     were glitches, from the training sweep's ``glitch`` column), ``n_nodes``.  The runs are tasks of
     :mod:`navlib.engine` (``workers``, ``scheduler``; every run has its own seeds)."""
-    if method_id(method) not in ELM_METHODS:
-        raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
+    _check_elm(method)
     items = [(train, test, variant, params, int(seed), method, window, threshold, frac)
              for variant in GLITCH_VARIANTS for seed in seeds]
     return pd.DataFrame(engine.run_batches(_glitch_row, items, GLITCH_BATCH, workers=workers, scheduler=scheduler,

@@ -67,6 +67,7 @@ from scipy import stats
 
 from ..errors import check_param
 from ..errors import InputError
+from ..seeding import child
 from .effects import testable
 from .fit import Fit, drift_design, orth_basis
 from .screen import Screening, screen as screen_data
@@ -398,7 +399,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     B = bootstrap_replicates(alpha)
     K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))     # >= 2: B >= 2.5 / alpha - 1
     family = _Family(fit, fits)
-    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(_BOOTSTRAP_KEY,)))
+    rng = np.random.default_rng(child(seed, _BOOTSTRAP_KEY))
     ser = noise.series
     bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order)   # with the basis-only blocks
     U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once

@@ -211,6 +211,7 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     folder = Path(folder)
     png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    import matplotlib.pyplot as plt                 # loop_figure made the figure through pyplot: release it
     fig = loop_figure(result)
     fig.savefig(png, dpi=110)
     import matplotlib.pyplot as plt                 # loop_figure made the figure with it
