@@ -214,7 +214,6 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     import matplotlib.pyplot as plt                 # loop_figure made the figure through pyplot: release it
     fig = loop_figure(result)
     fig.savefig(png, dpi=110)
-    import matplotlib.pyplot as plt                 # loop_figure made the figure with it
     plt.close(fig)
     unit = result.final.unit
     lines = [f"# Workbench loop: {result.final.system}" + (f" on `{source}`" if source else ""), "",
