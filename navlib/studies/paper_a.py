@@ -30,7 +30,7 @@ import pandas as pd
 from ..angles import wrap_deg
 from ..data.compass_sweeps import unwrap_measured
 from ..errors import InputError, check_choice, check_param
-from ..methods.bpnet import (AdamParams, train_adam_many, train_de_many, train_hybrid_many,
+from ..methods.bpnet import (AdamParams, train_adam_many, train_de_family, train_de_many, train_hybrid_many,
                              train_least_squares, train_matlab_bp_many)
 from ..methods.compensator import (HeadingTarget, MethodBase, ModelCompensator, NetworkCompensator,
                                    ScaledRegressor)
@@ -153,11 +153,23 @@ class _Uncompensated(MethodBase):
         return ModelCompensator(None)
 
 
-class _Smith8(MethodBase):
+@dataclass
+class _Eight(MethodBase):
+    """Paper A's 8-position least squares (readings at 0, 45, ..., 315 deg true heading) under one model:
+    ``'smith'`` (Smith's A..E, 5 terms), ``'harmonic3'`` (the harmonic series to 3rd order, 7 terms) or
+    ``'planar'`` (the exact 5-parameter hard/soft-iron model of :mod:`navlib.sensors.planar`)."""
+
+    model: str = "smith"
+
     def fit(self, measured_deg, reference_deg, rng=None):
         m, t = np.asarray(measured_deg, float), np.asarray(reference_deg, float)
         idx = eight_position_indices(t)
-        return ModelCompensator(fit_smith(np.mod(m[idx], 360.0), t[idx]))
+        if self.model == "planar":
+            return ModelCompensator(fit_planar_model(t[idx], np.mod(m[idx], 360.0)))
+        return ModelCompensator(fit_smith(np.mod(m[idx], 360.0), t[idx], 3 if self.model == "harmonic3" else 2))
+
+
+_Smith8 = _Eight
 
 
 class _Planar(MethodBase):
@@ -211,15 +223,25 @@ class MethodSpec:
     stochastic: bool
     paper_row: str | None = None
     reading: str = ""
+    family: tuple | None = None     # ((adaptive, f_rule, cr_rule), variant): runs sharing one full DE stage
 
 
-def _de(p: StudyParams, adaptive: bool) -> DEParams:
-    return replace(p.de, adaptive=adaptive)
+#: ADE's default rules (:class:`navlib.methods.de.DEParams`) and the other readings of section 1.2, as
+#: (f_rule, cr_rule, id suffix, label part).
+ADE_DEFAULT_RULES = ("generation", "value")
+ADE_RULE_READINGS = (("individual", "value", "f_ind", "F per individual"),
+                     ("combined", "value", "f_comb", "F combined"),
+                     ("generation", "rank", "cr_rank", "CR by rank"),
+                     ("individual", "rank", "f_ind_cr_rank", "F per individual, CR by rank"))
 
 
-def _pure(adaptive):
+def _de(p: StudyParams, adaptive: bool, rules=ADE_DEFAULT_RULES) -> DEParams:
+    return replace(p.de, adaptive=adaptive, f_rule=rules[0], cr_rule=rules[1])
+
+
+def _pure(adaptive, rules=ADE_DEFAULT_RULES):
     def make(p):
-        d = _de(p, adaptive)
+        d = _de(p, adaptive, rules)
         if p.pure_target == "normalised":
             return _Network(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g,
                                                               replace(p.lm, epochs=0)), p.target)
@@ -235,17 +257,38 @@ def _hybrid(adaptive, validation):
     return make
 
 
+def _full(adaptive, validation, rules=ADE_DEFAULT_RULES):
+    """The full DE stage (the paper's target read in deg^2, so all ``max_generations``), then trainlm."""
+    def make(p):
+        d = _de(p, adaptive, rules)
+        return _Network(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation, "deg2"),
+                        p.target)
+    return make
+
+
 def _matlab(validation):
     return lambda p: _Network(lambda x, t, g: train_matlab_bp_many(x, t, p.n_hidden, g, p.lm, validation),
                               p.target)
 
 
 R1, R2, R2V = "1: pure DE", "2: DE + trainlm", "2: DE + trainlm, val. stop"
+R4, R4V = "4: full DE + trainlm", "4: full DE + trainlm, val. stop"
 R3, R3V, RA = "3: MATLAB BP", "3: MATLAB BP, val. stop", "extra: Adam"
+_DE0, _ADE0 = (False,) + ADE_DEFAULT_RULES, (True,) + ADE_DEFAULT_RULES
+
+
+def _rule_reading(base: str, label: str) -> str:
+    return f"{base}, ADE {label}"
+
 
 METHODS: dict[str, MethodSpec] = {
     "uncompensated": MethodSpec("uncompensated", lambda p: _Uncompensated(), False, "uncompensated"),
-    "ls8": MethodSpec("LS 8-position", lambda p: _Smith8(), False, "8-position least squares"),
+    "ls8": MethodSpec("LS 8-position (Smith, 5 terms)", lambda p: _Eight("smith"), False,
+                      "8-position least squares"),
+    "ls8_planar": MethodSpec("LS 8-position (planar, 5 par.)", lambda p: _Eight("planar"), False,
+                             "8-position least squares"),
+    "ls8_h3": MethodSpec("LS 8-position (harmonic, 3rd order)", lambda p: _Eight("harmonic3"), False,
+                         "8-position least squares"),
     "physical": MethodSpec("physical model", lambda p: _Planar(), False),
     "bp_matlab": MethodSpec("BP MATLAB (trainlm)", _matlab(False), True, "BP network", R3),
     "bp_matlab_val": MethodSpec("BP MATLAB (trainlm, val. stop)", _matlab(True), True, "BP network", R3V),
@@ -253,31 +296,66 @@ METHODS: dict[str, MethodSpec] = {
         lambda x, t, g: train_adam_many(x, t, p.n_hidden, p.adam, g), p.target), True, "BP network", RA),
     "bp_scipy_lm": MethodSpec("BP (scipy LM)", lambda p: _Network(
         lambda x, t, g: [train_least_squares(x, t, p.n_hidden, r) for r in g], p.target), True),
-    "de_bp_pure": MethodSpec("DE-BP pure", _pure(False), True, "DE-BP", R1),
-    "ade_bp_pure": MethodSpec("ADE-BP pure", _pure(True), True, "ADE-BP", R1),
+    "de_bp_pure": MethodSpec("DE-BP pure", _pure(False), True, "DE-BP", R1, (_DE0, "pure")),
+    "ade_bp_pure": MethodSpec("ADE-BP pure", _pure(True), True, "ADE-BP", R1, (_ADE0, "pure")),
     "de_bp_hybrid_trainlm": MethodSpec("DE-BP hybrid (trainlm)", _hybrid(False, False), True, "DE-BP", R2),
     "ade_bp_hybrid_trainlm": MethodSpec("ADE-BP hybrid (trainlm)", _hybrid(True, False), True, "ADE-BP", R2),
     "de_bp_hybrid_trainlm_val": MethodSpec("DE-BP hybrid (trainlm, val. stop)", _hybrid(False, True), True,
                                            "DE-BP", R2V),
     "ade_bp_hybrid_trainlm_val": MethodSpec("ADE-BP hybrid (trainlm, val. stop)", _hybrid(True, True), True,
                                             "ADE-BP", R2V),
+    "de_bp_full_trainlm": MethodSpec("DE-BP full DE + trainlm", _full(False, False), True, "DE-BP", R4,
+                                     (_DE0, "trainlm")),
+    "ade_bp_full_trainlm": MethodSpec("ADE-BP full DE + trainlm", _full(True, False), True, "ADE-BP", R4,
+                                      (_ADE0, "trainlm")),
+    "de_bp_full_trainlm_val": MethodSpec("DE-BP full DE + trainlm, val. stop", _full(False, True), True, "DE-BP",
+                                         R4V, (_DE0, "trainlm_val")),
+    "ade_bp_full_trainlm_val": MethodSpec("ADE-BP full DE + trainlm, val. stop", _full(True, True), True,
+                                          "ADE-BP", R4V, (_ADE0, "trainlm_val")),
     "elm": MethodSpec("ELM", lambda p: _Network(_elm_train(p, False), p.target), True, None, "document B"),
     "elm_backtuned": MethodSpec("ELM back-tuned", lambda p: _Network(_elm_train(p, True), p.target), True,
                                 None, "document B"),
 }
+#: Each reading of ADE's rules (:data:`ADE_RULE_READINGS`), in pure DE and in full DE + trainlm: the ADE-BP
+#: of that reading (DE-BP is unchanged).
+RULE_READINGS: dict[str, str] = {}
+for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
+    _key = (True, _f, _c)
+    METHODS[f"ade_bp_pure_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}", _pure(True, (_f, _c)), True, "ADE-BP",
+                                                _rule_reading(R1, _lab), (_key, "pure"))
+    METHODS[f"ade_bp_full_trainlm_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}, full DE + trainlm",
+                                                        _full(True, False, (_f, _c)), True, "ADE-BP",
+                                                        _rule_reading(R4, _lab), (_key, "trainlm"))
+    RULE_READINGS[_rule_reading(R1, _lab)] = f"ade_bp_pure_{_sfx}"
+    RULE_READINGS[_rule_reading(R4, _lab)] = f"ade_bp_full_trainlm_{_sfx}"
+
+#: The 8-position least squares under each model (paper A does not print its model): id -> short name.
+LS_MODELS = {"ls8": "Smith 5 terms", "ls8_planar": "planar 5 par.", "ls8_h3": "harmonic 3rd order"}
+#: Glue-key part of each LS model (Smith's keeps the former keys).
+_LS_KEYS = {"ls8": "ls", "ls8_planar": "lsplanar", "ls8_h3": "lsh3"}
 
 #: The methods of the chapter's main table, in display order.
-MAIN_METHODS = ("uncompensated", "ls8", "bp_matlab", "bp_matlab_val", "bp_adam", "de_bp_pure", "ade_bp_pure",
-                "de_bp_hybrid_trainlm", "ade_bp_hybrid_trainlm", "de_bp_hybrid_trainlm_val",
-                "ade_bp_hybrid_trainlm_val", "elm", "elm_backtuned", "physical")
+MAIN_METHODS = ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "bp_matlab", "bp_matlab_val", "bp_adam",
+                "de_bp_pure", "ade_bp_pure", "de_bp_hybrid_trainlm", "ade_bp_hybrid_trainlm",
+                "de_bp_hybrid_trainlm_val", "ade_bp_hybrid_trainlm_val", "de_bp_full_trainlm",
+                "ade_bp_full_trainlm", "de_bp_full_trainlm_val", "ade_bp_full_trainlm_val") + tuple(
+    f"ade_bp_{v}_{sfx}" for _, _, sfx, _ in ADE_RULE_READINGS for v in ("pure", "full_trainlm")) + (
+    "elm", "elm_backtuned", "physical")
 ELM_METHODS = ("elm", "elm_backtuned")
 
-#: Each reading of paper A's four methods: (LS, BP, DE-BP, ADE-BP) ids.
+#: Each reading of paper A's four methods: (LS, BP, DE-BP, ADE-BP) ids (LS: Smith's; every LS claim is
+#: judged once per model of :data:`LS_MODELS`).  The readings of ADE's rules change only ADE-BP: their
+#: claims are those that involve ADE-BP (:data:`RULE_READINGS`).
 READINGS: dict[str, tuple[str, str, str, str]] = {
     R1: ("ls8", "bp_matlab", "de_bp_pure", "ade_bp_pure"),
     R2: ("ls8", "bp_matlab", "de_bp_hybrid_trainlm", "ade_bp_hybrid_trainlm"),
     R2V: ("ls8", "bp_matlab_val", "de_bp_hybrid_trainlm_val", "ade_bp_hybrid_trainlm_val"),
+    R4: ("ls8", "bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm"),
+    R4V: ("ls8", "bp_matlab_val", "de_bp_full_trainlm_val", "ade_bp_full_trainlm_val"),
 }
+for _r, _ade in RULE_READINGS.items():
+    _base = READINGS[R1 if _r.startswith(R1) else R4]
+    READINGS[_r] = _base[:3] + (_ade,)
 #: The same with the Adam extra as the "BP" (for the ordering probabilities).
 BP_VARIANTS = ("bp_matlab", "bp_matlab_val", "bp_adam")
 
@@ -324,31 +402,63 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
     return fitted.correct(sw.x_test), info
 
 
+def fit_family(methods, x, reference, params: StudyParams = StudyParams(), seeds=(0,),
+               base_seed: int = 0) -> dict[str, list]:
+    """Fit methods that share one full DE stage (the same ``family`` key of :class:`MethodSpec`: pure DE
+    and full DE + trainlm, with and without the validation stop, of one DE / ADE rule) from one stage per
+    seed (:func:`navlib.methods.bpnet.train_de_family`): the same fitted compensators as
+    :func:`fit_method` gives for each method alone, at the cost of one stage.  ``{method id: fitted}``."""
+    mids = [method_id(m) for m in methods]
+    fams = [METHODS[m].family for m in mids]
+    if any(f is None for f in fams) or len({f[0] for f in fams}) != 1:
+        raise InputError(f"fit_family: {', '.join(mids)} do not share one DE stage")
+    if params.pure_target != "deg2" and any(f[1] == "pure" for f in fams):
+        raise InputError("fit_family: pure DE shares the full stage only with pure_target='deg2'")
+    adaptive, f_rule, cr_rule = fams[0][0]
+    d = replace(params.de, adaptive=adaptive, f_rule=f_rule, cr_rule=cr_rule)
+    xx = np.asarray(x, dtype=float)
+    tgt = params.target
+    nets = train_de_family(xx, tgt.target(xx, reference), params.n_hidden, d, generators(seeds, base_seed),
+                           params.lm, [f[1] for f in fams])
+    return {m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
+            for m, f in zip(mids, fams)}
+
+
 #: CPU seconds per run of each method at the chapter's defaults (measured; for ordering parallel tasks,
-#: most expensive first).  Methods not listed count as cheap.
+#: most expensive first).  Methods not listed count as cheap; a family of methods sharing one DE stage
+#: costs the stage (``"de_stage"``) plus ``"trainlm"`` per trainlm variant.
 RUN_COST_S = {"de_bp_pure": 0.3, "ade_bp_pure": 0.3, "de_bp_hybrid_trainlm": 0.14,
               "ade_bp_hybrid_trainlm": 0.07, "de_bp_hybrid_trainlm_val": 0.1, "ade_bp_hybrid_trainlm_val": 0.03,
-              "bp_adam": 0.05, "bp_matlab": 0.06, "bp_matlab_val": 0.02, "elm_backtuned": 0.1}
+              "bp_adam": 0.05, "bp_matlab": 0.06, "bp_matlab_val": 0.02, "elm_backtuned": 0.1,
+              "de_stage": 0.3, "trainlm": 0.04}
 
 
-def _method_runs(sw: Sweeps, params: StudyParams, mid: str, seeds: list, base_seed: int,
+def _method_runs(sw: Sweeps, params: StudyParams, mids, seeds: list, base_seed: int,
                  keep_errors: bool) -> list[dict]:
-    """The rows of :func:`seed_study` for one method and the given seeds (one batch)."""
-    spec = METHODS[mid]
+    """The rows of :func:`seed_study` for one method (or one family sharing a DE stage, :func:`fit_family`)
+    and the given seeds (one batch).  A family's ``train_time_s`` is the family's time per seed."""
+    mids = (mids,) if isinstance(mids, str) else tuple(mids)
     t0 = time.perf_counter()
-    fitted = fit_method(mid, sw.x_train, sw.t_train, params, seeds, base_seed)
-    per = (time.perf_counter() - t0) / len(fitted)
+    if len(mids) > 1:
+        fitted_by = fit_family(mids, sw.x_train, sw.t_train, params, seeds, base_seed)
+    else:
+        fitted_by = {mids[0]: fit_method(mids[0], sw.x_train, sw.t_train, params, seeds, base_seed)}
+    per = (time.perf_counter() - t0) / len(next(iter(fitted_by.values())))
     rows = []
-    for s, f in zip(seeds if spec.stochastic else [-1], fitted):
-        err = test_errors(f.correct(sw.x_test), sw)
-        row = {"method": mid, "label": spec.label, "seed": s, **error_stats(err), "train_time_s": per,
-               "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
-               "stop": f.info.get("stop", "")}
-        if keep_errors:
-            net = getattr(f, "net", None)
-            row.update(error_deg=err, history=getattr(net, "history", None),
-                       de_history=f.info.get("de_history"))
-        rows.append(row)
+    for mid in mids:
+        spec = METHODS[mid]
+        for s, f in zip(seeds if spec.stochastic else [-1], fitted_by[mid]):
+            err = test_errors(f.correct(sw.x_test), sw)
+            row = {"method": mid, "label": spec.label, "seed": s, **error_stats(err), "train_time_s": per,
+                   "n_nodes": f.info.get("n_nodes", np.nan), "epochs": f.info.get("epochs", np.nan),
+                   "stop": f.info.get("stop", "")}
+            if keep_errors:
+                net = getattr(f, "net", None)
+                hist = getattr(net, "history", None)
+                row.update(error_deg=err, history=hist,
+                           de_history=f.info.get("de_history", hist if spec.family and spec.family[1] == "pure"
+                                                 else None))
+            rows.append(row)
     return rows
 
 
@@ -357,18 +467,43 @@ def _method_runs(sw: Sweeps, params: StudyParams, mid: str, seeds: list, base_se
 SEED_BATCH = 4
 
 
-def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
-    """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one,
-    with its estimated cost (CPU seconds)."""
-    tasks, cost = [], []
+def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
+    """The methods grouped into fitting units: the methods sharing one full DE stage (``family``; pure DE
+    only with ``pure_target='deg2'``) form one unit, every other method its own."""
+    units, at = [], {}
     for m in methods:
         mid = method_id(m)
-        stochastic = METHODS[mid].stochastic
+        fam = METHODS[mid].family
+        if fam is not None and (fam[1] != "pure" or params.pure_target == "deg2"):
+            if fam[0] in at:
+                units[at[fam[0]]].append(mid)
+                continue
+            at[fam[0]] = len(units)
+        units.append([mid])
+    return [tuple(u) for u in units]
+
+
+def _unit_cost(unit, params: StudyParams) -> float:
+    """Estimated CPU seconds per seed of a fitting unit (:data:`RUN_COST_S`)."""
+    fams = [METHODS[m].family for m in unit]
+    if all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
+        c = RUN_COST_S["de_stage"] + RUN_COST_S["trainlm"] * sum(f[1] != "pure" for f in fams)
+    else:
+        c = RUN_COST_S.get(unit[0], 0.001)
+    return c * params.de.max_generations / 3000
+
+
+def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
+    """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one
+    (or of a family sharing a DE stage, :func:`_units`), with its estimated cost (CPU seconds)."""
+    tasks, cost = [], []
+    for unit in _units(params, methods):
+        stochastic = METHODS[unit[0]].stochastic
         chunks = [seeds[i:i + SEED_BATCH] for i in range(0, len(seeds), SEED_BATCH)] if stochastic else [seeds]
         for c in chunks:
-            tasks.append((sw, params, mid, [int(v) for v in c], base_seed, keep_errors))
-            cost.append(RUN_COST_S.get(mid, 0.001) * len(c) * params.de.max_generations / 3000
-                        if stochastic else 0.001)
+            tasks.append((sw, params, unit if len(unit) > 1 else unit[0], [int(v) for v in c], base_seed,
+                          keep_errors))
+            cost.append(_unit_cost(unit, params) * len(c) if stochastic else 0.001)
     return tasks, cost
 
 
@@ -395,7 +530,8 @@ def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers
         cost += c
         owner += [k] * len(t)
     parts = engine.run(_method_runs, tasks, workers=workers, scheduler=scheduler, cost=cost,
-                       label="seed study", weight=[len(t[3]) for t in tasks])
+                       label="seed study", weight=[len(t[3]) * (1 if isinstance(t[2], str) else len(t[2]))
+                                                   for t in tasks])
     return [pd.DataFrame([row for o, part in zip(owner, parts) if o == k for row in part])
             for k in range(len(studies))]
 
@@ -450,7 +586,7 @@ def ordering_table(runs: pd.DataFrame) -> pd.DataFrame:
     rows = []
     by = {m: g for m, g in runs.groupby("method")}
     for reading, (ls, _, de, ade) in READINGS.items():
-        if not all(k in by for k in (ls, de, ade)):
+        if reading in RULE_READINGS or not all(k in by for k in (ls, de, ade)):
             continue
         for bp in BP_VARIANTS:
             if bp not in by:
@@ -555,7 +691,9 @@ def noise_summary(noise_runs: pd.DataFrame) -> pd.DataFrame:
 
 # ----------------------------------------------------------------------------------------------- verdict
 #: Short names of the readings, for the claims' glue keys.
-READING_KEYS = {R1: "r1", R2: "r2", R2V: "r2v"}
+READING_KEYS = {R1: "r1", R2: "r2", R2V: "r2v", R4: "r4", R4V: "r4v"}
+READING_KEYS.update({_rule_reading(base, lab): f"{READING_KEYS[base]}_{sfx.replace('_', '')}"
+                     for base in (R1, R4) for _, _, sfx, lab in ADE_RULE_READINGS})
 #: What every interval over training seeds covers (shown in each claim's ``decided_by``).
 TRAINING_ONLY = ("one fixed simulated sweep pair: the interval covers training randomness (seeds), not "
                  "sensor-noise draws")
@@ -563,7 +701,14 @@ _READING_ASSUMPTIONS = {
     R1: "pure DE with the chapter's DE budget in our search box (the paper gives none)",
     R2: "DE stage stopped by the paper's target read in normalised units, then MATLAB trainlm",
     R2V: "DE stage, then trainlm with MATLAB's dividerand split and validation stop",
+    R4: "the full DE stage (target 0.2 deg^2 never fires: all generations), then MATLAB trainlm",
+    R4V: "the full DE stage, then trainlm with MATLAB's dividerand split and validation stop",
 }
+for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
+    for _base in (R1, R4):
+        _READING_ASSUMPTIONS[_rule_reading(_base, _lab)] = (
+            f"{_READING_ASSUMPTIONS[_base]}; ADE's F {_f.replace('individual', 'per individual').replace('generation', 'by generation')}"
+            f", CR by {_c} (the default reads F by generation, CR by value)")
 
 
 def per_seed(runs: pd.DataFrame, method: str, col: str = "rms_deg") -> pd.Series:
@@ -655,37 +800,52 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
       ``implied_ut``); where it is not below the paper's width the claim cannot be judged, and the
       reason names the noise it would need (from :func:`floor_curve` ``floor``).
 
-    The intervals cover training randomness on one fixed sweep pair (:data:`TRAINING_ONLY`)."""
+    Every claim that involves the 8-position LS is judged once per LS model of :data:`LS_MODELS` found in
+    ``runs`` (the paper does not print its model); the readings of ADE's rules (:data:`RULE_READINGS`)
+    change only ADE-BP, so only the claims involving ADE-BP are judged there.  A reading whose methods are
+    not all in ``runs`` is skipped.  The intervals cover training randomness on one fixed sweep pair
+    (:data:`TRAINING_ONLY`)."""
     pr = paper.set_index("method")
     out = []
-    for reading, (ls, bp, de, ade) in READINGS.items():
+    present = set(runs.method)
+    ls_models = [m for m in LS_MODELS if m in present] or ["ls8"]
+    for reading, (_, bp, de, ade) in READINGS.items():
+        if not {bp, de, ade} <= present:
+            continue
         rk = READING_KEYS[reading]
         how = _READING_ASSUMPTIONS[reading]
-        pairs = [("ADE-BP beats DE-BP", ade, de, "ADE-BP", "DE-BP", "ade_de"),
-                 ("DE-BP beats BP", de, bp, "DE-BP", "BP network", "de_bp"),
-                 ("BP beats 8-position LS", bp, ls, "BP network", "8-position least squares", "bp_ls"),
-                 ("ADE-BP beats 8-position LS", ade, ls, "ADE-BP", "8-position least squares", "ade_ls")]
-        for text, better, worse, pb, pw, key in pairs:
+        ade_only = reading in RULE_READINGS          # a reading of ADE's rules: only ADE-BP changes
+        pairs = [("ADE-BP beats DE-BP", ade, de, "ADE-BP", "DE-BP", "ade_de", None)]
+        if not ade_only:
+            pairs.append(("DE-BP beats BP", de, bp, "DE-BP", "BP network", "de_bp", None))
+        for ls in ls_models:
+            if not ade_only:
+                pairs.append(("BP beats 8-position LS", bp, ls, "BP network", "8-position least squares", "bp_ls", ls))
+            pairs.append(("ADE-BP beats 8-position LS", ade, ls, "ADE-BP", "8-position least squares", "ade_ls", ls))
+        for text, better, worse, pb, pw, key, ls in pairs:
             est, short = verdicts.attempt(paired_rms_difference, runs, worse, better)
             rb, rw = per_seed(runs, better), per_seed(runs, worse)
-            dec = (how, TRAINING_ONLY) + (("our compass: hard iron a third of the horizontal field limits "
-                                            "the 8-position LS's five coefficients",) if worse == ls else ())
-            out.append(Claim(text, f"{_rng(pr.loc[pb])} vs {_rng(pr.loc[pw])} deg", reading=reading,
+            dec = (how, TRAINING_ONLY) + ((_ls_assumption(ls),) if ls else ())
+            out.append(Claim(_ls_text(text, ls), f"{_rng(pr.loc[pb])} vs {_rng(pr.loc[pw])} deg", reading=reading,
                              source="paper",
                              statistic=f"RMS {METHODS[worse].label} - RMS {METHODS[better].label}, paired by "
                                        f"seed, deg",
                              estimate=est, boundary=0.0, holds_when="above", unit="deg", decided_by=dec,
-                             why=short, ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms", key=f"a_{key}_{rk}"))
-        est = ordering_rate(runs, ls, bp, de, ade)
-        p_all = ordering_probability(per_seed(runs, ls).iloc[0], per_seed(runs, bp), per_seed(runs, de),
-                                     per_seed(runs, ade))
-        out.append(Claim("one run shows LS > BP > DE-BP > ADE-BP", "one run per method", reading=reading,
-                         source="paper",
-                         statistic="share of seeds whose runs show the ordering by RMS",
-                         estimate=est, boundary=0.5, holds_when="above", decided_by=(how, TRAINING_ONLY),
-                         why="boundary 0.5: the paper shows one run per method as typical",
-                         ours=f"{round(est.value * est.n)} of {est.n} seeds; P = {p_all:.2f} over all "
-                              f"combinations", spec="{:.2f}", key=f"a_order_{rk}"))
+                             why=short, ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms",
+                             key=f"a_{_ls_key(key, ls)}_{rk}"))
+        for ls in ls_models:
+            est = ordering_rate(runs, ls, bp, de, ade)
+            p_all = ordering_probability(per_seed(runs, ls).iloc[0], per_seed(runs, bp), per_seed(runs, de),
+                                         per_seed(runs, ade))
+            out.append(Claim(_ls_text("one run shows LS > BP > DE-BP > ADE-BP", ls), "one run per method",
+                             reading=reading, source="paper",
+                             statistic="share of seeds whose runs show the ordering by RMS",
+                             estimate=est, boundary=0.5, holds_when="above",
+                             decided_by=(how, TRAINING_ONLY, _ls_assumption(ls)),
+                             why="boundary 0.5: the paper shows one run per method as typical",
+                             ours=f"{round(est.value * est.n)} of {est.n} seeds; P = {p_all:.2f} over all "
+                                  f"combinations", spec="{:.2f}",
+                             key=f"a_order_{rk}" if ls == "ls8" else f"a_order_{_LS_KEYS[ls]}_{rk}"))
         for level_name, frame, noise in (("default", runs, default_ut), ("implied", None, implied_ut)):
             if frame is None:
                 if noise_runs is None or implied_ut is None or not np.isfinite(implied_ut):
@@ -695,8 +855,11 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
                     continue
             nz = f" ({noise:.3g} uT)" if noise is not None else ""
             phys = float(per_seed(frame, "physical", "width_deg").iloc[0])
-            for mid, prow, name in ((ade, "ADE-BP", "ADE-BP"), (de, "DE-BP", "DE-BP"), (bp, "BP network", "BP"),
-                                    (ls, "8-position least squares", "LS")):
+            subjects = [(ade, "ADE-BP", "ADE-BP", None)]
+            if not ade_only:
+                subjects += [(de, "DE-BP", "DE-BP", None), (bp, "BP network", "BP", None)]
+                subjects += [(ls, "8-position least squares", "LS", ls) for ls in ls_models]
+            for mid, prow, name, ls in subjects:
                 if mid not in set(frame.method):
                     continue
                 p_ = pr.loc[prow]
@@ -704,16 +867,43 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
                 g = frame[frame.method == mid]
                 est, short = verdicts.attempt(width_estimate, frame, mid)
                 fl = _floor(phys, width, noise, floor)
-                out.append(Claim(f"{name} error within the paper's range, {level_name} noise{nz}",
+                out.append(Claim(f"{_ls_text(name, ls)} error within the paper's range, {level_name} noise{nz}",
                                  _rng(p_) + " deg", reading=reading, source="paper",
                                  statistic="width of the test-sweep error band (max - min) per run, deg",
                                  estimate=est, boundary=width, holds_when="below", unit="deg", floor=fl,
                                  decided_by=(f"sensor noise {noise:.3g} uT (our simulator)" if noise is not None
-                                             else "our simulator's sensor noise", how, TRAINING_ONLY),
+                                             else "our simulator's sensor noise", how, TRAINING_ONLY)
+                                 + ((_ls_assumption(ls),) if ls else ()),
                                  why=short,
                                  ours=f"band {g.min_deg.median():+.2f}..{g.max_deg.median():+.2f} deg (medians)",
-                                 key=f"a_range_{name.lower().replace('-', '')}_{level_name}_{rk}"))
+                                 key=f"a_range_{_ls_key(name.lower().replace('-', ''), ls)}_{level_name}_{rk}"))
     return out
+
+
+def _ls_text(text: str, ls: str | None) -> str:
+    """A claim's text with the LS model it is judged against (``ls`` an id of :data:`LS_MODELS`)."""
+    if ls is None:
+        return text
+    tag = f"[{LS_MODELS[ls]}]"
+    if text == "LS":
+        return f"LS {tag}"
+    return f"{text} {tag}"
+
+
+def _ls_key(key: str, ls: str | None) -> str:
+    """Glue-key part: Smith's model keeps the former keys (``bp_ls``, ``ls``), the others add their model."""
+    if ls is None or ls == "ls8":
+        return key
+    return key.replace("ls", _LS_KEYS[ls], 1)
+
+
+def _ls_assumption(ls: str | None) -> str:
+    return {"ls8": "8-position LS as Smith's 5-term series: on our compass (hard iron a third of the "
+                   "horizontal field) its missing 3rd harmonic limits it",
+            "ls8_planar": "8-position LS as the exact 5-parameter hard/soft-iron model (our simulator's own "
+                          "model on a level table)",
+            "ls8_h3": "8-position LS as a harmonic series to 3rd order (7 coefficients from 8 readings)"
+            }.get(ls, "")
 
 
 def _floor(phys_width: float, width: float, noise: float | None, curve: pd.DataFrame | None) -> verdicts.Floor:
@@ -735,12 +925,16 @@ def headline_claims(claim_list) -> list:
     return [c for c in claim_list if "error within" not in c.claim or c.claim.startswith("ADE-BP")]
 
 
-def verdict_table(claim_list) -> pd.DataFrame:
-    """Claims x readings: the verdict of each claim under each reading (from :func:`claims`)."""
-    rows = [{"claim": c.claim, "reading": c.reading, "verdict": c.verdict} for c in claim_list]
+def verdict_table(claim_list, readings=None) -> pd.DataFrame:
+    """Claims x readings: the verdict of each claim under each reading (from :func:`claims`); ``readings``
+    selects and orders the columns (default: every reading found).  "-": the claim is not judged in that
+    reading (a reading of ADE's rules judges only the claims that involve ADE-BP)."""
+    rows = [{"claim": c.claim, "reading": c.reading, "verdict": c.verdict} for c in claim_list
+            if readings is None or c.reading in readings]
     df = pd.DataFrame(rows)
     order = list(dict.fromkeys(df.claim))
-    return df.pivot(index="claim", columns="reading", values="verdict").loc[order, list(dict.fromkeys(df.reading))]
+    cols = [r for r in (readings or dict.fromkeys(df.reading)) if r in set(df.reading)]
+    return df.pivot(index="claim", columns="reading", values="verdict").loc[order, cols].fillna("-")
 
 
 def results_methods(runs: pd.DataFrame) -> dict:
