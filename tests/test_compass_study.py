@@ -522,3 +522,69 @@ def test_family_of_one_de_stage_equals_each_method_alone(sw):
                                       fit_method(mid, sw.x_train, sw.t_train, p, seeds=[1])[0].net.theta)
     with pytest.raises(InputError, match="share one DE stage"):
         fit_family(("ade_bp_pure", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
+
+
+def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):
+    """Synthetic pure-DE runs: J falls from 1e5 to 121 (train RMS 1 deg) at generation first_* then to
+    final_*; one row per seed with its ``de_history``."""
+    rows = []
+    for mid, firsts, finals in (("de_bp_pure", first_de, final_de), ("ade_bp_pure", first_ade, final_ade)):
+        for s, (f, jf) in enumerate(zip(firsts, finals)):
+            h = np.geomspace(1e5, 121.0, f)
+            h = np.concatenate([h, np.geomspace(121.0, jf, gens - f)])
+            rows.append({"method": mid, "label": METHODS[mid].label, "seed": s, "de_history": h})
+    return pd.DataFrame(rows)
+
+
+def test_generations_to_reach_and_the_convergence_claims():
+    from navlib.studies.paper_a import convergence_claims, convergence_curves, generations_to_reach
+    n = 10
+    runs = _history_runs([150] * n, [60] * n, np.geomspace(10, 1000, n), np.geomspace(50, 60, n))
+    reach = generations_to_reach(runs, rms_levels=(1.0,))
+    assert set(reach.generations[reach.method == "de_bp_pure"]) == {150}      # J <= 121 first at generation f
+    assert set(reach.generations[reach.method == "ade_bp_pure"]) == {60}
+    never = generations_to_reach(runs, rms_levels=(0.1,))
+    assert not never.reached.any() and set(never.generations) == {201}          # G + 1 when never reached
+    cl = convergence_claims(reach, seed=1)
+    faster, stable = cl
+    assert faster.estimate.value == 90 and faster.verdict == "reproduced"
+    assert stable.boundary == 1.0 and stable.rule == "bootstrap over rows" and stable.verdict == "reproduced"
+    swapped = convergence_claims(reach, de="ade_bp_pure", ade="de_bp_pure", seed=1)
+    assert [c.verdict for c in swapped] == ["not reproduced", "not reproduced"]
+    curves = convergence_curves(runs)
+    assert len(curves) == 2 * 200 and np.all(curves.j_p10 <= curves.j_median + 1e-12)
+
+
+def test_compasses_are_drawn_by_the_stated_rule():
+    from navlib.studies.paper_a import CompassDrawRule, draw_compass, draw_compasses
+    rule = CompassDrawRule(n_compasses=3)
+    c = draw_compasses(rule, -16.0, 30.7, 0.04)
+    assert list(c.compass) == ["C1", "C2", "C3"] and np.all(np.diff(c.draw) > 0)
+    assert np.all(np.abs(c.min_deg + 16.0) <= 2.0) and np.all(np.abs(c.max_deg - 30.7) <= 2.0)
+    assert all(e.noise_ut == 0.04 for e in c.errors)
+    assert np.all((c.hard_frac >= 0.2) & (c.hard_frac <= 0.6))
+    assert draw_compass(rule, int(c.draw[1]), 0.04) == c.errors[1]             # a draw depends on its key only
+    # the rejected draws before the first kept one are outside the tolerance
+    first = int(c.draw[0])
+    for k in range(first):
+        err = simulate_sweep_errors(draw_compass(rule, k, 0.0))
+        assert abs(err.min() + 16.0) > 2.0 or abs(err.max() - 30.7) > 2.0
+    with pytest.raises(InputError, match="only"):
+        draw_compasses(replace(rule, max_draws=first + 1), -16.0, 30.7, 0.04)
+    with pytest.raises(InputError, match="hard_frac"):
+        CompassDrawRule(hard_frac=(0.5, 0.2))
+
+
+def simulate_sweep_errors(e):
+    from navlib.sensors.compass import simulate_sweep
+    return simulate_sweep(e, seed=0).heading_error_deg.to_numpy()
+
+
+def test_robustness_table_marks_verdicts_that_change_with_the_compass():
+    from navlib.studies.paper_a import robustness_table
+    robust = pd.DataFrame([{"compass": k, "claim": c, "reading": "r", "verdict": v}
+                           for k, c, v in (("C1", "a", "reproduced"), ("C2", "a", "reproduced"),
+                                           ("C1", "b", "reproduced"), ("C2", "b", "not reproduced"))])
+    t = robustness_table(robust)
+    assert list(t.columns) == ["C1", "C2", "stable"]
+    assert bool(t.loc[("a", "r"), "stable"]) and not bool(t.loc[("b", "r"), "stable"])

@@ -37,11 +37,11 @@ from ..methods.compensator import (HeadingTarget, MethodBase, ModelCompensator, 
 from ..methods.de import DEParams
 from ..methods.elm import ELMParams, IncrementalELMParams, fit_elm, fit_incremental_elm
 from ..methods.lm import LMParams
-from ..methods.seeding import generators
+from ..methods.seeding import generators, sequence
 from ..methods.smith import eight_position_indices, fit_smith
 from .. import verdicts
 from ..report import Claim, method_stats
-from ..sensors.compass import CompassErrors, simulate_train_test
+from ..sensors.compass import CompassErrors, EarthField, simulate_sweep, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
 from ..sensors.planar import fit_planar_model
 from .. import engine
@@ -919,10 +919,21 @@ def _floor(phys_width: float, width: float, noise: float | None, curve: pd.DataF
     return verdicts.Floor(phys_width, at, needs)
 
 
-def headline_claims(claim_list) -> list:
-    """The claims for the Results-at-a-glance table: comparisons, ordering and ADE-BP's range (the other
-    range claims stay in the verdict table and the results file)."""
-    return [c for c in claim_list if "error within" not in c.claim or c.claim.startswith("ADE-BP")]
+def headline_claims(claim_list, readings=None) -> list:
+    """The claims for the Results-at-a-glance table: comparisons, ordering, convergence and ADE-BP's range
+    in the readings ``readings`` (default: pure DE, DE + trainlm and full DE + trainlm, without the
+    validation-stop variants and ADE's rule readings, which stay in the verdict table and the results
+    file)."""
+    keep = set(readings or (R1, R2, R4))
+    return [c for c in claim_list if c.reading in keep
+            and ("error within" not in c.claim or c.claim.startswith("ADE-BP"))]
+
+
+#: The readings whose columns form the chapter's main verdict table (ADE's rule readings have their own).
+BASE_READINGS = (R1, R2, R2V, R4, R4V)
+#: The methods of the noise study: the base readings' methods, the LS models, the extras and the floor
+#: (ADE's rule readings are judged at the default noise only).
+NOISE_METHODS = tuple(m for m in MAIN_METHODS if not any(m == ade for ade in RULE_READINGS.values()))
 
 
 def verdict_table(claim_list, readings=None) -> pd.DataFrame:
@@ -942,3 +953,220 @@ def results_methods(runs: pd.DataFrame) -> dict:
     trainer)."""
     return {METHODS[m].label: method_stats(g.rms_deg, g.min_deg, g.max_deg) for m, g in
             runs.groupby("method", sort=False)}
+
+
+# ----------------------------------------------------------------------------------------------- convergence
+#: Training-error levels (RMS over the training sweep, deg) whose fitness J = N rms^2 the convergence study
+#: times: chosen before the runs, a decade apart from a coarse fit to the noise-floor region.
+CONVERGENCE_RMS_DEG = (10.0, 3.0, 1.0)
+
+
+def convergence_curves(runs: pd.DataFrame, methods=("de_bp_pure", "ade_bp_pure")) -> pd.DataFrame:
+    """Best fitness J (deg^2) against generation over the seeds of each DE method of a
+    :func:`seed_study` run with ``keep_errors=True`` (its ``de_history``): one row per (method, generation)
+    with the 10th, 50th and 90th percentiles over the seeds."""
+    rows = []
+    for mid in methods:
+        h = _histories(runs, mid)
+        q = np.percentile(h, [10, 50, 90], axis=0)
+        rows.append(pd.DataFrame({"method": mid, "label": METHODS[mid].label, "generation": np.arange(h.shape[1]),
+                                  "j_p10": q[0], "j_median": q[1], "j_p90": q[2]}))
+    return pd.concat(rows, ignore_index=True)
+
+
+def _histories(runs: pd.DataFrame, mid: str) -> np.ndarray:
+    """``(seeds, generations)`` best-J histories of a DE method (seed order), padded with the last value."""
+    g = runs[runs.method == mid].sort_values("seed")
+    if g.empty or "de_history" not in g or g.de_history.isna().any():
+        raise InputError(f"convergence: no DE histories of {mid!r} (run the seed study with keep_errors=True)")
+    hs = [np.asarray(h, dtype=float) for h in g.de_history]
+    n = max(len(h) for h in hs)
+    return np.stack([np.concatenate([h, np.full(n - len(h), h[-1])]) for h in hs])
+
+
+def generations_to_reach(runs: pd.DataFrame, methods=("de_bp_pure", "ade_bp_pure"),
+                         rms_levels=CONVERGENCE_RMS_DEG, n_train: int = 121) -> pd.DataFrame:
+    """Per (method, seed, level): the first generation (1-based) whose best J is at most
+    ``n_train rms^2`` (the training RMS ``rms`` in deg), or ``G + 1`` if never (``reached`` False), and the
+    final J."""
+    rows = []
+    for mid in methods:
+        h = _histories(runs, mid)
+        seeds = np.sort(runs[runs.method == mid].seed.to_numpy(int))
+        for rms in rms_levels:
+            hit = h <= n_train * rms ** 2
+            first = np.where(hit.any(axis=1), hit.argmax(axis=1) + 1, h.shape[1] + 1)
+            for s, f, ok, jf in zip(seeds, first, hit.any(axis=1), h[:, -1]):
+                rows.append({"method": mid, "label": METHODS[mid].label, "seed": int(s), "rms_level_deg": rms,
+                             "j_level": n_train * rms ** 2, "generations": int(f), "reached": bool(ok),
+                             "final_j": float(jf)})
+    return pd.DataFrame(rows)
+
+
+def convergence_claims(reach: pd.DataFrame, de: str = "de_bp_pure", ade: str = "ade_bp_pure",
+                       reading: str = R1, seed: int = 20) -> list[Claim]:
+    """Paper A's "faster convergence and good stability" of ADE against DE (contribution 3), from
+    :func:`generations_to_reach` ``reach`` (pure DE, the same seeds):
+
+    - faster convergence, once per level of :data:`CONVERGENCE_RMS_DEG`: generations DE needs minus
+      generations ADE needs to bring the training RMS to that level, paired by seed (boundary 0, holds
+      above; a run that never reaches it counts ``G + 1``);
+    - good stability: the spread of the final J over the seeds, the interquartile range of log10 J, DE's
+      over ADE's (boundary 1, holds above), with a paired percentile bootstrap over the seeds (seeded by
+      ``SeedSequence(seed)``)."""
+    out = []
+    rk = READING_KEYS.get(reading, "r")
+    for rms in sorted(set(reach.rms_level_deg), reverse=True):
+        a = reach[(reach.method == ade) & (reach.rms_level_deg == rms)].set_index("seed").generations
+        d = reach[(reach.method == de) & (reach.rms_level_deg == rms)].set_index("seed").generations
+        est, short = verdicts.attempt(paired_seed_difference, d.astype(float).rename(de),
+                                      a.astype(float).rename(ade))
+        never = int((~reach[(reach.rms_level_deg == rms) & reach.method.isin([de, ade])].reached).sum())
+        out.append(Claim(f"ADE-BP converges faster than DE-BP (training RMS {rms:g} deg)",
+                         "faster convergence (no numbers)", reading=reading, source="paper",
+                         statistic=f"generations DE-BP needs - generations ADE-BP needs to reach J = "
+                                   f"{reach[reach.rms_level_deg == rms].j_level.iloc[0]:.4g} deg^2, paired by seed",
+                         estimate=est, boundary=0.0, holds_when="above", unit="generations", spec="{:.0f}",
+                         decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY),
+                         why="; ".join(t for t in (short, f"{never} runs never reached it (counted as G + 1)"
+                                                   if never else "") if t),
+                         ours=f"{a.median():.0f} vs {d.median():.0f} generations (medians)",
+                         key=f"a_conv_{rk}_{str(rms).replace('.', 'p')}"))
+    fin = reach[reach.rms_level_deg == reach.rms_level_deg.iloc[0]]
+    fa = np.log10(fin[fin.method == ade].set_index("seed").final_j.sort_index())
+    fd = np.log10(fin[fin.method == de].set_index("seed").final_j.sort_index())
+    common = fa.index.intersection(fd.index)
+
+    def iqr_ratio(x, y):
+        return float(np.subtract(*np.percentile(x, [75, 25])) / max(np.subtract(*np.percentile(y, [75, 25])),
+                                                                  1e-12))
+    est, short = verdicts.attempt(lambda: verdicts.bootstrap([fd.loc[common], fa.loc[common]], iqr_ratio,
+                                                             seed=np.random.SeedSequence(seed)))
+    out.append(Claim("ADE-BP is more stable than DE-BP (spread of the final J over seeds)",
+                     "good stability (no numbers)", reading=reading, source="paper",
+                     statistic="interquartile range of log10 final J over seeds, DE-BP / ADE-BP (paired "
+                               "bootstrap over seeds)",
+                     estimate=est, boundary=1.0, holds_when="above", spec="{:.2f}",
+                     decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY), why=short,
+                     ours=f"IQR of log10 J: ADE-BP {np.subtract(*np.percentile(fa, [75, 25])):.2f}, DE-BP "
+                          f"{np.subtract(*np.percentile(fd, [75, 25])):.2f}",
+                     key=f"a_stab_{rk}"))
+    return out
+
+
+# ----------------------------------------------------------------------------------------------- robustness
+@dataclass(frozen=True)
+class CompassDrawRule:
+    """How the robustness study draws its simulated compasses: every error source of
+    :class:`navlib.sensors.compass.CompassErrors` uniform in a stated range (hard iron: horizontal
+    magnitude a fraction ``hard_frac`` of H at a uniform angle, vertical ``hard_z_ut``; soft iron: every
+    entry of S in ``(-soft, soft)``; scale and non-orthogonality per axis; tilt (roll, pitch) and yaw
+    misalignment), draw ``k`` from ``SeedSequence(seed, spawn_key=(k,))``.  A draw is kept when its
+    noiseless uncompensated error envelope lies within ``tolerance_deg`` of the paper's (both ends); the
+    first ``n_compasses`` kept, in draw order, are the study's compasses (at most ``max_draws`` tried).
+    Ranges chosen before any run: a carrier a decimetre from steel (hard iron up to 0.6 H, soft iron up to
+    10 %), a few degrees of mounting tilt and yaw, 3 % scale and half a degree of non-orthogonality."""
+
+    n_compasses: int = 5
+    hard_frac: tuple[float, float] = (0.2, 0.6)
+    hard_z_ut: float = 5.0
+    soft: float = 0.10
+    scale: float = 0.03
+    nonorth_deg: float = 0.5
+    tilt_deg: float = 3.0
+    yaw_deg: float = 5.0
+    tolerance_deg: float = 2.0
+    seed: int = 7
+    max_draws: int = 20000
+
+    def __post_init__(self):
+        check_param("n_compasses", self.n_compasses, lo=1, integer=True)
+        if not 0 <= self.hard_frac[0] < self.hard_frac[1] < 1:
+            raise InputError(f"parameter hard_frac={self.hard_frac}: need 0 <= low < high < 1")
+        for name in ("hard_z_ut", "nonorth_deg", "tilt_deg", "yaw_deg"):
+            check_param(name, getattr(self, name), lo=0)
+        check_param("soft", self.soft, lo=0, hi=0.5)
+        check_param("scale", self.scale, lo=0, hi=0.4)
+        check_param("tolerance_deg", self.tolerance_deg, lo=0, lo_open=True)
+        check_param("seed", self.seed, lo=0, integer=True)
+        check_param("max_draws", self.max_draws, lo=1, integer=True)
+
+
+def draw_compass(rule: CompassDrawRule, k: int, noise_ut: float) -> CompassErrors:
+    """Draw ``k`` of :class:`CompassDrawRule` (its own ``SeedSequence`` spawn key)."""
+    g = np.random.default_rng(sequence(rule.seed, k))
+    h = EarthField().horizontal_ut * g.uniform(*rule.hard_frac)
+    ang = g.uniform(0.0, 2 * np.pi)
+    return CompassErrors(hard_iron_ut=(h * np.cos(ang), h * np.sin(ang), g.uniform(-rule.hard_z_ut, rule.hard_z_ut)),
+                         soft_iron=tuple(map(tuple, g.uniform(-rule.soft, rule.soft, (3, 3)))),
+                         scale_error=tuple(g.uniform(-rule.scale, rule.scale, 3)),
+                         nonorthogonality_deg=tuple(g.uniform(-rule.nonorth_deg, rule.nonorth_deg, 3)),
+                         misalignment_deg=(g.uniform(-rule.tilt_deg, rule.tilt_deg),
+                                           g.uniform(-rule.tilt_deg, rule.tilt_deg),
+                                           g.uniform(-rule.yaw_deg, rule.yaw_deg)), noise_ut=float(noise_ut))
+
+
+def draw_compasses(rule: CompassDrawRule, paper_min_deg: float, paper_max_deg: float,
+                   noise_ut: float) -> pd.DataFrame:
+    """The robustness study's compasses: the first ``rule.n_compasses`` draws whose noiseless
+    uncompensated error envelope lies within ``rule.tolerance_deg`` of ``paper_min_deg..paper_max_deg``.
+    One row per compass: ``compass`` (name), ``draw`` (index), ``errors`` (:class:`CompassErrors`, with
+    ``noise_ut``), ``min_deg``, ``max_deg`` (the envelope), and the mix: ``hard_frac`` (horizontal hard
+    iron / H), ``soft_max`` (largest |S| entry), ``tilt_deg`` (largest of roll, pitch), ``yaw_deg``."""
+    rows = []
+    for k in range(rule.max_draws):
+        e = draw_compass(rule, k, 0.0)
+        err = simulate_sweep(e, seed=0).heading_error_deg.to_numpy()
+        lo, hi = float(err.min()), float(err.max())
+        if abs(lo - paper_min_deg) <= rule.tolerance_deg and abs(hi - paper_max_deg) <= rule.tolerance_deg:
+            rows.append({"compass": f"C{len(rows) + 1}", "draw": k, "errors": replace(e, noise_ut=float(noise_ut)),
+                         "min_deg": lo, "max_deg": hi,
+                         "hard_frac": float(np.hypot(*e.hard_iron_ut[:2]) / EarthField().horizontal_ut),
+                         "soft_max": float(np.abs(np.asarray(e.soft_iron)).max()),
+                         "tilt_deg": float(max(abs(e.misalignment_deg[0]), abs(e.misalignment_deg[1]))),
+                         "yaw_deg": float(e.misalignment_deg[2])})
+            if len(rows) == rule.n_compasses:
+                break
+    if len(rows) < rule.n_compasses:
+        raise InputError(f"robustness: only {len(rows)} of {rule.n_compasses} compasses within "
+                         f"{rule.tolerance_deg} deg of the paper's envelope in {rule.max_draws} draws")
+    return pd.DataFrame(rows)
+
+
+#: The methods of the robustness study: the readings' methods except ADE's rule readings, and the floor.
+ROBUST_METHODS = tuple(dict.fromkeys([i for r, ids in READINGS.items() if r not in RULE_READINGS for i in ids]
+                                     + list(LS_MODELS) + ["physical"]))
+
+
+def robustness_study(compasses: pd.DataFrame, paper: pd.DataFrame, params: StudyParams = StudyParams(),
+                     seeds=range(6), methods=ROBUST_METHODS, sim_seed: int = 2024, workers: int = 1,
+                     scheduler: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Every claim of :func:`claims` on each compass of :func:`draw_compasses`: sweeps simulated from the
+    compass (``sim_seed``, the chapter's noise), :func:`seed_study` of ``methods`` over ``seeds`` (all
+    compasses' tasks on the engine at once), the claims at that noise.  Returns ``(runs, verdicts)``:
+    the runs with a ``compass`` column, and one row per (compass, claim, reading) with the verdict."""
+    studies = [(Sweeps(*split_sweeps(simulate_train_test(e, seed=sim_seed))), params, seeds, methods)
+               for e in compasses.errors]
+    frames = seed_studies(studies, workers=workers, scheduler=scheduler)
+    rows, allruns = [], []
+    for (name, e), runs in zip(zip(compasses.compass, compasses.errors), frames):
+        allruns.append(runs.assign(compass=name))
+        for c in claims(runs, paper, default_ut=e.noise_ut):
+            rows.append({"compass": name, "claim": c.claim, "reading": c.reading, "verdict": c.verdict})
+    return pd.concat(allruns, ignore_index=True), pd.DataFrame(rows)
+
+
+def robustness_table(robust: pd.DataFrame, main_claims=None) -> pd.DataFrame:
+    """Claim and reading x compass: the verdicts of :func:`robustness_study` (plus the chapter's own compass,
+    ``main_claims``, as column ``default``) and ``stable`` (True when every compass gives the same verdict)."""
+    df = robust.copy()
+    if main_claims is not None:
+        keep = set(zip(df.claim, df.reading))
+        df = pd.concat([pd.DataFrame([{"compass": "default", "claim": c.claim, "reading": c.reading,
+                                       "verdict": c.verdict} for c in main_claims
+                                      if (c.claim, c.reading) in keep]), df], ignore_index=True)
+    t = df.pivot_table(index=["claim", "reading"], columns="compass", values="verdict", aggfunc="first",
+                       sort=False)
+    t = t[list(dict.fromkeys(df.compass))]
+    t["stable"] = t.nunique(axis=1) == 1
+    return t
