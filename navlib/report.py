@@ -453,8 +453,8 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
     significant digits.  ``tables`` adds top-level lists of records (e.g. ``"robustness"``: one
     ``{"compass", "claim", "reading", "verdict"}`` per simulated compass, claim and reading); their names
-    must not be one of the keys above.  An existing file (an earlier run's) is never replaced unless ``overwrite=True``:
-    the call stops with one line naming it.  Returns the path written; it displays as ``results written:
+    must not be one of the keys above.  An existing file (an earlier run's) is never replaced unless
+    ``overwrite=True``: the call stops with one line naming it.  Returns the path written; it displays as ``results written:
     <chapter>.json``, the same in every run, so a notebook cell that ends with this call shows no
     run-specific folder."""
     if not chapter.isidentifier():

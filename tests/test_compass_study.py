@@ -417,7 +417,7 @@ def test_patent_b_claims_paired_sources_and_by_construction():
     # paired by seed: back-tuned 0.12 + 0.001 k against BP 0.125 + 0.001 k: exactly 0.005 better in each seed
     bp = by["ELM back-tuned beats BP MATLAB (trainlm)"]
     assert bp.estimate.lo == pytest.approx(0.005) and bp.verdict == "reproduced"
-    assert by["ELM back-tuned beats 8-position LS [Smith 5 terms]"].estimate.n == 8          # LS paired with every seed
+    assert by["ELM back-tuned beats 8-position LS [Smith 5 terms]"].estimate.n == 8   # LS paired with every seed
     nodes = by["back-tuning needs fewer nodes for the same training goal"]
     assert nodes.estimate.value == 2 and nodes.verdict == "reproduced" and nodes.unit == "nodes"
     assert by["the data preparation lowers the error on sweeps with glitches"].verdict == "reproduced"

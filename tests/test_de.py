@@ -112,8 +112,8 @@ def _trials(pop, cr, bound=1e9, f=1.0, seed=0):
     fit = np.zeros(pop.shape[:2])
     trial = np.empty_like(pop)
     n = pop.shape[1]
-    de_trials(pop, xoshiro_states(generators([seed])), np.full((1, n), float(f)), np.full((1, n), float(cr)), bound,
-              trial)
+    de_trials(pop, xoshiro_states(generators([seed])), np.full((1, n), float(f)), np.full((1, n), float(cr)),
+              bound, trial)
     return trial[0]
 
 
@@ -189,7 +189,8 @@ def test_cr_by_value_and_by_rank_differ_when_fitness_spans_decades():
     assert np.all(by_value[:3] < 0.11) and by_value[3] == pytest.approx(0.9)
     np.testing.assert_allclose(by_rank, [0.1, 0.1 + 0.8 / 3, 0.1 + 1.6 / 3, 0.9])
     np.testing.assert_allclose(ade_cr(np.full(5, 2.0), 0.1, 0.9, "value"), 0.1)
-    np.testing.assert_allclose(ade_cr(np.array([3.0, 3.0, 1.0]), 0.1, 0.9, "rank"), [0.5, 0.9, 0.1])  # ties by index
+    ties = ade_cr(np.array([3.0, 3.0, 1.0]), 0.1, 0.9, "rank")
+    np.testing.assert_allclose(ties, [0.5, 0.9, 0.1])                   # ties ranked by index
 
 
 def test_kernel_uses_each_individuals_own_f_and_cr():

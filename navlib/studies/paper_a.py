@@ -226,9 +226,9 @@ class MethodSpec:
     family: tuple | None = None     # ((adaptive, f_rule, cr_rule), variant): runs sharing one full DE stage
 
 
-#: ADE's default rules (:class:`navlib.methods.de.DEParams`) and the other readings of section 1.2, as
-#: (f_rule, cr_rule, id suffix, label part).
+#: ADE's default rules (:class:`navlib.methods.de.DEParams`): F by generation, CR by value.
 ADE_DEFAULT_RULES = ("generation", "value")
+#: The other readings of ADE's rules in section 1.2, as (f_rule, cr_rule, id suffix, label part).
 ADE_RULE_READINGS = (("individual", "value", "f_ind", "F per individual"),
                      ("combined", "value", "f_comb", "F combined"),
                      ("generation", "rank", "cr_rank", "CR by rank"),
@@ -707,8 +707,9 @@ _READING_ASSUMPTIONS = {
 for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
     for _base in (R1, R4):
         _READING_ASSUMPTIONS[_rule_reading(_base, _lab)] = (
-            f"{_READING_ASSUMPTIONS[_base]}; ADE's F {_f.replace('individual', 'per individual').replace('generation', 'by generation')}"
-            f", CR by {_c} (the default reads F by generation, CR by value)")
+            f"{_READING_ASSUMPTIONS[_base]}; ADE's F "
+            f"{ {'individual': 'per individual', 'generation': 'by generation'}.get(_f, _f)}, CR by {_c} "
+            f"(the default reads F by generation, CR by value)")
 
 
 def per_seed(runs: pd.DataFrame, method: str, col: str = "rms_deg") -> pd.Series:
@@ -818,10 +819,11 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
         pairs = [("ADE-BP beats DE-BP", ade, de, "ADE-BP", "DE-BP", "ade_de", None)]
         if not ade_only:
             pairs.append(("DE-BP beats BP", de, bp, "DE-BP", "BP network", "de_bp", None))
+        lsp = "8-position least squares"
         for ls in ls_models:
             if not ade_only:
-                pairs.append(("BP beats 8-position LS", bp, ls, "BP network", "8-position least squares", "bp_ls", ls))
-            pairs.append(("ADE-BP beats 8-position LS", ade, ls, "ADE-BP", "8-position least squares", "ade_ls", ls))
+                pairs.append(("BP beats 8-position LS", bp, ls, "BP network", lsp, "bp_ls", ls))
+            pairs.append(("ADE-BP beats 8-position LS", ade, ls, "ADE-BP", lsp, "ade_ls", ls))
         for text, better, worse, pb, pw, key, ls in pairs:
             est, short = verdicts.attempt(paired_rms_difference, runs, worse, better)
             rb, rw = per_seed(runs, better), per_seed(runs, worse)
@@ -1025,7 +1027,8 @@ def convergence_claims(reach: pd.DataFrame, de: str = "de_bp_pure", ade: str = "
         out.append(Claim(f"ADE-BP converges faster than DE-BP (training RMS {rms:g} deg)",
                          "faster convergence (no numbers)", reading=reading, source="paper",
                          statistic=f"generations DE-BP needs - generations ADE-BP needs to reach J = "
-                                   f"{reach[reach.rms_level_deg == rms].j_level.iloc[0]:.4g} deg^2, paired by seed",
+                                   f"{reach[reach.rms_level_deg == rms].j_level.iloc[0]:.4g} deg^2, paired by "
+                                   f"seed",
                          estimate=est, boundary=0.0, holds_when="above", unit="generations", spec="{:.0f}",
                          decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY),
                          why="; ".join(t for t in (short, f"{never} runs never reached it (counted as G + 1)"
@@ -1097,7 +1100,8 @@ def draw_compass(rule: CompassDrawRule, k: int, noise_ut: float) -> CompassError
     g = np.random.default_rng(sequence(rule.seed, k))
     h = EarthField().horizontal_ut * g.uniform(*rule.hard_frac)
     ang = g.uniform(0.0, 2 * np.pi)
-    return CompassErrors(hard_iron_ut=(h * np.cos(ang), h * np.sin(ang), g.uniform(-rule.hard_z_ut, rule.hard_z_ut)),
+    hz = g.uniform(-rule.hard_z_ut, rule.hard_z_ut)
+    return CompassErrors(hard_iron_ut=(h * np.cos(ang), h * np.sin(ang), hz),
                          soft_iron=tuple(map(tuple, g.uniform(-rule.soft, rule.soft, (3, 3)))),
                          scale_error=tuple(g.uniform(-rule.scale, rule.scale, 3)),
                          nonorthogonality_deg=tuple(g.uniform(-rule.nonorth_deg, rule.nonorth_deg, 3)),
@@ -1110,9 +1114,10 @@ def draw_compasses(rule: CompassDrawRule, paper_min_deg: float, paper_max_deg: f
                    noise_ut: float) -> pd.DataFrame:
     """The robustness study's compasses: the first ``rule.n_compasses`` draws whose noiseless
     uncompensated error envelope lies within ``rule.tolerance_deg`` of ``paper_min_deg..paper_max_deg``.
-    One row per compass: ``compass`` (name), ``draw`` (index), ``errors`` (:class:`CompassErrors`, with
-    ``noise_ut``), ``min_deg``, ``max_deg`` (the envelope), and the mix: ``hard_frac`` (horizontal hard
-    iron / H), ``soft_max`` (largest |S| entry), ``tilt_deg`` (largest of roll, pitch), ``yaw_deg``."""
+    One row per compass: ``compass`` (name), ``draw`` (index), ``errors``
+    (:class:`navlib.sensors.compass.CompassErrors`, with ``noise_ut``), ``min_deg``, ``max_deg`` (the
+    envelope), and the mix: ``hard_frac`` (horizontal hard iron / H), ``soft_max`` (largest |S| entry),
+    ``tilt_deg`` (largest of roll, pitch), ``yaw_deg``."""
     rows = []
     for k in range(rule.max_draws):
         e = draw_compass(rule, k, 0.0)
