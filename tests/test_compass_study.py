@@ -457,12 +457,13 @@ def test_patent_b_small_sample_claim_per_trainer():
 def test_parallel_studies_give_the_same_numbers(sw):
     """Workers only change where runs execute: seed and noise studies equal with 1 and 2 processes."""
     p = StudyParams(de=DEParams(max_generations=40), lm=replace(StudyParams().lm, epochs=20))
-    methods = ("ls8", "ade_bp_pure", "de_bp_hybrid_trainlm", "bp_matlab_val", "elm_backtuned")
+    methods = ("ls8", "ade_bp_pure", "ade_bp_full_trainlm_val", "de_bp_hybrid_trainlm", "bp_matlab_val",
+               "elm_backtuned")                  # ade_bp_pure and its full hybrid: one family, one DE stage
     cols = ["method", "seed", "min_deg", "max_deg", "rms_deg", "n_nodes", "epochs", "stop"]
     one = seed_study(sw, p, seeds=range(4), methods=methods)
     two = seed_study(sw, p, seeds=range(4), methods=methods, workers=2)
     pd.testing.assert_frame_equal(one[cols], two[cols])
-    assert len(one) == 1 + 4 * 4
+    assert len(one) == 1 + 5 * 4
     n1 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"))
     n2 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"), workers=2)
     pd.testing.assert_frame_equal(n1[cols + ["noise_ut"]], n2[cols + ["noise_ut"]])
@@ -537,7 +538,8 @@ def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):
 
 
 def test_generations_to_reach_and_the_convergence_claims():
-    from navlib.studies.paper_a import convergence_claims, convergence_curves, generations_to_reach
+    from navlib.studies.paper_a import (convergence_claims, convergence_curves, generations_to_reach,
+                                        reach_summary)
     n = 10
     runs = _history_runs([150] * n, [60] * n, np.geomspace(10, 1000, n), np.geomspace(50, 60, n))
     reach = generations_to_reach(runs, rms_levels=(1.0,))
@@ -551,6 +553,9 @@ def test_generations_to_reach_and_the_convergence_claims():
     assert stable.boundary == 1.0 and stable.rule == "bootstrap over rows" and stable.verdict == "reproduced"
     swapped = convergence_claims(reach, de="ade_bp_pure", ade="de_bp_pure", seed=1)
     assert [c.verdict for c in swapped] == ["not reproduced", "not reproduced"]
+    summary = reach_summary(generations_to_reach(runs, rms_levels=(1.0, 0.1)))
+    assert len(summary) == 4 and list(summary["share reached"]) == [1.0, 0.0, 1.0, 0.0]
+    assert list(summary["generations (median)"]) == [150, 201, 60, 201]
     curves = convergence_curves(runs)
     assert len(curves) == 2 * 200 and np.all(curves.j_p10 <= curves.j_median + 1e-12)
 
@@ -581,10 +586,21 @@ def simulate_sweep_errors(e):
 
 
 def test_robustness_table_marks_verdicts_that_change_with_the_compass():
-    from navlib.studies.paper_a import robustness_table
+    from navlib.studies.paper_a import robustness_flips, robustness_table
     robust = pd.DataFrame([{"compass": k, "claim": c, "reading": "r", "verdict": v}
                            for k, c, v in (("C1", "a", "reproduced"), ("C2", "a", "reproduced"),
                                            ("C1", "b", "reproduced"), ("C2", "b", "not reproduced"))])
     t = robustness_table(robust)
     assert list(t.columns) == ["C1", "C2", "stable"]
     assert bool(t.loc[("a", "r"), "stable"]) and not bool(t.loc[("b", "r"), "stable"])
+    flips = robustness_flips(t)
+    assert not flips[("a", "r")] and flips[("b", "r")]
+    undecided = robust.assign(verdict=robust.verdict.replace({"not reproduced": "cannot be judged"}))
+    t2 = robustness_table(undecided)
+    assert not t2.loc[("b", "r"), "stable"] and not robustness_flips(t2).any()   # unstable, but no flip
+
+
+def test_fig4_draws_de_bp_against_ade_bp_in_every_reading():
+    from navlib.studies.paper_a import fig4_panels
+    drawn = {m for _, ids in fig4_panels() for m in ids}
+    assert {ids[3] for ids in READINGS.values()} <= drawn and {ids[2] for ids in READINGS.values()} <= drawn

@@ -1175,3 +1175,30 @@ def robustness_table(robust: pd.DataFrame, main_claims=None) -> pd.DataFrame:
     t = t[list(dict.fromkeys(df.compass))]
     t["stable"] = t.nunique(axis=1) == 1
     return t
+
+
+def robustness_flips(table: pd.DataFrame) -> pd.Series:
+    """Per row of :func:`robustness_table`: True when the compasses give both *reproduced* and *not
+    reproduced* (a change that a wider interval alone cannot make)."""
+    verdict_cols = [c for c in table.columns if c != "stable"]
+    return table[verdict_cols].apply(lambda r: {"reproduced", "not reproduced"} <= set(r), axis=1)
+
+
+def reach_summary(reach: pd.DataFrame) -> pd.DataFrame:
+    """Per (method, training-RMS level) of :func:`generations_to_reach`: the median generations, the share
+    of runs that reached the level, and the final J's median, 10th and 90th percentiles (deg^2)."""
+    g = reach.groupby(["label", "rms_level_deg"], sort=False)
+    return pd.DataFrame({"generations (median)": g.generations.median(), "share reached": g.reached.mean(),
+                         "final J (deg2)": g.final_j.median(), "J p10": g.final_j.quantile(0.1),
+                         "J p90": g.final_j.quantile(0.9)}).reset_index().rename(
+        columns={"rms_level_deg": "train rms (deg)"})
+
+
+def fig4_panels() -> list[tuple[str, list[str]]]:
+    """The panels of the chapter's Fig 4 (DE-BP against ADE-BP after compensation): one per main reading
+    (its DE-BP and ADE-BP), then pure DE and full DE + trainlm with every reading of ADE's rules."""
+    panels = [(r, [READINGS[r][2], READINGS[r][3]]) for r in BASE_READINGS]
+    for base in (R1, R4):
+        panels.append((f"{base}, ADE rules", [READINGS[base][2], READINGS[base][3]]
+                       + [ade for r, ade in RULE_READINGS.items() if r.startswith(base)]))
+    return panels
