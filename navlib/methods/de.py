@@ -18,17 +18,27 @@ fitness (lower fitness = better):
 
     q_i = (f_i - f_min) / (f_max - f_min)                         (0 for the best, 1 for the worst)
 
-    F by generation (``f_rule='generation'``, the default, :func:`ade_f`):
-        F(t) = F_max - (F_max - F_min) t / (G_max - 1),      t = 0 .. G_max - 1
-    F per individual (``'individual'``, :func:`ade_f_individual`; worse -> larger F, the form of the
-    printed CR equation with the F bounds):
-        F_i(t) = F_min + (F_max - F_min) q_i
-    F combining both (``'combined'``): the worst individual follows the generation schedule, the best
-    keeps F_min:
-        F_i(t) = F_min + (F(t) - F_min) q_i
+- F by generation (``f_rule='generation'``, the default, :func:`ade_f`)::
 
-    CR by value (``cr_rule='value'``, the default, :func:`ade_cr`):   CR_i = CR_min + (CR_max - CR_min) q_i
-    CR by rank (``'rank'``):   CR_i = CR_min + (CR_max - CR_min) r_i / (NP - 1)
+      F(t) = F_max - (F_max - F_min) t / (G_max - 1),      t = 0 .. G_max - 1
+
+- F per individual (``'individual'``, :func:`ade_f_individual`; worse -> larger F, the form of the
+  printed CR equation with the F bounds)::
+
+      F_i(t) = F_min + (F_max - F_min) q_i
+
+- F combining both (``'combined'``): the worst individual follows the generation schedule, the best keeps
+  F_min::
+
+      F_i(t) = F_min + (F(t) - F_min) q_i
+
+- CR by value (``cr_rule='value'``, the default, :func:`ade_cr`)::
+
+      CR_i = CR_min + (CR_max - CR_min) q_i
+
+- CR by rank (``'rank'``)::
+
+      CR_i = CR_min + (CR_max - CR_min) r_i / (NP - 1)
 
 with ``r_i`` the individual's 0-based rank (0 = best; ties broken by index).  When ``f_max == f_min``,
 ``q_i = 0`` (F_min, CR_min).  Defaults: F by generation, because the only prose about F describes a fall

@@ -1116,7 +1116,7 @@ def draw_compasses(rule: CompassDrawRule, paper_min_deg: float, paper_max_deg: f
     uncompensated error envelope lies within ``rule.tolerance_deg`` of ``paper_min_deg..paper_max_deg``.
     One row per compass: ``compass`` (name), ``draw`` (index), ``errors``
     (:class:`navlib.sensors.compass.CompassErrors`, with ``noise_ut``), ``min_deg``, ``max_deg`` (the
-    envelope), and the mix: ``hard_frac`` (horizontal hard iron / H), ``soft_max`` (largest |S| entry),
+    envelope), and the mix: ``hard_frac`` (horizontal hard iron / H), ``soft_max`` (largest ``abs`` entry of S),
     ``tilt_deg`` (largest of roll, pitch), ``yaw_deg``."""
     rows = []
     for k in range(rule.max_draws):
