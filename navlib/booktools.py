@@ -568,8 +568,9 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
     """Differences between a fresh results file and its committed reference: the same methods and
     statistics (numbers within ``atol + rtol * |reference|``, seed counts equal), the same claims (texts,
     source, rule, side) with the same verdicts, estimates, intervals and boundaries (within the same
-    tolerance; a ``volatile`` claim, a timing, is compared on its verdict, texts and boundary only), and
-    the same ``extra`` keys (their values are free-form, timings among them, and are not compared)."""
+    tolerance; a ``volatile`` claim, a timing, is compared on its verdict, texts and boundary only), the
+    same top-level tables of records (``write_results(tables=...)``, compared exactly), and the same
+    ``extra`` keys (their values are free-form, timings among them, and are not compared)."""
     p = []
     fm, rm = fresh.get("methods") or {}, ref.get("methods") or {}
     if fresh.get("unit") != ref.get("unit"):
@@ -614,6 +615,11 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
                 len(x) == len(y) == 2 and all(_is_num(u) and _is_num(v) and _close(u, v, rtol, atol)
                                               for u, v in zip(x, y)))):
             p.append(f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)")
+    base = {"chapter", "unit", "methods", "claims", "extra"}
+    for key in sorted((set(fresh) | set(ref)) - base):          # tables of records (write_results tables=)
+        if fresh.get(key) != ref.get(key):
+            p.append(f"{name}: table {key!r} differs from the reference's "
+                     f"({len(fresh.get(key) or [])} records, reference {len(ref.get(key) or [])})")
     fe, re_ = fresh.get("extra") or {}, ref.get("extra") or {}
     if set(fe) != set(re_):
         p.append(f"{name}: extra keys {sorted(fe)} differ from the reference's {sorted(re_)}")

@@ -444,7 +444,8 @@ def method_stats(rms, min_err=None, max_err=None) -> dict:
 def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = None,
                   methods: Mapping[str, Mapping[str, Any]] | None = None,
                   extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
-                  overwrite: bool = False) -> Path:
+                  overwrite: bool = False, tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None
+                  ) -> Path:
     """Write ``<folder>/<chapter>.json`` (``folder`` defaults to :func:`results_dir`)::
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
@@ -453,8 +454,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
 
     ``methods`` maps a display label to :func:`method_stats`-style keys (without unit suffix); the unit
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
-    significant digits.  An existing file (an earlier run's) is never replaced unless ``overwrite=True``:
-    the call stops with one line naming it.  Returns the path written; it displays as ``results written:
+    significant digits.  ``tables`` adds top-level lists of records (e.g. ``"robustness"``: one
+    ``{"compass", "claim", "reading", "verdict"}`` per simulated compass, claim and reading); their names
+    must not be one of the keys above.  An existing file (an earlier run's) is never replaced unless
+    ``overwrite=True``: the call stops with one line naming it.  Returns the path written; it displays as ``results written:
     <chapter>.json``, the same in every run, so a notebook cell that ends with this call shows no
     run-specific folder."""
     if not chapter.isidentifier():
@@ -484,6 +487,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if extra:
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}
+    for name, records in (tables or {}).items():
+        if name in ("chapter", "unit", "methods", "claims", "extra") or not str(name).isidentifier():
+            raise InputError(f"write_results({chapter!r}): table name {name!r} is reserved or not an identifier")
+        out[str(name)] = [{str(k): plain(v) for k, v in dict(r).items()} for r in records]
     d = Path(folder) if folder is not None else results_dir()
     text = json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
     path = d / f"{chapter}.json"

@@ -311,3 +311,21 @@ def test_compare_results_checks_intervals_except_for_a_volatile_timing():
     flipped["claims"][0]["volatile"] = True
     assert any("verdict" in p for p in compare_results(flipped, vol_ref, "c"))    # its verdict may not
     assert any("volatile" in p for p in compare_results(vol, ref, "c"))
+
+
+def test_compare_results_compares_tables_of_records_exactly(tmp_path):
+    """write_results(tables=...) writes top-level lists (the compass chapter's "robustness"); a changed or
+    missing record is a difference from the reference."""
+    from navlib import report
+    claim = report.Claim("c", "p", statistic="x, deg", estimate=None, boundary=0.0, holds_when="above",
+                         why="no statistic")
+    rows = [{"compass": "C1", "claim": "c", "reading": "r", "verdict": "reproduced"}]
+    path = report.write_results("demo", claims=[claim], folder=tmp_path, tables={"robustness": rows})
+    res = json.loads(path.read_text())
+    assert res["robustness"] == rows
+    other = json.loads(path.read_text())
+    other["robustness"][0]["verdict"] = "not reproduced"
+    assert any("robustness" in p for p in compare_results(other, res, "demo"))
+    assert compare_results(json.loads(path.read_text()), res, "demo") == []
+    with pytest.raises(Exception, match="reserved"):
+        report.write_results("demo2", claims=[claim], folder=tmp_path, tables={"claims": rows})

@@ -15,7 +15,8 @@ from navlib.sensors.compass import SweepConfig, simulate_train_test
 from navlib.methods.compensator import HeadingTarget
 from navlib.methods.de import DEParams
 from navlib import verdicts
-from navlib.studies.paper_a import (LEGACY_NAMES, METHODS, READINGS, R1 as READINGS_R1, StudyParams, Sweeps,
+from navlib.studies.paper_a import (LS_MODELS, RULE_READINGS, fit_family, LEGACY_NAMES, METHODS, READINGS,
+                                    R1 as READINGS_R1, StudyParams, Sweeps,
                                     claims, compensate, fit_method, floor_curve, implied_noise_ut, largest_noise,
                                     method_id, noise_study, ordering_probability, ordering_rate, ordering_table,
                                     paired_rms_difference, seed_study,
@@ -24,6 +25,8 @@ from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, 
     node_count_curve, nodes_to_goal_runs, prepare_patent_data, small_sample_study, small_sample_summary)
 from navlib.studies.patent_b import claims as patent_b_claims
 from navlib.errors import InputError
+from navlib.angles import wrap_deg
+from navlib.methods.smith import design, eight_position_indices, fit_smith
 from navlib.paths import data_path
 
 
@@ -71,7 +74,7 @@ def test_hybrid_reaches_floor_and_pure_does_not(sw):
 
 def test_claims_and_verdict_table(sw):
     p = StudyParams(de=DEParams(max_generations=100), lm=replace(StudyParams().lm, epochs=50))
-    ids = sorted({i for r in READINGS.values() for i in r} | {"physical"})
+    ids = sorted({i for r in READINGS.values() for i in r} | {"physical"} | set(LS_MODELS))
     runs = seed_study(sw, p, seeds=range(6), methods=ids)
     paper = pd.read_csv(data_path("paper_a_error_ranges.csv"))
     cl = claims(runs, paper, default_ut=0.04, floor=floor_curve(grid_ut=np.linspace(0.01, 0.05, 5)))
@@ -80,10 +83,18 @@ def test_claims_and_verdict_table(sw):
     keys = [c.key for c in cl]
     assert len(set(keys)) == len(keys) and all(keys)
     vt = verdict_table(cl)
-    assert list(vt.columns) == list(READINGS) and vt.notna().all().all()
+    assert list(vt.columns) == list(READINGS)
+    base = [r for r in READINGS if r not in RULE_READINGS]
+    assert (vt[base] != "-").all().all()
+    for r in RULE_READINGS:                              # only the claims involving ADE-BP
+        judged = vt.index[vt[r] != "-"]
+        assert len(judged) and all("ADE-BP" in c for c in judged)
 
     def ranges(name):
         return [c for c in cl if c.claim.startswith(f"{name} error within") and "default" in c.claim]
+
+    def ls_ranges(model):
+        return [c for c in cl if c.claim.startswith(f"LS [{model}] error within") and "default" in c.claim]
 
     # the default noise floor (physical model's band, 0.49 deg wide) is wider than ADE-BP's printed 0.42 deg:
     # that claim cannot be judged, whatever the method does, and says which noise it would need
@@ -91,12 +102,13 @@ def test_claims_and_verdict_table(sw):
         assert c.verdict == "cannot be judged" and c.basis == "noise floor"
         assert c.floor.value > c.boundary and "uT" in c.floor.needs and "0.04 uT" in c.floor.assumption
         assert c.floor.needs == "noise at most 0.03 uT"       # widths 0.37 deg at 0.03 uT, 0.49 at 0.04
-    for c in ranges("LS") + ranges("BP") + ranges("DE-BP"):
+    for c in ls_ranges("Smith 5 terms") + ranges("BP") + ranges("DE-BP"):
         assert c.floor.value < c.boundary                      # the floor resolves these widths
-    assert all(c.reproduced is False for c in ranges("LS"))   # LS band about 2.9 deg wide, paper 1.06
-    ls = ranges("LS")[0]
+    assert all(c.reproduced is False for c in ls_ranges("Smith 5 terms"))   # band about 2.9 deg wide, paper 1.06
+    assert all(c.reproduced is True for c in ls_ranges("planar 5 par."))   # band about 0.66 deg wide
+    ls = ls_ranges("Smith 5 terms")[0]
     assert ls.rule == "exact" and ls.boundary == pytest.approx(0.45 + 0.61)
-    assert len(ordering_table(runs)) == 3 * 2          # bp_adam not run: two BP variants per reading
+    assert len(ordering_table(runs)) == 5 * 2          # bp_adam not run: two BP variants per full reading
 
 
 def _synthetic_runs(rms, width, seeds=range(8), phys_width=0.3):
@@ -149,12 +161,13 @@ def test_claims_sides_boundaries_and_floor():
     cl = [c for c in claims(_synthetic_runs(rms, {"bp_matlab": 0.5, "de_bp_pure": 0.7, "ade_bp_pure": 0.2}),
                             paper, default_ut=0.04) if c.reading == READINGS_R1]
     by = {c.claim.split(",")[0]: c for c in cl}
-    for text in ("ADE-BP beats DE-BP", "DE-BP beats BP", "BP beats 8-position LS", "ADE-BP beats 8-position LS"):
+    for text in ("ADE-BP beats DE-BP", "DE-BP beats BP", "BP beats 8-position LS [Smith 5 terms]",
+                 "ADE-BP beats 8-position LS [Smith 5 terms]"):
         c = by[text]
         assert c.holds_when == "above" and c.boundary == 0.0 and c.rule == "paired difference" and c.floor is None
     assert by["ADE-BP beats DE-BP"].verdict == "reproduced"
-    assert by["BP beats 8-position LS"].verdict == "not reproduced"
-    order = by["one run shows LS > BP > DE-BP > ADE-BP"]
+    assert by["BP beats 8-position LS [Smith 5 terms]"].verdict == "not reproduced"
+    order = by["one run shows LS > BP > DE-BP > ADE-BP [Smith 5 terms]"]
     assert order.rule == "wilson rate" and order.boundary == 0.5 and order.holds_when == "above"
     assert order.estimate.value == 0.0 and order.verdict == "not reproduced"       # BP above LS in every seed
     for name, row in (("ADE-BP", "ADE-BP"), ("DE-BP", "DE-BP"), ("BP", "BP network")):
@@ -408,7 +421,7 @@ def test_patent_b_claims_paired_sources_and_by_construction():
     # paired by seed: back-tuned 0.12 + 0.001 k against BP 0.125 + 0.001 k: exactly 0.005 better in each seed
     bp = by["ELM back-tuned beats BP MATLAB (trainlm)"]
     assert bp.estimate.lo == pytest.approx(0.005) and bp.verdict == "reproduced"
-    assert by["ELM back-tuned beats 8-position LS"].estimate.n == 8          # LS paired with every seed
+    assert by["ELM back-tuned beats 8-position LS [Smith 5 terms]"].estimate.n == 8   # LS paired with every seed
     nodes = by["back-tuning needs fewer nodes for the same training goal"]
     assert nodes.estimate.value == 2 and nodes.verdict == "reproduced" and nodes.unit == "nodes"
     assert by["the data preparation lowers the error on sweeps with glitches"].verdict == "reproduced"
@@ -448,13 +461,150 @@ def test_patent_b_small_sample_claim_per_trainer():
 def test_parallel_studies_give_the_same_numbers(sw):
     """Workers only change where runs execute: seed and noise studies equal with 1 and 2 processes."""
     p = StudyParams(de=DEParams(max_generations=40), lm=replace(StudyParams().lm, epochs=20))
-    methods = ("ls8", "ade_bp_pure", "de_bp_hybrid_trainlm", "bp_matlab_val", "elm_backtuned")
+    methods = ("ls8", "ade_bp_pure", "ade_bp_full_trainlm_val", "de_bp_hybrid_trainlm", "bp_matlab_val",
+               "elm_backtuned")                  # ade_bp_pure and its full hybrid: one family, one DE stage
     cols = ["method", "seed", "min_deg", "max_deg", "rms_deg", "n_nodes", "epochs", "stop"]
     one = seed_study(sw, p, seeds=range(4), methods=methods)
     two = seed_study(sw, p, seeds=range(4), methods=methods, workers=2)
     pd.testing.assert_frame_equal(one[cols], two[cols])
-    assert len(one) == 1 + 4 * 4
+    assert len(one) == 1 + 5 * 4
     n1 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"))
     n2 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"), workers=2)
     pd.testing.assert_frame_equal(n1[cols + ["noise_ut"]], n2[cols + ["noise_ut"]])
     assert set(n1.noise_ut) == {0.01, 0.05} and len(n1) == 2 * (1 + 2)
+
+
+def test_new_readings_are_registered_with_their_labels():
+    labels = {m.label for m in METHODS.values()}
+    for lab in ("ADE-BP full DE + trainlm", "ADE-BP full DE + trainlm, val. stop", "DE-BP full DE + trainlm",
+                "ADE-BP F per individual", "ADE-BP F combined", "ADE-BP CR by rank",
+                "LS 8-position (Smith, 5 terms)", "LS 8-position (planar, 5 par.)",
+                "LS 8-position (harmonic, 3rd order)"):
+        assert lab in labels
+    for reading, ade in RULE_READINGS.items():
+        assert READINGS[reading][3] == ade and METHODS[ade].family[0][0] is True
+        assert METHODS[ade].family[0][1:] != ("generation", "value")      # not the default rules
+
+
+def test_third_order_ls_on_eight_readings_reproduces_a_third_order_error_exactly(sw):
+    """A compass whose deviation is a known harmonic series to 3rd order in the measured heading: the
+    3rd-order 8-position LS recovers it exactly (every test heading corrected to 1e-9 deg), Smith's 5 terms
+    cannot (the 3rd harmonic aliases at 8 positions)."""
+    coef = np.array([0.7, 3.0, -2.0, 1.1, 0.4, 1.2, -0.8])               # A, B1, C1, B2, C2, B3, C3 (deg)
+
+    def deviation(m):
+        return design(m, 3) @ coef
+
+    true = np.arange(0.0, 363.0, 3.0)
+    m = true.copy()
+    for _ in range(200):                                                 # measured: m - delta(m) = true
+        m = true + deviation(m)
+    assert np.max(np.abs(m - deviation(m) - true)) < 1e-10
+    model = fit_smith(np.mod(m[eight_position_indices(true)], 360.0), true[eight_position_indices(true)], 3)
+    np.testing.assert_allclose(model.coef, coef, atol=1e-9)
+    h3 = fit_method("ls8_h3", m, true)[0]
+    smith = fit_method("ls8", m, true)[0]
+    assert np.max(np.abs(wrap_deg(h3.correct(m) - true))) < 1e-9
+    assert np.max(np.abs(wrap_deg(smith.correct(m) - true))) > 0.5
+    with pytest.raises(InputError, match="7 coefficients"):
+        fit_smith(m[:6], true[:6], 3)
+
+
+def test_family_of_one_de_stage_equals_each_method_alone(sw):
+    """Pure DE and full DE + trainlm (with and without the validation stop) fitted from one shared DE stage
+    give the same networks as each method fitted alone with the same seeds."""
+    p = StudyParams(de=DEParams(max_generations=30), lm=replace(StudyParams().lm, epochs=15))
+    mids = ("ade_bp_pure_f_ind", "ade_bp_full_trainlm_f_ind")
+    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=[3, 4])
+    for mid in mids:
+        alone = fit_method(mid, sw.x_train, sw.t_train, p, seeds=[3, 4])
+        for a, b in zip(fam[mid], alone):
+            np.testing.assert_array_equal(a.net.theta, b.net.theta)
+    mids = ("ade_bp_pure", "ade_bp_full_trainlm", "ade_bp_full_trainlm_val")
+    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=[1])
+    for mid in mids:
+        np.testing.assert_array_equal(fam[mid][0].net.theta,
+                                      fit_method(mid, sw.x_train, sw.t_train, p, seeds=[1])[0].net.theta)
+    with pytest.raises(InputError, match="share one DE stage"):
+        fit_family(("ade_bp_pure", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
+
+
+def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):
+    """Synthetic pure-DE runs: J falls from 1e5 to 121 (train RMS 1 deg) at generation first_* then to
+    final_*; one row per seed with its ``de_history``."""
+    rows = []
+    for mid, firsts, finals in (("de_bp_pure", first_de, final_de), ("ade_bp_pure", first_ade, final_ade)):
+        for s, (f, jf) in enumerate(zip(firsts, finals)):
+            h = np.geomspace(1e5, 121.0, f)
+            h = np.concatenate([h, np.geomspace(121.0, jf, gens - f)])
+            rows.append({"method": mid, "label": METHODS[mid].label, "seed": s, "de_history": h})
+    return pd.DataFrame(rows)
+
+
+def test_generations_to_reach_and_the_convergence_claims():
+    from navlib.studies.paper_a import (convergence_claims, convergence_curves, generations_to_reach,
+                                        reach_summary)
+    n = 10
+    runs = _history_runs([150] * n, [60] * n, np.geomspace(10, 1000, n), np.geomspace(50, 60, n))
+    reach = generations_to_reach(runs, rms_levels=(1.0,))
+    assert set(reach.generations[reach.method == "de_bp_pure"]) == {150}      # J <= 121 first at generation f
+    assert set(reach.generations[reach.method == "ade_bp_pure"]) == {60}
+    never = generations_to_reach(runs, rms_levels=(0.1,))
+    assert not never.reached.any() and set(never.generations) == {201}          # G + 1 when never reached
+    cl = convergence_claims(reach, seed=1)
+    faster, stable = cl
+    assert faster.estimate.value == 90 and faster.verdict == "reproduced"
+    assert stable.boundary == 1.0 and stable.rule == "bootstrap over rows" and stable.verdict == "reproduced"
+    swapped = convergence_claims(reach, de="ade_bp_pure", ade="de_bp_pure", seed=1)
+    assert [c.verdict for c in swapped] == ["not reproduced", "not reproduced"]
+    summary = reach_summary(generations_to_reach(runs, rms_levels=(1.0, 0.1)))
+    assert len(summary) == 4 and list(summary["share reached"]) == [1.0, 0.0, 1.0, 0.0]
+    assert list(summary["generations (median)"]) == [150, 201, 60, 201]
+    curves = convergence_curves(runs)
+    assert len(curves) == 2 * 200 and np.all(curves.j_p10 <= curves.j_median + 1e-12)
+
+
+def test_compasses_are_drawn_by_the_stated_rule():
+    from navlib.studies.paper_a import CompassDrawRule, draw_compass, draw_compasses
+    rule = CompassDrawRule(n_compasses=3)
+    c = draw_compasses(rule, -16.0, 30.7, 0.04)
+    assert list(c.compass) == ["C1", "C2", "C3"] and np.all(np.diff(c.draw) > 0)
+    assert np.all(np.abs(c.min_deg + 16.0) <= 2.0) and np.all(np.abs(c.max_deg - 30.7) <= 2.0)
+    assert all(e.noise_ut == 0.04 for e in c.errors)
+    assert np.all((c.hard_frac >= 0.2) & (c.hard_frac <= 0.6))
+    assert draw_compass(rule, int(c.draw[1]), 0.04) == c.errors[1]             # a draw depends on its key only
+    # the rejected draws before the first kept one are outside the tolerance
+    first = int(c.draw[0])
+    for k in range(first):
+        err = simulate_sweep_errors(draw_compass(rule, k, 0.0))
+        assert abs(err.min() + 16.0) > 2.0 or abs(err.max() - 30.7) > 2.0
+    with pytest.raises(InputError, match="only"):
+        draw_compasses(replace(rule, max_draws=first + 1), -16.0, 30.7, 0.04)
+    with pytest.raises(InputError, match="hard_frac"):
+        CompassDrawRule(hard_frac=(0.5, 0.2))
+
+
+def simulate_sweep_errors(e):
+    from navlib.sensors.compass import simulate_sweep
+    return simulate_sweep(e, seed=0).heading_error_deg.to_numpy()
+
+
+def test_robustness_table_marks_verdicts_that_change_with_the_compass():
+    from navlib.studies.paper_a import robustness_flips, robustness_table
+    robust = pd.DataFrame([{"compass": k, "claim": c, "reading": "r", "verdict": v}
+                           for k, c, v in (("C1", "a", "reproduced"), ("C2", "a", "reproduced"),
+                                           ("C1", "b", "reproduced"), ("C2", "b", "not reproduced"))])
+    t = robustness_table(robust)
+    assert list(t.columns) == ["C1", "C2", "stable"]
+    assert bool(t.loc[("a", "r"), "stable"]) and not bool(t.loc[("b", "r"), "stable"])
+    flips = robustness_flips(t)
+    assert not flips[("a", "r")] and flips[("b", "r")]
+    undecided = robust.assign(verdict=robust.verdict.replace({"not reproduced": "cannot be judged"}))
+    t2 = robustness_table(undecided)
+    assert not t2.loc[("b", "r"), "stable"] and not robustness_flips(t2).any()   # unstable, but no flip
+
+
+def test_fig4_draws_de_bp_against_ade_bp_in_every_reading():
+    from navlib.studies.paper_a import fig4_panels
+    drawn = {m for _, ids in fig4_panels() for m in ids}
+    assert {ids[3] for ids in READINGS.values()} <= drawn and {ids[2] for ids in READINGS.values()} <= drawn

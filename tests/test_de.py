@@ -4,8 +4,8 @@ from scipy.optimize import differential_evolution
 
 from dataclasses import replace
 
-from navlib.methods.de import DEParams, ade_cr, ade_f, evolve, evolve_many
-from navlib.methods.jit import de_trials, sample_parents, sample_uniform, xoshiro_states
+from navlib.methods.de import DEParams, ade_cr, ade_f, ade_rates, evolve, evolve_many
+from navlib.methods.jit import ade_rates_into, de_trials, sample_parents, sample_uniform, xoshiro_states
 from navlib.methods.seeding import generators
 from navlib.errors import InputError
 
@@ -85,7 +85,7 @@ def test_ade_f_schedule():
     assert f[1500] == pytest.approx(0.9 - 0.6 * 1500 / 2999)
 
 
-def test_ade_cr_from_fitness_rank():
+def test_ade_cr_from_fitness_value():
     fit = np.array([5.0, 1.0, 3.0, 9.0])
     cr = ade_cr(fit, 0.1, 0.9)
     assert cr[1] == pytest.approx(0.1)            # best -> CR_min
@@ -111,7 +111,9 @@ def _trials(pop, cr, bound=1e9, f=1.0, seed=0):
     pop = np.ascontiguousarray(pop[None], dtype=float)
     fit = np.zeros(pop.shape[:2])
     trial = np.empty_like(pop)
-    de_trials(pop, fit, xoshiro_states(generators([seed])), f, cr, False, 0.1, 0.9, bound, trial)
+    n = pop.shape[1]
+    de_trials(pop, xoshiro_states(generators([seed])), np.full((1, n), float(f)), np.full((1, n), float(cr)),
+              bound, trial)
     return trial[0]
 
 
@@ -147,8 +149,96 @@ def test_zero_crossover_changes_exactly_the_forced_gene_and_out_of_box_genes_are
 
 @pytest.mark.parametrize("field,value,msg", [
     ("pop_size", 3, "NP"), ("f", 0.0, "F"), ("f", 2.5, "F"), ("cr", 1.5, "CR"), ("bound", -1, "bound"),
-    ("max_generations", 0, "max_generations"),
+    ("max_generations", 0, "max_generations"), ("f_rule", "rank", "f_rule"), ("cr_rule", "generation", "cr_rule"),
 ])
 def test_bad_de_parameters(field, value, msg):
     with pytest.raises(InputError, match=msg):
         DEParams(**{field: value})
+
+
+# ---------------------------------------------------------------------------------------- ADE's readings
+FIT = np.array([5.0, 1.0, 3.0, 9.0])          # q = (f - 1) / 8 = [1/2, 0, 1/4, 1]; ranks [2, 0, 1, 3]
+
+
+@pytest.mark.parametrize("f_rule,cr_rule,f_expected,cr_expected", [
+    ("generation", "value", [0.6, 0.6, 0.6, 0.6], [0.5, 0.1, 0.3, 0.9]),
+    ("individual", "value", [0.6, 0.3, 0.45, 0.9], [0.5, 0.1, 0.3, 0.9]),
+    ("combined", "value", [0.45, 0.3, 0.375, 0.6], [0.5, 0.1, 0.3, 0.9]),
+    ("generation", "rank", [0.6, 0.6, 0.6, 0.6], [0.1 + 0.8 * 2 / 3, 0.1, 0.1 + 0.8 / 3, 0.9]),
+    ("combined", "rank", [0.45, 0.3, 0.375, 0.6], [0.1 + 0.8 * 2 / 3, 0.1, 0.1 + 0.8 / 3, 0.9]),
+])
+def test_ade_rules_on_a_population_with_known_fitness(f_rule, cr_rule, f_expected, cr_expected):
+    """At generation 1500 of 3001 the schedule gives F(t) = 0.9 - 0.6 / 2 = 0.6; every reading's F_i and
+    CR_i from the equations of navlib.methods.de, each population of a batch on its own."""
+    p = DEParams(max_generations=3001, adaptive=True, f_rule=f_rule, cr_rule=cr_rule)
+    batch = np.stack([FIT, 10 * FIT + 7])       # an affine copy: the same q and ranks
+    f, cr = ade_rates(batch, 1500, p)
+    assert f.shape == cr.shape == batch.shape
+    for row in range(2):
+        np.testing.assert_allclose(f[row], f_expected, rtol=1e-12)
+        np.testing.assert_allclose(cr[row], cr_expected, rtol=1e-12)
+    f0, cr0 = ade_rates(batch, 1500, replace(p, adaptive=False))          # DE: fixed F and CR
+    assert np.all(f0 == p.f) and np.all(cr0 == p.cr)
+
+
+def test_cr_by_value_and_by_rank_differ_when_fitness_spans_decades():
+    """Fitness over four decades: by value all but the worst sit near CR_min, by rank they are evenly
+    spread; equal fitness gives CR_min by value."""
+    fit = np.array([1.0, 10.0, 100.0, 1e4])
+    by_value, by_rank = ade_cr(fit, 0.1, 0.9, "value"), ade_cr(fit, 0.1, 0.9, "rank")
+    assert np.all(by_value[:3] < 0.11) and by_value[3] == pytest.approx(0.9)
+    np.testing.assert_allclose(by_rank, [0.1, 0.1 + 0.8 / 3, 0.1 + 1.6 / 3, 0.9])
+    np.testing.assert_allclose(ade_cr(np.full(5, 2.0), 0.1, 0.9, "value"), 0.1)
+    ties = ade_cr(np.array([3.0, 3.0, 1.0]), 0.1, 0.9, "rank")
+    np.testing.assert_allclose(ties, [0.5, 0.9, 0.1])                   # ties ranked by index
+
+
+def test_kernel_uses_each_individuals_own_f_and_cr():
+    """Per-individual F_i and CR_i reach the compiled generation: with individual i = 2^i in every gene and
+    full crossover, u_i = 2^r1 + F_i (2^r2 - 2^r3) for some distinct r1, r2, r3 != i (the numpy
+    statement of the mutation); with CR_i = 0 exactly one gene (j_rand) comes from the mutant."""
+    n, dim = 10, 5
+    pop = np.ascontiguousarray(np.tile(2.0 ** np.arange(n)[:, None], (1, dim))[None])
+    f = np.where(np.arange(n) % 2 == 0, 1.0, 0.5)[None]
+    cr = np.ones((1, n))
+    trial = np.empty_like(pop)
+    de_trials(pop, xoshiro_states(generators([4])), f, cr, 1e9, trial)
+    for i in range(n):
+        v = trial[0, i, 0]
+        assert np.all(trial[0, i] == v)
+        assert any(len({a, b, c, i}) == 4 and 2.0 ** a + f[0, i] * (2.0 ** b - 2.0 ** c) == v
+                   for a in range(n) for b in range(n) for c in range(n)), (i, v)
+    rng = np.random.default_rng(5)
+    pop = np.ascontiguousarray(rng.uniform(-1, 1, (1, 20, 8)))
+    cr = np.where(np.arange(20) < 10, 0.0, 1.0)[None]
+    de_trials(pop, xoshiro_states(generators([6])), np.full((1, 20), 0.5), cr, 1e9, trial := np.empty_like(pop))
+    changed = (trial[0] != pop[0]).sum(axis=1)
+    assert np.all(changed[:10] == 1) and np.all(changed[10:] == 8)
+
+
+@pytest.mark.parametrize("f_rule,cr_rule", [("individual", "value"), ("combined", "rank"), ("generation", "rank")])
+def test_every_ade_reading_optimises_and_batches_equal_runs_alone(f_rule, cr_rule):
+    p = DEParams(pop_size=30, max_generations=300, target_fitness=1e-10, bound=5, adaptive=True,
+                 f_rule=f_rule, cr_rule=cr_rule)
+    batch = evolve_many(shifted_sphere, 4, p, generators([0, 1]))
+    assert all(r.fitness < 1e-6 for r in batch)
+    alone = evolve_many(shifted_sphere, 4, p, generators([1]))[0]
+    np.testing.assert_array_equal(batch[1].x, alone.x)
+
+
+@pytest.mark.parametrize("f_rule", ["generation", "individual", "combined"])
+@pytest.mark.parametrize("cr_rule", ["value", "rank"])
+def test_compiled_rates_equal_the_numpy_reference(f_rule, cr_rule):
+    """The compiled ADE rates used by evolve_many equal ade_rates (numpy) exactly, ties and flat runs
+    included."""
+    rng = np.random.default_rng(7)
+    fit = np.exp(rng.normal(0, 4, (3, 30)))
+    fit[1, :5] = fit[1, 5]                      # ties
+    fit[2] = 2.5                                # a flat run
+    p = DEParams(max_generations=500, adaptive=True, f_rule=f_rule, cr_rule=cr_rule)
+    f_ref, cr_ref = ade_rates(fit, 123, p)
+    f, cr = np.empty_like(fit), np.empty_like(fit)
+    ade_rates_into(fit, float(ade_f(123, 500, p.f_min, p.f_max)), p.f_min, p.f_max, p.cr_min, p.cr_max,
+                   ("generation", "individual", "combined").index(f_rule), cr_rule == "rank", f, cr)
+    np.testing.assert_array_equal(f, f_ref)
+    np.testing.assert_array_equal(cr, cr_ref)

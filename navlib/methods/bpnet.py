@@ -388,6 +388,49 @@ def train_de_many(x, t, n_hidden: int, params: DEParams, rngs) -> tuple[list[BPN
     return nets, results
 
 
+#: The trainings that share one full DE stage (:func:`train_de_family`).
+FAMILY_VARIANTS = ("pure", "trainlm", "trainlm_val")
+
+
+def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
+                    variants=FAMILY_VARIANTS) -> dict[str, list[BPNet]]:
+    """One DE / ADE stage run to its own stop (the paper's target read in deg^2: in practice the full
+    ``max_generations``), and from it every training in ``variants``:
+
+    - ``'pure'``: the stage's best individual (:func:`train_de_many`, paper A's first reading);
+    - ``'trainlm'``: ``trainlm`` from it on all readings (:func:`train_hybrid_many` with
+      ``target='deg2'``);
+    - ``'trainlm_val'``: the same with the ``dividerand`` split and validation stop, the split drawn from
+      each run's generator after the stage.
+
+    Each variant equals what its own trainer gives with the same generators (the stage draws first, only
+    ``'trainlm_val'`` draws after it), at the cost of one DE stage.  Returns ``{variant: nets}``."""
+    variants = tuple(variants)
+    for v in variants:
+        check_choice("variant", v, FAMILY_VARIANTS)
+    x, t = _check_xy(x, t, n_hidden)
+    rngs = _rngs(rngs)
+    de_nets, _ = train_de_many(x, t, n_hidden, params, rngs)
+    out: dict[str, list[BPNet]] = {}
+    if "pure" in variants:
+        out["pure"] = de_nets
+    theta0 = np.stack([n.theta for n in de_nets])
+    name = "ADE-BP" if params.adaptive else "DE-BP"
+    for v in ("trainlm", "trainlm_val"):
+        if v not in variants:
+            continue
+        validation = v == "trainlm_val"
+        splits = [dividerand(len(x), g) for g in rngs] if validation else None
+        nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
+                             splits, name + " full DE + trainlm" + (", val. stop" if validation else ""))
+        for net, de in zip(nets, de_nets):
+            net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
+                            de_theta=de.theta, de_history=de.history)
+            net.train_time_s += de.train_time_s
+        out[v] = nets
+    return out
+
+
 def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
                       validation: bool = False, target: Literal["deg2", "normalised"] = "normalised"
                       ) -> list[BPNet]:

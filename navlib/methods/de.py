@@ -7,17 +7,44 @@ Storn & Price (1997), as used by paper A (Yue et al.):
     selection  x_i <- u_i if J(u_i) <= J(x_i)
 
 DE (paper's DE-BP): fixed F = 0.5, CR = 0.6.
-ADE (paper's ADE-BP): F falls from F_max = 0.9 to F_min = 0.3 over the generations and each individual gets
-its own CR from its fitness rank, CR_min = 0.1 .. CR_max = 0.9, worse individuals getting larger CR.
-The OCR lost the F equation; we use the linear schedule
+ADE (paper's ADE-BP), section 1.2 of the original: F and CR are printed per individual, ``F_i(t)`` and
+``CR_i(t)``, next to the definitions of ``f_i(t)`` (the individual's fitness) and ``f_min(t)``, ``f_max(t)``
+(the population's best and worst); the OCR kept only ``CR_i(t) = CR_min + (CR_max - CR_min) ...`` and lost
+both fractions.  The prose: "early in the run F is large, which keeps the population diverse; as the
+generations advance F falls, which speeds up late convergence; an individual of poor fitness gets a larger
+CR so that it is replaced sooner, a good one a smaller CR so that it survives".  Every form consistent with
+that text is a reading (``DEParams.f_rule``, ``DEParams.cr_rule``); with ``q_i`` the individual's scaled
+fitness (lower fitness = better):
 
-    F(t) = F_max - (F_max - F_min) t / (G_max - 1),      t = 0 .. G_max - 1           (:func:`ade_f`)
+    q_i = (f_i - f_min) / (f_max - f_min)                         (0 for the best, 1 for the worst)
 
-and the CR equation as printed in the digest (min-max scaled fitness; lower fitness = better)
+- F by generation (``f_rule='generation'``, the default, :func:`ade_f`)::
 
-    CR_i = CR_min + (CR_max - CR_min) (f_i - f_min) / (f_max - f_min)                  (:func:`ade_cr`)
+      F(t) = F_max - (F_max - F_min) t / (G_max - 1),      t = 0 .. G_max - 1
 
-(all individuals get CR_min when f_max == f_min).  Out-of-bounds genes of a trial are re-drawn uniformly
+- F per individual (``'individual'``, :func:`ade_f_individual`; worse -> larger F, the form of the
+  printed CR equation with the F bounds)::
+
+      F_i(t) = F_min + (F_max - F_min) q_i
+
+- F combining both (``'combined'``): the worst individual follows the generation schedule, the best keeps
+  F_min::
+
+      F_i(t) = F_min + (F(t) - F_min) q_i
+
+- CR by value (``cr_rule='value'``, the default, :func:`ade_cr`)::
+
+      CR_i = CR_min + (CR_max - CR_min) q_i
+
+- CR by rank (``'rank'``)::
+
+      CR_i = CR_min + (CR_max - CR_min) r_i / (NP - 1)
+
+with ``r_i`` the individual's 0-based rank (0 = best; ties broken by index).  When ``f_max == f_min``,
+``q_i = 0`` (F_min, CR_min).  Defaults: F by generation, because the only prose about F describes a fall
+with the generations (and the digest reads it so); CR by value, because the printed fragment is
+``(CR_max - CR_min)`` times a fraction next to the definitions of ``f_i``, ``f_min`` and ``f_max``, which
+is the min-max scaling of the values.  Out-of-bounds genes of a trial are re-drawn uniformly
 within the bounds, as scipy does.  The objective receives the whole trial population ``(NP, D)`` and returns
 ``(NP,)`` fitness values: one vectorised call per generation.
 
@@ -31,18 +58,27 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Literal
 
 import numpy as np
 
-from ..errors import InputError, check_param
-from .jit import de_select, de_trials, xoshiro_states
+from ..errors import InputError, check_choice, check_param
+from .jit import ade_rates_into, de_select, de_trials, xoshiro_states
 from .seeding import generators
+
+
+#: ADE's readings of the adaptive mutation factor and crossover rate (module docstring).
+F_RULES = ("generation", "individual", "combined")
+CR_RULES = ("value", "rank")
 
 
 @dataclass(frozen=True)
 class DEParams:
     """Settings of DE/rand/1/bin; ``adaptive=True`` gives paper A's ADE. Defaults are paper A's.
+
+    ``f_rule`` and ``cr_rule`` choose the reading of ADE's adaptive F and CR (module docstring; ignored
+    unless ``adaptive``): F ``'generation'`` (default), ``'individual'`` or ``'combined'``; CR ``'value'``
+    (default) or ``'rank'``.
 
     ``seed`` is the run index of :mod:`navlib.methods.seeding` used by :func:`evolve` (``evolve_many``
     takes one generator per run instead)."""
@@ -59,6 +95,8 @@ class DEParams:
     cr_max: float = 0.9
     bound: float = 10.0          # search box [-bound, bound] for every gene (initial population and trials)
     seed: int = 0
+    f_rule: Literal["generation", "individual", "combined"] = "generation"
+    cr_rule: Literal["value", "rank"] = "value"
 
     def __post_init__(self):
         check_param("NP (pop_size)", self.pop_size, lo=4, integer=True)
@@ -74,6 +112,8 @@ class DEParams:
             raise InputError(f"parameter f_min={self.f_min} is above f_max={self.f_max}")
         if self.cr_min > self.cr_max:
             raise InputError(f"parameter cr_min={self.cr_min} is above cr_max={self.cr_max}")
+        check_choice("f_rule", self.f_rule, F_RULES)
+        check_choice("cr_rule", self.cr_rule, CR_RULES)
 
 
 def ade_f(generation, max_generations: int, f_min: float = 0.3, f_max: float = 0.9):
@@ -83,14 +123,61 @@ def ade_f(generation, max_generations: int, f_min: float = 0.3, f_max: float = 0
     return f_max - (f_max - f_min) * np.clip(frac, 0.0, 1.0)
 
 
-def ade_cr(fitness, cr_min: float = 0.1, cr_max: float = 0.9) -> np.ndarray:
-    """Per-individual crossover rate from fitness (lower is better): the best gets ``cr_min``, the worst
-    ``cr_max``, linear in between."""
+def scaled_fitness(fitness) -> np.ndarray:
+    """``q_i = (f_i - f_min) / (f_max - f_min)`` along the last axis (each population on its own): 0 for the
+    best individual, 1 for the worst, 0 for all when every fitness is equal."""
     f = np.asarray(fitness, dtype=float)
-    lo, hi = f.min(), f.max()
-    if hi <= lo:
-        return np.full(f.shape, cr_min)
-    return cr_min + (cr_max - cr_min) * (f - lo) / (hi - lo)
+    lo, hi = f.min(axis=-1, keepdims=True), f.max(axis=-1, keepdims=True)
+    spread = hi - lo
+    return np.where(spread > 0, (f - lo) / np.where(spread > 0, spread, 1.0), 0.0)
+
+
+def fitness_rank(fitness) -> np.ndarray:
+    """0-based rank of every individual along the last axis (0 = lowest fitness = best; ties by index)."""
+    f = np.asarray(fitness, dtype=float)
+    order = np.argsort(f, axis=-1, kind="stable")
+    rank = np.empty(f.shape, dtype=float)
+    np.put_along_axis(rank, order, np.broadcast_to(np.arange(f.shape[-1], dtype=float), f.shape), axis=-1)
+    return rank
+
+
+def ade_cr(fitness, cr_min: float = 0.1, cr_max: float = 0.9, rule: str = "value") -> np.ndarray:
+    """Per-individual crossover rate from fitness (lower is better), the best getting ``cr_min``, the worst
+    ``cr_max``: ``rule='value'`` linear in the fitness value, ``CR_min + (CR_max - CR_min) q_i``
+    (:func:`scaled_fitness`; ``cr_min`` for all when every fitness is equal), ``rule='rank'`` linear in the
+    rank, ``CR_min + (CR_max - CR_min) r_i / (NP - 1)`` (:func:`fitness_rank`).  Along the last axis."""
+    check_choice("cr_rule", rule, CR_RULES)
+    f = np.asarray(fitness, dtype=float)
+    if rule == "rank":
+        return cr_min + (cr_max - cr_min) * fitness_rank(f) / (f.shape[-1] - 1)
+    lo, hi = f.min(axis=-1, keepdims=True), f.max(axis=-1, keepdims=True)
+    # the same operations, in the same order, as the former compiled rule (bit-identical numbers)
+    return np.where(hi > lo, cr_min + (cr_max - cr_min) * (f - lo) / np.where(hi > lo, hi - lo, 1.0), cr_min)
+
+
+def ade_f_individual(fitness, f_min: float = 0.3, f_max: float = 0.9, f_top=None) -> np.ndarray:
+    """Per-individual mutation factor ``F_i = F_min + (F_top - F_min) q_i`` (:func:`scaled_fitness`): the
+    best individual gets ``f_min``, the worst ``f_top`` (``f_max`` by default: the reading "F per
+    individual"; the generation schedule :func:`ade_f` for "combined")."""
+    top = f_max if f_top is None else f_top
+    return f_min + (np.asarray(top, dtype=float) - f_min) * scaled_fitness(fitness)
+
+
+def ade_rates(fitness, generation: int, params: DEParams) -> tuple[np.ndarray, np.ndarray]:
+    """``(F_i, CR_i)`` of every individual of populations ``fitness (..., NP)`` at 0-based ``generation``
+    under ``params`` (fixed F and CR unless ``adaptive``; then the readings ``f_rule``, ``cr_rule``).  The
+    numpy reference of the compiled :func:`navlib.methods.jit.ade_rates_into`, which :func:`evolve_many`
+    calls every generation."""
+    f = np.asarray(fitness, dtype=float)
+    if not params.adaptive:
+        return np.full(f.shape, float(params.f)), np.full(f.shape, float(params.cr))
+    f_gen = float(ade_f(generation, params.max_generations, params.f_min, params.f_max))
+    if params.f_rule == "generation":
+        big_f = np.full(f.shape, f_gen)
+    else:
+        big_f = ade_f_individual(f, params.f_min, params.f_max,
+                                 params.f_max if params.f_rule == "individual" else f_gen)
+    return big_f, ade_cr(f, params.cr_min, params.cr_max, params.cr_rule)
 
 
 @dataclass
@@ -138,7 +225,6 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
         if pop.shape != (n_runs, n, dim):
             raise InputError(f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}")
     fit = np.ascontiguousarray(np.asarray(objective(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n))
-    f_schedule = (ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None)
     history = np.full((n_runs, gmax), np.nan)
     results: list = [None] * n_runs
     ids = np.arange(n_runs)                 # run index of each row still in the batch
@@ -154,6 +240,9 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
 
     trial = np.empty_like(pop)
     best = np.empty(n_runs)
+    # every individual's F and CR (:func:`ade_rates`, compiled as :func:`navlib.methods.jit.ade_rates_into`)
+    f_all, cr_all = np.full((n_runs, n), float(params.f)), np.full((n_runs, n), float(params.cr))
+    f_schedule = ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None
     state = xoshiro_states(rngs)        # each run's own stream for mutation, crossover and re-draws
     g = 0
     while True:
@@ -168,9 +257,12 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
             ids, pop, fit = ids[keep], np.ascontiguousarray(pop[keep]), np.ascontiguousarray(fit[keep])
             state = np.ascontiguousarray(state[keep])
             trial, best = trial[:keep.sum()], best[:keep.sum()]
-        f = f_schedule[g] if params.adaptive else params.f
-        de_trials(pop, fit, state, float(f), float(params.cr), bool(params.adaptive), float(params.cr_min),
-                  float(params.cr_max), b, trial)
+        f_i, cr_i = f_all[:ids.size], cr_all[:ids.size]
+        if params.adaptive:
+            ade_rates_into(fit, float(f_schedule[g]), float(params.f_min), float(params.f_max),
+                           float(params.cr_min), float(params.cr_max), F_RULES.index(params.f_rule),
+                           params.cr_rule == "rank", f_i, cr_i)
+        de_trials(pop, state, f_i, cr_i, b, trial)
         tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(ids.size, n)
         de_select(pop, fit, trial, tfit, best)                             # greedy selection, in place
         history[ids, g] = best

@@ -9,7 +9,7 @@ it says which); the tests compare each kernel with that numpy reference.
   (Moshier 1992: range reduction to ``y = k + f``, ``|f| <= 1/2``, degree-6 polynomial for ``2^f``, and the
   exponent ``k`` written into the float's bits), so the loop over the training points vectorises (libm's
   ``expf`` does not): absolute error of the sigmoid <= 2e-7 over all inputs, the accuracy of float32.
-- :func:`de_trials`, :func:`de_select`: one generation of DE/rand/1/bin (and ADE's per-individual CR) for
+- :func:`de_trials`, :func:`de_select`: one generation of DE/rand/1/bin (with per-individual F and CR) for
   all runs of a batch (:func:`navlib.methods.de.evolve_many`), each run drawing from its own xoshiro256**
   stream (:func:`xoshiro_states`, seeded from the run's numpy Generator).
 - :func:`elm_back_tune` (with :func:`elm_loss`, :func:`elm_loss_grad`): patent B's back-tuning of an ELM,
@@ -225,30 +225,23 @@ def sample_uniform(state, count):
 
 
 @njit(error_model="numpy", cache=True)
-def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
+def de_trials(pop, state, f, cr, bound, trial):
     """Trial vectors of one DE/rand/1/bin generation for every run of a batch (written into ``trial``).
 
-    ``pop (S, NP, D)``, ``fit (S, NP)``, ``state (S, 4)`` the runs' xoshiro256** states (advanced in place).
-    Per individual: parents r1, r2, r3 (distinct, != i) and j_rand uniformly at random, then
+    ``pop (S, NP, D)``, ``state (S, 4)`` the runs' xoshiro256** states (advanced in place), ``f (S, NP)``
+    and ``cr (S, NP)`` every individual's mutation factor and crossover rate (fixed for DE; ADE's readings
+    are computed by :func:`navlib.methods.de.ade_rates`).  Per individual: parents r1, r2, r3 (distinct,
+    != i) and j_rand uniformly at random, then
 
-        v_ij = x_r1,j + F (x_r2,j - x_r3,j);  u_ij = v_ij if U_ij < CR_i or j = j_rand(i) else x_ij;
+        v_ij = x_r1,j + F_i (x_r2,j - x_r3,j);  u_ij = v_ij if U_ij < CR_i or j = j_rand(i) else x_ij;
         u_ij <- U(-bound, bound)   (a fresh uniform)   if abs(u_ij) > bound
 
-    with ``U_ij`` uniform at 16-bit resolution (``k / 2^16``).  ``CR_i`` = ``cr`` or, if ``adaptive``,
-    ADE's ``cr_min + (cr_max - cr_min)(f_i - f_min)/(f_max - f_min)`` within the run (``cr_min`` for all
-    when every fitness is equal)."""
+    with ``U_ij`` uniform at 16-bit resolution (``k / 2^16``)."""
     n_runs, n_pop, dim = pop.shape
     for s in range(n_runs):
-        lo, hi = fit[s, 0], fit[s, 0]
-        if adaptive:
-            for i in range(1, n_pop):
-                lo = min(lo, fit[s, i])
-                hi = max(hi, fit[s, i])
         for i in range(n_pop):
-            c = cr
-            if adaptive:
-                c = cr_min + (cr_max - cr_min) * (fit[s, i] - lo) / (hi - lo) if hi > lo else cr_min
-            threshold = np.int64(np.ceil(c * 65536.0))       # U < c  <=>  k < ceil(c 2^16)
+            fi = f[s, i]
+            threshold = np.int64(np.ceil(cr[s, i] * 65536.0))       # U < c  <=>  k < ceil(c 2^16)
             r1, r2, r3, x = _parents(state, s, i, n_pop)
             jr = _below(x, dim)
             n_out = 0
@@ -258,7 +251,7 @@ def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
                     bits = next_u64(state, s)
                 k16 = np.int64((bits >> _U(16 * (j % 4))) & _U(0xFFFF))
                 if k16 < threshold or j == jr:
-                    u = pop[s, r1, j] + f * (pop[s, r2, j] - pop[s, r3, j])
+                    u = pop[s, r1, j] + fi * (pop[s, r2, j] - pop[s, r3, j])
                 else:
                     u = pop[s, i, j]
                 trial[s, i, j] = u
@@ -268,6 +261,35 @@ def de_trials(pop, fit, state, f, cr, adaptive, cr_min, cr_max, bound, trial):
                     if abs(trial[s, i, j]) > bound:
                         unit = np.float64(next_u64(state, s) >> _U(11)) * 2.0 ** -53
                         trial[s, i, j] = -bound + 2.0 * bound * unit
+
+
+@njit(error_model="numpy", cache=True)
+def ade_rates_into(fit, f_gen, f_min, f_max, cr_min, cr_max, f_mode, cr_rank, f_out, cr_out):
+    """ADE's per-individual ``F_i`` and ``CR_i`` of every run (``fit (S, NP)``) written into ``f_out`` and
+    ``cr_out``: the compiled form of :func:`navlib.methods.de.ade_rates` (its numpy reference, with the same
+    operations in the same order).  ``f_mode`` 0 = by generation (``f_gen`` for all), 1 = per individual
+    ``f_min + (f_max - f_min) q_i``, 2 = combined ``f_min + (f_gen - f_min) q_i``; ``cr_rank`` False = by
+    value ``cr_min + (cr_max - cr_min) q_i``, True = by rank ``cr_min + (cr_max - cr_min) r_i / (NP - 1)``
+    (ties by index), with ``q_i = (f_i - f_min)/(f_max - f_min)`` (0 when all are equal)."""
+    n_runs, n_pop = fit.shape
+    top = f_max if f_mode == 1 else f_gen
+    for s in range(n_runs):
+        lo, hi = fit[s, 0], fit[s, 0]
+        for i in range(1, n_pop):
+            lo = min(lo, fit[s, i])
+            hi = max(hi, fit[s, i])
+        for i in range(n_pop):
+            if f_mode == 0:
+                f_out[s, i] = f_gen
+            else:
+                q = (fit[s, i] - lo) / (hi - lo) if hi > lo else 0.0
+                f_out[s, i] = f_min + (top - f_min) * q
+            if not cr_rank:
+                cr_out[s, i] = cr_min + (cr_max - cr_min) * (fit[s, i] - lo) / (hi - lo) if hi > lo else cr_min
+        if cr_rank:
+            order = np.argsort(fit[s], kind="mergesort")
+            for r in range(n_pop):
+                cr_out[s, order[r]] = cr_min + (cr_max - cr_min) * r / (n_pop - 1)
 
 
 @njit(cache=True)

@@ -9,6 +9,15 @@ part); D, E: two-cycle (symmetric soft iron).  It is the first-order harmonic ap
 planar model in :mod:`navlib.sensors.compass` (Bowditch, ch. on compass adjustment).  The compensated heading is
 ``h - delta(h)``.  Paper A fits it by least squares to 8 readings, from 0 deg every 45 deg; the paper does
 not print its model, Smith's is the classical choice.
+
+The same least squares with more harmonics (:func:`fit_smith` ``order``): to order ``K``
+
+    delta(h) = A + sum_{k=1..K} (B_k sin kh + C_k cos kh)                                   (eq-harmonic)
+
+has ``2K + 1`` coefficients; Smith's series is ``K = 2``.  Eight readings 45 deg apart determine up to
+``K = 3`` (7 coefficients: the 4th harmonic's sine vanishes at those headings).  A hard iron of a fraction
+``k`` of the horizontal field leaves harmonics of about ``k^n / n`` rad at order ``n``: the 3rd-order series
+absorbs what the 5-term series cannot.
 """
 from __future__ import annotations
 
@@ -22,10 +31,14 @@ from ..errors import InputError
 COEFFICIENTS = ("A", "B", "C", "D", "E")
 
 
-def design(h_deg) -> np.ndarray:
-    """Columns [1, sin h, cos h, sin 2h, cos 2h] for headings in degrees."""
+def design(h_deg, order: int = 2) -> np.ndarray:
+    """Columns ``[1, sin h, cos h, sin 2h, cos 2h, ..., sin Kh, cos Kh]`` (``K = order``) for headings in
+    degrees; ``order=2`` is Smith's A..E."""
     h = np.radians(np.asarray(h_deg, dtype=float))
-    return np.stack([np.ones_like(h), np.sin(h), np.cos(h), np.sin(2 * h), np.cos(2 * h)], axis=-1)
+    cols = [np.ones_like(h)]
+    for k in range(1, int(order) + 1):
+        cols += [np.sin(k * h), np.cos(k * h)]
+    return np.stack(cols, axis=-1)
 
 
 @dataclass(frozen=True)
@@ -34,8 +47,13 @@ class SmithModel:
 
     coef: np.ndarray
 
+    @property
+    def order(self) -> int:
+        """Highest harmonic of the series (2 for Smith's A..E)."""
+        return (len(self.coef) - 1) // 2
+
     def deviation(self, measured_deg) -> np.ndarray:
-        return design(measured_deg) @ self.coef
+        return design(measured_deg, self.order) @ self.coef
 
     def correct(self, measured_deg) -> np.ndarray:
         """Compensated heading in [0, 360)."""
@@ -43,18 +61,25 @@ class SmithModel:
         return np.mod(m - self.deviation(m), 360.0)
 
     def as_dict(self) -> dict:
-        return dict(zip(COEFFICIENTS, map(float, self.coef)))
+        """Coefficients by name: A..E, then ``B3``, ``C3``, ... for the harmonics above the second."""
+        names = list(COEFFICIENTS) + [f"{c}{k}" for k in range(3, self.order + 1) for c in "BC"]
+        return dict(zip(names, map(float, self.coef)))
 
 
-def fit_smith(measured_deg, true_deg) -> SmithModel:
-    """Least-squares A..E from readings; deviation = wrap(measured - true). Needs >= 5 distinct readings."""
+def fit_smith(measured_deg, true_deg, order: int = 2) -> SmithModel:
+    """Least-squares harmonic deviation series (:func:`design`; ``order=2``: Smith's A..E) from readings;
+    deviation = wrap(measured - true).  Needs at least ``2 order + 1`` distinct readings."""
+    if not isinstance(order, (int, np.integer)) or order < 1:
+        raise InputError(f"parameter order: must be an integer >= 1, got {order!r}")
     m = np.asarray(measured_deg, dtype=float)
     t = np.asarray(true_deg, dtype=float)
     if m.shape != t.shape or m.ndim != 1:
         raise InputError("measured and true headings must be 1-D arrays of the same length")
-    if len(np.unique(np.round(np.mod(m, 360.0), 6))) < 5:
-        raise InputError(f"Smith's A..E model needs at least 5 distinct headings, got {len(m)} readings")
-    coef, *_ = np.linalg.lstsq(design(m), wrap_deg(m - t), rcond=None)
+    need = 2 * int(order) + 1
+    if len(np.unique(np.round(np.mod(m, 360.0), 6))) < need:
+        raise InputError(f"a harmonic series of order {order} ({need} coefficients) needs at least {need} "
+                         f"distinct headings, got {len(m)} readings")
+    coef, *_ = np.linalg.lstsq(design(m, order), wrap_deg(m - t), rcond=None)
     return SmithModel(coef)
 
 
