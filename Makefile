@@ -53,8 +53,12 @@ screenshots: $(STAMP)
 
 test: test-lib test-notebooks test-results
 
+# Two pytest processes (pytest-xdist), each test file whole in one of them (module fixtures computed once);
+# TEST_WORKERS=1 runs them in this process.
+TEST_WORKERS ?= 2
 test-lib: $(STAMP)
-	@$(PY) -m pytest -q tests -p no:cacheprovider
+	@if [ "$(TEST_WORKERS)" = 1 ]; then $(PY) -m pytest -q tests -p no:cacheprovider; \
+	 else $(PY) -m pytest -q tests -p no:cacheprovider -n $(TEST_WORKERS) --dist loadfile; fi
 
 # nbval re-executes every notebook; each chapter's last cell rewrites $(GENERATED)/results/<chapter>.json.
 # The folder is cleared first so a stale file cannot pass test-results.
