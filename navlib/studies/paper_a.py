@@ -381,7 +381,7 @@ def label(mid: str) -> str:
 
 def fit_method(method: str, x, reference, params: StudyParams = StudyParams(), seeds=(0,), base_seed: int = 0):
     """Fit ``method`` (an id of ``METHODS``) on measured headings ``x`` (unwrapped) and true headings,
-    one run per seed (run ``k`` uses generator ``k`` of :func:`navlib.methods.seeding.generators`).
+    one run per seed (run ``k`` uses generator ``k`` of :func:`navlib.seeding.generators`).
     Returns the fitted compensators (one for a deterministic method)."""
     spec = METHODS[method_id(method)]
     rngs = generators(seeds if spec.stochastic else [0], base_seed)
