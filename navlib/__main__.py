@@ -9,9 +9,7 @@ worker processes.  The variables must be set before numpy loads, hence here and 
 import os
 import sys
 
-#: One thread for every numerical library (BLAS, OpenMP, MKL, numexpr, Accelerate).
-ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-              "NUMEXPR_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1"}
+from . import ONE_THREAD
 
 
 def run() -> int:

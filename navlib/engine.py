@@ -42,7 +42,7 @@ import uuid
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
 
-from .__main__ import ONE_THREAD
+from . import ONE_THREAD
 from ._optional import installed, need
 from .errors import InputError, check_param
 
