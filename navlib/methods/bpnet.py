@@ -414,21 +414,29 @@ def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = 
     out: dict[str, list[BPNet]] = {}
     if "pure" in variants:
         out["pure"] = de_nets
-    theta0 = np.stack([n.theta for n in de_nets])
     name = "ADE-BP" if params.adaptive else "DE-BP"
     for v in ("trainlm", "trainlm_val"):
-        if v not in variants:
-            continue
-        validation = v == "trainlm_val"
-        splits = [dividerand(len(x), g) for g in rngs] if validation else None
-        nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
-                             splits, name + " full DE + trainlm" + (", val. stop" if validation else ""))
-        for net, de in zip(nets, de_nets):
-            net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
-                            de_theta=de.theta, de_history=de.history)
-            net.train_time_s += de.train_time_s
-        out[v] = nets
+        if v in variants:
+            validation = v == "trainlm_val"
+            out[v] = _trainlm_from_stage(x, t, n_hidden, de_nets, rngs, lm, validation,
+                                         name + " full DE + trainlm" + (", val. stop" if validation else ""))
     return out
+
+
+def _trainlm_from_stage(x, t, n_hidden: int, de_nets: list, rngs, lm: LMParams, validation: bool,
+                        name: str) -> list[BPNet]:
+    """``trainlm`` (:func:`train_lm_many`) from each DE stage's best individual ``de_nets``, with a
+    ``dividerand`` split drawn from each run's generator if ``validation``; ``info`` keeps the stage's
+    ``de_generations``, ``de_fitness``, ``de_theta``, ``de_history`` and the time includes the stage's."""
+    theta0 = np.stack([n.theta for n in de_nets])
+    splits = [dividerand(len(x), g) for g in rngs] if validation else None
+    nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
+                         splits, name)
+    for net, de in zip(nets, de_nets):
+        net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
+                        de_theta=de.theta, de_history=de.history)
+        net.train_time_s += de.train_time_s
+    return nets
 
 
 def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
@@ -449,14 +457,6 @@ def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams 
     span = float(np.ptp(t))
     stage = params if target == "deg2" else replace(params, target_fitness=params.target_fitness * span ** 2)
     de_nets, _ = train_de_many(x, t, n_hidden, stage, rngs)
-    theta0 = np.stack([n.theta for n in de_nets])
-    splits = [dividerand(len(x), g) for g in rngs] if validation else None
     name = ("ADE-BP" if params.adaptive else "DE-BP") + " hybrid (trainlm" + (", val. stop)" if validation
                                                                               else ")")
-    nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
-                         splits, name)
-    for net, de in zip(nets, de_nets):
-        net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
-                        de_theta=de.theta, de_history=de.history)
-        net.train_time_s += de.train_time_s
-    return nets
+    return _trainlm_from_stage(x, t, n_hidden, de_nets, rngs, lm, validation, name)
