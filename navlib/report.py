@@ -526,6 +526,17 @@ def read_results(folder: str | os.PathLike | None = None) -> dict[str, dict]:
     return out
 
 
+def read_result(path: str | os.PathLike) -> dict:
+    """One results file (:func:`write_results`), e.g. to build a chapter's tables from what it wrote."""
+    p = Path(path)
+    try:
+        return json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{p}: no results file there") from None
+    except json.JSONDecodeError as err:
+        raise InputError(f"{p.name}: not valid JSON ({err.msg}, line {err.lineno})") from None
+
+
 def claims_summary(results: Mapping[str, dict]) -> pd.DataFrame:
     """Per chapter, source (the paper's claims or the book's own) and reading: claims reproduced, not
     reproduced, cannot be judged (for the landing page)."""

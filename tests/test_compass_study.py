@@ -84,6 +84,24 @@ def test_claims_and_verdict_table(sw):
     assert len(set(keys)) == len(keys) and all(keys)
     vt = verdict_table(cl)
     assert list(vt.columns) == list(READINGS)
+    # the chapter builds this table from the results file's records: same table
+    from navlib.report import read_result, write_results
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        written = read_result(write_results("compass", claims=cl, folder=tmp))["claims"]
+    pd.testing.assert_frame_equal(verdict_table(written), vt)
+    pd.testing.assert_frame_equal(verdict_table(written, list(RULE_READINGS)), verdict_table(cl, list(RULE_READINGS)))
+    from navlib.studies.paper_a import R4, rule_reading_table
+    rt = rule_reading_table(written, READINGS_R1)
+    assert list(rt.columns) == ["F by generation, CR by value", "F per individual", "F combined", "CR by rank",
+                                "F per individual, CR by rank"]
+    assert len(rt) and all("ADE-BP" in c for c in rt.index)
+    assert (rt["CR by rank"] == vt.loc[rt.index, f"{READINGS_R1}, ADE CR by rank"]).all()
+    assert list(rule_reading_table(written, R4).columns) == list(rt.columns)
+    with pytest.raises(InputError, match="no readings of ADE"):
+        rule_reading_table(written, "2: DE + trainlm")
+    with pytest.raises(InputError, match="no 'verdict'"):
+        verdict_table([{"claim": "x", "reading": "y"}])
     base = [r for r in READINGS if r not in RULE_READINGS]
     assert (vt[base] != "-").all().all()
     for r in RULE_READINGS:                              # only the claims involving ADE-BP
@@ -608,3 +626,33 @@ def test_fig4_draws_de_bp_against_ade_bp_in_every_reading():
     from navlib.studies.paper_a import fig4_panels
     drawn = {m for _, ids in fig4_panels() for m in ids}
     assert {ids[3] for ids in READINGS.values()} <= drawn and {ids[2] for ids in READINGS.values()} <= drawn
+
+
+def test_robustness_judges_every_reading_including_ades_rules():
+    from navlib.studies.paper_a import ROBUST_METHODS
+    assert {i for ids in READINGS.values() for i in ids} <= set(ROBUST_METHODS)
+    assert set(RULE_READINGS.values()) <= set(ROBUST_METHODS) and set(LS_MODELS) <= set(ROBUST_METHODS)
+
+
+def test_choices_study_reuses_the_default_runs_and_reruns_the_others(sw):
+    from navlib.studies.paper_a import choices_study
+    p = StudyParams(de=DEParams(max_generations=60), adam=replace(StudyParams().adam, epochs=30))
+    runs = seed_study(sw, p, seeds=range(3), methods=("de_bp_pure", "ade_bp_pure", "bp_adam"))
+    out = choices_study(sw, p, runs, box_bounds=(5.0, 10.0), box_seeds=range(2), budget_factor=2,
+                        budget_seeds=range(2), target_seeds=range(3))
+    assert list(out.columns) == ["choice", "setting", "method", "runs", "median_rms_deg", "min_rms_deg",
+                                 "max_rms_deg", "default"]
+    assert list(dict.fromkeys(out.choice)) == ["search box", "DE budget", "network target"]
+    d = out[out.default].set_index(["choice", "method"])
+    own = runs[runs.seed < 2].groupby("label").rms_deg
+    assert d.loc[("search box", "ADE-BP pure"), "median_rms_deg"] == pytest.approx(own.median()["ADE-BP pure"])
+    assert d.loc[("search box", "DE-BP pure"), "max_rms_deg"] == pytest.approx(own.max()["DE-BP pure"])
+    assert d.loc[("DE budget", "ADE-BP pure"), "runs"] == 2 and d.loc[("network target", "BP (Adam)"), "runs"] == 3
+    # a setting other than the chapter's is run anew, not copied from the chapter's runs
+    budget = out[out.choice == "DE budget"].set_index("setting")
+    assert budget.loc["120 generations", "median_rms_deg"] != budget.loc["60 generations", "median_rms_deg"]
+    assert (out.min_rms_deg <= out.median_rms_deg).all() and (out.median_rms_deg <= out.max_rms_deg).all()
+    with pytest.raises(InputError, match="seed 3"):
+        choices_study(sw, p, runs, box_seeds=range(4))
+    with pytest.raises(InputError, match="budget_factor"):
+        choices_study(sw, p, runs, budget_factor=1)

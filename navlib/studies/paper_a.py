@@ -939,15 +939,37 @@ NOISE_METHODS = tuple(m for m in MAIN_METHODS if not any(m == ade for ade in RUL
 
 
 def verdict_table(claim_list, readings=None) -> pd.DataFrame:
-    """Claims x readings: the verdict of each claim under each reading (from :func:`claims`); ``readings``
-    selects and orders the columns (default: every reading found).  "-": the claim is not judged in that
-    reading (a reading of ADE's rules judges only the claims that involve ADE-BP)."""
-    rows = [{"claim": c.claim, "reading": c.reading, "verdict": c.verdict} for c in claim_list
-            if readings is None or c.reading in readings]
+    """Claims x readings: the verdict of each claim under each reading; ``claim_list`` holds
+    :class:`navlib.report.Claim` objects (:func:`claims`) or the claim records of a results file
+    (``read_results()["compass"]["claims"]``, the chapter's way); ``readings`` selects and orders the
+    columns (default: every reading found).  "-": the claim is not judged in that reading (a reading of
+    ADE's rules judges only the claims that involve ADE-BP)."""
+    recs = [c if isinstance(c, Mapping) else {"claim": c.claim, "reading": c.reading, "verdict": c.verdict}
+            for c in claim_list]
+    missing = [k for k in ("claim", "reading", "verdict") if recs and k not in recs[0]]
+    if missing:
+        raise InputError(f"verdict_table: a claim record has no {missing[0]!r}")
+    rows = [{"claim": c["claim"], "reading": c["reading"], "verdict": c["verdict"]} for c in recs
+            if readings is None or c["reading"] in readings]
+    if not rows:
+        raise InputError("verdict_table: no claim under the readings asked for")
     df = pd.DataFrame(rows)
     order = list(dict.fromkeys(df.claim))
     cols = [r for r in (readings or dict.fromkeys(df.reading)) if r in set(df.reading)]
     return df.pivot(index="claim", columns="reading", values="verdict").loc[order, cols].fillna("-")
+
+
+def rule_reading_table(claim_list, base: str) -> pd.DataFrame:
+    """:func:`verdict_table` of the claims under ADE's rule readings built on reading ``base`` (``R1`` or
+    ``R4``), the default rules (``base`` itself) first; columns named by the rules only (``'F by
+    generation, CR by value'`` for the default, then each label of :data:`ADE_RULE_READINGS`)."""
+    cols = [base] + [r for r in RULE_READINGS if r.startswith(base + ", ")]
+    if len(cols) == 1:
+        raise InputError(f"rule_reading_table: {base!r} has no readings of ADE's rules")
+    t = verdict_table(claim_list, cols)
+    t = t[t.drop(columns=base).ne("-").any(axis=1)]        # the claims judged under the rule readings
+    return t.rename(columns={base: "F by generation, CR by value"}
+                    | {r: r[len(base) + len(", ADE "):] for r in cols[1:]})
 
 
 def results_methods(runs: pd.DataFrame) -> dict:
@@ -1057,6 +1079,73 @@ def convergence_claims(reach: pd.DataFrame, de: str = "de_bp_pure", ade: str = "
     return out
 
 
+# ----------------------------------------------------------------------------------------------- our choices
+#: The DE search boxes of :func:`choices_study` (the paper gives none; the chapter's default is 10).
+BOX_BOUNDS = (2.0, 5.0, 10.0, 20.0)
+
+
+def choices_study(sw: Sweeps, params: StudyParams, runs: pd.DataFrame, box_bounds=BOX_BOUNDS,
+                  box_seeds=range(4), budget_factor: int = 10, budget_seeds=range(3), target_seeds=range(5),
+                  workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
+    """Is it our choices?  Pure DE-BP and ADE-BP with each DE search box ``[-b, b]`` of ``box_bounds``
+    (``box_seeds``), pure ADE-BP with ``budget_factor`` times ``max_generations`` (``budget_seeds``), and
+    pure ADE-BP and the Adam row with the heading *error* as the network's target (``target_seeds``), all
+    on the engine at once.  Settings equal to the chapter's (the default box, budget and target) are taken
+    from ``runs`` (:func:`seed_study`) at the same seeds, not run again.
+
+    One row per (choice, setting, method): ``choice`` (``'search box'``, ``'DE budget'``,
+    ``'network target'``), ``setting``, ``method`` (label), ``runs``, the test RMS ``median_rms_deg``,
+    ``min_rms_deg`` and ``max_rms_deg`` over the seeds, and ``default`` (True for the chapter's setting).
+    Over a few seeds: the spread (min..max) is shown, not an interval, and no verdict rests on it."""
+    check_param("budget_factor", budget_factor, lo=2, integer=True)
+    box_seeds, budget_seeds, target_seeds = (list(map(int, s)) for s in (box_seeds, budget_seeds, target_seeds))
+    for name, s in (("box_seeds", box_seeds), ("budget_seeds", budget_seeds), ("target_seeds", target_seeds)):
+        if not s:
+            raise InputError(f"choices_study: parameter {name} is empty")
+    pure = ("de_bp_pure", "ade_bp_pure")
+    base_bound, gmax = float(params.de.bound), int(params.de.max_generations)
+    studies, keys = [], []
+    for b in box_bounds:
+        if float(b) != base_bound:
+            studies.append((sw, replace(params, de=replace(params.de, bound=float(b))), box_seeds, pure))
+            keys.append(("search box", float(b)))
+    studies.append((sw, replace(params, de=replace(params.de, max_generations=budget_factor * gmax)),
+                    budget_seeds, ("ade_bp_pure",)))
+    keys.append(("DE budget", budget_factor * gmax))
+    other = "error" if params.network_target == "heading" else "heading"
+    studies.append((sw, replace(params, network_target=other), target_seeds, ("bp_adam", "ade_bp_pure")))
+    keys.append(("network target", other))
+    frames = dict(zip(keys, seed_studies(studies, workers=workers, scheduler=scheduler)))
+
+    def base(mids, seeds):
+        part = runs[runs.method.isin(mids) & runs.seed.isin(seeds)]
+        missing = {(m, s) for m in mids for s in seeds} - set(zip(part.method, part.seed))
+        if missing:
+            m, s = sorted(missing)[0]
+            raise InputError(f"choices_study: runs has no run of {m} with seed {s} (run seed_study with it)")
+        return part
+
+    parts = []
+    for b in box_bounds:
+        key = ("search box", float(b))
+        f = frames[key] if key in frames else base(pure, box_seeds)
+        parts.append(f.assign(choice="search box", setting=f"[-{b:g}, {b:g}]", default=key not in frames))
+    for g, f in ((gmax, base(("ade_bp_pure",), budget_seeds)),
+                 (budget_factor * gmax, frames[("DE budget", budget_factor * gmax)])):
+        parts.append(f.assign(choice="DE budget", setting=f"{g} generations", default=g == gmax))
+    for t, f in ((params.network_target, base(("bp_adam", "ade_bp_pure"), target_seeds)),
+                 (other, frames[("network target", other)])):
+        parts.append(f.assign(choice="network target", setting=t, default=t == params.network_target))
+    df = pd.concat([f.assign(part=k) for k, f in enumerate(parts)], ignore_index=True)
+    df["method"] = df.method.map(label)
+    order = {m: k for k, m in enumerate(map(label, ("de_bp_pure", "ade_bp_pure", "bp_adam")))}
+    df = df.assign(rank=df.method.map(order)).sort_values(["part", "rank"], kind="stable")
+    g = df.groupby(["part", "choice", "setting", "method"], sort=False)
+    return pd.DataFrame({"runs": g.size(), "median_rms_deg": g.rms_deg.median(), "min_rms_deg": g.rms_deg.min(),
+                         "max_rms_deg": g.rms_deg.max(), "default": g["default"].first()}
+                        ).reset_index().drop(columns="part")
+
+
 # ----------------------------------------------------------------------------------------------- robustness
 @dataclass(frozen=True)
 class CompassDrawRule:
@@ -1138,9 +1227,10 @@ def draw_compasses(rule: CompassDrawRule, paper_min_deg: float, paper_max_deg: f
     return pd.DataFrame(rows)
 
 
-#: The methods of the robustness study: the readings' methods except ADE's rule readings, and the floor.
-ROBUST_METHODS = tuple(dict.fromkeys([i for r, ids in READINGS.items() if r not in RULE_READINGS for i in ids]
-                                     + list(LS_MODELS) + ["physical"]))
+#: The methods of the robustness study: every reading's methods (ADE's rule readings included), the LS
+#: models and the floor.
+ROBUST_METHODS = tuple(dict.fromkeys([i for ids in READINGS.values() for i in ids] + list(LS_MODELS)
+                                     + ["physical"]))
 
 
 def robustness_study(compasses: pd.DataFrame, paper: pd.DataFrame, params: StudyParams = StudyParams(),
