@@ -2071,3 +2071,24 @@ def cold_world_claims(params: StudyParams = StudyParams(), workers: int = 1,
             decided_by=common + ("position error from the axial drift error alone (no residual errors)",),
             ours=f"median P {np.median(pos):.2f} nmi", key=f"gyro_cold_world{k}_pos", spec="{:.2f}"))
     return out
+
+
+def thermal_worlds_table(params: StudyParams = StudyParams()) -> pd.DataFrame:
+    """The stated parameter ranges of every thermal world of :func:`cold_thermal_study` (each draw takes its
+    gyro uniformly within them); ``k_G tau`` in (deg/h) per (C/h), from the world's multiples of ``k_R``.
+
+    Parameters
+    ----------
+    params : StudyParams
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per world.
+    """
+    k_r = _k_r_table4()
+    return pd.DataFrame([{"world": w.name, "k_T low (deg/h per C)": w.temp_coeff_deg_h_per_c[0],
+                          "k_T high": w.temp_coeff_deg_h_per_c[1],
+                          "k_G tau low ((deg/h)/(C/h))": w.rate_coeff_in_k_r[0] * k_r,
+                          "k_G tau high": w.rate_coeff_in_k_r[1] * k_r,
+                          "tau low (h)": w.lag_h[0], "tau high (h)": w.lag_h[1]} for w in params.thermal.worlds])
