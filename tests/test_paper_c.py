@@ -15,7 +15,10 @@ from navlib.studies import paper_c as pc
 P = pc.StudyParams()
 FAST = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=1))
 #: the fewest draws with which every claim has its interval (6 runs: 3 tests x 2 draws)
-CLAIMS = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=2))
+CLAIMS = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=2),
+                        thermal=pc.ColdStudySettings(n_draws=7, batch_size=7, worlds=pc.THERMAL_WORLDS[:2]))
+#: claims before issue 21, those of the readings and stored claims it added, and 3 per thermal world
+N_CLAIMS = 16 + 14 + 3 * 2
 
 
 def _t2():
@@ -375,8 +378,8 @@ def _by_key(cl):
 def test_claims_one_per_reading_all_judged_by_the_rule(claims):
     assert all(isinstance(c, Claim) for c in claims)
     keys = [(c.claim, c.reading) for c in claims]
-    assert len(keys) == len(set(keys)) == 16
-    assert len({c.key for c in claims}) == 16 and all(c.key.startswith("gyro_") for c in claims)
+    assert len(keys) == len(set(keys)) == N_CLAIMS
+    assert len({c.key for c in claims}) == N_CLAIMS and all(c.key.startswith("gyro_") for c in claims)
     for c in claims:
         assert c.source == "paper" and c.paper != "(not in the paper)"
         # the verdict is the rule's, from the stored interval, boundary, side and floor
@@ -386,7 +389,7 @@ def test_claims_one_per_reading_all_judged_by_the_rule(claims):
         if c.estimate is not None:
             assert c.holds_when == "below" and c.statistic and c.unit
     t3 = {c.reading: c for c in claims if c.claim.endswith("(Table 3)")}
-    assert len(t3) == 6
+    assert len(t3) == 9
     for c in t3.values():                      # the paper's bound, on Table 3's 3 rows: exact, and says so
         assert c.boundary == pc.fact("claimed_accuracy") and c.rule == "exact"
         assert any("3 rows" in d for d in c.decided_by)
@@ -491,3 +494,79 @@ def test_methods_summary():
         assert stats["median_rms"] <= max(-stats["median_min"], stats["median_max"])
     assert len(m) == 4
     assert pd.notna(m["our RBF, input in deg (LOO)"]["median_rms"])
+
+
+# ------------------------------------------------------------------------------------------ issue 21
+SMALL = pc.StudyParams(thermal=pc.ColdStudySettings(n_draws=7, batch_size=3, worlds=pc.THERMAL_WORLDS[:2]))
+
+
+@pytest.fixture(scope="module")
+def small_study():
+    return pc.cold_thermal_study(SMALL)
+
+
+def test_cold_study_rows_and_batching_do_not_change_results(small_study):
+    assert len(small_study) == 14 and list(small_study["world"].unique()) == [w.name for w in pc.THERMAL_WORLDS[:2]]
+    other = pc.StudyParams(thermal=pc.ColdStudySettings(n_draws=7, batch_size=7, worlds=pc.THERMAL_WORLDS[:2]))
+    again = pc.cold_thermal_study(other)
+    pd.testing.assert_frame_equal(small_study.reset_index(drop=True), again.reset_index(drop=True))
+    # the residual errors and test drifts are shared by the worlds, the gyros differ
+    a, b = (small_study[small_study["world"] == w.name] for w in pc.THERMAL_WORLDS[:2])
+    assert not np.allclose(a["tau (h)"].to_numpy(), b["tau (h)"].to_numpy())
+    w = pc.THERMAL_WORLDS[1]
+    assert b["tau (h)"].between(*w.lag_h).all()
+    for m in pc.COLD_STUDY_METHODS:
+        assert (small_study[f"{m} RMS (deg/h)"] >= 0).all()
+
+
+def test_rate_limit_world_is_the_rate_baselines_own(small_study):
+    # tau -> 0 with k_G tau in the k_R range: the drift is final + k_R dT/dt, the rate correction's model
+    g = small_study[small_study["world"] == pc.THERMAL_WORLDS[0].name]
+    assert (g["hot + rate corr. RMS (deg/h)"] < g["hot net RMS (deg/h)"]).mean() > 0.5
+
+
+def test_new_claims_one_verdict_each(small_study):
+    cl = pc.cold_world_claims(SMALL) + pc.reading_claims(SMALL)
+    keys = [c.key for c in cl]
+    assert len(keys) == len(set(keys))
+    assert {"gyro_cold_world0_z", "gyro_cold_world0_raw", "gyro_cold_world1_pos", "gyro_required_needed",
+            "gyro_cold_hot_miss_rows", "gyro_t3_outputs_arcmin_mse_gauss", "gyro_t3_outputs_arcmin_rss"} <= set(keys)
+    assert all(c.verdict in ("reproduced", "not reproduced", "cannot be judged") for c in cl)
+    rows = {c.key: c for c in cl}
+    t4 = pc.table4_hot_net(SMALL)
+    e = np.abs(t4["err ours"].to_numpy())
+    lo, hi = pc.fact("cold_hot_net_drift_error_min"), pc.fact("cold_hot_net_drift_error_max")
+    assert rows["gyro_cold_hot_miss_rows"].estimate.value == np.sum((e < lo) | (e > hi))
+
+
+def test_scale_scan_contains_the_arcmin_net_and_the_band():
+    scan = pc.input_scale_scan(P, n_scales=9)
+    at60 = scan[(scan["scale"] == 60.0) & (scan["width"] == "matlab")].iloc[0]
+    t3 = pc.table3_identification(P).errors
+    assert at60["max |T3 err| (deg/h)"] == pytest.approx(np.max(np.abs(t3["err our RBF"])))
+    band = pc.scale_band(scan)
+    assert band["lowest scale"].iloc[0] <= 60.0 <= band["highest scale"].iloc[0]
+    w = pc.width_readings(P).set_index("width")
+    assert w.loc["gaussian", "b (per input unit)"] == pytest.approx(1.0 / P.hot.spread)
+    assert w.loc["matlab", "b (per input unit)"] == pytest.approx(0.8326 / P.hot.spread, rel=1e-4)
+
+
+def test_fig2_goal_readings_and_position_requirement():
+    f2 = pc.fig2_goal_readings(P).set_index("goal")
+    assert (f2["neurons at stop"] <= f2["neurons of the full path"]).all()
+    assert f2.loc["RSS", "neurons at stop"] >= f2.loc["MSE", "neurons at stop"]
+    q = pc.position_requirement(FAST)["value"]
+    gain = q.iloc[0]
+    assert q.iloc[2] == pytest.approx(pc.fact("position_goal") / gain)
+    assert q.iloc[1] == pytest.approx(gain * pc.fact("required_accuracy"))
+
+
+def test_thermal_settings_reject_bad_input():
+    with pytest.raises(InputError, match="lag_h"):
+        pc.ThermalWorld("w", lag_h=(2.0, 1.0))
+    with pytest.raises(InputError, match="n_cold_draws"):
+        pc.ColdStudySettings(n_draws=2)
+    with pytest.raises(InputError, match="width"):
+        pc.HotNetSettings(width="cauchy")
+    with pytest.raises(InputError, match="thermal"):
+        pc.StudyParams(thermal=3)

@@ -137,3 +137,18 @@ def test_bad_shapes():
 
 def test_radbas():
     assert radbas(np.array([0.0, 1.0]))[1] == pytest.approx(math.exp(-1))
+
+
+def test_gaussian_width_conversion_matches_matlab_radbas():
+    from navlib.methods.rbf import LN2_SQRT, radbas, spread_from_gaussian_width, width_from_spread
+    delta = 2.0
+    sp = spread_from_gaussian_width(delta)
+    assert sp == pytest.approx(0.8326 * delta, rel=1e-4)
+    b = width_from_spread(sp)                 # newrb's bias 0.8326 / SPREAD
+    assert b == pytest.approx(1.0 / delta)
+    u = np.linspace(-5, 5, 11)
+    assert np.allclose(radbas(b * u), np.exp(-u ** 2 / delta ** 2))
+    assert radbas(np.array(1.0)) == pytest.approx(math.exp(-1.0))           # radbas(n) = exp(-n^2)
+    assert radbas(LN2_SQRT / 3.0 * np.array(3.0)) == pytest.approx(0.5)      # MATLAB: 0.5 at distance SPREAD
+    with pytest.raises(InputError, match="delta"):
+        spread_from_gaussian_width(0.0)

@@ -52,6 +52,15 @@ def width_from_spread(spread: float) -> float:
     return LN2_SQRT / float(spread)
 
 
+def spread_from_gaussian_width(delta: float) -> float:
+    """The MATLAB SPREAD whose neurons are ``exp(-u^2 / delta^2)`` (a Gaussian of width ``delta``, the form
+    papers often print): ``radbas(b u) = exp(-(b u)^2)`` with ``b = sqrt(-ln 0.5) / SPREAD`` equals it when
+    ``b = 1 / delta``, i.e. ``SPREAD = sqrt(ln 2) delta`` (0.8326 ``delta``)."""
+    if not (isinstance(delta, (int, float, np.integer, np.floating)) and math.isfinite(delta) and delta > 0):
+        raise InputError(f"parameter delta={delta!r}: the Gaussian width must be a positive number")
+    return LN2_SQRT * float(delta)
+
+
 def radbas(n: np.ndarray) -> np.ndarray:
     """MATLAB ``radbas``: ``exp(-n^2)``."""
     n = np.asarray(n, dtype=float)
