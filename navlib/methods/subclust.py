@@ -73,8 +73,20 @@ def _bounds(X: np.ndarray, bounds):
     return lo, hi
 
 
+def unit_sqdist(X, bounds=None) -> np.ndarray:
+    """Squared distances ``||z_i - z_j||^2`` (N, N) between the rows of ``X`` scaled to the unit box (as
+    :func:`subclust` scales them), for :func:`subclust`'s ``sqdist``: a search over radii that clusters the
+    same data many times computes them once."""
+    X = np.asarray(X, float)
+    if X.ndim == 1:
+        X = X[:, None]
+    lo, hi = _bounds(X, bounds)
+    Z = np.clip((X - lo) / (hi - lo), 0.0, 1.0)
+    return np.sum((Z[:, None, :] - Z[None, :, :]) ** 2, axis=2)
+
+
 def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions(), *,
-             return_trace: bool = False, max_centers: int | None = None):
+             return_trace: bool = False, max_centers: int | None = None, sqdist=None):
     """Subtractive clustering exactly as MATLAB ``subclust`` (see the module docstring).
 
     Parameters
@@ -90,6 +102,9 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
         Stop as soon as more than this many centres are accepted (not in MATLAB; lets a search discard
         radii that give too many rules without finishing the clustering); the result then has
         ``max_centers + 1`` centres and the trace ends with ``"too-many"``.
+    sqdist : (N, N) array, optional
+        :func:`unit_sqdist` of the same ``X`` and ``bounds`` (one shared radius only): the potentials are
+        then ``exp(-4 d^2/r^2)`` of these distances instead of recomputing them (equal up to rounding).
     return_trace : bool
         Also return the list of decisions (``"accept"``, ``"grey-accept"``, ``"grey-reject"``, ``"stop"``,
         ``"exhausted"``) for tests.
@@ -110,10 +125,18 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
     r = _radii(radii, d)
     lo, hi = _bounds(X, bounds)
     Z = np.clip((X - lo) / (hi - lo), 0.0, 1.0)
-    Zs = Z / r
-    sq = np.sum(Zs ** 2, axis=1)
-    d2 = np.maximum(sq[:, None] + sq[None, :] - 2.0 * Zs @ Zs.T, 0.0)
-    pot = np.exp(-4.0 * d2).sum(axis=1)
+    shared = sqdist is not None and np.all(r == r[0])
+    if sqdist is not None:
+        sqdist = np.asarray(sqdist, float)
+        if sqdist.shape != (n, n):
+            raise InputError(f"subclust: sqdist of shape {sqdist.shape}, expected ({n}, {n})")
+    if shared:
+        pot = np.exp((-4.0 / r[0] ** 2) * sqdist).sum(axis=1)
+    else:
+        Zs = Z / r
+        sq = np.sum(Zs ** 2, axis=1)
+        d2 = np.maximum(sq[:, None] + sq[None, :] - 2.0 * Zs @ Zs.T, 0.0)
+        pot = np.exp(-4.0 * d2).sum(axis=1)
     centres = np.empty((0, d))
     trace: list[str] = []
     k = int(np.argmax(pot))
@@ -137,8 +160,12 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
             if max_centers is not None and len(centres) > max_centers:
                 trace.append("too-many")
                 break
-            dz = (Z - x) / (options.squash * r)
-            pot = np.maximum(pot - pmax * np.exp(-4.0 * np.sum(dz ** 2, axis=1)), 0.0)
+            if shared:
+                e = np.exp((-4.0 / (options.squash * r[0]) ** 2) * sqdist[k])
+            else:
+                dz = (Z - x) / (options.squash * r)
+                e = np.exp(-4.0 * np.sum(dz ** 2, axis=1))
+            pot = np.maximum(pot - pmax * e, 0.0)
         else:
             pot[k] = 0.0
         k = int(np.argmax(pot))
