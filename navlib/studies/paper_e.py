@@ -16,6 +16,16 @@ the run after ``settle_s`` per Euler angle (arcsec).  Training time: ``n_timings
 45-input and the 6-input net timed in the same repetition on the same training set.  The innovation test
 runs on each run alone (train and test runs), so how often it names an effect is a rate over runs.
 
+Beyond the paper's tables (issue 22): the paper's "average time of one training" as MATLAB trains, a whole
+``trainlm`` training with validation stop of the 45-, 6- and 9-input nets (:func:`_lm_timing`,
+:mod:`navlib.methods.feedforward`) in ``lm_timings`` paired repetitions; the gyro scale factor swept over
+``sweep_ppm`` on held-out S-turn runs (:func:`_sweep`; the draws of the first ``sweep_repeats`` repeats at
+every level, the study's own level taken from its repeats); a blind effect outside the innovation test's
+candidates, a star-sensor time offset (``latency_ms_levels``, no scale factor), with the candidate test, the
+generalised test (:func:`navlib.methods.kalman.innovation_structure_test`) and the test again on the filter
+with the scale-factor states (:func:`_diagnose`); and the filter-residual features the paper rejects
+(case ``level_resid3``).
+
 Claims (:func:`claims`) follow the one rule of :mod:`navlib.verdicts`: comparisons are paired over the same
 held-out runs (or the same timing repetitions), every statistic has a 95 % interval.
 """
