@@ -284,14 +284,22 @@ def test_notebook_stops_at_validation_with_one_line(tmp_path):
 
 # ------------------------------------------------------------------------------------------- claims
 def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=0.5, aug_factor=0.5,
-              bp9_worst=2.0, kf_worst=4.0, t45_over_t6=2.0, named=None, gyro_scale_ppm=100.0, permute=None):
+              bp9_worst=2.0, kf_worst=4.0, t45_over_t6=2.0, named=None, gyro_scale_ppm=100.0, permute=None,
+              lm_ratio=12.0, sweep_factor=0.5, sweep_rate_factor=0.5, raw45_factor=0.8, resid_factor=0.95,
+              blind_named=None, blind_flagged=None, quiet_flagged=None, blind_left=None):
     """A StudyData with hand-made per-run scores whose claims have known answers.  KF per-run errors vary
     from run to run; BPKF = factor x KF on the same run (``bp_factor`` per case and mode), 6 QR = qr_factor x
     45 raw, 6 QR + rates yaw = rate_factor x 6 QR yaw, augmented KF = aug_factor x 9-input BPKF; the worst
     and pitch and roll of the S-turn 9-input BPKF set to ``bp9_worst`` (its worst angle unless its yaw is larger),
     the KF's worst angle to ``kf_worst``; timings with the given
-    ratio; ``named`` the per-run innovation-test results."""
-    spec = StudySpec(n_repeats=n_repeats, n_test_runs=n_runs, gyro_scale_ppm=gyro_scale_ppm)
+    ratio; ``named`` the per-run innovation-test results; whole trainlm trainings with the ratio ``lm_ratio``;
+    the sweep: 9-input BPKF = ``sweep_factor`` x KF (pitch, roll), its yaw ``sweep_rate_factor`` x the 6 QR
+    yaw, 45 raw = ``raw45_factor`` x 6 QR, at every level; residual features = ``resid_factor`` x KF; the
+    innovation diagnosis: per run with a time offset what the candidate test names (``blind_named``) and
+    whether the generalised test flags (``blind_flagged``) and still flags with the scale-factor states
+    (``blind_left``, test runs); ``quiet_flagged`` its flags with nothing missing."""
+    spec = StudySpec(n_repeats=n_repeats, n_test_runs=n_runs, gyro_scale_ppm=gyro_scale_ppm,
+                     sweep_repeats=min(2, n_repeats))
     bp_factor = {**{("level_raw45", "held-out"): 1.2, ("level_raw45", "same run"): 0.5,
                     ("level_qr6", "held-out"): 0.9, ("level_qr6", "same run"): 0.6}, **(bp_factor or {})}
     rng = np.random.default_rng(0)
@@ -314,7 +322,8 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
             mode == "same run" else {k: v * qr_factor for k, v in raw.items()})
         q6 = {k: v * (0.8 + 0.1 * rng.random()) for k, v in kf.items()}
         add("sturn_qr6", mode, "BPKF", q6)
-        add("sturn_raw45", mode, "BPKF", q6)
+        add("sturn_raw45", mode, "BPKF", {k: v * raw45_factor for k, v in q6.items()})
+        add("level_resid3", mode, "BPKF", {k: v * resid_factor for k, v in kf.items()})
         q9 = {k: np.r_[bp9_worst, bp9_worst, v[2] * rate_factor] for k, v in q6.items()}
         add("sturn_qr6_rate", mode, "BPKF", q9)
         for case in ("sturn_qr6", "sturn_qr6_rate", "sturn_raw45"):
@@ -337,8 +346,34 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
     named = named if named is not None else ["gyro scale factor z"] * 16
     glr_runs = pd.DataFrame([{"repeat": 0, "kind": "s_turns", "runs": "test", "run": i, "named": v}
                              for i, v in enumerate(named)])
+    lm = pd.DataFrame([{"timing": j, "n_in": n, "n_weights": w, "seconds": t, "epochs": 10, "stop": "validation stop"}
+                       for j in range(n_t) for n, w, t in ((45, 493, t6[j] * lm_ratio), (6, 103, t6[j]),
+                                                           (9, 133, 1.5 * t6[j]))])
+    sw = []
+    for level in spec.sweep_ppm:
+        for (r, i), e in kf.items():
+            k = e * (1 + level / 100)
+            q6 = 0.9 * k
+            for method, err in (("KF", k), ("BPKF 6 QR", q6), ("BPKF 6 QR + 3 rates", np.r_[sweep_factor * k[:2],
+                                                                                           sweep_rate_factor * q6[2]]),
+                                ("BPKF 45 raw", raw45_factor * q6), ("augmented KF", 0.5 * k)):
+                for a, ax in enumerate(paper_e.AXES):
+                    sw.append({"repeat": r, "case": "s_turns", "mode": "held-out", "method": method, "run": i,
+                               "axis": ax, "rms_arcsec": float(err[a]), "level_ppm": float(level),
+                               "latency_ms": 0.0})
+    n_d = 16
+    blind_named = ["accelerometer scale factor x"] * n_d if blind_named is None else blind_named
+    blind_flagged = [True] * n_d if blind_flagged is None else blind_flagged
+    blind_left = [True] * n_d if blind_left is None else blind_left
+    quiet_flagged = [False] * n_d if quiet_flagged is None else quiet_flagged
+    diag = [{"level_ppm": 0.0, "latency_ms": 10.0, "repeat": 0, "runs": "test", "run": i, "named": nm, "chi2": 1.0,
+             "flagged": fl, "flagged_aug": float(lf)} for i, (nm, fl, lf) in enumerate(zip(blind_named, blind_flagged,
+                                                                                        blind_left))]
+    diag += [{"level_ppm": 0.0, "latency_ms": 0.0, "repeat": 0, "runs": "test", "run": i, "named": "none",
+              "chi2": 1.0, "flagged": fl, "flagged_aug": 0.0} for i, fl in enumerate(quiet_flagged)]
     empty = pd.DataFrame()
-    return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty)
+    return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty, {}, lm,
+                             pd.DataFrame(sw), pd.DataFrame(diag))
 
 
 def by_key(data):
@@ -354,13 +389,22 @@ def test_claims_sources_sides_boundaries_and_keys():
         assert (c.source == "book") == (c.paper == "(not in the paper)")
         assert c.estimate is not None and c.statistic
     c = {c.key: c for c in cl}
-    assert {k for k, v in c.items() if v.source == "book"} == {"cel_kf_within", "cel_innov", "cel_aug"}
+    assert {k for k, v in c.items() if v.source == "book"} == {"cel_kf_within", "cel_innov", "cel_aug",
+                                                                "cel_raw45_sturn", "cel_blind_named", "cel_blind_flag",
+                                                                "cel_blind_quiet", "cel_blind_left"}
     for k in ("cel_imp45_held", "cel_imp45_same", "cel_imp6_held", "cel_imp6_same"):
         assert c[k].boundary == paper["improvement_min_pct"] and c[k].holds_when == "above"
         assert c[k].estimate.rule == "paired ratio"
     assert "training data" in c["cel_imp45_same"].reading and "training data" in c["cel_imp6_same"].reading
     assert c["cel_time"].boundary == pytest.approx(paper["train_time_45_s"] / paper["train_time_6_s"])
     assert c["cel_time"].holds_when == "above" and c["cel_time"].estimate.rule == "paired ratio"
+    assert c["cel_time_lm"].boundary == c["cel_time"].boundary and c["cel_time_lm"].estimate.rule == "paired ratio"
+    assert "trainlm" in c["cel_time_lm"].reading and "Adam" in c["cel_time"].reading
+    for k in ("cel_qr_sturn", "cel_raw45_sturn"):
+        assert c[k].boundary == 0 and c[k].holds_when == "above" and "held-out" in c[k].reading
+    for level in (0, 25, 50, 100, 200):
+        assert c[f"cel_sw_imp_{level}ppm"].boundary == paper["improvement_min_pct"]
+        assert c[f"cel_sw_rates_{level}ppm"].boundary == 0 and f"{level} ppm" in c[f"cel_sw_rates_{level}ppm"].reading
     for k in ("cel_qr", "cel_rates", "cel_aug"):
         assert c[k].boundary == 0 and c[k].holds_when == "above" and c[k].estimate.rule == "paired difference"
     for k in ("cel_within", "cel_kf_within"):
@@ -448,7 +492,8 @@ def test_too_few_runs_cannot_be_judged_with_the_reason():
 
 def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run():
     spec = StudySpec(duration_s=30.0, n_train_runs=2, n_test_runs=3, n_repeats=2, epochs=5, n_timings=6,
-                     timing_epochs=2, settle_s=5.0)
+                     timing_epochs=2, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0),
+                     sweep_repeats=1, latency_ms_levels=(10.0,))
     data = paper_e.simulate(spec)
     n = spec.n_repeats * spec.n_test_runs
     for mode in ("held-out", "same run"):
@@ -461,13 +506,108 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
     assert c["cel_imp6_same"].estimate.n == n and c["cel_imp6_held"].estimate.n == n
     assert c["cel_time"].estimate.n == spec.n_timings
     assert c["cel_innov"].estimate.n == spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
+    assert len(data.lm_timing) == 3 * spec.lm_timings and set(data.lm_timing["n_in"]) == {45, 6, 9}
+    assert set(zip(data.diagnosis["level_ppm"], data.diagnosis["latency_ms"])) == {(0, 0), (0, 10), (100, 0)}
+    # the sweep at the study's own level is the study's held-out S-turn scores (same draws, nets, filters)
+    for method, case in (("KF", "sturn_qr6"), ("BPKF 6 QR + 3 rates", "sturn_qr6_rate"), ("BPKF 45 raw", "sturn_raw45")):
+        own = paper_e.per_run(data, case, "held-out", method.split(" ")[0])
+        own = own[own.index.get_level_values("repeat") < spec.sweep_repeats]
+        assert paper_e.sweep_per_run(data, 100.0, method).to_numpy() == pytest.approx(own.to_numpy())
+    assert len(paper_e.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs
+    assert len(paper_e.sweep_per_run(data, 0.0, "KF", latency_ms=10.0)) == spec.sweep_repeats * spec.n_test_runs
 
 
 def test_the_timing_claim_is_stored_as_volatile_and_the_others_are_not():
     data = fake_data(t45_over_t6=2.0)
     cl = paper_e.claims(data)
-    assert [c.key for c in cl if c.volatile] == ["cel_time"]
+    assert [c.key for c in cl if c.volatile] == ["cel_time_lm", "cel_time"]
     t = {c.key: c for c in cl}["cel_time"]
     assert t.verdict == "not reproduced" and t.record()["volatile"] is True
     extra = paper_e.results_extra(data)
     assert extra["time_ratio_45_over_6"] == pytest.approx(2.0)
+
+def test_trainlm_timing_ratio_is_paired_and_judged_against_the_papers_ratio():
+    for ratio, verdict in ((12.0, "reproduced"), (2.0, "not reproduced")):
+        data = fake_data(lm_ratio=ratio)
+        c = by_key(data)["cel_time_lm"]
+        assert c.estimate.value == pytest.approx(ratio) and c.verdict == verdict and c.volatile
+        assert paper_e.results_extra(data)["trainlm_time_ratio_45_over_6"] == pytest.approx(ratio)
+    tab = paper_e.trainlm_time(fake_data(lm_ratio=12.0)).set_index("inputs")
+    assert tab.loc[45, "ratio_to_6"] == pytest.approx(12.0) and tab.loc[9, "ratio_to_6"] == pytest.approx(1.5)
+    assert tab.loc[45, "weights"] == 493 and np.isnan(tab.loc[9, "paper_s"])
+
+
+def test_sweep_claims_land_on_each_side_at_every_level():
+    c = by_key(fake_data(sweep_factor=0.3, sweep_rate_factor=0.5))
+    for level in (0, 25, 50, 100, 200):
+        assert c[f"cel_sw_imp_{level}ppm"].verdict == "reproduced"
+        assert c[f"cel_sw_rates_{level}ppm"].verdict == "reproduced"
+    c = by_key(fake_data(sweep_factor=0.9, sweep_rate_factor=1.5))
+    for level in (0, 25, 50, 100, 200):
+        assert c[f"cel_sw_imp_{level}ppm"].verdict == "not reproduced"
+        assert c[f"cel_sw_rates_{level}ppm"].verdict == "not reproduced"
+    v = paper_e.sweep_verdicts(fake_data())
+    assert len(v) == 10 and set(v["scale_ppm"]) == {0, 25, 50, 100, 200}
+
+
+def test_s_turn_raw45_and_conclusion_3_readings():
+    c = by_key(fake_data(raw45_factor=0.3))          # 45 raw well below 6 QR and below 6 QR + rates (2 arcsec)
+    assert c["cel_raw45_sturn"].verdict == "reproduced" and c["cel_qr_sturn"].verdict == "not reproduced"
+    c = by_key(fake_data(raw45_factor=3.0))
+    assert c["cel_raw45_sturn"].verdict == "not reproduced" and c["cel_qr_sturn"].verdict == "reproduced"
+
+
+def test_blind_effect_claims_count_runs_and_land_on_each_side():
+    c = by_key(fake_data())
+    assert c["cel_blind_named"].verdict == "not reproduced" and c["cel_blind_named"].estimate.n == 16
+    assert c["cel_blind_flag"].verdict == "reproduced" and c["cel_blind_left"].verdict == "reproduced"
+    c = by_key(fake_data(blind_named=["none"] * 16, blind_flagged=[False] * 16, blind_left=[False] * 16))
+    assert c["cel_blind_named"].estimate.value == 0 and c["cel_blind_flag"].verdict == "not reproduced"
+    assert c["cel_blind_left"].verdict == "not reproduced"
+    c = by_key(fake_data(quiet_flagged=[True] * 8 + [False] * 8))
+    assert c["cel_blind_quiet"].verdict == "not reproduced"
+    assert c["cel_blind_quiet"].holds_when == "below" and c["cel_blind_named"].holds_when == "below"
+
+
+def test_residual_feature_claim():
+    assert by_key(fake_data(resid_factor=0.95))["cel_resid_held"].verdict == "reproduced"        # 5 % better
+    assert by_key(fake_data(resid_factor=0.4))["cel_resid_held"].verdict == "not reproduced"     # 60 % better
+
+
+def test_star_sensor_time_offset_is_the_rate_times_the_offset():
+    """Closed form, small angle: a star sensor late by tau reports C(t - tau) = C(t) exp(-[w_nb^b tau x]),
+    an attitude error of -w tau about the body axes (here the yaw rate of the S-turns, up to a few deg/s)."""
+    from navlib.sensors.strapdown import InitialError, StarSensorSpec, dcm_to_rotvec, strapdown
+    from navlib.sensors.trajectory import FlightProfile, generate
+    tr = generate(FlightProfile(kind="s_turns", duration_s=20.0, imu_rate_hz=100.0, manoeuvre_seed=3))
+    tau_ms = 20.0
+    late = strapdown(tr, [1], star=StarSensorSpec(latency_ms=tau_ms), ideal=True)
+    on_time = strapdown(tr, [1], star=StarSensorSpec(), ideal=True)
+    np.testing.assert_array_equal(on_time.star_cbn, on_time.cbn_true)       # no offset: the truth itself
+    err = dcm_to_rotvec(np.swapaxes(late.cbn_true[0], -1, -2) @ late.star_cbn[0])[3:]   # body frame
+    k = np.arange(len(tr.t_s))[::10][3:]                                     # epochs after the first tau
+    w = 0.5 * (tr.rate_b[k - 1] + tr.rate_b[np.minimum(k, len(tr.rate_b) - 1)])
+    want = -w * tau_ms * 1e-3
+    assert np.abs(want[:, 2]).max() / ARCSEC > 50                            # a large effect: tens of arcsec
+    np.testing.assert_allclose(err, want, atol=0.01 * np.abs(want).max())
+    with pytest.raises(InputError, match="latency_ms"):
+        StarSensorSpec(latency_ms=-1.0)
+
+
+def test_generalised_innovation_test_flags_rate_structure_only_when_present():
+    from navlib.methods.kalman import innovation_structure_test, rate_regressors
+    rng = np.random.default_rng(7)
+    n = 1500
+    t = np.arange(n) * 0.1
+    rate = np.stack([0.001 * np.sin(t), 0.002 * np.cos(0.3 * t), 0.05 * np.sin(2 * np.pi * t / 12)], -1)
+    cbn = np.broadcast_to(np.eye(3), (n, 3, 3))
+    x = rate_regressors(cbn, rate, t)
+    s = np.broadcast_to(np.diag([1.0, 1.0, 4.0]), (n, 3, 3))
+    white = rng.standard_normal((n, 3)) * np.array([1.0, 1.0, 2.0])
+    quiet = innovation_structure_test(white, s, x)
+    assert not quiet.flagged and quiet.dof == 6 and quiet.p_value > 0.01
+    # a latency-like term: innovation = -rate_z * tau about z, tau = 20 s in these units
+    late = innovation_structure_test(white - 20.0 * x[..., 2], s, x)
+    assert late.flagged and late.coef[2] == pytest.approx(-20.0, abs=3.0)
+    with pytest.raises(InputError, match="shapes"):
+        innovation_structure_test(white[:, :2], s, x)

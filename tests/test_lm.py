@@ -172,3 +172,58 @@ def test_compiled_trainlm_equals_the_generic_numpy_trainlm(activation, validatio
                                               "maximum mu"}
     if validation:
         assert any(n.info["stop"] == "validation stop" for n in fast)
+
+
+# ------------------------------------------------------------------ multi-input, multi-output nets (paper E)
+def _ff_problem(n=60, seed=5):
+    """A 3-4-2 net's outputs plus noise.  The seed gives an isolated minimum near the true weights (with
+    some draws a saturated unit leaves a flat valley along which both solvers drift without end)."""
+    from navlib.methods import feedforward as ff
+    rng = np.random.default_rng(seed)
+    xn = rng.uniform(-1, 1, (n, 3))
+    true = rng.normal(0, 1.5, ff.n_weights(3, 4, 2))
+    y = ff.forward(true[None], xn, 3, 4, 2)[0] + 0.01 * rng.standard_normal((n, 2))
+    return ff, xn, y, true
+
+
+def test_multi_output_jacobian_matches_finite_differences():
+    ff, xn, _, true = _ff_problem()
+    j = ff.jacobian(true[None], xn, 3, 4, 2)[0].reshape(-1, true.size)
+    eps = 1e-6
+    num = np.stack([(ff.forward((true + eps * e)[None], xn, 3, 4, 2)[0]
+                     - ff.forward((true - eps * e)[None], xn, 3, 4, 2)[0]).ravel() / (2 * eps)
+                    for e in np.eye(true.size)], axis=1)
+    np.testing.assert_allclose(j, num, atol=1e-7)
+
+
+def test_lm_matches_scipy_least_squares_on_a_multi_output_net():
+    ff, xn, y, true = _ff_problem()
+    start = true + 0.3 * np.random.default_rng(4).standard_normal(true.size)
+
+    def res(th):
+        return (ff.forward(th, xn, 3, 4, 2) - y[None]).reshape(th.shape[0], -1)
+
+    def jac(th):
+        return ff.jacobian(th, xn, 3, 4, 2).reshape(th.shape[0], y.size, -1)
+
+    ours = levenberg_marquardt(res, jac, start[None], LMParams(epochs=500, min_grad=0.0))
+    ref = least_squares(lambda th: res(th[None])[0], start, jac=lambda th: jac(th[None])[0], method="lm",
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=10000)
+    sse_ours = float(np.sum(res(ours.theta) ** 2))
+    assert sse_ours == pytest.approx(2 * ref.cost, rel=1e-8)
+    np.testing.assert_allclose(ours.theta[0], ref.x, atol=1e-5)
+    assert sse_ours < float(np.sum(res(start[None]) ** 2)) / 10       # it did train
+
+
+def test_train_feedforward_learns_and_stops_on_validation():
+    from navlib.methods.feedforward import train_feedforward
+    ff, xn, y, _ = _ff_problem(n=200)
+    x = 5.0 + 3.0 * xn                                       # raw units: mapminmax must undo them
+    x = np.column_stack([x, np.full(len(x), 2.0)])          # a constant column: removeconstantrows drops it
+    net = train_feedforward(x, 100.0 * y, 4, np.random.default_rng(0), activation="logsig")
+    assert net.info["n_weights"] == ff.n_weights(3, 4, 2) and net.keep.tolist() == [True] * 3 + [False]
+    assert net.info["stop"] in ("validation stop", "minimum gradient", "maximum mu")
+    rms = float(np.sqrt(np.mean((net.predict(x) - 100.0 * y) ** 2)))
+    assert rms < 0.1 * float(np.std(100.0 * y))
+    with pytest.raises(InputError, match="activation"):
+        train_feedforward(x, y, 4, np.random.default_rng(0), activation="relu")

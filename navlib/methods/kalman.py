@@ -202,15 +202,18 @@ def r_from_features(feat):
     return r
 
 
-FeatureSet = Literal["raw45", "qr6", "qr6_rate"]
-N_INPUTS = {"raw45": 45, "qr6": 6, "qr6_rate": 9}
+FeatureSet = Literal["raw45", "qr6", "qr6_rate", "residual3"]
+N_INPUTS = {"raw45": 45, "qr6": 6, "qr6_rate": 9, "residual3": 3}
 
 
 def gain_features(result: FilterResult, kind: FeatureSet) -> np.ndarray:
     """Network inputs per epoch, shape (n_runs, n_epochs, n_in): ``raw45`` the 45 entries of the 15x3 gain
-    (base states only), ``qr6`` its QR features, ``qr6_rate`` those plus the INS angular rates (deg/s)."""
+    (base states only), ``qr6`` its QR features, ``qr6_rate`` those plus the INS angular rates (deg/s);
+    ``residual3`` the filter residual (the innovation, arcsec), the features paper E tried and rejected."""
     if kind not in N_INPUTS:
         raise InputError(f"parameter features={kind!r}: must be one of {', '.join(N_INPUTS)}")
+    if kind == "residual3":
+        return result.kf["innov"] / ARCSEC
     K = result.kf["K"][..., :N_BASE, :]
     if kind == "raw45":
         return K.reshape(K.shape[:-2] + (45,))
@@ -318,3 +321,59 @@ def rate_correlation(result: FilterResult, axis: int = 2) -> tuple[float, float]
         return float("nan"), float("nan")
     r, p = stats.pearsonr(nu.ravel(), w.ravel())
     return float(r), float(p)
+
+
+# ------------------------------------------------------------------------------------------- generalised test
+@dataclass(frozen=True)
+class StructureResult:
+    """The generalised innovation test on one run: chi-square statistic with ``dof`` degrees of freedom,
+    its p-value, whether it flags structure at ``alpha``, and the fitted coefficients (one per regressor)."""
+
+    chi2: float
+    dof: int
+    p_value: float
+    flagged: bool
+    coef: np.ndarray
+
+
+def rate_regressors(cbn: np.ndarray, rate_b: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+    """Regressors of the generalised test per epoch, shape (..., steps, 3, 6): the columns ``C_b^n e_i w_i``
+    (the body rate about axis ``i`` seen in the navigation frame) and ``C_b^n e_i dw_i/dt`` (its time
+    derivative, central differences), ``i = x, y, z``; rates in rad/s, derivatives in rad/s^2."""
+    cbn, rate_b = np.asarray(cbn, float), np.asarray(rate_b, float)
+    dw = np.gradient(rate_b, np.asarray(t_s, float), axis=-2)
+    return np.concatenate([cbn * rate_b[..., None, :], cbn * dw[..., None, :]], axis=-1)
+
+
+def innovation_structure_test(nu, s, x, alpha: float = 0.01) -> StructureResult:
+    """Generalised innovation test: are the innovations ``nu_k`` (covariance ``S_k`` when the model is right)
+    explained by the regressors ``X_k`` (3 x p per epoch, e.g. :func:`rate_regressors`)?  With the whitened
+    ``u_k = L_k^-1 nu_k`` and ``A_k = L_k^-1 X_k`` (``S_k = L_k L_k^T``), stacked over the epochs,
+
+        b = (A^T A)^-1 A^T u,    chi2 = u^T A (A^T A)^-1 A^T u  ~  chi2(p) if nothing is missing,
+
+    and the test flags structure when ``P(chi2(p) > chi2) < alpha``.  Unlike :func:`innovation_glr` it
+    names no candidate: it says that something proportional to the rates or their derivatives is missing
+    from the model.  Shapes: ``nu (steps, 3)``, ``s (steps, 3, 3)``, ``x (steps, 3, p)``."""
+    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
+    nu, s, x = np.asarray(nu, float), np.asarray(s, float), np.asarray(x, float)
+    if nu.ndim != 2 or nu.shape[1] != 3 or s.shape != nu.shape + (3,) or x.shape[:2] != nu.shape:
+        raise InputError(f"innovation_structure_test: shapes nu {nu.shape}, S {s.shape}, X {x.shape}; "
+                         "expected (steps, 3), (steps, 3, 3), (steps, 3, p)")
+    chol = np.linalg.cholesky(s)
+    u = np.linalg.solve(chol, nu[..., None])[..., 0].reshape(-1)
+    a = np.linalg.solve(chol, x).reshape(-1, x.shape[-1])
+    coef, *_ = np.linalg.lstsq(a, u, rcond=None)
+    fit = a @ coef
+    chi2 = float(fit @ fit)
+    p = int(np.linalg.matrix_rank(a))
+    pv = float(stats.chi2.sf(chi2, p)) if p else 1.0
+    return StructureResult(chi2, p, pv, bool(pv < alpha), coef)
+
+
+def innovation_structure_per_run(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[StructureResult]:
+    """:func:`innovation_structure_test` of the filter's innovations on each run alone, regressed on the
+    INS's body rates and their derivatives (:func:`rate_regressors`)."""
+    x = rate_regressors(run.cbn[:, 1:], result.rate_deg_s * DEG, result.t_s)
+    nu, s = result.kf["innov"], result.kf["S"]
+    return [innovation_structure_test(nu[i], s[i], x[i], alpha) for i in range(nu.shape[0])]

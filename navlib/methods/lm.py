@@ -138,9 +138,11 @@ def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray],
     J = jacobian(theta)
     for epoch in range(p.epochs + 1):
         idx = np.flatnonzero(active)
-        Jt = J[idx].transpose(0, 2, 1) * wt[idx, None, :]                  # (S, D, N), masked
-        jj = np.matmul(Jt, J[idx])
-        je = np.matmul(Jt, r[idx, :, None])[..., 0]
+        rows = np.flatnonzero(wt[idx].any(axis=0))                         # samples some net trains on
+        Ju = J[idx][:, rows] if rows.size < n else J[idx]
+        Jt = Ju.transpose(0, 2, 1) * wt[idx][:, None, rows]                # (S, D, N_used), masked
+        jj = np.matmul(Jt, Ju)
+        je = np.matmul(Jt, r[idx][:, rows, None])[..., 0]
         grad = np.linalg.norm(2.0 * je / wt[idx].sum(axis=1)[:, None], axis=1)
         for k, i in enumerate(idx):      # MATLAB's stopping tests, in its order
             why = ("maximum epoch" if epoch == p.epochs else "performance goal" if perf[i] <= p.goal

@@ -15,7 +15,10 @@ Yan Gongmin's PSINS toolbox, read for orders of magnitude only):
 
 IMU model per sample interval ``T`` (increments): ``dtheta_m = (I + diag(s_g)) dtheta + eps T + n_g``,
 ``dv_m = dv + nabla T + n_a`` with ``n_g ~ N(0, ARW^2 T)``, ``n_a ~ N(0, VRW^2 T)``.  Star sensor:
-``C_s = exp([C_b^n dth_b x]) C_b^n`` with ``dth_b ~ N(0, diag(s_c^2, s_c^2, s_b^2))``.
+``C_s = exp([C_b^n dth_b x]) C_b^n`` with ``dth_b ~ N(0, diag(s_c^2, s_c^2, s_b^2))``.  With a time offset
+``tau`` (``latency_ms``, an effect the filter does not model) the star sensor reports the attitude of
+``tau`` earlier, ``C_b^n(t - tau)`` (spherical interpolation of the truth at the IMU rate), stamped ``t``:
+to first order an attitude error ``-w_nb^b tau`` about the body axes.
 
 Mechanisation (ENU, batched over runs, two speeds): at the IMU rate the body increments are chained,
 ``C <- C exp([dtheta_m x])``, and the velocity increments ``dv_m + dtheta_m x dv_m / 2`` rotated into the
@@ -83,8 +86,10 @@ class StarSensorSpec:
     cross_arcsec: float = 3.0
     boresight_arcsec: float = 15.0
     rate_hz: float = 10.0
+    latency_ms: float = 0.0
 
     def __post_init__(self):
+        check_param("latency_ms", self.latency_ms, lo=0.0, hi=1000.0)
         check_param("cross_arcsec", self.cross_arcsec, lo=0.0, lo_open=True, hi=3600.0)
         check_param("boresight_arcsec", self.boresight_arcsec, lo=0.0, lo_open=True, hi=3600.0)
         check_param("rate_hz", self.rate_hz, lo=0.0, lo_open=True, hi=200.0)
@@ -177,6 +182,20 @@ class InsRun:
     @property
     def n_runs(self) -> int:
         return self.cbn.shape[0]
+
+
+def delayed_attitude(traj: Trajectory, t_s, latency_ms: float) -> np.ndarray:
+    """The true attitude matrices ``C_b^n(t - tau)`` at the times ``t_s`` for a time offset ``tau =
+    latency_ms`` (spherical linear interpolation of the truth at the IMU rate; times before the start take the
+    first attitude).  ``latency_ms = 0`` gives the truth at ``t_s`` itself."""
+    check_param("latency_ms", latency_ms, lo=0.0, hi=1000.0)
+    t_s = np.asarray(t_s, dtype=float)
+    k = np.searchsorted(traj.t_s, t_s)
+    if latency_ms == 0.0 and np.array_equal(traj.t_s[np.minimum(k, len(traj.t_s) - 1)], t_s):
+        return euler_to_dcm(traj.att[k])                    # on the IMU grid: the truth itself
+    from scipy.spatial.transform import Rotation, Slerp
+    slerp = Slerp(traj.t_s, Rotation.from_matrix(euler_to_dcm(traj.att)))
+    return slerp(np.clip(t_s - 1e-3 * latency_ms, traj.t_s[0], traj.t_s[-1])).as_matrix()
 
 
 def decimation(traj: Trajectory, star: StarSensorSpec) -> int:
@@ -290,7 +309,7 @@ def strapdown(traj: Trajectory, seeds, imu: ImuSpec = ImuSpec(), star: StarSenso
         dstar = np.zeros((n, n_ep, 3))
     else:
         dstar = np.stack([g.standard_normal((n_ep, 3)) for g in g_star]) * star.noise_rad
-    star_cbn = cbn_true[None] @ rotvec_to_dcm(dstar)        # noise about body axes
+    star_cbn = delayed_attitude(traj, traj.t_s[idx], star.latency_ms)[None] @ rotvec_to_dcm(dstar)  # noise about body axes
     return InsRun(t_s=traj.t_s[idx], cbn=out["cbn"], att=dcm_to_euler(out["cbn"]), vn=out["vn"],
                   pos=out["pos"], cbn_true=np.broadcast_to(cbn_true, (n, n_ep, 3, 3)),
                   att_true=np.broadcast_to(att_true, (n, n_ep, 3)), fn=out["fn"], rate_b=out["rate_b"],
