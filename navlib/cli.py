@@ -15,6 +15,10 @@ Commands:
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
       compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
       --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
+  field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
+      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
+      loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
+      estimates with it and flags a local anomaly when they differ beyond the uncertainty.
   calibrate magnetometer FILE.csv [--model hard_iron,scale,soft_iron] --out CAL.json
       fit the reference-free magnetometer model (no attitude needed) and write the correction in magcal's
       convention, m_corrected = (m - b) A, with the expected field strength and every parameter's
@@ -99,6 +103,12 @@ def build_parser() -> argparse.ArgumentParser:
         cmd.add_argument("--alpha", type=float, default=None, help="family-wise false-alarm level (default 0.025)")
         if name == "loop":
             cmd.add_argument("--report", default=None, help="folder for loop.png and loop.md (never overwritten)")
+            _site_options(cmd, required=False)
+    fld = sub.add_parser("field", help="the Earth's field from IGRF-14 at a site and date",
+                         description="the IGRF-14 main field (ppigrf, offline) at a site: north, east, down, "
+                                     "intensity (uT), dip and declination (deg)")
+    _site_options(fld, required=True)
+    fld.add_argument("--json", action="store_true", help="print one JSON object")
     cal = sub.add_parser("calibrate", help="fit a magnetometer calibration without reference attitude",
                          description="fit the reference-free magnetometer model (field magnitude and, with an "
                                      "accelerometer, dip constant) and write the correction m_corrected = "
@@ -141,6 +151,41 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _site_options(cmd, required: bool) -> None:
+    cmd.add_argument("--site", required=required, default=None, metavar="LAT,LON[,HEIGHT_M]",
+                     help="geodetic latitude and longitude (deg) and height above the WGS84 ellipsoid (m, default 0)"
+                          + ("" if required else "; magnetometer_free: the loop compares the estimated local "
+                             "field with IGRF-14 there and flags a local anomaly"))
+    cmd.add_argument("--date", default=None, metavar="YYYY-MM-DD", help="date of the field (default 2025-01-01)")
+
+
+def _site(args):
+    """The :class:`navlib.sensors.earth_field.Site` of --site/--date, or None without --site."""
+    from .sensors.earth_field import Site
+    if args.site is None:
+        if args.date is not None:
+            raise InputError("parameter --date: give --site LAT,LON[,HEIGHT_M] with it")
+        return None
+    v = _numbers("--site", args.site, None)
+    if len(v) not in (2, 3):
+        raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
+    return Site(v[0], v[1], v[2] if len(v) == 3 else 0.0, args.date or "2025-01-01")
+
+
+def _field(args) -> int:
+    from .sensors.earth_field import igrf_field
+    site = _site(args)
+    f = igrf_field(site).to_dict()
+    if args.json:
+        print(json.dumps({"model": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
+                          "height_m": site.height_m, "date": site.date, **f}))
+    else:
+        print(f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
+              f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+              f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
+    return 0
+
+
 def _simulate_compass(args) -> int:
     errors = CompassErrors()
     if args.noise_ut is not None:
@@ -179,18 +224,31 @@ def _diagnose(args) -> int:
 def _loop(args) -> int:
     if args.report:
         check_report_folder(args.report)            # refuse before the work, not after it
+    site = _site(args)
+    if site is not None and args.system != "magnetometer_free":
+        raise InputError(f"parameter --site: the field check is made by the magnetometer_free system, not "
+                         f"{args.system}")
     system, users, names, data = _prepare(args)
     result = loop(system, data, names, user_effects=users, alpha=args.alpha)
+    check = None
+    if system.name == "magnetometer_free":
+        from .workbench.calibration import field_check, field_lines
+        check = field_check(result.final, site, result.screening.noise if result.screening else None)
     if args.report:
         png, md = write_report(result, args.report, source=str(args.file))
     if args.json:
-        print(json.dumps(result.to_dict(), allow_nan=False, default=float))
+        out = result.to_dict()
+        if check is not None:
+            out["field"] = check
+        print(json.dumps(out, allow_nan=False, default=float))
     else:
         print(result.steps_table().to_string(float_format=lambda x: f"{x:.4g}"))
         print()
         print(result.final_diagnosis.message)
         for u in result.untested:
             print(f"not tested: {u['effect']} ({u['why']})")
+        if check is not None:
+            print("\n".join(field_lines(check)))
         if args.report:
             print(f"report: {md} and {png}")
     return 0
@@ -254,7 +312,7 @@ def _grid(args) -> int:
 
 
 COMMANDS = {"simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
-            "grid": _grid, "calibrate": _calibrate, "apply": _apply}
+            "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field}
 
 
 #: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.

@@ -50,13 +50,7 @@ def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "") -> dict
     sc = screen(fit)
     fit = sc.refit(fit)
     noise = sc.noise
-    J, r = fit.jacobian, fit.residuals
-    if noise.correlated:
-        J, r = noise.whiten(J), noise.whiten(r)
-    dof = max(fit.n - fit.n_params, 1)
-    s2 = float(r @ r) / dof
-    cov = s2 * np.linalg.pinv(J.T @ J, hermitian=True)
-    names = list(fit.params)
+    names, cov = parameter_covariance(fit, noise)
     std = dict(zip(names, np.sqrt(np.clip(np.diag(cov), 0, None))))
     effects = {}
     for e in fit.effects:
@@ -171,3 +165,87 @@ def calibrate_file(data_path, model, out_path) -> tuple[Path, dict]:
     data = load_free(data_path)
     cal = calibrate(data, model, source=Path(data_path).name)
     return write_calibration(cal, out_path), cal
+
+
+def parameter_covariance(fit, noise=None) -> tuple[list, np.ndarray]:
+    """``(names, cov)``: the covariance of ``fit``'s parameters, ``s^2 (J'J)^-1`` with ``s^2 = RSS / (n - p)``,
+    on the whitened residual and Jacobian when ``noise`` (a :class:`navlib.workbench.serial.NoiseModel`)
+    is correlated (generalised least squares)."""
+    J, r = fit.jacobian, fit.residuals
+    if noise is not None and noise.correlated:
+        J, r = noise.whiten(J), noise.whiten(r)
+    s2 = float(r @ r) / max(fit.n - fit.n_params, 1)
+    return list(fit.params), s2 * np.linalg.pinv(J.T @ J, hermitian=True)
+
+
+#: Tolerances of the comparison with the model field (:func:`field_check`): the crustal field IGRF leaves
+#: out (typically up to a few hundred nT away from magnetic rocks: Alken et al. 2021) and the sensor's
+#: absolute scale, which the invariants cannot calibrate (the mean scale trades against the intensity) --
+#: a free choice, stated: 1 % unless the user gives another.
+CRUST_TOL_UT = 0.3
+SCALE_TOL = 0.01
+
+
+def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dict:
+    """The local field the reference-free fit estimates beside the IGRF-14 model at ``site``
+    (:class:`navlib.sensors.earth_field.Site`), and whether they differ beyond the uncertainty.
+
+    Intensity: estimate +- 1.96 sigma (parameter covariance, :func:`parameter_covariance`); anomaly when
+    ``|F - F_model| > 1.96 sigma + CRUST_TOL_UT + scale_tol F_model``.  Dip (with an accelerometer; free of
+    the sensor's scale): anomaly when ``|dip - dip_model| > 1.96 sigma + deg(CRUST_TOL_UT / F_model)``.
+    Without a site only the estimate is returned."""
+    from ..errors import check_param
+    from ..sensors.earth_field import igrf_field
+    check_param("scale_tol", scale_tol, lo=0, hi=0.5)
+    names, cov = parameter_covariance(fit, noise)
+    iF = names.index("field_ut")
+    F = fit.params["field_ut"]
+    out = {"intensity_ut": F, "intensity_std_ut": float(np.sqrt(cov[iF, iF]))}
+    if "field_down_ut" in fit.params:
+        iD = names.index("field_down_ut")
+        D = fit.params["field_down_ut"]
+        x = float(np.clip(-D / F, -1, 1))
+        g = np.zeros(len(names))                       # d dip / d(F, D), rad
+        k = 1.0 / np.sqrt(max(1 - x * x, 1e-12))
+        g[iF], g[iD] = k * D / F ** 2, -k / F
+        out["dip_deg"] = float(np.degrees(np.arcsin(x)))
+        out["dip_std_deg"] = float(np.degrees(np.sqrt(g @ cov @ g)))
+    if site is None:
+        return out
+    model = igrf_field(site)
+    out["model"] = {"name": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
+                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model.intensity_ut,
+                    "dip_deg": model.dip_deg, "declination_deg": model.declination_deg}
+    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model.intensity_ut
+    out["intensity_difference_ut"] = F - model.intensity_ut
+    out["intensity_tolerance_ut"] = tol_f
+    anomalies = []
+    if abs(F - model.intensity_ut) > tol_f:
+        anomalies.append(f"intensity {F:.2f} uT against the model's {model.intensity_ut:.2f} uT "
+                         f"(beyond +-{tol_f:.2f} uT)")
+    if "dip_deg" in out:
+        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model.intensity_ut))
+        out["dip_difference_deg"] = out["dip_deg"] - model.dip_deg
+        out["dip_tolerance_deg"] = tol_d
+        if abs(out["dip_difference_deg"]) > tol_d:
+            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model.dip_deg:.2f} deg "
+                             f"(beyond +-{tol_d:.2f} deg)")
+    out["local_anomaly"] = bool(anomalies)
+    out["message"] = ("local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "
+                      "error beyond the tolerance)" if anomalies else
+                      "the local field agrees with the model within the uncertainty")
+    return out
+
+
+def field_lines(check: dict) -> list[str]:
+    """The field check as report lines."""
+    est = f"estimated local field: intensity {check['intensity_ut']:.2f} +- {1.96 * check['intensity_std_ut']:.2f} uT"
+    if "dip_deg" in check:
+        est += f", dip {check['dip_deg']:.2f} +- {1.96 * check['dip_std_deg']:.2f} deg"
+    lines = [est + " (95 %)"]
+    if "model" in check:
+        m = check["model"]
+        lines.append(f"model ({m['name']} at {m['lat_deg']:g}, {m['lon_deg']:g}, {m['height_m']:g} m, {m['date']}): "
+                     f"intensity {m['intensity_ut']:.2f} uT, dip {m['dip_deg']:.2f} deg")
+        lines.append(check["message"])
+    return lines
