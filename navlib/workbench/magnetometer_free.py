@@ -439,20 +439,24 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
 
 
 def hidden_effect_study(ratios=(3.0, 10.0), noises=(0.3,), seeds=range(10), none_seeds=None,
-                        correlation: float = 0.0, workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
+                        correlation: float = 0.0, duration_s: float = 40.0, workers: int = 1,
+                        scheduler: str | None = None) -> pd.DataFrame:
     """Detection and false-alarm trials for the reference-free system over hidden effects, sizes, noise
     levels and seeds (nothing-hidden: twice as many seeds by default); each trial's seed is
     :func:`navlib.workbench.trials.trial_seed` of its coordinates (study "hidden effect", or "correlated
-    noise" when ``correlation`` is not 0, then this system, noise level, effect, size, seed number)."""
+    noise" when ``correlation`` is not 0, then this system, the recording's length in s, noise level, effect,
+    size, seed number)."""
     from .trials import SYSTEM_KEYS, run_trials, trial_seed
     check_param("correlation", correlation, lo=-1, hi=1, lo_open=True, hi_open=True)
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
     study = "hidden effect" if correlation == 0 else "correlated noise"
-    base = (SYSTEM_KEYS[SYSTEM.name], 0)
+    check_param("duration_s", duration_s, lo=3.0, hi=1e5)
+    base = (SYSTEM_KEYS[SYSTEM.name], int(round(duration_s)))
     args = []
     for j, noise in enumerate(noises):
-        args += [(h, r, float(noise), trial_seed(study, *base, j, i, k, s), correlation)
+        args += [(h, r, float(noise), trial_seed(study, *base, j, i, k, s), correlation, float(duration_s))
                  for i, h in enumerate(FREE_EFFECTS, start=1) for k, r in enumerate(ratios) for s in seeds]
-        args += [(None, 0.0, float(noise), trial_seed(study, *base, j, 0, 0, s), correlation) for s in none_seeds]
+        args += [(None, 0.0, float(noise), trial_seed(study, *base, j, 0, 0, s), correlation, float(duration_s))
+                 for s in none_seeds]
     return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "magnetometer_free trials"))
