@@ -2,7 +2,7 @@
 hidden at 3x the noise (0.3 uT), and nothing hidden, with independent noise and with AR(1) noise of lag-1
 correlation 0.9; 95 % Wilson intervals.  The unit tests run a few of these trials; this is the full run.
 
-    .venv/bin/python benchmarks/workbench_free_rates.py [trials] [workers] [duration_s]
+    .venv/bin/python benchmarks/workbench_free_rates.py [trials] [workers] [duration_s] [correlations]
 """
 import sys
 import time
@@ -18,7 +18,8 @@ def main():
     workers = int(sys.argv[2]) if len(sys.argv) > 2 else 1
     duration = float(sys.argv[3]) if len(sys.argv) > 3 else 20.0
     pd.set_option("display.width", 200)
-    for rho in (0.0, 0.9):
+    rhos = [float(v) for v in sys.argv[4].split(",")] if len(sys.argv) > 4 else [0.0, 0.9]
+    for rho in rhos:
         t = time.time()
         st = hidden_effect_study(ratios=(3.0,), noises=(0.3,), seeds=range(trials), none_seeds=range(trials),
                                  correlation=rho, duration_s=duration, workers=workers)

@@ -399,7 +399,9 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
     :func:`effect_rms` is ``ratio`` x ``noise_ut``, and the model is the catalogue without it; with ``None``
     the data hold a random subset and the model is exactly that subset.  The parameters and the recording
     come from streams of their own (spawn children 0 and 1 of ``seed``), so the noise-free probe that
-    scales the hidden effect sees the same motion as the data."""
+    scales the hidden effect sees the same motion as the data; a motion that does not turn the sensor
+    through enough directions for the catalogue (the loader would refuse the file) is drawn again from
+    child ``(1, k)``, k = 1, 2, ... (``redraws`` in the result)."""
     from ..seeding import child
     from .diagnose import diagnose
     from .fit import fit_model
@@ -419,9 +421,22 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
     for e in present:
         params.update(zip(FREE_EFFECTS[e].params, rng.uniform(-PARAM_HALF[e], PARAM_HALF[e],
                                                                len(FREE_EFFECTS[e].params))))
+    # the recording: the first hand-turned motion (stream child 1, then 1/1, 1/2, ...) that turns the sensor
+    # through enough directions for the whole catalogue (:func:`check_orientations`; a file that fails it
+    # is refused by the loader, so it is no trial of the tests)
+    need = max(MIN_ORIENTATIONS, 2 + sum(len(e.params) for e in FREE_EFFECTS.values()))
+    for redraw in range(20):
+        stream = child(seed, 1) if redraw == 0 else child(seed, 1, redraw)
+        try:
+            check_orientations(simulate_free({}, duration_s=duration_s, noise_ut=0.0,
+                                             seed=np.random.default_rng(stream)), "simulated", need)
+            break
+        except InputError:
+            continue
+
     def draw(p, noise):
         return simulate_free(p, duration_s=duration_s, noise_ut=noise, noise_correlation=correlation,
-                             seed=np.random.default_rng(child(seed, 1)))
+                             seed=np.random.default_rng(stream))
     if hidden is not None:
         probe = draw(params, 0.0)
         for _ in range(3):
@@ -433,7 +448,7 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
         model = present
     d = diagnose(fit_model(SYSTEM, draw(params, noise_ut), model))
     return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise_ut,
-            "correlation": correlation, "seed": _seed_label(seed), "named": d.missing or "(none)",
+            "correlation": correlation, "seed": _seed_label(seed), "redraws": redraw, "named": d.missing or "(none)",
             "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
             "consistent_with_noise": d.consistent_with_noise}
 
