@@ -58,14 +58,14 @@ def _trials(rho, seeds, nulls):
 
 
 def test_each_hidden_effect_named_and_quiet_without_one():
-    named, quiet = _trials(0.0, 2, 4)
+    named, quiet = _trials(0.0, 2, 3)
     assert set(named.hidden) == set(MF.FREE_EFFECTS)
     assert named.correct.astype(bool).all(), named[~named.correct.astype(bool)][["hidden", "named"]]
     assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
 
 
 def test_hidden_effects_with_ar1_noise_of_correlation_09():
-    named, quiet = _trials(0.9, 1, 3)
+    named, quiet = _trials(0.9, 1, 2)
     assert named.correct.astype(bool).all(), named[["hidden", "named"]]
     assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
 
