@@ -417,36 +417,35 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
         present = tuple(cat[i] for i in sorted(rng.choice(len(cat), size=k, replace=False)))
     else:
         present = cat
-    params = {}
+    base = {}
     for e in present:
-        params.update(zip(FREE_EFFECTS[e].params, rng.uniform(-PARAM_HALF[e], PARAM_HALF[e],
-                                                               len(FREE_EFFECTS[e].params))))
-    # the recording: the first hand-turned motion (stream child 1, then 1/1, 1/2, ...) that turns the sensor
-    # through enough directions for the whole catalogue (:func:`check_orientations`; a file that fails it
-    # is refused by the loader, so it is no trial of the tests)
+        base.update(zip(FREE_EFFECTS[e].params, rng.uniform(-PARAM_HALF[e], PARAM_HALF[e],
+                                                             len(FREE_EFFECTS[e].params))))
+    model = tuple(e for e in cat if e != hidden) if hidden is not None else present
+    # the recording: the first hand-turned motion (stream child 1, then 1/1, 1/2, ...) whose data turn the
+    # sensor through enough directions for the whole catalogue (:func:`check_orientations`; a file that
+    # fails it is refused by the loader, so it is no trial of the tests)
     need = max(MIN_ORIENTATIONS, 2 + sum(len(e.params) for e in FREE_EFFECTS.values()))
     for redraw in range(20):
         stream = child(seed, 1) if redraw == 0 else child(seed, 1, redraw)
+
+        def draw(p, noise):
+            return simulate_free(p, duration_s=duration_s, noise_ut=noise, noise_correlation=correlation,
+                                 seed=np.random.default_rng(stream))
+        params = dict(base)
+        if hidden is not None:
+            probe = draw(params, 0.0)
+            for _ in range(3):
+                now = effect_rms(probe, params, hidden)
+                for q in FREE_EFFECTS[hidden].params:
+                    params[q] *= ratio * noise_ut / now
+        data = draw(params, noise_ut)
         try:
-            check_orientations(simulate_free({}, duration_s=duration_s, noise_ut=0.0,
-                                             seed=np.random.default_rng(stream)), "simulated", need)
+            check_orientations(data, "simulated", need)
             break
         except InputError:
             continue
-
-    def draw(p, noise):
-        return simulate_free(p, duration_s=duration_s, noise_ut=noise, noise_correlation=correlation,
-                             seed=np.random.default_rng(stream))
-    if hidden is not None:
-        probe = draw(params, 0.0)
-        for _ in range(3):
-            now = effect_rms(probe, params, hidden)
-            for q in FREE_EFFECTS[hidden].params:
-                params[q] *= ratio * noise_ut / now
-        model = tuple(e for e in cat if e != hidden)
-    else:
-        model = present
-    d = diagnose(fit_model(SYSTEM, draw(params, noise_ut), model))
+    d = diagnose(fit_model(SYSTEM, data, model))
     return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise_ut,
             "correlation": correlation, "seed": _seed_label(seed), "redraws": redraw, "named": d.missing or "(none)",
             "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
