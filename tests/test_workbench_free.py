@@ -65,6 +65,9 @@ def test_each_hidden_effect_named_and_quiet_without_one():
 
 
 def test_hidden_effects_with_ar1_noise_of_correlation_09():
+    # a few trials only; the full run (benchmarks/workbench_free_rates.py) finds every effect named in
+    # 100/100 trials but only 86/100 nothing-hidden trials quiet (Wilson 0.78-0.92): BELOW the 95 % target
+    # with AR(0.9) noise -- an open limitation, not hidden by this test
     named, quiet = _trials(0.9, 1, 2)
     assert named.correct.astype(bool).all(), named[["hidden", "named"]]
     assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
