@@ -15,6 +15,16 @@ Commands:
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
       compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
       --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
+  field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
+      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
+      loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
+      estimates with it and flags a local anomaly when they differ beyond the uncertainty.
+  calibrate magnetometer FILE.csv [--model hard_iron,scale,soft_iron] --out CAL.json
+      fit the reference-free magnetometer model (no attitude needed) and write the correction in magcal's
+      convention, m_corrected = (m - b) A, with the expected field strength and every parameter's
+      uncertainty (navlib.workbench.calibration).
+  apply CAL.json FILE.csv --out CORRECTED.csv
+      correct the field columns of FILE with a calibration (never over an existing file).
   grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
       one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
       file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
@@ -24,11 +34,13 @@ rates and grid run on dask.distributed (navlib.engine): --workers N local worker
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
 variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.
 
-SYSTEM is compass, drift, magnetometer or accelerometer:
+SYSTEM is compass, drift, magnetometer, magnetometer_free or accelerometer:
   compass columns: true_heading_deg, measured_heading_deg; optional temperature_c, time_s, sweep.
   drift columns: latitude_error_deg, drift_deg_h; optional temperature_c, temperature_change_c.
   magnetometer columns: mag_x_ut, mag_y_ut, mag_z_ut, q_w, q_x, q_y, q_z (reference attitude, body FRD to
   NED); optional time_s, gyr_*_dps, pos_*_m.
+  magnetometer_free columns: mag_x_ut, mag_y_ut, mag_z_ut (no attitude); optional acc_x_ms2, acc_y_ms2,
+  acc_z_ms2 (still or slow), time_s, temperature_c.
   accelerometer columns (one unit's tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
   output_mg (output / nominal scale factor), unit; optional set_point_c.  Extra columns are ignored.
 
@@ -60,6 +72,8 @@ from .workbench.diagnose import diagnose
 from .workbench.effects import resolve
 from .workbench.fit import fit_model
 from .workbench.loop import check_report_folder, loop, write_report
+from .workbench.calibration import DEFAULT_MODEL, apply_file, calibrate_file
+from .workbench.magnetometer_free import FREE_EFFECTS
 from .workbench.rates import DEFAULT_RATIOS, RATE_SYSTEMS, rates
 
 
@@ -89,6 +103,26 @@ def build_parser() -> argparse.ArgumentParser:
         cmd.add_argument("--alpha", type=float, default=None, help="family-wise false-alarm level (default 0.025)")
         if name == "loop":
             cmd.add_argument("--report", default=None, help="folder for loop.png and loop.md (never overwritten)")
+            _site_options(cmd, required=False)
+    fld = sub.add_parser("field", help="the Earth's field from IGRF-14 at a site and date",
+                         description="the IGRF-14 main field (ppigrf, offline) at a site: north, east, down, "
+                                     "intensity (uT), dip and declination (deg)")
+    _site_options(fld, required=True)
+    fld.add_argument("--json", action="store_true", help="print one JSON object")
+    cal = sub.add_parser("calibrate", help="fit a magnetometer calibration without reference attitude",
+                         description="fit the reference-free magnetometer model (field magnitude and, with an "
+                                     "accelerometer, dip constant) and write the correction m_corrected = "
+                                     "(m - b) A with its uncertainties as JSON")
+    cal.add_argument("sensor", choices=["magnetometer"])
+    cal.add_argument("file", help="measurement CSV (mag_*_ut; optional acc_*_ms2, time_s, temperature_c)")
+    cal.add_argument("--model", default=",".join(DEFAULT_MODEL),
+                     help=f"comma-separated effects (default {','.join(DEFAULT_MODEL)}: the full ellipsoid)")
+    cal.add_argument("--out", required=True, help="calibration JSON to write (never overwritten)")
+    app = sub.add_parser("apply", help="apply a calibration to a measurement file",
+                         description="correct the field columns of FILE with a calibration of `navlib calibrate`")
+    app.add_argument("calibration", help="calibration JSON written by `navlib calibrate`")
+    app.add_argument("file", help="measurement CSV with the columns the calibration needs")
+    app.add_argument("--out", required=True, help="corrected CSV to write (never overwritten)")
     rates = sub.add_parser("rates", help="detection, false-alarm and out-of-catalogue rates of the loop",
                            description="detection, false-alarm and out-of-catalogue rates of the workbench's loop "
                                        "on simulated data at your noise level and effect sizes (95 % Wilson "
@@ -115,6 +149,41 @@ def build_parser() -> argparse.ArgumentParser:
                          help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
     rates.add_argument("--json", action="store_true", help="print one JSON object")
     return ap
+
+
+def _site_options(cmd, required: bool) -> None:
+    cmd.add_argument("--site", required=required, default=None, metavar="LAT,LON[,HEIGHT_M]",
+                     help="geodetic latitude and longitude (deg) and height above the WGS84 ellipsoid (m, default 0)"
+                          + ("" if required else "; magnetometer_free: the loop compares the estimated local "
+                             "field with IGRF-14 there and flags a local anomaly"))
+    cmd.add_argument("--date", default=None, metavar="YYYY-MM-DD", help="date of the field (default 2025-01-01)")
+
+
+def _site(args):
+    """The :class:`navlib.sensors.earth_field.Site` of --site/--date, or None without --site."""
+    from .sensors.earth_field import Site
+    if args.site is None:
+        if args.date is not None:
+            raise InputError("parameter --date: give --site LAT,LON[,HEIGHT_M] with it")
+        return None
+    v = _numbers("--site", args.site, None)
+    if len(v) not in (2, 3):
+        raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
+    return Site(v[0], v[1], v[2] if len(v) == 3 else 0.0, args.date or "2025-01-01")
+
+
+def _field(args) -> int:
+    from .sensors.earth_field import igrf_field
+    site = _site(args)
+    f = igrf_field(site).to_dict()
+    if args.json:
+        print(json.dumps({"model": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
+                          "height_m": site.height_m, "date": site.date, **f}))
+    else:
+        print(f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
+              f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+              f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
+    return 0
 
 
 def _simulate_compass(args) -> int:
@@ -155,20 +224,53 @@ def _diagnose(args) -> int:
 def _loop(args) -> int:
     if args.report:
         check_report_folder(args.report)            # refuse before the work, not after it
+    site = _site(args)
+    if site is not None and args.system != "magnetometer_free":
+        raise InputError(f"parameter --site: the field check is made by the magnetometer_free system, not "
+                         f"{args.system}")
     system, users, names, data = _prepare(args)
     result = loop(system, data, names, user_effects=users, alpha=args.alpha)
+    check = None
+    if system.name == "magnetometer_free":
+        from .workbench.calibration import field_check, field_lines
+        check = field_check(result.final, site, result.screening.noise if result.screening else None)
     if args.report:
         png, md = write_report(result, args.report, source=str(args.file))
     if args.json:
-        print(json.dumps(result.to_dict(), allow_nan=False, default=float))
+        out = result.to_dict()
+        if check is not None:
+            out["field"] = check
+        print(json.dumps(out, allow_nan=False, default=float))
     else:
         print(result.steps_table().to_string(float_format=lambda x: f"{x:.4g}"))
         print()
         print(result.final_diagnosis.message)
         for u in result.untested:
             print(f"not tested: {u['effect']} ({u['why']})")
+        if check is not None:
+            print("\n".join(field_lines(check)))
         if args.report:
             print(f"report: {md} and {png}")
+    return 0
+
+
+def _calibrate(args) -> int:
+    names = [e.name for e in resolve(FREE_EFFECTS, args.model.split(","), None, "magnetometer_free")]
+    path, cal = calibrate_file(args.file, names, args.out)
+    mc = cal["magcal"]
+    print(f"model: {' + '.join(cal['model'])}   rows: {cal['rows']}   residual rms: {cal['residual_rms_ut']:.4g} uT")
+    print(f"expected field strength: {mc['expected_field_strength_ut']:.4g} "
+          f"+- {cal['expected_field_strength_ut']['std']:.2g} uT" +
+          (f"   dip: {cal['dip_deg']:.2f} deg" if "dip_deg" in cal else ""))
+    print("b (uT): " + ", ".join(f"{v:.4g} +- {e:.2g}" for v, e in zip(mc["b_ut"], mc["b_std_ut"])))
+    print("A: " + "; ".join(", ".join(f"{v:.5f}" for v in row) for row in mc["A"]))
+    print(f"wrote {path}")
+    return 0
+
+
+def _apply(args) -> int:
+    path, n = apply_file(args.calibration, args.file, args.out)
+    print(f"wrote {n} corrected rows to {path}")
     return 0
 
 
@@ -210,7 +312,7 @@ def _grid(args) -> int:
 
 
 COMMANDS = {"simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
-            "grid": _grid}
+            "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field}
 
 
 #: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.

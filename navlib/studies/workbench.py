@@ -516,3 +516,44 @@ def drift_study(alpha: float | None = None) -> DriftStudy:
     full = fit_model("drift", allrows, ["earth_rate", "bias", "temperature_change"])
     return DriftStudy(hot, cold, hot_fit, diagnose(hot_fit, alpha=alpha), diags, pd.DataFrame(loo).T,
                       full.params["temperature_change_coef_deg_h_per_c"])
+
+
+def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.DataFrame | None:
+    """Issue 23: the reference-free calibration against the reference-based one on BROAD.  On the
+    calibration trial 05 (every ``row_step``-th block) the reference-free system
+    (:mod:`navlib.workbench.magnetometer_free`: field and accelerometer only, the reference quaternion
+    ignored) is calibrated with hard iron, scale and soft iron (the full ellipsoid, what ``navlib calibrate
+    magnetometer`` fits) and its correction ``(m - b) A`` applied to every undisturbed trial, beside the
+    reference-based calibration ``reference`` (the loop of :func:`magnet_study` on the same trial) and the
+    raw field.  Heading error (deg) of each against the optical reference: the corrected field levelled
+    with the reference attitude, its declination minus its circular mean on that trial (so a constant
+    heading offset, the declination and the rotation the invariants cannot see are not counted).  One row
+    per trial: rows, RMS heading error raw / reference-free / reference-based, and the reference-free
+    calibration's field strength and dip.  None if the data are absent."""
+    from ..workbench.calibration import DEFAULT_MODEL, apply_calibration as apply_free, calibrate
+    from ..workbench.magnetometer_free import ACC, with_invariants
+    names = undisturbed_trials()
+    if not names:
+        return None
+    check_param("row_step", row_step, lo=1, integer=True)
+
+    def free_frame(d):
+        return with_invariants(d[list(MAG) + list(ACC) + ["time_s"]])
+
+    cal = calibrate(free_frame(load_trial(CALIBRATION_TRIAL, row_step)), DEFAULT_MODEL, source=CALIBRATION_TRIAL)
+    rows = []
+    for name in names:
+        d = load_trial(name, row_step)
+        free = apply_free(cal, free_frame(d))[list(MAG)].to_numpy(float)
+
+        def rms(field):
+            return float(np.sqrt(np.mean(heading_error_deg(field, d) ** 2)))
+
+        rows.append({"trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "), "rows": len(d),
+                     "raw field (deg)": rms(d[list(MAG)].to_numpy(float)),
+                     "reference-free calibration (deg)": rms(free),
+                     "reference-based calibration (deg)": rms(correct_field(reference.final.params, d))})
+    out = pd.DataFrame(rows).set_index("trial")
+    out.attrs["field_ut"] = cal["expected_field_strength_ut"]["value"]
+    out.attrs["dip_deg"] = cal.get("dip_deg", float("nan"))
+    return out

@@ -41,7 +41,9 @@ def measured_columns(system: str, axes: int) -> tuple[str, ...]:
     """The names of a system's measured columns (:data:`MEASURED`; ``"axis j"`` for a system without an
     entry)."""
     cols = MEASURED.get(system, ((), False))[0]
-    return cols if len(cols) == axes else tuple(f"axis {j}" for j in range(axes))
+    # a system whose residual has fewer axes on some data (magnetometer_free without an accelerometer)
+    # names its first ones
+    return cols[:axes] if len(cols) >= axes else tuple(f"axis {j}" for j in range(axes))
 
 
 def residuals_on(fit: "Fit", frame: pd.DataFrame) -> np.ndarray:
@@ -49,7 +51,7 @@ def residuals_on(fit: "Fit", frame: pd.DataFrame) -> np.ndarray:
     ``frame``, shape (rows, axes): also on rows the fit did not use."""
     cols, wrapped = MEASURED[fit.system]
     model = np.asarray(fit.predict(frame), float).reshape(len(frame), -1)
-    r = frame[list(cols)].to_numpy(float) - model
+    r = frame[list(cols[:model.shape[1]])].to_numpy(float) - model
     return wrap_deg(r) if wrapped else r
 
 

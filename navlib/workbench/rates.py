@@ -25,14 +25,15 @@ import pandas as pd
 
 from .. import verdicts
 from ..errors import InputError, check_param
-from . import accelerometer
+from . import accelerometer, magnetometer_free
 from .effects import get_system
 from .trials import TRIAL_SYSTEMS, hidden_effect_study, out_of_catalogue_study
 
 #: Systems whose simulated data the rate trials draw.
-RATE_SYSTEMS = TRIAL_SYSTEMS + ("accelerometer",)
+RATE_SYSTEMS = TRIAL_SYSTEMS + ("accelerometer", "magnetometer_free")
 #: Default noise (1 sigma, in the system's unit): the book's chapters' levels.
-DEFAULT_NOISE = {"compass": 0.1, "drift": 1e-4, "magnetometer": 0.3, "accelerometer": 0.003}
+DEFAULT_NOISE = {"compass": 0.1, "drift": 1e-4, "magnetometer": 0.3, "accelerometer": 0.003,
+                 "magnetometer_free": 0.3}
 #: Default effect sizes, as multiples of the noise.
 DEFAULT_RATIOS = (3.0, 10.0)
 #: Trials a command may ask for per case (a guard against a typo of a few zeros).
@@ -96,7 +97,7 @@ def rates(system: str, trials: int = 20, noises=None, ratios=DEFAULT_RATIOS, nul
     Parameters
     ----------
     system : str
-        ``compass``, ``drift``, ``magnetometer`` or ``accelerometer``.
+        ``compass``, ``drift``, ``magnetometer``, ``accelerometer`` or ``magnetometer_free``.
     trials : int
         Trials per (hidden effect, size, noise) and per (out-of-catalogue kind, size, noise).
     noises : sequence of float, optional
@@ -134,6 +135,9 @@ def rates(system: str, trials: int = 20, noises=None, ratios=DEFAULT_RATIOS, nul
         study = accelerometer.hidden_effect_study(ratios, tuple(1000.0 * v for v in noises), seeds, none_seeds,
                                                   workers=workers, scheduler=scheduler)
         study["noise"] = study.pop("noise_ug") / 1000.0
+    elif system == "magnetometer_free":
+        study = magnetometer_free.hidden_effect_study(ratios, noises, seeds, none_seeds, workers=workers,
+                                                      scheduler=scheduler)
     else:
         study = hidden_effect_study(system, ratios=ratios, noises=noises, seeds=seeds, none_seeds=none_seeds,
                                     workers=workers, scheduler=scheduler)

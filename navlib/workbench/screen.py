@@ -181,7 +181,7 @@ def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
     """RMS of the measured values of ``frame`` (:data:`navlib.workbench.fit.MEASURED`; for a system
     without an entry, of the model's prediction plus the residual)."""
     if fit.system in MEASURED:
-        v = frame[list(MEASURED[fit.system][0])].to_numpy(float)
+        v = frame[[c for c in MEASURED[fit.system][0] if c in frame]].to_numpy(float)
     else:
         v = np.asarray(fit.predict(frame), float).ravel() + fit.residuals
     return float(np.sqrt(np.mean(v ** 2)))

@@ -24,7 +24,7 @@ from .magnetometer import effect_rms as magnetometer_effect_rms, simulate_hand_t
 TRIAL_ENTROPY = 0
 #: First element of the spawn key: which study the trial belongs to.
 STUDY_KEYS = {"hidden effect": 1, "out of catalogue": 2, "correlated noise": 3}
-SYSTEM_KEYS = {"compass": 0, "drift": 1, "magnetometer": 2, "accelerometer": 3}
+SYSTEM_KEYS = {"compass": 0, "drift": 1, "magnetometer": 2, "accelerometer": 3, "magnetometer_free": 4}
 #: The systems whose simulated data the hidden-effect trials can draw.
 TRIAL_SYSTEMS = ("compass", "drift", "magnetometer")
 #: Length of a simulated hand-turned magnetometer recording (s, at 10 Hz) in the trials.

@@ -1,0 +1,251 @@
+"""Calibrate a magnetometer without a reference attitude, write the correction, and apply it to a file
+(``python -m navlib calibrate magnetometer FILE --out cal.json`` and ``python -m navlib apply cal.json FILE
+--out corrected.csv``).
+
+The fit is the reference-free system :mod:`navlib.workbench.magnetometer_free` with the chosen effects
+(default ``hard_iron, scale, soft_iron``: the full symmetric ellipsoid).  The correction is written in the
+convention of MATLAB's ``magcal`` and the field's calibration scripts::
+
+    m_corrected = (m - b) A          (row vectors; A symmetric)
+
+with ``expected_field_strength_ut`` the intensity the corrected field has (magcal's ``expmfs``).  With the
+system's correction ``u = M (m - b)`` (column vectors) and ``M`` symmetric, ``A = M^T = M``.  The
+workbench's reference-based ``magnetometer`` system writes the *distortion* instead, ``m = A_wb C m_n + b``
+with ``A_wb = R (I + S)``; the two are inverse to each other up to a rotation the reference-free
+invariants cannot see: ``A ~ (I + S)^-1``, so ``A - I ~ -S`` for small soft iron.  A temperature-dependent
+offset (``temperature`` effect) makes ``b`` a function of the temperature, ``b(T) = b + k (T - T_c)``; with
+``misalignment`` (accelerometer columns) the corrected field is also turned into the accelerometer's axes,
+``m_corrected R^T``.
+
+Uncertainties: the parameters' standard errors from the fit's Jacobian (``s^2 (J'J)^-1``), on the whitened
+residuals and Jacobian when the workbench's screen finds serially correlated noise (generalised least
+squares), after setting aside the rows the screen calls outliers.  ``A``'s entries are linear in the scale
+and soft-iron parameters, so their standard errors are those of the parameters.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+from ..data.tables import read_table, write_new, write_new_csv
+from ..errors import InputError
+from .fit import fit_model
+from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, check_units, correction_matrix,
+                                field_summary, free_columns, full_params, has_acc, load_free)
+from .screen import screen
+
+FORMAT = "navlib calibration"
+VERSION = 1
+DEFAULT_MODEL = ("hard_iron", "scale", "soft_iron")
+
+
+def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "") -> dict:
+    """The calibration of ``data`` (a frame of :func:`navlib.workbench.magnetometer_free.load_free`) with
+    the effects ``model``, as a JSON-ready dict (module docstring)."""
+    fit = fit_model(SYSTEM, data, list(model))
+    sc = screen(fit)
+    fit = sc.refit(fit)
+    noise = sc.noise
+    names, cov = parameter_covariance(fit, noise)
+    std = dict(zip(names, np.sqrt(np.clip(np.diag(cov), 0, None))))
+    effects = {}
+    for e in fit.effects:
+        eff = FREE_EFFECTS[e]
+        effects[e] = {q: {"value": fit.params[q], "std": float(std[q]), "unit": u}
+                      for q, u in zip(eff.params, eff.units)}
+    p = full_params(fit.params)
+    A = correction_matrix(p)
+    dA = np.zeros((3, 3))
+    for (i, j), q in {(0, 0): "scale_x", (1, 1): "scale_y", (0, 1): "soft_xy", (0, 2): "soft_xz",
+                      (1, 2): "soft_yz"}.items():
+        dA[i, j] = dA[j, i] = std.get(q, 0.0)
+    dA[2, 2] = float(np.sqrt(cov[names.index("scale_x"), names.index("scale_x")]
+                             + cov[names.index("scale_y"), names.index("scale_y")]
+                             + 2 * cov[names.index("scale_x"), names.index("scale_y")])) if "scale" in fit.effects else 0.0
+    hard = ["hard_x_ut", "hard_y_ut", "hard_z_ut"]
+    summary = field_summary(fit)
+    out = {
+        "format": FORMAT, "version": VERSION, "system": SYSTEM.name, "source": source,
+        "model": list(fit.effects), "rows": int(len(fit.data)), "outliers_set_aside": len(sc.outliers),
+        "residual_rms_ut": fit.rms,
+        "noise": noise.describe() if noise.series is not None else "independent samples",
+        "columns": {"field": list(MAG), "acceleration": list(ACC) if has_acc(data) else None,
+                    "temperature": "temperature_c" if "temperature" in fit.effects else None},
+        "expected_field_strength_ut": {"value": fit.params["field_ut"], "std": float(std["field_ut"]), "unit": "uT"},
+        "effects": effects,
+        "magcal": {"convention": "m_corrected = (m - b(T)) A (row vectors); |m_corrected| = expected field strength",
+                   "A": A.tolist(), "A_std": dA.tolist(),
+                   "b_ut": [p[q] for q in hard], "b_std_ut": [float(std.get(q, 0.0)) for q in hard],
+                   "expected_field_strength_ut": fit.params["field_ut"]},
+        "temperature": ({"centre_c": fit.model["temperature_centre_c"],
+                         "coef_ut_per_c": [p["temp_x_ut_c"], p["temp_y_ut_c"], p["temp_z_ut_c"]]}
+                        if "temperature" in fit.effects else None),
+        "to_accelerometer_axes": (Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"],
+                                                                     p["mis_z_deg"]])).as_matrix().tolist()
+                                  if "misalignment" in fit.effects else None),
+    }
+    if "dip (deg)" in summary:
+        out["dip_deg"] = summary["dip (deg)"]
+    return out
+
+
+def write_calibration(cal: dict, path) -> Path:
+    """Write ``cal`` as JSON to ``path`` (never over an existing file)."""
+    return write_new(path, lambda fh: json.dump(cal, fh, indent=2, allow_nan=False))
+
+
+def read_calibration(path) -> dict:
+    """A calibration file written by :func:`write_calibration`; one-line InputError for anything else (not
+    JSON, not a navlib calibration, a calibration of another system, a newer version)."""
+    name = Path(path).name
+    try:
+        cal = json.loads(Path(path).read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputError(f"{name}: not a calibration file (not JSON: {str(err).splitlines()[0]})") from None
+    if not isinstance(cal, dict) or cal.get("format") != FORMAT:
+        raise InputError(f"{name}: not a navlib calibration file (no \"format\": \"{FORMAT}\")")
+    if cal.get("system") != SYSTEM.name:
+        raise InputError(f"{name}: a calibration of the system {cal.get('system')!r}; apply corrects "
+                         f"'{SYSTEM.name}' calibrations (python -m navlib calibrate magnetometer)")
+    if cal.get("version") != VERSION:
+        raise InputError(f"{name}: calibration format version {cal.get('version')!r}; this navlib reads {VERSION}")
+    try:
+        A = np.asarray(cal["magcal"]["A"], float)
+        b = np.asarray(cal["magcal"]["b_ut"], float)
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{name}: the calibration has no valid magcal A and b_ut") from None
+    if A.shape != (3, 3) or b.shape != (3,) or not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        raise InputError(f"{name}: magcal A must be 3x3 and b_ut 3 finite numbers")
+    return cal
+
+
+def apply_calibration(cal: dict, frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with its field columns corrected: ``(m - b(T)) A`` (and turned into the accelerometer's
+    axes when the calibration has a misalignment)."""
+    A = np.asarray(cal["magcal"]["A"], float)
+    b = np.asarray(cal["magcal"]["b_ut"], float)
+    m = frame[list(MAG)].to_numpy(float) - b
+    if cal.get("temperature"):
+        t = cal["temperature"]
+        m = m - (frame["temperature_c"].to_numpy(float) - t["centre_c"])[:, None] * np.asarray(t["coef_ut_per_c"])
+    u = m @ A
+    if cal.get("to_accelerometer_axes") is not None:
+        u = u @ np.asarray(cal["to_accelerometer_axes"], float).T
+    out = frame.drop(columns=[c for c in DERIVED if c in frame]).copy()
+    out[list(MAG)] = u
+    return out
+
+
+def apply_file(cal_path, data_path, out_path) -> tuple[Path, int]:
+    """Read a calibration and a measurement file, check they match, write the corrected file (never over
+    an existing one: checked before the work)."""
+    out_path = Path(out_path)
+    if out_path.exists() or out_path.is_symlink():
+        raise InputError(f"{out_path}: already exists; not overwritten (choose another --out)")
+    cal = read_calibration(cal_path)
+    name = Path(data_path).name
+    frame = read_table(data_path, free_columns(), min_rows=1, kind="magnetometer file")
+    check_units(frame, name)
+    if cal.get("temperature") and "temperature_c" not in frame:
+        raise InputError(f"{name}: the calibration corrects a temperature-dependent offset: the file needs a "
+                         f"'temperature_c' column")
+    return write_new_csv(apply_calibration(cal, frame), out_path), len(frame)
+
+
+def calibrate_file(data_path, model, out_path) -> tuple[Path, dict]:
+    """Load a file (:func:`load_free`), calibrate it with ``model`` and write the JSON to ``out_path``
+    (existing files refused before the work)."""
+    out_path = Path(out_path)
+    if out_path.exists() or out_path.is_symlink():
+        raise InputError(f"{out_path}: already exists; not overwritten (choose another --out)")
+    data = load_free(data_path)
+    cal = calibrate(data, model, source=Path(data_path).name)
+    return write_calibration(cal, out_path), cal
+
+
+def parameter_covariance(fit, noise=None) -> tuple[list, np.ndarray]:
+    """``(names, cov)``: the covariance of ``fit``'s parameters, ``s^2 (J'J)^-1`` with ``s^2 = RSS / (n - p)``,
+    on the whitened residual and Jacobian when ``noise`` (a :class:`navlib.workbench.serial.NoiseModel`)
+    is correlated (generalised least squares)."""
+    J, r = fit.jacobian, fit.residuals
+    if noise is not None and noise.correlated:
+        J, r = noise.whiten(J), noise.whiten(r)
+    s2 = float(r @ r) / max(fit.n - fit.n_params, 1)
+    return list(fit.params), s2 * np.linalg.pinv(J.T @ J, hermitian=True)
+
+
+#: Tolerances of the comparison with the model field (:func:`field_check`): the crustal field IGRF leaves
+#: out (typically up to a few hundred nT away from magnetic rocks: Alken et al. 2021) and the sensor's
+#: absolute scale, which the invariants cannot calibrate (the mean scale trades against the intensity) --
+#: a free choice, stated: 1 % unless the user gives another.
+CRUST_TOL_UT = 0.3
+SCALE_TOL = 0.01
+
+
+def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dict:
+    """The local field the reference-free fit estimates beside the IGRF-14 model at ``site``
+    (:class:`navlib.sensors.earth_field.Site`), and whether they differ beyond the uncertainty.
+
+    Intensity: estimate +- 1.96 sigma (parameter covariance, :func:`parameter_covariance`); anomaly when
+    ``|F - F_model| > 1.96 sigma + CRUST_TOL_UT + scale_tol F_model``.  Dip (with an accelerometer; free of
+    the sensor's scale): anomaly when ``|dip - dip_model| > 1.96 sigma + deg(CRUST_TOL_UT / F_model)``.
+    Without a site only the estimate is returned."""
+    from ..errors import check_param
+    from ..sensors.earth_field import igrf_field
+    check_param("scale_tol", scale_tol, lo=0, hi=0.5)
+    names, cov = parameter_covariance(fit, noise)
+    iF = names.index("field_ut")
+    F = fit.params["field_ut"]
+    out = {"intensity_ut": F, "intensity_std_ut": float(np.sqrt(cov[iF, iF]))}
+    if "field_down_ut" in fit.params:
+        iD = names.index("field_down_ut")
+        D = fit.params["field_down_ut"]
+        x = float(np.clip(-D / F, -1, 1))
+        g = np.zeros(len(names))                       # d dip / d(F, D), rad
+        k = 1.0 / np.sqrt(max(1 - x * x, 1e-12))
+        g[iF], g[iD] = k * D / F ** 2, -k / F
+        out["dip_deg"] = float(np.degrees(np.arcsin(x)))
+        out["dip_std_deg"] = float(np.degrees(np.sqrt(g @ cov @ g)))
+    if site is None:
+        return out
+    model = igrf_field(site)
+    out["model"] = {"name": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
+                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model.intensity_ut,
+                    "dip_deg": model.dip_deg, "declination_deg": model.declination_deg}
+    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model.intensity_ut
+    out["intensity_difference_ut"] = F - model.intensity_ut
+    out["intensity_tolerance_ut"] = tol_f
+    anomalies = []
+    if abs(F - model.intensity_ut) > tol_f:
+        anomalies.append(f"intensity {F:.2f} uT against the model's {model.intensity_ut:.2f} uT "
+                         f"(beyond +-{tol_f:.2f} uT)")
+    if "dip_deg" in out:
+        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model.intensity_ut))
+        out["dip_difference_deg"] = out["dip_deg"] - model.dip_deg
+        out["dip_tolerance_deg"] = tol_d
+        if abs(out["dip_difference_deg"]) > tol_d:
+            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model.dip_deg:.2f} deg "
+                             f"(beyond +-{tol_d:.2f} deg)")
+    out["local_anomaly"] = bool(anomalies)
+    out["message"] = ("local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "
+                      "error beyond the tolerance)" if anomalies else
+                      "the local field agrees with the model within the uncertainty")
+    return out
+
+
+def field_lines(check: dict) -> list[str]:
+    """The field check as report lines."""
+    est = f"estimated local field: intensity {check['intensity_ut']:.2f} +- {1.96 * check['intensity_std_ut']:.2f} uT"
+    if "dip_deg" in check:
+        est += f", dip {check['dip_deg']:.2f} +- {1.96 * check['dip_std_deg']:.2f} deg"
+    lines = [est + " (95 %)"]
+    if "model" in check:
+        m = check["model"]
+        lines.append(f"model ({m['name']} at {m['lat_deg']:g}, {m['lon_deg']:g}, {m['height_m']:g} m, {m['date']}): "
+                     f"intensity {m['intensity_ut']:.2f} uT, dip {m['dip_deg']:.2f} deg")
+        lines.append(check["message"])
+    return lines

@@ -1,0 +1,476 @@
+"""The ``magnetometer_free`` system: a 3-D magnetometer turned by hand, with no reference attitude.
+
+What holds without an attitude (document B's "magnitude constraint" and "dot-product invariance"): the
+Earth field at one place has a constant intensity ``F``, and, while the sensor is still or slow, a constant
+angle to gravity, so its component along the measured gravity direction is a constant ``D = F sin(dip)``.
+The sensor model is written, as magcal and the field's calibration scripts write it, as its correction::
+
+    u_i = M (m_i - b - k (T_i - T_c)),      M = I + K   (K symmetric, trace-free)
+    e_i = |u_i| - F,     g_i = a_i/|a_i| . R(theta) u_i - D,     c = D / F
+    residual_i = ( e_i ,  (g_i - c e_i) / sqrt(1 - c^2) )      [uT; the second only with an accelerometer]
+
+The second residual is the dot-product misfit with its share of the magnitude misfit taken out: the same
+sensor noise ``n`` enters ``e ~ n . u/|u|`` and ``g ~ n . a/|a|``, which are correlated by ``c`` (0.94 at a
+dip of 70 deg); the combination is the noise across the field in the plane of field and gravity, i.e.
+``F`` times the error of the dip angle, independent of ``e`` and of the same variance for isotropic noise,
+so the F tests of the workbench hold.
+
+- ``hard_iron`` = ``b`` (uT): a field fixed to the body (the centre of the ellipsoid the raw field traces);
+- ``scale`` = the diagonal of ``K`` (2 parameters, the third is minus their sum): per-axis scale mismatch,
+  the ellipsoid's axes along the sensor's axes (magcal's ``diag``);
+- ``soft_iron`` = the off-diagonal of ``K`` (3): cross-axis soft iron, the ellipsoid's axes turned;
+  ``scale`` + ``soft_iron`` together are the full symmetric ellipsoid (magcal's ``sym``).  The two are kept
+  apart in the catalogue so that each can be missing from a model and be named; the trace of ``K`` is not
+  observable (it trades against ``F``) and is fixed at zero;
+- ``misalignment`` = ``theta`` (deg, a rotation vector, only with ``acc_*_ms2``): the magnetometer's axes
+  turned against the accelerometer's; it breaks the dot-product invariance and leaves the magnitude alone;
+- ``temperature`` = ``k`` (uT/degC, only with ``temperature_c``): an offset drifting with temperature
+  (``T_c`` the mean temperature).
+
+``F`` (``field_ut``) and, with an accelerometer, ``D`` (``field_down_ut``) are always estimated; the dip is
+``asin(D / F)`` with the sign convention of the accelerometer's specific force (``a`` points up at rest, so
+``D`` is minus the downward component; :func:`field_summary` reports the dip positive downward).
+
+The residual is (measured - model) of two derived columns the loader adds, ``field_norm_ut = |m|`` and
+``field_gravity_ut = a/|a| . m`` (raw), so that the workbench's outlier screen can name a column; the model's
+"prediction" of them is the measured value minus the invariants' residual.  Residuals per row: 1 (no
+accelerometer) or 2, flattened row by row.
+
+Relation to the ``magnetometer`` system: there ``m = A C m_n + b`` with ``A = R (I + S)``, the distortion;
+here ``M`` is the correction, ``M = A^-1`` up to the rotation the invariants cannot see and the overall
+scale: ``(I + S)^-1 = I - S + S^2 ...``, so ``K ~ -S`` for small soft iron.
+
+Structure tests (shapes no catalogued effect produces): the magnitude changing in time (an offset per
+10 % of the recording, per residual column), and the magnitude depending on the direction of the sample on
+the sphere beyond the ellipsoid (the seven third-degree harmonics of the field's direction: an ellipsoid
+is of degree <= 2).
+
+Files: ``mag_x_ut, mag_y_ut, mag_z_ut``; optional ``acc_x_ms2, acc_y_ms2, acc_z_ms2``, ``time_s``,
+``temperature_c``, ``gyr_*_dps``; other columns ignored.  :func:`load_free` refuses bad input in one line.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.spatial.transform import Rotation
+
+from ..data.tables import Column, read_table, require_variation
+from ..errors import InputError, check_param
+from .effects import Effect, System, register_system
+from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
+from .magnetometer import FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
+from .serial import ar1_noise
+
+ACC = ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2")
+DERIVED = ("field_norm_ut", "field_gravity_ut")
+G0 = 9.80665
+#: Median |a| must lie in this band (m/s^2) for an accelerometer in m/s^2 held still or turned slowly.
+GRAVITY_BAND = (5.0, 15.0)
+#: Distinct 30-deg cells of the field's direction needed (and at least one per model parameter).
+MIN_ORIENTATIONS = 12
+#: The field's directions must span 3-D: smallest eigenvalue of their second moment at least this (a
+#: sensor turned about one axis only traces an ellipse, which cannot give an ellipsoid: 0).
+MIN_SPREAD = 0.02
+
+FREE_EFFECTS = {
+    "hard_iron": Effect(
+        "hard_iron", ("hard_x_ut", "hard_y_ut", "hard_z_ut"), ("uT", "uT", "uT"),
+        "A field fixed to the body (magnet, magnetised steel, sensor offsets): the raw field traces a sphere "
+        "whose centre is off the origin. Missing, the magnitude varies as one cycle over the sphere."),
+    "scale": Effect(
+        "scale", ("scale_x", "scale_y"), ("-", "-"),
+        "Per-axis scale mismatch (z = -x - y; the mean scale is in the field strength): an ellipsoid with "
+        "its axes along the sensor's. Missing, the magnitude varies as two cycles, aligned with the axes."),
+    "soft_iron": Effect(
+        "soft_iron", ("soft_xy", "soft_xz", "soft_yz"), ("-", "-", "-"),
+        "Cross-axis soft iron (induced magnetisation): the ellipsoid's axes are turned against the sensor's. "
+        "Missing, the magnitude varies as two cycles along the diagonals."),
+    "misalignment": Effect(
+        "misalignment", ("mis_x_deg", "mis_y_deg", "mis_z_deg"), ("deg", "deg", "deg"),
+        "The magnetometer's axes are turned against the accelerometer's. Missing, the angle between field and "
+        "gravity (the dip) seems to change with orientation while the magnitude stays constant.", ACC),
+    "temperature": Effect(
+        "temperature", ("temp_x_ut_c", "temp_y_ut_c", "temp_z_ut_c"), ("uT/degC",) * 3,
+        "The offset (hard iron, sensor bias) drifts with temperature. Missing, the ellipsoid's centre moves "
+        "as the sensor warms.", ("temperature_c",)),
+}
+_PARAMS = [p for e in FREE_EFFECTS.values() for p in e.params]
+#: The simulators' local field: BROAD's room (:data:`navlib.workbench.magnetometer.BROAD_FIELD`), intensity
+#: 43.5 uT, dip 69.6 deg.
+SIM_FIELD_UT, SIM_DIP_DEG = 43.54, 69.56
+
+
+def free_columns() -> list[Column]:
+    return ([Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT) for c in MAG]
+            + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4) for c in ACC]
+            + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10),
+               Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0)]
+            + [Column(c, "deg/s", required=False, checked=False) for c in GYR])
+
+
+def has_acc(frame: pd.DataFrame) -> bool:
+    return all(c in frame for c in ACC)
+
+
+def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with the derived columns ``field_norm_ut`` (|m|) and, with an accelerometer,
+    ``field_gravity_ut`` (a/|a| . m), the raw values of the two invariants."""
+    out = frame.copy()
+    m = out[list(MAG)].to_numpy(float)
+    out["field_norm_ut"] = np.linalg.norm(m, axis=1)
+    if has_acc(out):
+        a = out[list(ACC)].to_numpy(float)
+        out["field_gravity_ut"] = np.einsum("ij,ij->i", a / np.linalg.norm(a, axis=1, keepdims=True), m)
+    return out
+
+
+def orientation_cells(frame: pd.DataFrame) -> int:
+    """Distinct 30-deg cells of the raw field's direction (each component of the unit vector x 2, rounded)."""
+    m = frame[list(MAG)].to_numpy(float)
+    u = m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
+    return len({tuple(v) for v in np.round(u * 2).astype(int)})
+
+
+def orientation_spread(frame: pd.DataFrame) -> float:
+    """Smallest eigenvalue of the second moment of the field's unit directions (about their mean)."""
+    m = frame[list(MAG)].to_numpy(float)
+    u = m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
+    return float(np.linalg.eigvalsh(np.cov(u.T))[0])
+
+
+def check_orientations(frame: pd.DataFrame, name: str, needed: int = MIN_ORIENTATIONS) -> None:
+    cells, spread = orientation_cells(frame), orientation_spread(frame)
+    if cells < needed or spread < MIN_SPREAD:
+        raise InputError(f"{name}: columns mag_x_ut..mag_z_ut: only {cells} distinct orientations (30-deg cells "
+                         f"of the field's direction; smallest spread {spread:.3f}); the model needs at least "
+                         f"{needed} and a spread of {MIN_SPREAD:g} (turn the sensor through all directions, "
+                         f"not about one axis)")
+
+
+def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
+    """Load and validate a magnetometer file without reference attitude (one-line InputError naming file,
+    column and row): missing field columns; empty cells, text, NaN, infinity; values outside their limits
+    (field +-1e6 uT, acceleration +-1e4 m/s^2, temperature -80..200 degC); fewer than ``min_rows`` rows; a
+    stuck axis; a unit other than uT (the median |m| must lie in 10-150 uT: the Earth's field is 22-67 uT; the
+    message names gauss, mG, nT, mT or T when one of them brings it there); an accelerometer in g (the
+    median |a| must lie in 5-15 m/s^2; near 1 names g); too few distinct orientations
+    (:func:`check_orientations`).  Adds the derived columns of :func:`with_invariants`."""
+    name = Path(path).name
+    frame = read_table(path, free_columns(), min_rows=min_rows, kind="magnetometer file")
+    require_variation(frame, MAG, name, "a magnetometer turned through many orientations")
+    check_units(frame, name)
+    check_orientations(frame, name)
+    return with_invariants(frame)
+
+
+def check_units(frame: pd.DataFrame, name: str = "data") -> None:
+    """Field in uT and acceleration in m/s^2 (see :func:`load_free`)."""
+    med = float(np.median(np.linalg.norm(frame[list(MAG)].to_numpy(float), axis=1)))
+    lo, hi = FIELD_BAND_UT
+    if not lo <= med <= hi:
+        units = [(u, f) for u, f in FIELD_UNITS if lo <= med * f <= hi]
+        look = (f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)" if units
+                else "this is not a field in uT")
+        raise InputError(f"{name}: columns mag_x_ut, mag_y_ut, mag_z_ut: median |m| is {med:.4g}, where the Earth's "
+                         f"field is 22-67 uT and {lo:g}-{hi:g} uT is accepted: {look}")
+    if any(c in frame for c in ACC) and not has_acc(frame):
+        raise InputError(f"{name}: give all three of {', '.join(ACC)} or none")
+    if has_acc(frame):
+        g = float(np.median(np.linalg.norm(frame[list(ACC)].to_numpy(float), axis=1)))
+        glo, ghi = GRAVITY_BAND
+        if not glo <= g <= ghi:
+            look = ("these look like g (multiply by 9.80665 for m/s^2)" if glo <= g * G0 <= ghi else
+                    "this is not a still or slowly turned accelerometer in m/s^2")
+            raise InputError(f"{name}: columns {', '.join(ACC)}: median |a| is {g:.4g}, where gravity is 9.81 m/s^2 "
+                             f"and {glo:g}-{ghi:g} is accepted: {look}")
+
+
+# ------------------------------------------------------------------------------------------- the model
+def full_params(params: dict) -> dict:
+    p = {k: 0.0 for k in _PARAMS}
+    p.update(params)
+    return p
+
+
+def correction_matrix(params: dict) -> np.ndarray:
+    """``M = I + K`` (symmetric; K trace-free) from the scale and soft-iron parameters (absent = 0)."""
+    p = full_params(params)
+    sx, sy = p["scale_x"], p["scale_y"]
+    return np.eye(3) + np.array([[sx, p["soft_xy"], p["soft_xz"]],
+                                 [p["soft_xy"], sy, p["soft_yz"]],
+                                 [p["soft_xz"], p["soft_yz"], -sx - sy]])
+
+
+def offset(params: dict, frame: pd.DataFrame, t_c: float) -> np.ndarray:
+    """``b + k (T - T_c)`` per row, (n, 3) uT."""
+    p = full_params(params)
+    b = np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
+    k = np.array([p["temp_x_ut_c"], p["temp_y_ut_c"], p["temp_z_ut_c"]])
+    if "temperature_c" in frame and np.any(k):
+        return b + (frame["temperature_c"].to_numpy(float) - t_c)[:, None] * k
+    return np.broadcast_to(b, (len(frame), 3))
+
+
+def corrected(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
+    """The corrected field ``u = M (m - b - k (T - T_c))``, (n, 3) uT, in the magnetometer's axes."""
+    return (frame[list(MAG)].to_numpy(float) - offset(params, frame, t_c)) @ correction_matrix(params).T
+
+
+def invariant_residuals(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
+    """(n, 1) or (n, 2): ``e = |u| - F`` and, with an accelerometer, ``(g - c e) / sqrt(1 - c^2)`` (uT;
+    module docstring)."""
+    p = full_params(params)
+    u = corrected(params, frame, t_c)
+    cols = [np.linalg.norm(u, axis=1) - p.get("field_ut", 0.0)]
+    if has_acc(frame):
+        a = frame[list(ACC)].to_numpy(float)
+        R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
+        g = np.einsum("ij,ij->i", a / np.linalg.norm(a, axis=1, keepdims=True), u @ R.T) - p.get("field_down_ut", 0.0)
+        c = float(np.clip(p.get("field_down_ut", 0.0) / max(p.get("field_ut", 0.0), 1e-9), -0.99, 0.99))
+        cols.append((g - c * cols[0]) / np.sqrt(1.0 - c * c))
+    return np.column_stack(cols)
+
+
+def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
+    if not all(c in data for c in DERIVED[:1 + has_acc(data)]):
+        data = with_invariants(data)
+    cat = tuple(e.name for e in effects if e.contribution is None)
+    users = tuple(e for e in effects if e.contribution is not None)
+    acc = has_acc(data)
+    base = ["field_ut"] + (["field_down_ut"] if acc else [])
+    names = base + [p for e in cat for p in FREE_EFFECTS[e].params] + [p for e in users for p in e.params]
+    clash = sorted({n for n in names if names.count(n) > 1})
+    if clash:
+        raise InputError(f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
+                         f"not be named like the field strength {', '.join(base)})")
+    k = 2 if acc else 1
+    if len(data) * k < len(names) + 1:
+        raise InputError(f"{len(data)} rows cannot determine {len(names)} model parameters")
+    check_orientations(data, "magnetometer data", max(MIN_ORIENTATIONS, len(names)))
+    t_c = float(data["temperature_c"].mean()) if "temperature_c" in data else 0.0
+    shape = (len(data), k)
+    obs = data[list(DERIVED[:k])].to_numpy(float)
+
+    def resid(x):
+        p = dict(zip(names, x))
+        return invariant_residuals(p, data, t_c).ravel() - user_columns(users, p, data, shape)
+
+    # start 2 (linearised): a sphere fit |m|^2 = 2 m.b + c for the centre (if hard iron is in the model)
+    m = data[list(MAG)].to_numpy(float)
+    x2 = dict.fromkeys(names, 0.0)
+    if "hard_iron" in cat:
+        X = np.column_stack([2 * m, np.ones(len(m))])
+        sol = np.linalg.lstsq(X, np.sum(m * m, axis=1), rcond=None)[0]
+        x2.update(hard_x_ut=sol[0], hard_y_ut=sol[1], hard_z_ut=sol[2])
+    r0 = invariant_residuals(x2, data, t_c)
+    x2["field_ut"] = float(np.mean(r0[:, 0]))
+    if acc:
+        x2["field_down_ut"] = float(np.mean(r0[:, 1]))
+    if users:
+        U = user_design(users, data, shape)
+        r0 = invariant_residuals(x2, data, t_c).ravel()
+        beta = np.linalg.lstsq(U, -r0, rcond=None)[0]
+        x2.update(zip([p for e in users for p in e.params], beta))
+    x2v = np.array([x2[n] for n in names])
+    x1v = np.array([(start or {}).get(n, x2[n]) for n in names])
+    inf = np.full(len(names), np.inf)
+    sol = best_least_squares(resid, [x1v, x2v], -inf, inf)
+    params = dict(zip(names, map(float, sol.x)))
+
+    def predict(frame):
+        r = invariant_residuals(params, frame, t_c) - user_columns(users, params, frame,
+                                                                   (len(frame), k)).reshape(len(frame), k)
+        return frame[list(DERIVED[:k])].to_numpy(float) - r
+
+    # residual = measured - model = -(model - measured): the invariants' residual with the sign of a misfit
+    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, (obs - predict(data)).ravel(),
+               -np.asarray(sol.jac), predict, {"temperature_centre_c": t_c})
+
+
+def _per_column(x: np.ndarray, k: int, cols=None) -> np.ndarray:
+    n = len(x)
+    cols = range(k) if cols is None else cols
+    out = np.zeros((k * n, len(cols) * x.shape[1]))
+    for i, j in enumerate(cols):
+        out[j::k, i * x.shape[1]:(i + 1) * x.shape[1]] = x
+    return out
+
+
+def _cubic_harmonics(u: np.ndarray) -> np.ndarray:
+    """The seven real third-degree harmonics of unit vectors ``u`` (unnormalised)."""
+    x, y, z = u.T
+    return np.column_stack([x * (x * x - 3 * y * y), y * (3 * x * x - y * y), z * (x * x - y * y), x * y * z,
+                            x * (5 * z * z - 1), y * (5 * z * z - 1), z * (5 * z * z - 3)])
+
+
+def free_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
+    """Module docstring: magnitude (and dip) changing in time; magnitude depending on the direction on
+    the sphere beyond an ellipsoid."""
+    d = fit.data
+    k = fit.n // len(d)
+    out = []
+    if "time_s" in d and np.ptp(d["time_s"].to_numpy(float)) > 0:
+        t = d["time_s"].to_numpy(float)
+        edges = np.quantile(t, np.linspace(0, 1, 11)[1:-1])
+        cell = np.searchsorted(edges, t, side="right")
+        X = np.column_stack([(cell == i).astype(float) - np.mean(cell == i) for i in np.unique(cell)[1:]])
+        out.append(("field changing in time (per invariant)", _per_column(X, k), 2.0))
+    m = d[list(MAG)].to_numpy(float)
+    u = m / np.linalg.norm(m, axis=1, keepdims=True)
+    H = _cubic_harmonics(u)
+    out.append(("magnitude depending on direction beyond an ellipsoid (3rd-degree harmonics)",
+                _per_column(H - H.mean(axis=0), k, [0]), np.sqrt(2.0)))
+    return out
+
+
+MEASURED["magnetometer_free"] = (DERIVED, False)
+SYSTEM = register_system(System(
+    "magnetometer_free", "uT", FREE_EFFECTS, load_free, _fit_free, free_structure,
+    "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
+    "and (with an accelerometer) its component along gravity - D, uT"))
+
+
+def field_summary(fit: Fit) -> dict:
+    """The local field the invariants estimate: intensity (uT) and, with an accelerometer, the dip (deg,
+    positive downward)."""
+    F = fit.params["field_ut"]
+    out = {"intensity (uT)": F}
+    if "field_down_ut" in fit.params:
+        out["dip (deg)"] = float(np.degrees(np.arcsin(np.clip(-fit.params["field_down_ut"] / F, -1, 1))))
+    return out
+
+
+# ------------------------------------------------------------------------------------------- simulation
+def simulate_free(params: dict, *, duration_s: float = 40.0, rate_hz: float = 10.0, noise_ut: float = 0.3,
+                  noise_correlation: float = 0.0, field_ut: float = SIM_FIELD_UT, dip_deg: float = SIM_DIP_DEG,
+                  acc_noise_ms2: float = 0.0, temperatures_c: tuple = (20.0, 35.0), seed=0) -> pd.DataFrame:
+    """A magnetometer (and accelerometer) turned by hand without reference: the attitude of
+    :func:`navlib.workbench.magnetometer.simulate_hand_turned`; the true field of intensity ``field_ut`` and
+    dip ``dip_deg``; the sensor's raw field ``m = M^-1 R^T v + b + k (T - T_c)`` plus AR(1) noise (marginal
+    ``noise_ut``, lag-1 ``noise_correlation``) with ``params`` as in the catalogue (absent = 0; ``R`` the
+    misalignment); the specific force ``-g`` in body axes (plus white ``acc_noise_ms2``); the temperature
+    rising linearly from ``temperatures_c[0]`` to ``[1]`` (``T_c`` their mean)."""
+    check_param("field_ut", field_ut, lo=0, lo_open=True, hi=1e6)
+    check_param("dip_deg", dip_deg, lo=-90, hi=90)
+    check_param("noise_ut", noise_ut, lo=0)
+    check_param("acc_noise_ms2", acc_noise_ms2, lo=0)
+    rng = np.random.default_rng(seed)
+    frame = simulate_hand_turned({}, duration_s=duration_s, rate_hz=rate_hz, noise_ut=0.0, seed=rng)
+    n = len(frame)
+    C = body_from_nav(frame)
+    dip = np.radians(dip_deg)
+    v = C @ (field_ut * np.array([np.cos(dip), 0.0, np.sin(dip)]))
+    f = C @ np.array([0.0, 0.0, -G0])
+    p = full_params(params)
+    R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
+    t0, t1 = temperatures_c
+    temp = np.linspace(t0, t1, n)
+    frame["temperature_c"] = temp
+    raw = (v @ R) @ np.linalg.inv(correction_matrix(p)).T + offset(p, frame, 0.5 * (t0 + t1))
+    frame[list(MAG)] = raw + ar1_noise(rng, (n, 3), noise_ut, noise_correlation)
+    frame[list(ACC)] = f + acc_noise_ms2 * rng.standard_normal((n, 3))
+    keep = ["time_s", *GYR, *MAG, *ACC, "temperature_c"]
+    return with_invariants(frame[keep])
+
+
+#: Half-widths of the uniform draws of each effect's parameters in the trials.
+PARAM_HALF = {"hard_iron": 10.0, "scale": 0.03, "soft_iron": 0.03, "misalignment": 2.0, "temperature": 0.1}
+
+
+def effect_rms(data: pd.DataFrame, params: dict, effect: str, field_ut: float = SIM_FIELD_UT,
+               dip_deg: float = SIM_DIP_DEG) -> float:
+    """RMS (uT) of what ``effect`` does to the invariants' residual on the noiseless ``data``: the true
+    parameters fitted with ``effect`` left out (its parameters at zero, field strength kept)."""
+    p = {**params, "field_ut": field_ut,
+         "field_down_ut": -field_ut * np.sin(np.radians(dip_deg))}
+    t_c = float(data["temperature_c"].mean())
+    without = {k: v for k, v in p.items() if k not in FREE_EFFECTS[effect].params}
+    return float(np.sqrt(np.mean((invariant_residuals(without, data, t_c)
+                                  - invariant_residuals(p, data, t_c)) ** 2)))
+
+
+# ------------------------------------------------------------------------------------------------ trials
+def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed, correlation: float = 0.0,
+                        duration_s: float = 40.0) -> dict:
+    """One trial (as :func:`navlib.workbench.trials.hidden_effect_trial`): with ``hidden`` set the data
+    hold every effect (uniform draws within :data:`PARAM_HALF`), ``hidden`` rescaled so that its
+    :func:`effect_rms` is ``ratio`` x ``noise_ut``, and the model is the catalogue without it; with ``None``
+    the data hold a random subset and the model is exactly that subset.  The parameters and the recording
+    come from streams of their own (spawn children 0 and 1 of ``seed``), so the noise-free probe that
+    scales the hidden effect sees the same motion as the data; a motion that does not turn the sensor
+    through enough directions for the catalogue (the loader would refuse the file) is drawn again from
+    child ``(1, k)``, k = 1, 2, ... (``redraws`` in the result)."""
+    from ..seeding import child
+    from .diagnose import diagnose
+    from .fit import fit_model
+    from .trials import _seed_label
+    cat = tuple(FREE_EFFECTS)
+    if hidden is not None and hidden not in cat:
+        raise InputError(f"unknown magnetometer_free effect '{hidden}'; known: {', '.join(cat)}")
+    if not isinstance(seed, np.random.SeedSequence):
+        seed = np.random.SeedSequence(seed)
+    rng = np.random.default_rng(child(seed, 0))
+    if hidden is None:
+        k = int(rng.integers(1, len(cat)))
+        present = tuple(cat[i] for i in sorted(rng.choice(len(cat), size=k, replace=False)))
+    else:
+        present = cat
+    base = {}
+    for e in present:
+        base.update(zip(FREE_EFFECTS[e].params, rng.uniform(-PARAM_HALF[e], PARAM_HALF[e],
+                                                             len(FREE_EFFECTS[e].params))))
+    model = tuple(e for e in cat if e != hidden) if hidden is not None else present
+    # the recording: the first hand-turned motion (stream child 1, then 1/1, 1/2, ...) whose data turn the
+    # sensor through enough directions for the whole catalogue (:func:`check_orientations`; a file that
+    # fails it is refused by the loader, so it is no trial of the tests)
+    need = max(MIN_ORIENTATIONS, 2 + sum(len(e.params) for e in FREE_EFFECTS.values()))
+    for redraw in range(20):
+        stream = child(seed, 1) if redraw == 0 else child(seed, 1, redraw)
+
+        def draw(p, noise):
+            return simulate_free(p, duration_s=duration_s, noise_ut=noise, noise_correlation=correlation,
+                                 seed=np.random.default_rng(stream))
+        params = dict(base)
+        if hidden is not None:
+            probe = draw(params, 0.0)
+            for _ in range(3):
+                now = effect_rms(probe, params, hidden)
+                for q in FREE_EFFECTS[hidden].params:
+                    params[q] *= ratio * noise_ut / now
+        data = draw(params, noise_ut)
+        try:
+            check_orientations(data, "simulated", need)
+            break
+        except InputError:
+            continue
+    d = diagnose(fit_model(SYSTEM, data, model))
+    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise_ut,
+            "correlation": correlation, "seed": _seed_label(seed), "redraws": redraw, "named": d.missing or "(none)",
+            "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
+            "consistent_with_noise": d.consistent_with_noise}
+
+
+def hidden_effect_study(ratios=(3.0, 10.0), noises=(0.3,), seeds=range(10), none_seeds=None,
+                        correlation: float = 0.0, duration_s: float = 40.0, workers: int = 1,
+                        scheduler: str | None = None) -> pd.DataFrame:
+    """Detection and false-alarm trials for the reference-free system over hidden effects, sizes, noise
+    levels and seeds (nothing-hidden: twice as many seeds by default); each trial's seed is
+    :func:`navlib.workbench.trials.trial_seed` of its coordinates (study "hidden effect", or "correlated
+    noise" when ``correlation`` is not 0, then this system, the recording's length in s, noise level, effect,
+    size, seed number)."""
+    from .trials import SYSTEM_KEYS, run_trials, trial_seed
+    check_param("correlation", correlation, lo=-1, hi=1, lo_open=True, hi_open=True)
+    seeds = list(seeds)
+    none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
+    study = "hidden effect" if correlation == 0 else "correlated noise"
+    check_param("duration_s", duration_s, lo=3.0, hi=1e5)
+    base = (SYSTEM_KEYS[SYSTEM.name], int(round(duration_s)))
+    args = []
+    for j, noise in enumerate(noises):
+        args += [(h, r, float(noise), trial_seed(study, *base, j, i, k, s), correlation, float(duration_s))
+                 for i, h in enumerate(FREE_EFFECTS, start=1) for k, r in enumerate(ratios) for s in seeds]
+        args += [(None, 0.0, float(noise), trial_seed(study, *base, j, 0, 0, s), correlation, float(duration_s))
+                 for s in none_seeds]
+    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "magnetometer_free trials"))

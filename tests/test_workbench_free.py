@@ -1,0 +1,196 @@
+"""The reference-free magnetometer system (issue 23): fits, hidden effects named and quiet without one
+(independent and AR(1) noise), calibrate -> apply round trip, a cross-check against an independent
+ellipsoid fit, bad input, and the IGRF field at two sites against published values."""
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from navlib.cli import main
+from navlib.errors import InputError
+from navlib.sensors.earth_field import Site, igrf_field
+from navlib.workbench import get_system
+from navlib.workbench import magnetometer_free as MF
+from navlib.workbench.calibration import field_check
+from navlib.workbench.diagnose import diagnose
+from navlib.workbench.fit import fit_model
+
+TRUE = {"hard_x_ut": 6.0, "hard_y_ut": -4.0, "hard_z_ut": 2.5, "scale_x": 0.03, "scale_y": -0.02,
+        "soft_xy": 0.015, "soft_xz": -0.02, "soft_yz": 0.01}
+NOISE = 0.3
+
+
+@pytest.fixture(scope="module")
+def sim():
+    """A 30 s hand-turned recording with hard iron and the full ellipsoid, no misalignment/temperature."""
+    return MF.simulate_free(TRUE, duration_s=30.0, noise_ut=NOISE, seed=np.random.SeedSequence(23))
+
+
+@pytest.fixture(scope="module")
+def sim_file(sim, tmp_path_factory):
+    p = tmp_path_factory.mktemp("free") / "sim.csv"
+    sim.drop(columns=list(MF.DERIVED)).to_csv(p, index=False)
+    return p
+
+
+def test_registered_and_fits_the_truth(sim):
+    assert get_system("magnetometer_free").catalogue is MF.FREE_EFFECTS
+    f = fit_model("magnetometer_free", sim, ["hard_iron", "scale", "soft_iron"])
+    assert f.n == 2 * len(sim)                                   # magnitude and dip residual per row
+    assert f.rms == pytest.approx(NOISE, rel=0.1)
+    for k, v in TRUE.items():
+        assert f.params[k] == pytest.approx(v, abs=0.2 if k.startswith("hard") else 3e-3), k
+    assert f.params["field_ut"] == pytest.approx(MF.SIM_FIELD_UT, abs=0.1)
+    assert MF.field_summary(f)["dip (deg)"] == pytest.approx(MF.SIM_DIP_DEG, abs=0.2)
+    # without the accelerometer: one residual per row, misalignment cannot be tested
+    noacc = sim.drop(columns=list(MF.ACC) + ["field_gravity_ut"])
+    d = diagnose(fit_model("magnetometer_free", noacc, ["hard_iron", "scale", "soft_iron"]))
+    assert d.n == len(sim) and "misalignment" in d.untestable and d.consistent_with_noise
+
+
+def _trials(rho, seeds, nulls):
+    st = MF.hidden_effect_study(ratios=(3.0,), noises=(NOISE,), seeds=range(seeds), none_seeds=range(nulls),
+                                correlation=rho, duration_s=20.0)
+    named = st[st.hidden != "(none)"]
+    quiet = st[st.hidden == "(none)"]
+    return named, quiet
+
+
+def test_each_hidden_effect_named_and_quiet_without_one():
+    named, quiet = _trials(0.0, 2, 3)
+    assert set(named.hidden) == set(MF.FREE_EFFECTS)
+    assert named.correct.astype(bool).all(), named[~named.correct.astype(bool)][["hidden", "named"]]
+    assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
+
+
+def test_hidden_effects_with_ar1_noise_of_correlation_09():
+    # a few trials only; the full run (benchmarks/workbench_free_rates.py) finds every effect named in
+    # 100/100 trials but only 86/100 nothing-hidden trials quiet (Wilson 0.78-0.92): BELOW the 95 % target
+    # with AR(0.9) noise -- an open limitation, not hidden by this test
+    named, quiet = _trials(0.9, 1, 2)
+    assert named.correct.astype(bool).all(), named[["hidden", "named"]]
+    assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
+
+
+def test_calibrate_apply_round_trip_and_uncertainties(sim, sim_file, tmp_path, capsys):
+    cal_path, out = tmp_path / "cal.json", tmp_path / "corrected.csv"
+    assert main(["calibrate", "magnetometer", str(sim_file), "--out", str(cal_path)]) == 0
+    cal = json.loads(cal_path.read_text())
+    mc = cal["magcal"]
+    b, A = np.array(mc["b_ut"]), np.array(mc["A"])
+    # the truth within 4 of the reported standard errors
+    b_true = np.array([TRUE["hard_x_ut"], TRUE["hard_y_ut"], TRUE["hard_z_ut"]])
+    assert np.all(np.abs(b - b_true) < 4 * np.array(mc["b_std_ut"]))
+    A_true = MF.correction_matrix(TRUE)
+    assert np.all(np.abs(A - A_true) < 4 * np.array(mc["A_std"]) + 1e-12)
+    assert main(["apply", str(cal_path), str(sim_file), "--out", str(out)]) == 0
+    corr = pd.read_csv(out)
+    u = corr[list(MF.MAG)].to_numpy()
+    assert np.sqrt(np.mean((np.linalg.norm(u, axis=1) - mc["expected_field_strength_ut"]) ** 2)) < 1.2 * NOISE
+    # the corrected field is the true body field to the noise (no misalignment simulated)
+    true_u = (sim[list(MF.MAG)].to_numpy() - b_true) @ A_true.T
+    noise_free = MF.simulate_free(TRUE, duration_s=30.0, noise_ut=0.0, seed=np.random.SeedSequence(23))
+    v = (noise_free[list(MF.MAG)].to_numpy() - b_true) @ A_true.T
+    assert np.sqrt(np.mean((u - v) ** 2)) < 1.2 * np.sqrt(np.mean((true_u - v) ** 2))
+    assert main(["apply", str(cal_path), str(sim_file), "--out", str(out)]) == 2          # never overwritten
+    assert "already exists" in capsys.readouterr().err
+
+
+def _algebraic_ellipsoid(m):
+    """Independent peer: the quadric x'Qx + 2 p'x = 1 by plain least squares; centre c = -Q^-1 p; the
+    symmetric correction mapping the ellipsoid onto the unit sphere is sqrtm(Q / (1 + c'Qc))."""
+    x, y, z = m.T
+    D = np.column_stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z, 2 * x, 2 * y, 2 * z])
+    v = np.linalg.lstsq(D, np.ones(len(m)), rcond=None)[0]
+    Q = np.array([[v[0], v[3], v[4]], [v[3], v[1], v[5]], [v[4], v[5], v[2]]])
+    c = -np.linalg.solve(Q, v[6:])
+    Q = Q / (1 + c @ Q @ c)
+    w, U = np.linalg.eigh(Q)
+    return c, U @ np.diag(np.sqrt(w)) @ U.T
+
+
+def test_agrees_with_an_independent_ellipsoid_fit(sim):
+    from navlib.workbench.calibration import calibrate
+    mc = calibrate(sim.drop(columns=list(MF.ACC) + ["field_gravity_ut"]))["magcal"]
+    c, W = _algebraic_ellipsoid(sim[list(MF.MAG)].to_numpy())
+    assert np.allclose(mc["b_ut"], c, atol=0.15)
+    assert np.allclose(np.array(mc["A"]) / mc["expected_field_strength_ut"], W, atol=3e-3 / MF.SIM_FIELD_UT * 10)
+
+
+def test_bad_input_one_line_exit_2(sim, tmp_path, capsys):
+    raw = sim.drop(columns=list(MF.DERIVED))
+
+    def run(frame, *extra):
+        p = tmp_path / "bad.csv"
+        frame.to_csv(p, index=False)
+        rc = main(["calibrate", "magnetometer", str(p), "--out", str(tmp_path / "never.json"), *extra])
+        err = capsys.readouterr().err.strip()
+        assert rc == 2 and len(err.splitlines()) == 1, err
+        p.unlink()
+        return err
+
+    nt = raw.copy()
+    nt[list(MF.MAG)] *= 1000.0
+    assert "look like nT" in run(nt)
+    gauss = raw.copy()
+    gauss[list(MF.MAG)] /= 100.0
+    assert "gauss" in run(gauss)
+    g = raw.copy()
+    g[list(MF.ACC)] /= MF.G0
+    assert "look like g" in run(g)
+    flat = raw.copy()
+    t = np.linspace(0, 2 * np.pi, len(flat))
+    flat["mag_x_ut"], flat["mag_y_ut"], flat["mag_z_ut"] = 40 * np.cos(t), 40 * np.sin(t), 5 + 0.01 * t
+    assert "distinct orientations" in run(flat)
+    assert "unknown magnetometer_free effect" in run(raw, "--model", "hard_iron,wobble")
+    few = raw.iloc[::12]                                # 25 rows: too few for the loader
+    assert "rows" in run(few)
+    # a calibration of another system
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"format": "navlib calibration", "version": 1, "system": "compass"}))
+    src = tmp_path / "ok.csv"
+    raw.to_csv(src, index=False)
+    assert main(["apply", str(other), str(src), "--out", str(tmp_path / "x.csv")]) == 2
+    assert "a calibration of the system 'compass'" in capsys.readouterr().err
+    # too few distinct orientations for a model with more parameters than cells
+    part = sim.iloc[:40]
+    with pytest.raises(InputError, match="distinct orientations"):
+        MF.check_orientations(part, "part", needed=MF.orientation_cells(part) + 1)
+
+
+# IGRF: published values of the NOAA/NCEI geomagnetic calculator (model IGRF2020, calculator 0.5.1.11) at
+# 2020-01-01, 5 km above the WGS84 ellipsoid, as stored in ppigrf's test data
+# (github.com/klaundal/ppigrf, test/data/2020-01-01/b_n.csv, b_e.csv, b_z.csv), nT: north, east, down.
+PUBLISHED = {(60.0, 10.0): (15063.0, 920.3, 48911.3), (-30.0, 150.0): (26417.7, 5070.0, -47914.2)}
+
+
+@pytest.mark.parametrize("lat, lon", list(PUBLISHED))
+def test_igrf_at_two_sites_against_published_values(lat, lon):
+    f = igrf_field(Site(lat, lon, 5000.0, "2020-01-01"))
+    n, e, d = (v / 1000.0 for v in PUBLISHED[(lat, lon)])
+    assert abs(f.north_ut - n) < 0.1 and abs(f.east_ut - e) < 0.1 and abs(f.down_ut - d) < 0.1
+    assert f.intensity_ut == pytest.approx(np.sqrt(n * n + e * e + d * d), abs=0.1)
+
+
+def test_igrf_ships_offline_and_bad_site():
+    import importlib.resources
+    assert importlib.resources.files("ppigrf").joinpath("IGRF14.shc").is_file()
+    with pytest.raises(InputError, match="lat_deg"):
+        Site(91.0, 0.0)
+    with pytest.raises(InputError, match="date"):
+        Site(50.0, 0.0, 0.0, "2040-01-01")
+
+
+def test_field_check_flags_an_anomaly_and_not_the_model_field(sim):
+    site = Site(52.5, 13.4, 50.0, "2021-01-01")
+    model = igrf_field(site)
+    same = MF.simulate_free(TRUE, duration_s=20.0, noise_ut=NOISE, field_ut=model.intensity_ut,
+                            dip_deg=model.dip_deg, seed=np.random.SeedSequence(231))
+    ok = field_check(fit_model("magnetometer_free", same, ["hard_iron", "scale", "soft_iron"]), site)
+    assert not ok["local_anomaly"] and "agrees" in ok["message"]
+    assert abs(ok["intensity_difference_ut"]) < 3 * ok["intensity_std_ut"] + 0.05
+    assert abs(ok["dip_difference_deg"]) < 3 * ok["dip_std_deg"] + 0.05
+    # BROAD's room field (43.5 uT, dip 69.6 deg) is not the IGRF field there: flagged
+    far = field_check(fit_model("magnetometer_free", sim, ["hard_iron", "scale", "soft_iron"]), site)
+    assert far["local_anomaly"] and "local anomaly" in far["message"]
