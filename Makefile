@@ -29,7 +29,7 @@ venv: $(STAMP)
 $(STAMP): environment.lock pyproject.toml
 	@echo "== creating $(VENV) from environment.lock"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	@$(PY) -m pip install --quiet --disable-pip-version-check -r environment.lock 2>&1 | { grep -v "is ignored: it is neither" || true; }
+	@$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -r environment.lock 2>&1 | { grep -v "is ignored: it is neither" || true; }
 	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . 2>&1 | { grep -v "is ignored: it is neither" || true; }
 	@$(PY) -m ipykernel install --sys-prefix --name python3 > /dev/null
 	@touch $(STAMP)
@@ -61,12 +61,15 @@ test-lib: $(STAMP)
 	 else $(PY) -m pytest -q tests -p no:cacheprovider -n $(TEST_WORKERS) --dist loadfile; fi
 
 # nbval re-executes every notebook; each chapter's last cell rewrites $(GENERATED)/results/<chapter>.json.
-# The folder is cleared first so a stale file cannot pass test-results.
+# The folder is cleared first so a stale file cannot pass test-results.  Two notebooks run at a time
+# (pytest-xdist, one whole notebook per process): one chapter's serial cells overlap the other's engine
+# work; the numbers do not depend on it (TEST_WORKERS=1: one at a time).
 test-notebooks: $(STAMP)
 	@rm -rf $(GENERATED)/results
 	@$(PY) -m navlib.booktools compile
 	@NAVBOOK_RESULTS_DIR=$(CURDIR)/$(GENERATED)/results $(PY) -m pytest -q -p no:cacheprovider --nbval \
-	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks
+	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks \
+	    $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
 
 # The fresh results files against the committed references notebooks/results/<chapter>.json (make notebooks).
 test-results: $(STAMP)

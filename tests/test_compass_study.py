@@ -656,3 +656,14 @@ def test_choices_study_reuses_the_default_runs_and_reruns_the_others(sw):
         choices_study(sw, p, runs, box_seeds=range(4))
     with pytest.raises(InputError, match="budget_factor"):
         choices_study(sw, p, runs, budget_factor=1)
+
+
+def test_a_costly_unit_goes_in_smaller_batches(sw):
+    from navlib.studies.paper_a import MAX_TASK_S, SEED_BATCH, _tasks, _unit_cost
+    p = StudyParams()
+    long = replace(p, de=replace(p.de, max_generations=10 * p.de.max_generations))
+    sizes = [len(t[3]) for t in _tasks(sw, p, list(range(6)), ("ade_bp_pure",), 0, False)[0]]
+    assert sizes == [SEED_BATCH, 6 - SEED_BATCH]
+    tasks, cost = _tasks(sw, long, list(range(3)), ("ade_bp_pure",), 0, False)
+    assert [len(t[3]) for t in tasks] == [1, 1, 1] and _unit_cost(("ade_bp_pure",), long) > MAX_TASK_S
+    assert cost == pytest.approx([_unit_cost(("ade_bp_pure",), long)] * 3)

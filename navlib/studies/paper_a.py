@@ -463,8 +463,11 @@ def _method_runs(sw: Sweeps, params: StudyParams, mids, seeds: list, base_seed: 
 
 
 #: Runs of a stochastic method per task (a fixed size: the batches, and so the numbers, never depend on the
-#: number of workers).
+#: number of workers; nor on the batch: every run draws from its own generator).
 SEED_BATCH = 4
+#: A task's estimated CPU seconds at most: seeds of a costly unit (e.g. ten times the DE budget) go in
+#: smaller batches, so the engine's workers finish together.
+MAX_TASK_S = 2.0
 
 
 def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
@@ -494,12 +497,14 @@ def _unit_cost(unit, params: StudyParams) -> float:
 
 
 def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
-    """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one
-    (or of a family sharing a DE stage, :func:`_units`), with its estimated cost (CPU seconds)."""
+    """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one (or
+    of a family sharing a DE stage, :func:`_units`; fewer seeds when a batch would cost more than
+    :data:`MAX_TASK_S`), with its estimated cost (CPU seconds)."""
     tasks, cost = [], []
     for unit in _units(params, methods):
         stochastic = METHODS[unit[0]].stochastic
-        chunks = [seeds[i:i + SEED_BATCH] for i in range(0, len(seeds), SEED_BATCH)] if stochastic else [seeds]
+        size = max(1, min(SEED_BATCH, int(MAX_TASK_S // max(_unit_cost(unit, params), 1e-9))))
+        chunks = [seeds[i:i + size] for i in range(0, len(seeds), size)] if stochastic else [seeds]
         for c in chunks:
             tasks.append((sw, params, unit if len(unit) > 1 else unit[0], [int(v) for v in c], base_seed,
                           keep_errors))
