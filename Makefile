@@ -29,7 +29,7 @@ venv: $(STAMP)
 $(STAMP): environment.lock pyproject.toml
 	@echo "== creating $(VENV) from environment.lock"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	@$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -r environment.lock 2>&1 | { grep -v "is ignored: it is neither" || true; }
+	@$(PY) -m pip install --quiet --disable-pip-version-check -r environment.lock 2>&1 | { grep -v "is ignored: it is neither" || true; }
 	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . 2>&1 | { grep -v "is ignored: it is neither" || true; }
 	@$(PY) -m ipykernel install --sys-prefix --name python3 > /dev/null
 	@touch $(STAMP)
