@@ -22,6 +22,19 @@ def small_problem(noise=0.01, n=40, seed=0):
     return xn, y, true
 
 
+def _against_least_squares(res, jac, start):
+    """Our LM from ``start`` against scipy's MINPACK LM on the same residuals: the same minimum (SSE and
+    weights), well below the start's; returns our result."""
+    ours = levenberg_marquardt(res, jac, start[None], LMParams(epochs=500, min_grad=0.0))
+    ref = least_squares(lambda th: res(th[None])[0], start, jac=lambda th: jac(th[None])[0], method="lm",
+                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=10000)
+    sse_ours = float(np.sum(res(ours.theta) ** 2))
+    assert sse_ours == pytest.approx(2 * ref.cost, rel=1e-8)
+    np.testing.assert_allclose(ours.theta[0], ref.x, atol=1e-5)
+    assert sse_ours < float(np.sum(res(start[None]) ** 2)) / 10       # it did train
+    return ours
+
+
 def test_lm_matches_scipy_least_squares_on_a_small_net():
     xn, y, true = small_problem()
     start = true + 0.3 * np.random.default_rng(1).standard_normal(true.size)
@@ -32,13 +45,7 @@ def test_lm_matches_scipy_least_squares_on_a_small_net():
     def jac(th):
         return output_jacobian(th, xn, 3)[1]
 
-    ours = levenberg_marquardt(res, jac, start[None], LMParams(epochs=500, min_grad=0.0))
-    ref = least_squares(lambda th: res(th[None])[0], start, jac=lambda th: jac(th[None])[0], method="lm",
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=10000)
-    sse_ours = float(np.sum(res(ours.theta) ** 2))
-    assert sse_ours == pytest.approx(2 * ref.cost, rel=1e-8)
-    np.testing.assert_allclose(ours.theta[0], ref.x, atol=1e-5)
-    assert sse_ours < float(np.sum(res(start[None]) ** 2)) / 10       # it did train
+    ours = _against_least_squares(res, jac, start)
     h = ours.perf[0][np.isfinite(ours.perf[0])]
     assert np.all(np.diff(h) <= 0) and np.sum(np.diff(h) < 0) > 5      # accepted steps lower the MSE
     assert ours.stop[0] in ("maximum mu", "maximum epoch")
@@ -206,13 +213,7 @@ def test_lm_matches_scipy_least_squares_on_a_multi_output_net():
     def jac(th):
         return ff.jacobian(th, xn, 3, 4, 2).reshape(th.shape[0], y.size, -1)
 
-    ours = levenberg_marquardt(res, jac, start[None], LMParams(epochs=500, min_grad=0.0))
-    ref = least_squares(lambda th: res(th[None])[0], start, jac=lambda th: jac(th[None])[0], method="lm",
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=10000)
-    sse_ours = float(np.sum(res(ours.theta) ** 2))
-    assert sse_ours == pytest.approx(2 * ref.cost, rel=1e-8)
-    np.testing.assert_allclose(ours.theta[0], ref.x, atol=1e-5)
-    assert sse_ours < float(np.sum(res(start[None]) ** 2)) / 10       # it did train
+    ours = _against_least_squares(res, jac, start)
 
 
 def test_train_feedforward_learns_and_stops_on_validation():

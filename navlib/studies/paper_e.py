@@ -648,6 +648,12 @@ def per_run(data: StudyData, case: str, mode: str, method: str, angle: str = "al
     s = s[(s["case"] == case) & (s["mode"] == mode) & (s["method"] == method)]
     if s.empty:
         raise InputError(f"no scores for case={case!r}, mode={mode!r}, method={method!r}")
+    return _by_angle(s, angle)
+
+
+def _by_angle(s: pd.DataFrame, angle: str) -> pd.Series:
+    """Per (repeat, run) of the score rows ``s``: one axis's RMS (arcsec), the worst axis, or the RMS over
+    the three axes (``'all'``)."""
     if angle in AXES:
         return s[s["axis"] == angle].set_index(["repeat", "run"])["rms_arcsec"].sort_index()
     if angle == "worst":
@@ -670,13 +676,7 @@ def sweep_per_run(data: StudyData, level_ppm: float, method: str, angle: str = "
     s = s[(s["level_ppm"] == float(level_ppm)) & (s["latency_ms"] == float(latency_ms)) & (s["method"] == method)]
     if s.empty:
         raise InputError(f"parameter level_ppm={level_ppm!r}, latency_ms={latency_ms!r}: not in the sweep")
-    if angle in AXES:
-        return s[s["axis"] == angle].set_index(["repeat", "run"])["rms_arcsec"].sort_index()
-    if angle == "worst":
-        out = s.groupby(["repeat", "run"])["rms_arcsec"].max()
-    else:
-        out = np.sqrt((s["rms_arcsec"] ** 2).groupby([s["repeat"], s["run"]]).mean())
-    return out.sort_index()
+    return _by_angle(s, angle)
 
 
 def sweep_table(data: StudyData) -> pd.DataFrame:
