@@ -5,7 +5,7 @@ is downloaded at run time).
     B = -grad V,   V(r, theta, phi, t) = a sum_n sum_m (a / r)^(n+1) [g_n^m(t) cos m phi + h_n^m(t) sin m phi] P_n^m(cos theta)
 
 (Alken et al. 2021, *Earth Planets Space* 73:49, IGRF-13; IGRF-14, IAGA 2024), evaluated in geodetic
-coordinates (WGS84) by :func:`ppigrf.igrf`.  Reported in NED, uT: north, east, down, horizontal, intensity
+coordinates (WGS84) by ``ppigrf.igrf``.  Reported in NED, uT: north, east, down, horizontal, intensity
 ``F``, dip (inclination, positive downward) and declination (positive east of true north).
 """
 from __future__ import annotations

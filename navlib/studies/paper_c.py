@@ -1624,8 +1624,8 @@ def input_scale_scan(params: StudyParams = StudyParams(), n_scales: int = 121) -
     Returns
     -------
     pandas.DataFrame
-        Columns scale (input units per deg), width, neurons, max |ours - printed| (deg/h),
-        max |T3 err| (deg/h).
+        Columns scale (input units per deg), width, neurons, ``max |ours - printed| (deg/h)``,
+        ``max |T3 err| (deg/h)``.
     """
     check_param("n_scales", n_scales, lo=3, hi=2000, integer=True)
     x2, y2, x3, y3 = _hot_xy()

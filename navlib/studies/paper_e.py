@@ -17,13 +17,13 @@ the run after ``settle_s`` per Euler angle (arcsec).  Training time: ``n_timings
 runs on each run alone (train and test runs), so how often it names an effect is a rate over runs.
 
 Beyond the paper's tables (issue 22): the paper's "average time of one training" as MATLAB trains, a whole
-``trainlm`` training with validation stop of the 45-, 6- and 9-input nets (:func:`_lm_timing`,
+``trainlm`` training with validation stop of the 45-, 6- and 9-input nets (``_lm_timing``,
 :mod:`navlib.methods.feedforward`) in ``lm_timings`` paired repetitions; the gyro scale factor swept over
-``sweep_ppm`` on held-out S-turn runs (:func:`_sweep`; the draws of the first ``sweep_repeats`` repeats at
+``sweep_ppm`` on held-out S-turn runs (``_sweep``; the draws of the first ``sweep_repeats`` repeats at
 every level, the study's own level taken from its repeats); a blind effect outside the innovation test's
 candidates, a star-sensor time offset (``latency_ms_levels``, no scale factor), with the candidate test, the
 generalised test (:func:`navlib.methods.kalman.innovation_structure_test`) and the test again on the filter
-with the scale-factor states (:func:`_diagnose`); and the filter-residual features the paper rejects
+with the scale-factor states (``_diagnose``); and the filter-residual features the paper rejects
 (case ``level_resid3``).
 
 Claims (:func:`claims`) follow the one rule of :mod:`navlib.verdicts`: comparisons are paired over the same
@@ -287,7 +287,7 @@ def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0)
     paired run by run; the filters are the study's (the augmented KF's prior on the scale factor is not
     set from the level).  ``latency_ms``: the star sensor's time offset (an effect outside the innovation
     test's candidates; then only the 9-input BPKF, the one with the rate inputs, is trained).  Returns the
-    score rows and the innovation diagnosis (:func:`_diagnose`)."""
+    score rows and the innovation diagnosis (``_diagnose``)."""
     sp = replace(spec, gyro_scale_ppm=float(level_ppm), star_latency_ms=float(latency_ms))
     train, test, _ = _runs(sp, "s_turns", rep)
     f_train, f_test = km.run_filter(train, spec.filter), km.run_filter(test, spec.filter)
@@ -342,7 +342,7 @@ def _subset(run, sl):
 
 def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     """One repeat of one simulation kind (a task of :func:`simulate`): its rows of every table; ``kind
-    = "trainlm"``: timing repetition ``rep`` of :func:`_lm_timing`."""
+    = "trainlm"``: timing repetition ``rep`` of ``_lm_timing``."""
     if kind == "trainlm":
         t0 = time.perf_counter()
         return {"lm": _lm_timing(spec, rep), "secs": {"trainlm": time.perf_counter() - t0}}

@@ -157,7 +157,7 @@ def apply_file(cal_path, data_path, out_path) -> tuple[Path, int]:
 
 
 def calibrate_file(data_path, model, out_path) -> tuple[Path, dict]:
-    """Load a file (:func:`load_free`), calibrate it with ``model`` and write the JSON to ``out_path``
+    """Load a file (:func:`navlib.workbench.magnetometer_free.load_free`), calibrate it with ``model`` and write the JSON to ``out_path``
     (existing files refused before the work)."""
     out_path = Path(out_path)
     if out_path.exists() or out_path.is_symlink():

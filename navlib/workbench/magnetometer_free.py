@@ -66,7 +66,7 @@ from .serial import ar1_noise
 ACC = ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2")
 DERIVED = ("field_norm_ut", "field_gravity_ut")
 G0 = 9.80665
-#: Median |a| must lie in this band (m/s^2) for an accelerometer in m/s^2 held still or turned slowly.
+#: Median ``|a|`` must lie in this band (m/s^2) for an accelerometer in m/s^2 held still or turned slowly.
 GRAVITY_BAND = (5.0, 15.0)
 #: Distinct 30-deg cells of the field's direction needed (and at least one per model parameter).
 MIN_ORIENTATIONS = 12
@@ -115,8 +115,8 @@ def has_acc(frame: pd.DataFrame) -> bool:
 
 
 def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
-    """``frame`` with the derived columns ``field_norm_ut`` (|m|) and, with an accelerometer,
-    ``field_gravity_ut`` (a/|a| . m), the raw values of the two invariants."""
+    """``frame`` with the derived columns ``field_norm_ut`` (``|m|``) and, with an accelerometer,
+    ``field_gravity_ut`` (``a/|a| . m``), the raw values of the two invariants."""
     out = frame.copy()
     m = out[list(MAG)].to_numpy(float)
     out["field_norm_ut"] = np.linalg.norm(m, axis=1)
@@ -153,10 +153,10 @@ def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
     """Load and validate a magnetometer file without reference attitude (one-line InputError naming file,
     column and row): missing field columns; empty cells, text, NaN, infinity; values outside their limits
     (field +-1e6 uT, acceleration +-1e4 m/s^2, temperature -80..200 degC); fewer than ``min_rows`` rows; a
-    stuck axis; a unit other than uT (the median |m| must lie in 10-150 uT: the Earth's field is 22-67 uT; the
+    stuck axis; a unit other than uT (the median ``|m|`` must lie in 10-150 uT: the Earth's field is 22-67 uT; the
     message names gauss, mG, nT, mT or T when one of them brings it there); an accelerometer in g (the
-    median |a| must lie in 5-15 m/s^2; near 1 names g); too few distinct orientations
-    (:func:`check_orientations`).  Adds the derived columns of :func:`with_invariants`."""
+    median ``|a|`` must lie in 5-15 m/s^2; near 1 names g); too few distinct orientations
+    (``check_orientations``).  Adds the derived columns of :func:`with_invariants`."""
     name = Path(path).name
     frame = read_table(path, free_columns(), min_rows=min_rows, kind="magnetometer file")
     require_variation(frame, MAG, name, "a magnetometer turned through many orientations")
