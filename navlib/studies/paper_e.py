@@ -716,6 +716,17 @@ def improvement_pct(bp, kf) -> verdicts.Estimate:
     return verdicts.Estimate(100 * (1 - r.value), 100 * (1 - r.hi), 100 * (1 - r.lo), r.rule, r.n)
 
 
+def _time_ratio(t45, t6, ratio_p: float):
+    """The paired ratio of the 45-input to the 6-input training times (:func:`navlib.verdicts.paired_ratio`),
+    and the note on the paper's "order of magnitude": the verdict the interval would get against 10x."""
+    est, why = verdicts.attempt(verdicts.paired_ratio, t45, t6)
+    if est is not None:
+        ten, _ = verdicts.decide(est.interval, 10.0, "above")
+        why = (f"the paper calls its {ratio_p:.1f}x an order of magnitude; against 10x: "
+               f"{verdicts.verdict_name(ten)}")
+    return est, why
+
+
 def claims(data: StudyData) -> list[report.Claim]:
     """The paper's claims and the book's own, each judged by the one rule of :mod:`navlib.verdicts`.
 
@@ -758,12 +769,8 @@ def claims(data: StudyData) -> list[report.Claim]:
                 why=why, key=f"cel_imp{tag}_{'held' if held else 'same'}"))
 
     lm45, lm6 = lm_timing_pairs(data)
-    est, why = verdicts.attempt(verdicts.paired_ratio, lm45, lm6)
+    est, why = _time_ratio(lm45, lm6, ratio_p)
     ep = data.lm_timing.pivot(index="timing", columns="n_in", values="epochs").sort_index()
-    if est is not None:
-        ten, _ = verdicts.decide(est.interval, 10.0, "above")
-        why = (f"the paper calls its {ratio_p:.1f}x an order of magnitude; against 10x: "
-               f"{verdicts.verdict_name(ten)}")
     out.append(report.Claim(
         "QR features train an order of magnitude faster (45 vs 6 inputs)",
         f"{t45_p:.4f} s vs {t6_p:.4f} s, average time of one training ({ratio_p:.1f}x)",
@@ -780,11 +787,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         why=why, key="cel_time_lm", volatile=True))
 
     t45, t6 = timing_pairs(data)
-    est, why = verdicts.attempt(verdicts.paired_ratio, t45, t6)
-    if est is not None:
-        ten, _ = verdicts.decide(est.interval, 10.0, "above")
-        why = (f"the paper calls its {ratio_p:.1f}x an order of magnitude; against 10x: "
-               f"{verdicts.verdict_name(ten)}")
+    est, why = _time_ratio(t45, t6, ratio_p)
     out.append(report.Claim(
         "QR features train an order of magnitude faster (45 vs 6 inputs)",
         f"{t45_p:.4f} s vs {t6_p:.4f} s per training ({ratio_p:.1f}x)",
