@@ -58,6 +58,7 @@ from scipy.spatial.transform import Rotation
 
 from ..data.tables import Column, read_table, require_variation
 from ..errors import InputError, check_param
+from ..methods.preprocess import field_gravity_dot
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
 from .magnetometer import FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
@@ -122,22 +123,24 @@ def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
     out["field_norm_ut"] = np.linalg.norm(m, axis=1)
     if has_acc(out):
         a = out[list(ACC)].to_numpy(float)
-        out["field_gravity_ut"] = np.einsum("ij,ij->i", a / np.linalg.norm(a, axis=1, keepdims=True), m)
+        out["field_gravity_ut"] = field_gravity_dot(m, a) / np.linalg.norm(a, axis=1)     # a/|a| . m
     return out
+
+
+def _directions(frame: pd.DataFrame) -> np.ndarray:
+    """The raw field's unit directions, one row per sample."""
+    m = frame[list(MAG)].to_numpy(float)
+    return m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
 
 
 def orientation_cells(frame: pd.DataFrame) -> int:
     """Distinct 30-deg cells of the raw field's direction (each component of the unit vector x 2, rounded)."""
-    m = frame[list(MAG)].to_numpy(float)
-    u = m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
-    return len({tuple(v) for v in np.round(u * 2).astype(int)})
+    return len({tuple(v) for v in np.round(_directions(frame) * 2).astype(int)})
 
 
 def orientation_spread(frame: pd.DataFrame) -> float:
     """Smallest eigenvalue of the second moment of the field's unit directions (about their mean)."""
-    m = frame[list(MAG)].to_numpy(float)
-    u = m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
-    return float(np.linalg.eigvalsh(np.cov(u.T))[0])
+    return float(np.linalg.eigvalsh(np.cov(_directions(frame).T))[0])
 
 
 def check_orientations(frame: pd.DataFrame, name: str, needed: int = MIN_ORIENTATIONS) -> None:
