@@ -23,7 +23,9 @@ Scheduling: tasks with a ``cost`` estimate get dask priorities, the most expensi
 processing time first), so no worker idles at the end while another still runs a long task.  A worker
 that dies (killed, out of memory) is restarted by its nanny and the scheduler re-runs its tasks on
 another worker (up to :data:`ALLOWED_FAILURES` deaths per task); an exception raised by a task (bad
-input) is not retried: it reaches the caller as raised.
+input) is not retried: it reaches the caller as raised.  :func:`background` starts a whole study and
+returns at once: its tasks wait below the foreground's, and fill the workers while the caller does other
+work (a chapter drawing its figures); the numbers are those of the direct call.
 
 Progress: a tqdm bar on stderr for studies that run longer than :data:`PROGRESS_DELAY_S`, only when stderr
 is a terminal (never in a notebook's stored outputs) unless ``NAVLIB_PROGRESS=1`` asks for it (``0``
@@ -80,6 +82,10 @@ _CLUSTERS: dict[tuple, Any] = {}         # ("local", n) -> LocalCluster
 _PRELOADS: list = []                     # futures of start()'s imports (a released future is cancelled)
 _STARTING: dict[tuple, Any] = {}         # key -> concurrent.futures.Future of a start() in the background
 _LOCK = threading.RLock()
+_TIER = threading.local()                # .tier of the study this thread runs (background(); 0 otherwise)
+#: Priority distance between tiers of :func:`background` studies: every task of a higher tier outranks every
+#: task of a lower one (a study's own priorities are at most its number of tasks).
+TIER_STEP = 10 ** 6
 
 
 # ------------------------------------------------------------------------------------------ where
@@ -345,7 +351,8 @@ def _run_dask(c, fn, tasks, cost, label, bar, weight, on_result) -> list:
 
     n = len(tasks)
     order = sorted(range(n), key=lambda i: -cost[i]) if cost is not None else list(range(n))
-    priority = {i: n - rank for rank, i in enumerate(order)}      # higher runs first
+    tier = getattr(_TIER, "tier", 0) * TIER_STEP                  # background studies: below the foreground
+    priority = {i: tier + n - rank for rank, i in enumerate(order)}   # higher runs first
     tag = re.sub(r"[^A-Za-z0-9_]+", "_", label or getattr(fn, "__name__", "task"))[:40]
     run_id = uuid.uuid4().hex[:10]
     futures = [None] * n
@@ -366,6 +373,63 @@ def _run_dask(c, fn, tasks, cost, label, bar, weight, on_result) -> list:
         pending = [f for f in futures if f is not None and not f.done()]
         if pending:
             c.cancel(pending)
+
+
+class Job:
+    """A study started by :func:`background`: :meth:`result` waits for it and returns what the call
+    returned (or raises what it raised)."""
+
+    def __init__(self, fn: Callable, args: tuple, kwargs: dict, tier: int, threaded: bool):
+        self._call = (fn, args, kwargs)
+        self._tier = int(tier)
+        self._done = threading.Event()
+        self._value: Any = None
+        self._error: BaseException | None = None
+        self._thread = None
+        if threaded:
+            self._thread = threading.Thread(target=self._run, name=f"navlib-background-{fn.__name__}",
+                                            daemon=True)
+            self._thread.start()
+
+    def _run(self) -> None:
+        fn, args, kwargs = self._call
+        _TIER.tier = self._tier
+        try:
+            self._value = fn(*args, **kwargs)
+        except BaseException as err:       # handed to result(), in the caller's thread, as raised
+            self._error = err
+        finally:
+            self._done.set()
+
+    def done(self) -> bool:
+        """True once the study has finished (always False for a deferred one-process study)."""
+        return self._done.is_set()
+
+    def result(self):
+        """The study's return value (a one-process study runs now, in this thread)."""
+        if self._thread is None and not self._done.is_set():
+            self._run()
+        self._done.wait()
+        if self._error is not None:
+            raise self._error
+        return self._value
+
+
+def background(fn: Callable, *args, tier: int = -1, **kwargs) -> Job:
+    """Start the study ``fn(*args, **kwargs)`` (a function that sends its tasks to :func:`run`) now and
+    return at once: its tasks queue on the workers below every task of the foreground (``tier`` < 0;
+    between background studies, the higher tier first), so a chapter's later cells keep the workers busy
+    while it draws and tabulates what is already done.  ``Job.result()`` collects it.
+
+    The tasks, and so the numbers, are those of calling ``fn(*args, **kwargs)`` directly.  With one worker
+    and no scheduler (``workers``/``scheduler`` in ``kwargs``, as ``fn`` takes them) the study has nowhere
+    to run beside this process: it runs when ``result()`` is first asked, as the direct call would."""
+    if not isinstance(tier, int) or isinstance(tier, bool) or tier >= 0:
+        raise InputError(f"engine.background: parameter tier must be a negative integer, got {tier!r}")
+    workers = kwargs.get("workers", 1)
+    check_param("workers", workers, lo=1, integer=True)
+    threaded = scheduler_address(kwargs.get("scheduler")) is not None or int(workers) > 1
+    return Job(fn, args, kwargs, tier, threaded)
 
 
 def run_batches(fn: Callable, items: Sequence[tuple], batch_size: int, *, workers: int = 1,

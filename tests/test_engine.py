@@ -173,6 +173,40 @@ def test_an_error_in_a_task_reaches_the_caller_as_raised():
         engine.run(_raise_input_error, [(k,) for k in range(6)], workers=2)
 
 
+def _stamp(k, pause_s):
+    """When task ``k`` started (the system's monotonic clock, shared by the processes of this machine)."""
+    t = time.monotonic()
+    time.sleep(pause_s)
+    return k, t
+
+
+def test_a_background_study_gives_the_direct_numbers_and_yields_to_the_foreground(reference):
+    job = engine.background(_drift_study, workers=2)
+    slow = engine.background(engine.run, _stamp, [(k, 0.2) for k in range(24)], workers=2, tier=-2)
+    time.sleep(0.5)                                   # its tasks are queued on the workers by now
+    fore = engine.run(_stamp, [(k, 0.05) for k in range(4)], workers=2)
+    pd.testing.assert_frame_equal(job.result(), reference)
+    back = slow.result()
+    assert [k for k, _ in back] == list(range(24)) and job.done() and slow.done()
+    # the foreground's tasks started before most of the queued background ones (without the tiers a
+    # 4-task study's priorities, 1..4, sit below a 24-task one's, and it would start last)
+    last_fore = max(t for _, t in fore)
+    assert sum(t > last_fore for _, t in back) >= 12
+
+
+def test_a_one_process_background_study_runs_when_asked_and_errors_come_back_as_raised():
+    calls = []
+    job = engine.background(lambda workers=1: calls.append(workers) or 7)
+    assert calls == [] and not job.done()
+    assert job.result() == 7 and calls == [1] and job.result() == 7 and calls == [1]
+    bad = engine.background(engine.run, _raise_input_error, [(k,) for k in range(6)], workers=2)
+    with pytest.raises(InputError, match="k=3: refused"):
+        bad.result()
+    for tier in (0, 1, 1.5, True):
+        with pytest.raises(InputError, match="parameter tier"):
+            engine.background(len, (), tier=tier)
+
+
 def _trial_or_die(marker: str, *args):
     """A hidden-effect trial; the first time it is asked for the trial marked, its worker process dies."""
     m = Path(marker)
