@@ -407,7 +407,7 @@ def _glance_html(claims: list[Claim], caption: str) -> str:
         cols = GLANCE_COLUMNS if with_reading else [k for k in GLANCE_COLUMNS if k != "reading"]
         return pd.DataFrame(rows, columns=GLANCE_COLUMNS)[cols]
 
-    link = (f'<p class="navbook-glance-note">{html.escape(caption)} (<a href="{VERDICTS_HREF}">what the '
+    link = (f'<p class="navbook-glance-note">{html.escape(caption, quote=False)} (<a href="{VERDICTS_HREF}">what the '
             f'verdicts mean</a>)</p>')
     if len(claims) <= GLANCE_OPEN_ROWS:
         return link + Table(frame(claims), index=False)._repr_html_()
