@@ -420,12 +420,22 @@ def load_baseline(path: Path | None) -> dict[str, dict[str, int]]:
     when the checks were added; ``check-html`` fails only where a page has more.  {} without a file."""
     if path is None or not Path(path).exists():
         return {}
-    data = json.loads(Path(path).read_text(encoding="utf-8"))
-    return {page: {k: int(v) for k, v in kinds.items()} for page, kinds in data.get("pages", {}).items()}
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        return {page: {k: int(v) for k, v in kinds.items()} for page, kinds in data["pages"].items()}
+    except (json.JSONDecodeError, KeyError, AttributeError, TypeError, ValueError) as err:
+        raise InputError(f"{path}: not a check-html baseline ({{\"pages\": {{page: {{kind: count}}}}}}): "
+                         f"{type(err).__name__}: {err}") from None
 
 
 def _kind(problem: str) -> str | None:
     return next((k for k in LAYOUT_KINDS if problem.startswith(k)), None)
+
+
+def is_chapter_page(rel: Path) -> bool:
+    """A built chapter (an executed notebook under ``_generated/``; the API pages there are not)."""
+    rel = Path(rel)
+    return rel.parts[0] == "_generated" and not rel.name.startswith("api_")
 
 
 def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) -> int:
@@ -437,7 +447,7 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
         text = page.read_text(encoding="utf-8", errors="replace")
         rel = page.relative_to(html_dir)
         found += [(rel.as_posix(), p) for p in check_page(text, content=rel.parts[0] != "_modules")]
-        if rel.parts[0] == "_generated":              # the chapters (executed notebooks)
+        if is_chapter_page(rel):                       # the chapters (executed notebooks)
             found += [(rel.as_posix(), p) for p in check_chapter_opening(text)]
             chapter_pages[rel.as_posix()] = text
         landing.update(landing_counts(text))
@@ -767,12 +777,85 @@ def api_markdown(modules: list[str]) -> str:
     return "\n".join(parts)
 
 
+#: The API reference's pages, one per layer of navlib, in the order the sidebar shows them: (page name,
+#: title, module prefixes).  A module matches the longest prefix; the book's build tooling comes last.
+API_LAYERS = (
+    ("sensors", "Sensors: simulators and exact error models", ("navlib.sensors",)),
+    ("methods", "Methods: estimators, networks, optimisers, filters", ("navlib.methods",)),
+    ("workbench", "Workbench: find the missing physical effect", ("navlib.workbench",)),
+    ("studies", "Studies: one module per source", ("navlib.studies",)),
+    ("data", "Data: loaders with validation", ("navlib.data", "navlib.paths")),
+    ("cli", "Command line", ("navlib.cli",)),
+    ("foundations", "Shared tools: verdicts, results, engine, seeds",
+     ("navlib.verdicts", "navlib.report", "navlib.engine", "navlib.seeding", "navlib.grid", "navlib.angles",
+      "navlib.errors", "navlib._optional")),
+    ("internals", "Build internals (the book's tooling, not part of the user API)", ("navlib.booktools",)),
+)
+
+
+def api_layer(module: str) -> str:
+    """The :data:`API_LAYERS` page of a module (the longest matching prefix); ``"foundations"`` for a
+    module no layer names."""
+    best, length = "foundations", -1
+    for name, _, prefixes in API_LAYERS:
+        for pre in prefixes:
+            if (module == pre or module.startswith(pre + ".")) and len(pre) > length:
+                best, length = name, len(pre)
+    return best
+
+
+def module_summary(module: str) -> str:
+    """The first sentence of a module's docstring (for the API pages' summary tables)."""
+    import importlib
+
+    try:
+        doc = importlib.import_module(module).__doc__ or ""
+    except ImportError as err:            # an optional extra missing: say so instead of failing the page
+        return f"(not importable here: {err})"
+    text = re.sub(r"\s+", " ", doc).strip()
+    first = text
+    for m in re.finditer(r"[.:](?=\s|$)", text):
+        word = re.search(r"(\S+)$", text[:m.start()])
+        if word and word.group(1).lower() in _NOT_SENTENCE_ENDS:
+            continue                       # "Yu et al. 2012", "eq. 3", "e.g. a sensor"
+        first = text[:m.start()] + "."
+        break
+    return re.sub(r"[*`]|:\w+:", "", first)[:200]
+
+
+_NOT_SENTENCE_ENDS = {"al", "eq", "e.g", "i.e", "fig", "figs", "vs", "cf", "no", "sec"}
+
+
+def api_pages(modules: list[str]) -> dict[str, str]:
+    """The API reference as pages (MyST markdown), keyed by file stem: ``api_modules`` (the overview: one
+    row per layer with its modules) and ``api_<layer>`` per layer of :data:`API_LAYERS` (a summary table
+    of its modules, then one ``automodule`` section per module, :func:`api_markdown`)."""
+    groups = {name: [m for m in modules if api_layer(m) == name] for name, _, _ in API_LAYERS}
+    overview = ["| layer | modules |", "|---|---|"]
+    pages = {}
+    for name, title, _ in API_LAYERS:
+        mods = groups[name]
+        if not mods:                      # the table of contents lists every layer's page
+            pages[f"api_{name}"] = f"# {title}\n\nNo module of navlib belongs here yet.\n"
+            continue
+        overview.append(f"| {{doc}}`{title} </_generated/api_{name}>` | "
+                        + ", ".join(f"`{m}`" for m in mods) + " |")
+        table = ["| module | what it holds |", "|---|---|"]
+        table += [f"| {{py:mod}}`{m}` | {_md_cell(module_summary(m))} |" for m in mods]
+        pages[f"api_{name}"] = "\n".join([f"# {title}", ""] + table + ["", api_markdown(mods)])
+    pages["api_modules"] = "\n".join(overview) + "\n"
+    return pages
+
+
 def write_api(out: Path) -> int:
+    """Write the API overview to ``out`` and one page per layer beside it (``api_<layer>.md``)."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     mods = navlib_modules()
-    out.write_text(api_markdown(mods), encoding="utf-8")
-    print(f"api-modules: {len(mods)} modules -> {out}")
+    pages = api_pages(mods)
+    for stem, text in pages.items():
+        (out if stem == "api_modules" else out.with_name(f"{stem}.md")).write_text(text, encoding="utf-8")
+    print(f"api-modules: {len(mods)} modules on {len(pages) - 1} pages -> {out.parent}")
     return 0
 
 
@@ -1296,6 +1379,14 @@ def main(argv: list[str] | None = None) -> int:
     sc.add_argument("--width", type=int, default=1400)
     sc.add_argument("--chromium", default=None)
     args = ap.parse_args(argv)
+    try:
+        return _run(args)
+    except InputError as err:
+        print(f"booktools {args.cmd}: {err}", file=sys.stderr)
+        return 2
+
+
+def _run(args) -> int:
     if args.cmd == "execute":
         return execute(args.notebooks, args.out, args.in_place)
     if args.cmd == "check-html":

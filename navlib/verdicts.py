@@ -288,7 +288,7 @@ REASONS = {
                      "our runs are too few for a 95 % interval of the statistic"),
 }
 #: The verdict labels of the book in order, each with its definition (the three verdicts of
-#: :data:`VERDICTS`, *cannot be judged* split by :data:`REASONS`).
+#: ``VERDICTS``, *cannot be judged* split by :data:`REASONS`).
 VERDICT_DEFINITIONS = {
     "reproduced": "the whole 95 % interval of our statistic lies on the claim's side of its boundary",
     "not reproduced": "the whole 95 % interval lies on the other side of the boundary",
