@@ -564,27 +564,30 @@ def _reasons_text(claims: list[dict]) -> str:
 
 
 def verdict_sentence(counts: dict[str, int], whose: str = "the paper's", claims: list[dict] = ()) -> str:
-    """One sentence computed from a chapter's counts: "Mostly not reproduced: 97 of 211 of the paper's
-    claims do not reproduce, 61 do, 53 cannot be judged (mostly below our noise floor)." The lead is
-    *mostly X* when a verdict holds more than half of the claims, else *mixed* (saying which of reproduced
-    and not reproduced is the more frequent)."""
+    """One sentence computed from a chapter's counts: "Mostly not reproduced: 25 of the paper's 45
+    claims do not reproduce, 13 do, 7 cannot be judged (mostly our interval contains the boundary)."  The lead is *mostly X* when a verdict holds more than half of the claims, else *mixed*
+    (saying which of reproduced and not reproduced is the more frequent); the reason is the most frequent
+    case of *cannot be judged* among ``claims`` (the stored records)."""
     r, nr, cj = (counts[k] for k in COUNTED)
     n = r + nr + cj
     if n == 0:
         return "No claims judged yet."
+    pct = counts
+    of = f"of {whose} {n} claims"
     if 2 * r > n:
-        lead, first = "Mostly reproduced", f"{r} of {n} of {whose} claims reproduce, {nr} do not"
+        lead, first = "Mostly reproduced", f"{pct['reproduced']} {of} reproduce, {pct['not reproduced']} do not"
     elif 2 * nr > n:
-        lead, first = "Mostly not reproduced", f"{nr} of {n} of {whose} claims do not reproduce, {r} do"
+        lead, first = "Mostly not reproduced", f"{pct['not reproduced']} {of} do not reproduce, {pct['reproduced']} do"
     elif 2 * cj > n:
-        lead, first = "Mostly cannot be judged", f"{cj} of {n} of {whose} claims cannot be judged"
-        first += f", {r} reproduce, {nr} do not"
+        lead = "Mostly cannot be judged"
+        first = (f"{pct['cannot be judged']} {of} cannot be judged, {pct['reproduced']} reproduce, "
+                 f"{pct['not reproduced']} do not")
     else:
         more = "more reproduced than not" if r > nr else ("more not reproduced than reproduced" if nr > r
                                                            else "as many reproduced as not")
-        lead, first = f"Mixed, {more}", f"{r} of {n} of {whose} claims reproduce, {nr} do not"
+        lead, first = f"Mixed, {more}", f"{pct['reproduced']} {of} reproduce, {pct['not reproduced']} do not"
     if cj and not lead.startswith("Mostly cannot"):
-        first += f", {cj} cannot be judged"
+        first += f", {pct['cannot be judged']} cannot be judged"
     keys = [k for k in (_reason_key(c) for c in claims if c.get("reproduced") is None) if k]
     if keys:
         top = max(dict.fromkeys(keys), key=keys.count)
@@ -669,8 +672,7 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
     that defines the verdicts.  The chapters that wrote no results file are listed after the table.
     ``sources`` (:func:`read_chapter_sources`) gives each notebook's short title and source.""" 
     counts = claim_counts(results)
-    lines = ["| chapter and source | in one sentence | paper's claims: reproduced / not / cannot be judged | "
-             "book's own claims | |", "|---|---|---|---|---|"]
+    rows = []
     missing = []
     for chapter, doc, title, source in _chapters(results, notebooks, sources):
         if chapter not in results:
@@ -686,10 +688,14 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
                f'data-paper="{" ".join(str(cnt["paper"][k]) for k in COUNTED)}" '
                f'data-book="{" ".join(str(cnt["book"][k]) for k in COUNTED)}"></span>')
         src_text = f"<br>{_md_cell(source)}" if source else ""
-        lines.append(f"| {{doc}}`{_md_cell(title)} <{doc}>`{tag}{src_text} | {_md_cell(sentence)} | "
-                     f"{_counts_cell(cnt['paper'])} | {_counts_cell(cnt['book'])} | "
-                     f"{stacked_bar(cnt[src])} |")
-    if len(lines) == 2:
+        rows += [f"* - {{doc}}`{_md_cell(title)} <{doc}>`{tag}{src_text}", f"  - {_md_cell(sentence)}",
+                 f"  - {stacked_bar(cnt[src])}<br>paper's: {_counts_cell(cnt['paper'])}<br>"
+                 f"book's own: {_counts_cell(cnt['book'])}"]
+    if rows:
+        lines = [":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 30 45 25", "",
+                 "* - chapter and source", "  - in one sentence",
+                 "  - claims: reproduced / not / cannot be judged"] + rows + [":::"]
+    else:
         lines = ["No chapter has written its results yet."]
     if missing:
         lines += ["", f"Not yet summarised (no results file): {', '.join(missing)}."]
@@ -698,7 +704,8 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
         lines += ["", f"In all, **{total['paper']['reproduced']} of {sum(total['paper'].values())}** of the "
                   f"papers' claims reproduce, {total['paper']['not reproduced']} do not and "
                   f"{total['paper']['cannot be judged']} cannot be judged; of the book's own claims "
-                  f"{total['book']['reproduced']} of {sum(total['book'].values())} hold. Bars: "
+                  f"{total['book']['reproduced']} of {sum(total['book'].values())} hold. Counts are reproduced / "
+                  f"not reproduced / cannot be judged; bars: "
                   + ", ".join(f'<span style="color:{BAR_COLOURS[k]}">&#9632;</span> {k}' for k in COUNTED)
                   + ". Each chapter's *Results at a glance* lists the same claims; the readings are "
                   "[below](status-by-reading)."]

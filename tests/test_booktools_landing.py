@@ -69,12 +69,12 @@ def test_reading_labels_are_readable():
 
 def test_verdict_sentence_follows_the_counts():
     c = dict(zip(bt.COUNTED, (61, 97, 53)))
-    assert bt.verdict_sentence(c).startswith("Mixed, more not reproduced than reproduced: 61 of 211")
-    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (13, 25, 7)))).startswith("Mostly not reproduced: 25 of 45")
-    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (5, 0, 2)))).startswith("Mostly reproduced: 5 of 7")
+    assert bt.verdict_sentence(c).startswith("Mixed, more not reproduced than reproduced: 61 of the paper's 211 claims")
+    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (13, 25, 7)))).startswith("Mostly not reproduced: 25 of the paper's 45 claims do not")
+    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (5, 0, 2)))).startswith("Mostly reproduced: 5 of the paper's 7")
     recs = [_claim("x", None, floor=verdicts.Floor(1.2, "noise", "less")).record()] * 3
     s = bt.verdict_sentence(dict(zip(bt.COUNTED, (1, 0, 3))), claims=recs)
-    assert s.startswith("Mostly cannot be judged: 3 of 4") and "(all below our noise floor)" in s
+    assert s.startswith("Mostly cannot be judged: 3 of the paper's 4") and "(all below our noise floor)" in s
 
 
 def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_path):
@@ -88,13 +88,16 @@ def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_pat
     assert [p.stem for p in order] == ["compass", "gyro", "celestial"]
     sources = {"compass": ("Electronic compass", "paper A")}
     md = bt.status_markdown(_results(), order, sources)
-    rows = [ln for ln in md.splitlines() if ln.startswith("| {doc}")]
+    rows = [ln for ln in md.split("\n* - ")[1:]]                     # the list-table's rows after the header
+    assert len(rows) == 2 + 1 and rows[0].startswith("chapter and source")
+    rows = rows[1:]
     assert len(rows) == 2 and "Electronic compass </_generated/compass>" in rows[0] and "paper A" in rows[0]
     assert "Axial gyro drift: RBF </_generated/gyro>" in rows[1]       # no short title: the notebook's
     # counts: compass paper 1 reproduced (a), 1 not (b), 4 cannot be judged (c, d, e, f); book 1 / 0 / 0
-    assert "| 1 / 1 / 4 | 1 / 0 / 0 |" in rows[0] and "| 0 / 1 / 0 | – |" in rows[1]
+    assert "paper's: 1 / 1 / 4<br>book's own: 1 / 0 / 0" in rows[0]
+    assert "paper's: 0 / 1 / 0<br>book's own: –" in rows[1]
     assert rows[0].count("<rect") == 3 and 'aria-label="1 reproduced, 1 not reproduced, 4 cannot be judged"' in rows[0]
-    assert "Mostly cannot be judged: 4 of 6 of the paper's claims cannot be judged, 1 reproduce" in rows[0]
+    assert "Mostly cannot be judged: 4 of the paper's 6 claims cannot be judged, 1 reproduce" in rows[0]
     assert "In all, **1 of 7** of the papers' claims reproduce" in md
     assert "(what-the-verdicts-mean)=" in md and "**cannot be judged: below our noise floor**" in md
     assert "Not yet summarised (no results file): {doc}`INS/celestial </_generated/celestial>`" in md
@@ -213,3 +216,20 @@ def test_the_committed_baseline_names_only_known_kinds():
     path = Path(__file__).resolve().parents[1] / "book" / bt.BASELINE_FILE
     known = bt.load_baseline(path)
     assert known and all(set(kinds) <= set(bt.LAYOUT_KINDS) for kinds in known.values())
+
+
+# ------------------------------------------------------------------ API pages
+def test_api_pages_one_per_layer_build_internals_last():
+    mods = ["navlib.verdicts", "navlib.booktools", "navlib.report", "navlib.sensors.nope", "navlib.grid"]
+    pages = bt.api_pages(mods)
+    assert list(pages)[-2:] == ["api_internals", "api_modules"]      # every layer, the tooling last
+    assert {f"api_{name}" for name, _, _ in bt.API_LAYERS} | {"api_modules"} == set(pages)
+    assert "navlib.booktools" in pages["api_internals"] and "navlib.booktools" not in pages["api_foundations"]
+    assert pages["api_foundations"].count(".. automodule:: ") == 3
+    assert "| {py:mod}`navlib.verdicts` | One rule for every verdict in the book. |" in pages["api_foundations"]
+    assert "(not importable here" in pages["api_sensors"]
+    assert "No module of navlib belongs here yet" in pages["api_cli"]
+    overview = pages["api_modules"]
+    assert overview.index("api_sensors") < overview.index("api_foundations") < overview.index("api_internals")
+    assert "api_cli" not in overview                                  # an empty layer is not listed
+    assert bt.api_layer("navlib.data.tables") == "data" and bt.api_layer("navlib.newthing") == "foundations"
