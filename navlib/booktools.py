@@ -10,15 +10,21 @@ Subcommands of ``python -m navlib.booktools``:
     notebooks instead (how the outputs that nbval checks are regenerated) and also stores each chapter's
     results file as ``notebooks/results/<chapter>.json`` (the committed reference ``make test`` compares
     with).  With ``--out DIR`` the results files go to ``DIR/results/``.
-``check-html DIR``
+``check-html DIR [--baseline FILE]``
     Fail if a built page loads anything from the network, shows an execution error, has an output block
     wider than the content column (a preformatted line over :data:`MAX_PRE_CHARS` characters), a figure
     without a caption or a visible nbval marker, or is a chapter (``_generated/``) that does not open with
-    its *Results at a glance* admonition.
-``status RESULTS_DIR --notebooks DIR --out FILE``
-    Write the landing page's status table (claims reproduced per chapter and reading) from the results.
+    its *Results at a glance* admonition.  Also (:data:`LAYOUT_KINDS`): a code line over
+    :data:`MAX_CODE_CHARS` characters that is not folded, pandas' index-name row or a snake_case column
+    name in a result table, and a chapter whose glance box counts its claims differently from the landing
+    page; these fail only beyond the page's count in the baseline (``book/check_html_baseline.json``).
+``status RESULTS_DIR --notebooks DIR --out FILE [--toc FILE]``
+    Write the top of the landing page (one row per chapter in the sidebar's order: source, a sentence and
+    the counts by verdict with a bar; the box that defines the verdicts) to FILE, and its per-reading rows
+    (one dropdown per chapter) to ``status_readings.md`` beside it, from the results files.
 ``api-modules --out FILE``
-    Write one ``automodule`` section per module of ``navlib`` (the API reference page includes it).
+    Write the API reference: an overview to FILE and one page per layer of ``navlib`` beside it
+    (``api_<layer>.md``: a summary table of its modules, then their ``automodule`` sections).
 ``check-results --fresh DIR --reference DIR NOTEBOOK...``
     Compare the results files a fresh run wrote with the committed references, within tolerance.
 ``screenshots HTML_DIR OUT_DIR``
@@ -940,6 +946,10 @@ def claim_problems(c: dict) -> list[str]:
             p.append(f"verdict {c.get('verdict')!r} disagrees with reproduced={c['reproduced']}")
         if c.get("basis") != basis:
             p.append(f"basis {c.get('basis')!r}, the rule gives {basis!r}")
+        elif "reason" in c:               # files written before the field have none
+            want_reason = verdicts.reason_category(basis, c.get("why") or "")
+            if c["reason"] != want_reason:
+                p.append(f"reason {c['reason']!r}, the basis {basis!r} and the why give {want_reason!r}")
     if c.get("reproduced") is None and not (isinstance(c.get("why"), str) and c["why"].strip()):
         p.append("cannot be judged without a why")
     return p

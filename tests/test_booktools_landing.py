@@ -58,6 +58,10 @@ def test_each_case_of_cannot_be_judged_gets_its_own_label():
     assert set(verdicts.VERDICT_DEFINITIONS) >= {f"cannot be judged: {v[0]}" for v in verdicts.REASONS.values()}
     with pytest.raises(InputError, match="basis='guess'"):
         verdicts.reason_category("guess")
+    assert all(bt.claim_problems(c.record()) == [] for c in CLAIMS)
+    edited = dict(CLAIMS[3].record(), reason="straddles")             # a reason edited by hand
+    assert bt.claim_problems(edited) == ["reason 'straddles', the basis 'noise floor' and the why give "
+                                         "'noise floor'"]
 
 
 # ------------------------------------------------------------------ landing page
