@@ -829,11 +829,18 @@ def module_summary(module: str) -> str:
     first = text
     for m in re.finditer(r"[.:](?=\s|$)", text):
         word = re.search(r"(\S+)$", text[:m.start()])
-        if word and word.group(1).lower() in _NOT_SENTENCE_ENDS:
+        if (word and word.group(1).lower() in _NOT_SENTENCE_ENDS) or text[m.start() - 1:m.start()] == ".":
             continue                       # "Yu et al. 2012", "eq. 3", "e.g. a sensor"
         first = text[:m.start()] + "."
         break
-    return re.sub(r"[*`]|:\w+:", "", first)[:200]
+    first = re.sub(r":\w+:`~?([^`]+)`", r"``\1``", first).replace("*", "")    # roles -> literals
+    first = first.replace("``", "`")                                           # RST -> MyST literal
+    if len(first) > 200:                   # cut at a word, closing an open literal
+        first = first[:200].rsplit(" ", 1)[0]
+        first += ("`" if first.count("`") % 2 else "") + " ..."
+    elif first.count("`") % 2:             # the sentence ended inside a literal
+        first = first[:-1] + "`."
+    return first
 
 
 _NOT_SENTENCE_ENDS = {"al", "eq", "e.g", "i.e", "fig", "figs", "vs", "cf", "no", "sec"}

@@ -237,3 +237,16 @@ def test_api_pages_one_per_layer_build_internals_last():
     assert overview.index("api_sensors") < overview.index("api_foundations") < overview.index("api_internals")
     assert "api_cli" not in overview                                  # an empty layer is not listed
     assert bt.api_layer("navlib.data.tables") == "data" and bt.api_layer("navlib.newthing") == "foundations"
+
+
+def test_module_summary_is_the_first_sentence_as_myst(monkeypatch):
+    import sys
+    import types
+    fake = types.ModuleType("navlib._fake_summary")
+    fake.__doc__ = "Paper C (Yu et al. 2012) with :func:`navlib.verdicts.decide` and ``x ... y``. More text."
+    monkeypatch.setitem(sys.modules, "navlib._fake_summary", fake)
+    assert bt.module_summary("navlib._fake_summary") == \
+        "Paper C (Yu et al. 2012) with `navlib.verdicts.decide` and `x ... y`."
+    fake.__doc__ = "Run ``" + "word " * 60 + "``. Next."
+    cut = bt.module_summary("navlib._fake_summary")
+    assert cut.endswith("` ...") and cut.count("`") == 2 and len(cut) < 210
