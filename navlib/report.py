@@ -390,6 +390,9 @@ def tally(claims: Iterable[Claim]) -> str:
             f"{v.count('cannot be judged')} cannot be judged")
 
 
+#: The (claim, reading) pairs shown in a glance box in this process (:func:`write_results` warns about the
+#: claims it writes that none showed: the landing page counts them, the chapter's glance box would not).
+_GLANCED: set[tuple[str, str]] = set()
 #: A glance table with more rows than this is folded by reading on the page (one dropdown per reading).
 GLANCE_OPEN_ROWS = 12
 #: Where a chapter page's glance box links the definitions of the verdicts (the landing page's box).
@@ -433,6 +436,7 @@ class Glance:
         claims = list(claims)
         self.paper = [c for c in claims if c.source == "paper"]
         self.book = [c for c in claims if c.source == "book"]
+        _GLANCED.update((c.claim, c.reading) for c in claims)
 
     def tables(self) -> list[Table]:
         out = []
@@ -530,6 +534,12 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
         dup = next(k for k in keys if keys.count(k) > 1)
         raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
     out["claims"] = [c.record() for c in claims]
+    unseen = [k for k in keys if k not in _GLANCED]
+    if _GLANCED and unseen:                 # a chapter that shows a glance box, but not all of its claims
+        import warnings
+        warnings.warn(f"write_results({chapter!r}): {len(unseen)} of the {len(keys)} claims are in no glance "
+                      f"box (first: {unseen[0][0]!r}, {unseen[0][1]!r}); the landing page counts every claim "
+                      f"written: pass them all to report.glance", stacklevel=2)
     if extra:
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}

@@ -250,3 +250,15 @@ def test_module_summary_is_the_first_sentence_as_myst(monkeypatch):
     fake.__doc__ = "Run ``" + "word " * 60 + "``. Next."
     cut = bt.module_summary("navlib._fake_summary")
     assert cut.endswith("` ...") and cut.count("`") == 2 and len(cut) < 210
+
+
+def test_write_results_warns_about_claims_no_glance_box_showed(tmp_path, monkeypatch):
+    monkeypatch.setattr(report, "_GLANCED", set())
+    report.glance(CLAIMS[:2])
+    with pytest.warns(UserWarning, match="5 of the 7 claims are in no glance box"):
+        report.write_results("compass", claims=CLAIMS, folder=tmp_path)
+    report.glance(CLAIMS)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        report.write_results("compass", claims=CLAIMS, folder=tmp_path, overwrite=True)
