@@ -54,7 +54,7 @@ from pathlib import Path
 
 from . import verdicts
 from .errors import InputError
-from .report import RESULTS_ENV, claims_summary, read_results
+from .report import RESULTS_ENV, read_results
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
@@ -1414,7 +1414,7 @@ def _run(args) -> int:
     if args.cmd == "execute":
         return execute(args.notebooks, args.out, args.in_place)
     if args.cmd == "check-html":
-        default = Path(args.html_dir).resolve().parents[1] / BASELINE_FILE
+        default = Path(args.html_dir).absolute().parents[1] / BASELINE_FILE
         return check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
     if args.cmd == "status":
         return write_status(args.results_dir, args.notebooks, args.out, args.toc)
