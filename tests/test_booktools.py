@@ -187,7 +187,7 @@ def test_a_floor_on_the_wrong_side_makes_a_stored_claim_undecidable():
     c = res["claims"][0]
     c["floor"] = {"value": 1.2, "assumption": "sensor noise 3 ug", "needs": "noise below 2.5 ug"}
     assert any("does not follow" in p for p in validate_results(res, "compass.json"))
-    c.update(reproduced=None, verdict="cannot be judged", basis="noise floor", why="floor")
+    c.update(reproduced=None, verdict="cannot be judged", basis="noise floor", reason="noise floor", why="floor")
     assert validate_results(res, "compass.json") == []
     c["why"] = ""
     assert any("without a why" in p for p in validate_results(res, "compass.json"))
