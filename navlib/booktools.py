@@ -54,7 +54,7 @@ from pathlib import Path
 
 from . import verdicts
 from .errors import InputError
-from .report import RESULTS_ENV, read_results
+from .report import RESULTS_ENV, read_results, reading_label
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
@@ -512,26 +512,6 @@ def _md_cell(text) -> str:
 #: The three verdicts in the order the book counts them, and the colours of the landing page's bars.
 COUNTED = ("reproduced", "not reproduced", "cannot be judged")
 BAR_COLOURS = {"reproduced": "#2e7d32", "not reproduced": "#c62828", "cannot be judged": "#9e9e9e"}
-#: Abbreviations of the results files' reading labels, spelled out on the landing page (the glossary
-#: explains the methods' names).
-READING_WORDS = {r"\bval\. stop\b": "validation stop", r"\bF per individual\b": "F per individual",
-                 r"\bCR by rank\b": "CR by rank", r"\bsd\b": "standard deviations",
-                 r"\bKF\b": "Kalman filter", r"\bLOO\b": "leave-one-out"}
-
-
-def reading_label(reading: str) -> str:
-    """A reading's label as the landing page shows it: a leading number ("2: DE + trainlm, val. stop")
-    moves to the end ("DE + trainlm, validation stop (reading 2)"), abbreviations are spelled out
-    (:data:`READING_WORDS`) and the first letter is a capital."""
-    text = str(reading).strip()
-    m = re.match(r"^(\d+)\s*:\s*(.+)$", text)
-    if m:
-        text = f"{m.group(2)} (reading {m.group(1)})"
-    for pattern, words in READING_WORDS.items():
-        text = re.sub(pattern, words, text)
-    return text[:1].upper() + text[1:]
-
-
 def claim_counts(results: dict[str, dict]) -> dict[str, dict[str, dict[str, int]]]:
     """The one source of the book's counts: per chapter and source (``"paper"``, ``"book"``), how many of
     the chapter's claims (every claim of its results file) are reproduced, not reproduced and cannot be
@@ -721,7 +701,7 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
                       sources: dict[str, tuple[str, str]] | None = None) -> str:
     """The landing page's per-reading rows (MyST markdown): one dropdown per chapter, in the order of
-    ``notebooks``, with a row per source and reading (its readable label, :func:`reading_label`): claims,
+    ``notebooks``, with a row per source and reading (its readable label, :func:`navlib.report.reading_label`): claims,
     reproduced, not reproduced, and cannot be judged with the cases that apply."""
     parts = ["(status-by-reading)=", "## Claims by reading", "",
              "Where a paper's method or claim can be read in more than one way, each reading is judged on its "

@@ -390,6 +390,26 @@ def tally(claims: Iterable[Claim]) -> str:
             f"{v.count('cannot be judged')} cannot be judged")
 
 
+#: Abbreviations of the results files' reading labels, spelled out on the landing page and in the glance
+#: boxes' folds (the glossary
+#: explains the methods' names).
+READING_WORDS = {r"\bval\. stop\b": "validation stop", r"\bsd\b": "standard deviations",
+                 r"\bKF\b": "Kalman filter", r"\bLOO\b": "leave-one-out"}
+
+
+def reading_label(reading: str) -> str:
+    """A reading's label as the landing page shows it: a leading number ("2: DE + trainlm, val. stop")
+    moves to the end ("DE + trainlm, validation stop (reading 2)"), abbreviations are spelled out
+    (:data:`READING_WORDS`) and the first letter is a capital."""
+    text = str(reading).strip()
+    m = re.match(r"^(\d+)\s*:\s*(.+)$", text)
+    if m:
+        text = f"{m.group(2)} (reading {m.group(1)})"
+    for pattern, words in READING_WORDS.items():
+        text = re.sub(pattern, words, text)
+    return text[:1].upper() + text[1:]
+
+
 #: The (claim, reading) pairs shown in a glance box in this process (:func:`write_results` warns about the
 #: claims it writes that none showed: the landing page counts them, the chapter's glance box would not).
 _GLANCED: set[tuple[str, str]] = set()
@@ -418,7 +438,7 @@ def _glance_html(claims: list[Claim], caption: str) -> str:
     parts = [link]
     for r in readings:
         cs = [c for c in claims if c.reading == r]
-        parts.append(f"<details><summary>{html.escape(r)}: {html.escape(tally(cs))}</summary>"
+        parts.append(f"<details><summary>{html.escape(reading_label(r))}: {html.escape(tally(cs))}</summary>"
                      + Table(frame(cs, with_reading=False), index=False)._repr_html_() + "</details>")
     return "\n".join(parts)
 
