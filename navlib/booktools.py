@@ -10,15 +10,21 @@ Subcommands of ``python -m navlib.booktools``:
     notebooks instead (how the outputs that nbval checks are regenerated) and also stores each chapter's
     results file as ``notebooks/results/<chapter>.json`` (the committed reference ``make test`` compares
     with).  With ``--out DIR`` the results files go to ``DIR/results/``.
-``check-html DIR``
+``check-html DIR [--baseline FILE]``
     Fail if a built page loads anything from the network, shows an execution error, has an output block
     wider than the content column (a preformatted line over :data:`MAX_PRE_CHARS` characters), a figure
     without a caption or a visible nbval marker, or is a chapter (``_generated/``) that does not open with
-    its *Results at a glance* admonition.
-``status RESULTS_DIR --notebooks DIR --out FILE``
-    Write the landing page's status table (claims reproduced per chapter and reading) from the results.
+    its *Results at a glance* admonition.  Also (:data:`LAYOUT_KINDS`): a code line over
+    :data:`MAX_CODE_CHARS` characters that is not folded, pandas' index-name row or a snake_case column
+    name in a result table, and a chapter whose glance box counts its claims differently from the landing
+    page; these fail only beyond the page's count in the baseline (``book/check_html_baseline.json``).
+``status RESULTS_DIR --notebooks DIR --out FILE [--toc FILE]``
+    Write the top of the landing page (one row per chapter in the sidebar's order: source, a sentence and
+    the counts by verdict with a bar; the box that defines the verdicts) to FILE, and its per-reading rows
+    (one dropdown per chapter) to ``status_readings.md`` beside it, from the results files.
 ``api-modules --out FILE``
-    Write one ``automodule`` section per module of ``navlib`` (the API reference page includes it).
+    Write the API reference: an overview to FILE and one page per layer of ``navlib`` beside it
+    (``api_<layer>.md``: a summary table of its modules, then their ``automodule`` sections).
 ``check-results --fresh DIR --reference DIR NOTEBOOK...``
     Compare the results files a fresh run wrote with the committed references, within tolerance.
 ``screenshots HTML_DIR OUT_DIR``
@@ -48,7 +54,7 @@ from pathlib import Path
 
 from . import verdicts
 from .errors import InputError
-from .report import RESULTS_ENV, claims_summary, read_results
+from .report import RESULTS_ENV, read_results, reading_label
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
@@ -56,6 +62,14 @@ VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
 #: headless Chromium on the built book with sphinx-book-theme 1.3; an output ``<pre>`` is 784 px wide with
 #: 32 px of padding, and its 14 px monospace font is 8.43 px per character, so 89 characters fit).
 MAX_PRE_CHARS = 89
+#: A line of a code block shown on a page (a notebook's input cell not folded away, a command on the landing
+#: page) longer than this scrolls sideways in the content column at 1400 px (the code font is the output's,
+#: in a box a few pixels narrower than an output block's).
+MAX_CODE_CHARS = 88
+#: The presentation checks added with issue 24 (each message of :func:`check_page` of these kinds starts
+#: with the kind).  Pages built before them carry such problems: ``check-html`` fails only where a page has
+#: more of a kind than its entry in the baseline file (:func:`load_baseline`), and reports the rest.
+LAYOUT_KINDS = ("wide code line", "index-name row", "snake_case header", "counts differ")
 #: Tolerances of ``check-results`` (a number passes if ``|fresh - ref| <= ATOL + RTOL * |ref|``).
 RTOL = 1e-3
 ATOL = 1e-9
@@ -170,6 +184,8 @@ class _PageScan(HTMLParser):
         self.figures: list[dict] = []          # open <figure> elements
         self.problems: list[str] = []
         self._skip = 0                         # inside <script>/<style>
+        self.code_stack: list[list[str]] = []  # text of code <pre> blocks (not outputs) being read
+        self.tables: list[dict] = []           # open result tables (inside cell outputs)
 
     # -- helpers
     def _classes(self, attrs) -> set[str]:
@@ -206,6 +222,18 @@ class _PageScan(HTMLParser):
             self.figures[-1]["caption"] = True
         if tag == "pre" and self._in_output():
             self.pre_stack.append([])
+        elif tag == "pre" and not any(t == "details" for t, _ in self.stack):
+            self.code_stack.append([])
+        if tag == "table" and self._in_output():
+            self.tables.append({"thead": False, "row": None, "cell": None, "flagged": set()})
+        if self.tables:
+            t = self.tables[-1]
+            if tag == "thead":
+                t["thead"] = True
+            elif tag == "tr" and t["thead"]:
+                t["row"] = []
+            elif tag in ("th", "td") and t["row"] is not None:
+                t["cell"] = [("index_name" in classes), []]
         if tag not in _VOID:
             self.stack.append((tag, classes))
 
@@ -224,6 +252,20 @@ class _PageScan(HTMLParser):
             self.heading = re.sub(r"\s+", " ", "".join(self._heading_buf)).strip().rstrip("#").strip()
         if tag == "pre" and self.pre_stack and self._in_output():
             self._check_pre("".join(self.pre_stack.pop()))
+        elif tag == "pre" and self.code_stack:
+            self._check_code("".join(self.code_stack.pop()))
+        if self.tables:
+            t = self.tables[-1]
+            if tag in ("th", "td") and t["row"] is not None and t["cell"] is not None:
+                t["row"].append((t["cell"][0], re.sub(r"\s+", " ", "".join(t["cell"][1])).strip()))
+                t["cell"] = None
+            elif tag == "tr" and t["row"] is not None:
+                self._check_header_row(t, t["row"])
+                t["row"] = None
+            elif tag == "thead":
+                t["thead"] = False
+            elif tag == "table":
+                self.tables.pop()
         if tag == "figure" and self.figures:
             fig = self.figures.pop()
             if not fig["caption"]:
@@ -243,6 +285,10 @@ class _PageScan(HTMLParser):
             self._heading_buf.append(data)
         if self.pre_stack:
             self.pre_stack[-1].append(data)
+        if self.code_stack:
+            self.code_stack[-1].append(data)
+        if self.tables and self.tables[-1]["cell"] is not None:
+            self.tables[-1]["cell"][1].append(data)
         if "NBVAL_" in data:
             m = re.search(r"#?\s*NBVAL_\w*", data)
             self.problems.append(f"visible nbval marker '{m.group(0).strip()}' {self._where()}: use the cell "
@@ -255,6 +301,33 @@ class _PageScan(HTMLParser):
                     f"output line of {len(line.rstrip())} characters (max {MAX_PRE_CHARS}) {self._where()}: "
                     f"'{line.strip()[:70]}...': show a report.table(...) or shorten the printed text")
                 return      # one message per block
+
+    def _check_code(self, text: str):
+        for line in text.splitlines():
+            if len(line.rstrip()) > MAX_CODE_CHARS:
+                self.problems.append(
+                    f"wide code line of {len(line.rstrip())} characters (max {MAX_CODE_CHARS}) {self._where()}: "
+                    f"'{line.strip()[:60]}...': break the line (or fold the cell: tag hide-input)")
+                return      # one message per block
+
+    def _check_header_row(self, table: dict, row: list[tuple[bool, str]]):
+        """A header row of a result table: pandas' index-name row (the index's name alone, the column
+        cells blank), and snake_case column names (``median_rms_deg``: say "median RMS (deg)")."""
+        if len(row) >= 2 and "index" not in table["flagged"] and (
+                row[0][0] or (row[0][1] and not any(text for _, text in row[1:]))):
+            table["flagged"].add("index")
+            self.problems.append(f"index-name row '{row[0][1]}' in a result table {self._where()}: reset the "
+                                 f"index or set its name to None (report.table(..., index=False))")
+        snake = [text for _, text in row if SNAKE.fullmatch(text)]
+        if snake and "snake" not in table["flagged"]:
+            table["flagged"].add("snake")
+            self.problems.append(f"snake_case header '{snake[0]}' in a result table {self._where()} "
+                                 f"({len(snake)} in the row): name the column in words with its unit in "
+                                 f"parentheses")
+
+
+#: A column name in snake_case (two or more lower-case words joined by underscores).
+SNAKE = re.compile(r"[a-z][a-z0-9]*(?:_[a-z0-9]+)+")
 
 
 def check_page(text: str, content: bool = True) -> list[str]:
@@ -276,6 +349,8 @@ def check_page(text: str, content: bool = True) -> list[str]:
 
 
 GLANCE = "Results at a glance"
+#: The known problems of the :data:`LAYOUT_KINDS` per page, in the book folder (``book/``).
+BASELINE_FILE = "check_html_baseline.json"
 
 
 def check_chapter_opening(text: str) -> list[str]:
@@ -291,16 +366,118 @@ def check_chapter_opening(text: str) -> list[str]:
     return []
 
 
-def check_html(html_dir: Path, limit: int = 60) -> int:
+_TALLY = re.compile(r"The (paper's|book's own) claims: (\d+) of (\d+) reproduced, (\d+) not reproduced, "
+                    r"(\d+) cannot be judged")
+_COUNTS_TAG = re.compile(r'<span class="navbook-counts"([^>]*)>')
+
+
+def glance_counts(text: str) -> dict[str, tuple[int, int, int]] | None:
+    """The counts a chapter page's *Results at a glance* box shows (its tallies "The paper's claims: k of
+    n reproduced, m not reproduced, j cannot be judged"), by source; None without a glance box."""
+    m = re.search(r'<p class="admonition-title">\s*' + GLANCE, text)
+    if not m:
+        return None
+    end = text.find('<div class="cell docutils container', m.end())
+    box = html.unescape(re.sub(r"<[^>]+>", " ", text[m.end(): end if end >= 0 else len(text)]))
+    out = {}
+    for t in _TALLY.finditer(re.sub(r"\s+", " ", box)):
+        src = "paper" if t.group(1) == "paper's" else "book"
+        out.setdefault(src, (int(t.group(2)), int(t.group(4)), int(t.group(5))))
+    return out
+
+
+def landing_counts(text: str) -> dict[str, dict]:
+    """The counts the landing page shows (:func:`status_markdown`'s ``navbook-counts`` marks), by chapter
+    page: ``{"_generated/compass.html": {"chapter": ..., "paper": (r, nr, cj), "book": (r, nr, cj)}}``."""
+    out = {}
+    for m in _COUNTS_TAG.finditer(text):
+        a = dict(re.findall(r'([\w-]+)="([^"]*)"', m.group(1)))
+        if "data-page" in a:
+            out[a["data-page"]] = {"chapter": a.get("data-chapter", ""),
+                                   **{src: tuple(int(v) for v in a.get(f"data-{src}", "0 0 0").split())
+                                      for src in verdicts.SOURCES}}
+    return out
+
+
+def count_problems(landing: dict[str, dict], chapter_pages: dict[str, str]) -> list[tuple[str, str]]:
+    """``(page, problem)`` where a chapter's glance box and the landing page count its claims differently
+    (both must come from the chapter's results file: every claim it writes is in its glance box)."""
+    out = []
+    for page, want in sorted(landing.items()):
+        text = chapter_pages.get(page)
+        if text is None:
+            out.append(("intro.html", f"counts differ: the landing page counts {page}, which was not built"))
+            continue
+        got = glance_counts(text) or {}
+        for src in verdicts.SOURCES:
+            shown = got.get(src, (0, 0, 0))
+            if tuple(want[src]) != tuple(shown):
+                whose = "the paper's" if src == "paper" else "the book's own"
+                out.append((page, f"counts differ: the glance box shows {whose} claims as {shown[0]} of "
+                                  f"{sum(shown)} reproduced / {shown[1]} not / {shown[2]} cannot be judged, the "
+                                  f"landing page (the results file) {want[src][0]} of {sum(want[src])} / "
+                                  f"{want[src][1]} / {want[src][2]}: pass every claim written to "
+                                  f"report.write_results to report.glance"))
+    return out
+
+
+def load_baseline(path: Path | None) -> dict[str, dict[str, int]]:
+    """The known problems of the :data:`LAYOUT_KINDS` per page (``{"page": {"kind": count}}``), measured
+    when the checks were added; ``check-html`` fails only where a page has more.  {} without a file."""
+    if path is None or not Path(path).exists():
+        return {}
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        return {page: {k: int(v) for k, v in kinds.items()} for page, kinds in data["pages"].items()}
+    except (json.JSONDecodeError, KeyError, AttributeError, TypeError, ValueError) as err:
+        raise InputError(f"{path}: not a check-html baseline ({{\"pages\": {{page: {{kind: count}}}}}}): "
+                         f"{type(err).__name__}: {err}") from None
+
+
+def _kind(problem: str) -> str | None:
+    return next((k for k in LAYOUT_KINDS if problem.startswith(k)), None)
+
+
+def is_chapter_page(rel: Path) -> bool:
+    """A built chapter (an executed notebook under ``_generated/``; the API pages there are not)."""
+    rel = Path(rel)
+    return rel.parts[0] == "_generated" and not rel.name.startswith("api_")
+
+
+def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) -> int:
     """Run :func:`check_page` on every built page; print each problem as ``page: problem``; 1 if any."""
-    problems = []
+    found: list[tuple[str, str]] = []
     pages = sorted(Path(html_dir).rglob("*.html"))
+    chapter_pages, landing = {}, {}
     for page in pages:
         text = page.read_text(encoding="utf-8", errors="replace")
         rel = page.relative_to(html_dir)
-        problems += [f"{rel}: {p}" for p in check_page(text, content=rel.parts[0] != "_modules")]
-        if rel.parts[0] == "_generated":              # the chapters (executed notebooks)
-            problems += [f"{rel}: {p}" for p in check_chapter_opening(text)]
+        found += [(rel.as_posix(), p) for p in check_page(text, content=rel.parts[0] != "_modules")]
+        if is_chapter_page(rel):                       # the chapters (executed notebooks)
+            found += [(rel.as_posix(), p) for p in check_chapter_opening(text)]
+            chapter_pages[rel.as_posix()] = text
+        landing.update(landing_counts(text))
+    found += count_problems(landing, chapter_pages)
+    known = load_baseline(baseline)
+    problems, tolerated = [], {}
+    by_page_kind: dict[tuple[str, str], list[str]] = {}
+    for page, p in found:
+        kind = _kind(p)
+        if kind is None:
+            problems.append(f"{page}: {p}")
+        else:
+            by_page_kind.setdefault((page, kind), []).append(p)
+    for (page, kind), ps in sorted(by_page_kind.items()):
+        allowed = known.get(page, {}).get(kind, 0)
+        if len(ps) > allowed:
+            problems += [f"{page}: {p}" for p in ps]
+            problems.append(f"{page}: {len(ps)} problem(s) of the kind '{kind}', the baseline allows {allowed}"
+                            if allowed else f"{page}: {kind}: none allowed (the page had none)")
+        else:
+            tolerated.setdefault(page, {})[kind] = len(ps)
+    for page, kinds in sorted(tolerated.items()):
+        print(f"check-html: known, to fix: {page}: " + ", ".join(f"{n} {k}" for k, n in kinds.items()),
+              file=sys.stderr)
     for p in problems[:limit]:
         print(p, file=sys.stderr)
     if len(problems) > limit:
@@ -310,7 +487,7 @@ def check_html(html_dir: Path, limit: int = 60) -> int:
         return 1
     print(f"check-html: {len(pages)} pages: nothing loaded from the network, no errors, no output wider than "
           f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers, every chapter opens with "
-          f"its results at a glance")
+          f"its results at a glance; code lines, table headers and glance counts no worse than the baseline")
     return 0
 
 
@@ -332,71 +509,241 @@ def _md_cell(text) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
-def _status_table(summary, chapter_doc: dict, titles: dict) -> list[str]:
-    lines = ["| chapter | reading | reproduced | not reproduced | cannot be judged |", "|---|---|---|---|---|"]
-    for chap, rows in summary.groupby("chapter", sort=False):
-        doc = chapter_doc.get(chap)
-        name = _md_cell(titles.get(chap, chap))
-        label = f"{{doc}}`{name} <{doc}>`" if doc else name
-        if len(rows) > 1:                   # the chapter's total first, then one row per reading
-            lines.append(f"| {label} | **all readings** | **{rows['reproduced'].sum()} of "
-                         f"{rows['claims'].sum()}** | {rows['not reproduced'].sum()} | "
-                         f"{rows['cannot be judged'].sum()} |")
-            label = ""
-        for row in rows.to_dict("records"):
-            lines.append(f"| {label} | {_md_cell(row['reading'])} | {row['reproduced']} of "
-                         f"{row['claims']} | {row['not reproduced']} | {row['cannot be judged']} |")
-            label = ""
-    return lines
+#: The three verdicts in the order the book counts them, and the colours of the landing page's bars.
+COUNTED = ("reproduced", "not reproduced", "cannot be judged")
+BAR_COLOURS = {"reproduced": "#2e7d32", "not reproduced": "#c62828", "cannot be judged": "#9e9e9e"}
+def claim_counts(results: dict[str, dict]) -> dict[str, dict[str, dict[str, int]]]:
+    """The one source of the book's counts: per chapter and source (``"paper"``, ``"book"``), how many of
+    the chapter's claims (every claim of its results file) are reproduced, not reproduced and cannot be
+    judged.  The landing page shows these; each chapter's *Results at a glance* must show the same
+    (``check-html`` compares them on the built pages)."""
+    out = {}
+    for chapter, res in results.items():
+        counts = {src: dict.fromkeys(COUNTED, 0) for src in verdicts.SOURCES}
+        for c in res.get("claims", []):
+            counts[c.get("source", "paper")][verdicts.verdict_name(c.get("reproduced"))] += 1
+        out[chapter] = counts
+    return out
 
 
-def status_markdown(results: dict[str, dict], notebooks: list[Path]) -> str:
-    """The landing page's status tables (MyST markdown): per chapter and reading, how many claims are
-    reproduced, not reproduced, or cannot be judged, each chapter linked; the papers' claims and the
-    book's own claims in separate tables, with their totals; then the chapters that wrote no results
-    file."""
-    chapter_doc, titles = {}, {}
+def _reason_key(c: dict) -> str | None:
+    """The reason category of a stored claim: its ``reason`` field, else from its basis and why (results
+    files written before the field existed)."""
+    if c.get("reproduced") is not None:
+        return None
+    if c.get("reason"):
+        return c["reason"]
+    basis = c.get("basis")
+    return verdicts.reason_category(basis, c.get("why") or "") if basis in verdicts.BASES else None
+
+
+def _reasons_text(claims: list[dict]) -> str:
+    """"12 (8 below our noise floor, 4 our interval contains the boundary)" for the claims that cannot be
+    judged."""
+    keys = [_reason_key(c) for c in claims if c.get("reproduced") is None]
+    if not keys:
+        return "0"
+    found = {k: keys.count(k) for k in dict.fromkeys(keys)}
+    parts = [f"{n} {verdicts.REASONS[k][0] if k else 'reason not recorded'}"
+             for k, n in sorted(found.items(), key=lambda kv: -kv[1])]
+    return f"{len(keys)} ({', '.join(parts)})"
+
+
+def verdict_sentence(counts: dict[str, int], whose: str = "the paper's", claims: list[dict] = ()) -> str:
+    """One sentence computed from a chapter's counts: "Mostly not reproduced: 25 of the paper's 45
+    claims do not reproduce, 13 do, 7 cannot be judged (mostly our interval contains the boundary)."  The lead is *mostly X* when a verdict holds more than half of the claims, else *mixed*
+    (saying which of reproduced and not reproduced is the more frequent); the reason is the most frequent
+    case of *cannot be judged* among ``claims`` (the stored records)."""
+    r, nr, cj = (counts[k] for k in COUNTED)
+    n = r + nr + cj
+    if n == 0:
+        return "No claims judged yet."
+    pct = counts
+    of = f"of {whose} {n} claims"
+    if 2 * r > n:
+        lead, first = "Mostly reproduced", f"{pct['reproduced']} {of} reproduce, {pct['not reproduced']} do not"
+    elif 2 * nr > n:
+        lead, first = "Mostly not reproduced", f"{pct['not reproduced']} {of} do not reproduce, {pct['reproduced']} do"
+    elif 2 * cj > n:
+        lead = "Mostly cannot be judged"
+        first = (f"{pct['cannot be judged']} {of} cannot be judged, {pct['reproduced']} reproduce, "
+                 f"{pct['not reproduced']} do not")
+    else:
+        more = "more reproduced than not" if r > nr else ("more not reproduced than reproduced" if nr > r
+                                                           else "as many reproduced as not")
+        lead, first = f"Mixed, {more}", f"{pct['reproduced']} {of} reproduce, {pct['not reproduced']} do not"
+    if cj and not lead.startswith("Mostly cannot"):
+        first += f", {pct['cannot be judged']} cannot be judged"
+    keys = [k for k in (_reason_key(c) for c in claims if c.get("reproduced") is None) if k]
+    if keys:
+        top = max(dict.fromkeys(keys), key=keys.count)
+        share = "all" if keys.count(top) == len(keys) else "mostly"
+        first += f" ({share} {verdicts.REASONS[top][0]})"
+    return f"{lead}: {first}."
+
+
+def stacked_bar(counts: dict[str, int], width_px: int = 110, height_px: int = 12) -> str:
+    """A small stacked bar (inline SVG, nothing to download): reproduced, not reproduced and cannot be
+    judged as shares of the claims, with the counts in its title (shown on hover) and aria label."""
+    n = sum(counts[k] for k in COUNTED)
+    label = ", ".join(f"{counts[k]} {k}" for k in COUNTED)
+    parts, x = [], 0.0
+    for k in COUNTED:
+        w = width_px * counts[k] / n if n else 0.0
+        if w > 0:
+            parts.append(f'<rect x="{x:.1f}" y="0" width="{w:.1f}" height="{height_px}" '
+                         f'fill="{BAR_COLOURS[k]}"/>')
+        x += w
+    return (f'<svg class="navbook-bar" width="{width_px}" height="{height_px}" role="img" '
+            f'aria-label="{label}"><title>{label}</title>{"".join(parts)}</svg>')
+
+
+def _counts_cell(counts: dict[str, int]) -> str:
+    n = sum(counts.values())
+    return "–" if n == 0 else f"{counts['reproduced']} / {counts['not reproduced']} / {counts['cannot be judged']}"
+
+
+def chapter_order(notebooks: list[Path], toc: Path | None = None) -> list[Path]:
+    """The notebooks in the sidebar's order (their ``_generated/<stem>`` entries in ``_toc.yml``), the
+    ones the table of contents does not list after them in name order."""
+    notebooks = sorted(Path(n) for n in notebooks)
+    if toc is None or not Path(toc).exists():
+        return notebooks
+    entries = re.findall(r"file:\s*_generated/([\w-]+)", Path(toc).read_text(encoding="utf-8"))
+    rank = {stem: i for i, stem in enumerate(entries)}
+    return sorted(notebooks, key=lambda nb: (rank.get(nb.stem, len(rank)), nb.stem))
+
+
+def read_chapter_sources(path: Path | None) -> dict[str, tuple[str, str]]:
+    """``book/chapters.csv`` (columns ``chapter`` = the notebook's stem, ``short_title``, ``source``): the
+    landing page's short chapter names and sources; {} if the file is absent."""
+    if path is None or not Path(path).exists():
+        return {}
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    need = {"chapter", "short_title", "source"}
+    if rows and not need <= set(rows[0]):
+        raise InputError(f"{path}: needs the columns {sorted(need)}, has {sorted(rows[0])}")
+    return {r["chapter"]: (r["short_title"].strip(), r["source"].strip()) for r in rows}
+
+
+def _chapters(results: dict[str, dict], notebooks: list[Path], sources: dict | None = None):
+    """(chapter, doc, title, source) per notebook; the title is the short title of ``sources`` if given."""
     for nb in notebooks:
         chapter = results_chapter(nb) or nb.stem
-        chapter_doc[chapter] = f"/_generated/{nb.stem}"
-        titles[chapter] = notebook_title(nb)
-    lines = []
-    summary = claims_summary(results)
-    if len(summary):
-        for source, title in (("paper", "The papers' claims"), ("book", "The book's own claims")):
-            part = summary[summary["source"] == source]
-            if not len(part):
-                continue
-            lines += [f"**{title}**: {part['reproduced'].sum()} of {part['claims'].sum()} reproduced, "
-                      f"{part['not reproduced'].sum()} not reproduced, {part['cannot be judged'].sum()} "
-                      f"cannot be judged.", ""]
-            lines += _status_table(part, chapter_doc, titles) + [""]
-        lines.append("A claim is *reproduced* when the 95 % interval of our statistic lies wholly on the "
-                     "claim's side of its boundary, *not reproduced* when it lies wholly on the other side, "
-                     "and *cannot be judged* when the interval contains the boundary, when our experiment's "
-                     "noise floor cannot resolve the claim, when the statistic is true by construction of "
-                     "our simulator, or when the paper prints nothing to compare with "
-                     "(`navlib.verdicts`). Counts are computed from each chapter's claims (its *Results at "
-                     "a glance*) when the book is built.")
+        short, source = (sources or {}).get(nb.stem, (notebook_title(nb), ""))
+        yield chapter, f"/_generated/{nb.stem}", short, source
+
+
+def verdict_box() -> str:
+    """The box that defines the verdicts (one rule, :mod:`navlib.verdicts`), each *cannot be judged* case
+    with its own line; glance boxes link to it."""
+    lines = ["(what-the-verdicts-mean)=", ":::{admonition} What the verdicts mean", ":class: note", "",
+             "Every claim, the paper's and the book's own, is judged by one rule (`navlib.verdicts`) on a "
+             "statistic of our runs with its 95 % interval and the claim's boundary "
+             "(a paired difference over the same seeds where two methods are compared):", ""]
+    for label, text in verdicts.VERDICT_DEFINITIONS.items():
+        lines.append(f"- **{label}**: {text}.")
+    lines += ["", "The papers' claims and the book's own (tests the papers did not run) are counted apart. "
+              "Where a paper can be read in several ways, each reading is judged on its own.", ":::"]
+    return "\n".join(lines)
+
+
+def status_markdown(results: dict[str, dict], notebooks: list[Path],
+                    sources: dict[str, tuple[str, str]] | None = None) -> str:
+    """The top of the landing page (MyST markdown): one row per chapter, in the order of ``notebooks``
+    (the sidebar's, :func:`chapter_order`), with the chapter and its source, a sentence computed from
+    the counts, the paper's claims and the book's own claims by verdict (reproduced / not reproduced /
+    cannot be judged, from :func:`claim_counts`) and a stacked bar of the paper's claims; then the box
+    that defines the verdicts.  The chapters that wrote no results file are listed after the table.
+    ``sources`` (:func:`read_chapter_sources`) gives each notebook's short title and source.""" 
+    counts = claim_counts(results)
+    rows = []
+    missing = []
+    for chapter, doc, title, source in _chapters(results, notebooks, sources):
+        if chapter not in results:
+            missing.append(f"{{doc}}`{_md_cell(title)} <{doc}>`")
+            continue
+        cnt = counts[chapter]
+        claims = results[chapter].get("claims", [])
+        src = "paper" if sum(cnt["paper"].values()) else "book"
+        whose = "the paper's" if src == "paper" else "the book's own"
+        sentence = verdict_sentence(cnt[src], whose, [c for c in claims if c.get("source", "paper") == src])
+        tag = (f'<span class="navbook-counts" data-chapter="{html.escape(chapter)}" '
+               f'data-page="{doc.lstrip("/")}.html" '
+               f'data-paper="{" ".join(str(cnt["paper"][k]) for k in COUNTED)}" '
+               f'data-book="{" ".join(str(cnt["book"][k]) for k in COUNTED)}"></span>')
+        src_text = f"<br>{_md_cell(source)}" if source else ""
+        rows += [f"* - {{doc}}`{_md_cell(title)} <{doc}>`{tag}{src_text}", f"  - {_md_cell(sentence)}",
+                 f"  - {stacked_bar(cnt[src])}<br>paper's: {_counts_cell(cnt['paper'])}<br>"
+                 f"book's own: {_counts_cell(cnt['book'])}"]
+    if rows:
+        lines = [":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 30 45 25", "",
+                 "* - chapter and source", "  - in one sentence",
+                 "  - claims: reproduced / not / cannot be judged"] + rows + [":::"]
     else:
-        lines.append("No chapter has written its results yet.")
-    missing = [c for c in chapter_doc if c not in results]
+        lines = ["No chapter has written its results yet."]
     if missing:
-        names = ", ".join(f"{{doc}}`{_md_cell(titles[c])} <{chapter_doc[c]}>`" for c in missing)
-        lines += ["", f"Not yet summarised (no results file): {names}."]
-    return "\n".join(lines) + "\n"
+        lines += ["", f"Not yet summarised (no results file): {', '.join(missing)}."]
+    total = {src: {k: sum(counts[c][src][k] for c in counts) for k in COUNTED} for src in verdicts.SOURCES}
+    if counts:
+        lines += ["", f"In all, **{total['paper']['reproduced']} of {sum(total['paper'].values())}** of the "
+                  f"papers' claims reproduce, {total['paper']['not reproduced']} do not and "
+                  f"{total['paper']['cannot be judged']} cannot be judged; of the book's own claims "
+                  f"{total['book']['reproduced']} of {sum(total['book'].values())} hold. Counts are reproduced / "
+                  f"not reproduced / cannot be judged; bars: "
+                  + ", ".join(f'<span style="color:{BAR_COLOURS[k]}">&#9632;</span> {k}' for k in COUNTED)
+                  + ". Each chapter's *Results at a glance* lists the same claims; the readings are "
+                  "[below](status-by-reading)."]
+    return "\n".join(lines) + "\n\n" + verdict_box() + "\n"
 
 
-def write_status(results_dir: Path, notebooks_dir: Path, out: Path) -> int:
+def readings_markdown(results: dict[str, dict], notebooks: list[Path],
+                      sources: dict[str, tuple[str, str]] | None = None) -> str:
+    """The landing page's per-reading rows (MyST markdown): one dropdown per chapter, in the order of
+    ``notebooks``, with a row per source and reading (its readable label, :func:`navlib.report.reading_label`): claims,
+    reproduced, not reproduced, and cannot be judged with the cases that apply."""
+    parts = ["(status-by-reading)=", "## Claims by reading", "",
+             "Where a paper's method or claim can be read in more than one way, each reading is judged on its "
+             "own (the chapter says why each reading is plausible). Open a chapter to see its readings.", ""]
+    for chapter, doc, title, _ in _chapters(results, notebooks, sources):
+        if chapter not in results:
+            continue
+        claims = results[chapter].get("claims", [])
+        readings = list(dict.fromkeys((c.get("source", "paper"), c.get("reading", "as printed"))
+                                      for c in claims))
+        parts += [f"::::{{dropdown}} {_md_cell(title)}: {len(claims)} claims, {len(readings)} readings", "",
+                  f"{{doc}}`The chapter <{doc}>`.", "",
+                  "| reading | claims | reproduced | not reproduced | cannot be judged |", "|---|---|---|---|---|"]
+        for src in verdicts.SOURCES:
+            for s, r in readings:
+                if s != src:
+                    continue
+                cs = [c for c in claims if c.get("source", "paper") == s and c.get("reading", "as printed") == r]
+                label = reading_label(r) + (" (the book's own claims)" if s == "book" else "")
+                rep = sum(c.get("reproduced") is True for c in cs)
+                nrep = sum(c.get("reproduced") is False for c in cs)
+                parts.append(f"| {_md_cell(label)} | {len(cs)} | {rep} | {nrep} | {_md_cell(_reasons_text(cs))} |")
+        parts += ["", "::::", ""]
+    return "\n".join(parts)
+
+
+def write_status(results_dir: Path, notebooks_dir: Path, out: Path, toc: Path | None = None) -> int:
     """Write :func:`status_markdown` for the results in ``results_dir`` and the executed notebooks in
-    ``notebooks_dir`` to ``out``."""
+    ``notebooks_dir`` to ``out``, and :func:`readings_markdown` beside it (``status_readings.md``), the
+    chapters in the order of ``toc`` (default ``book/_toc.yml`` beside ``out``'s folder), with the short
+    titles and sources of ``chapters.csv`` beside ``toc`` (:func:`read_chapter_sources`)."""
     results = read_results(results_dir) if Path(results_dir).is_dir() else {}
-    notebooks = sorted(Path(notebooks_dir).glob("*.ipynb"))
     out = Path(out)
+    toc = Path(toc) if toc is not None else out.parent.parent / "_toc.yml"
+    notebooks = chapter_order(list(Path(notebooks_dir).glob("*.ipynb")), toc)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(status_markdown(results, notebooks), encoding="utf-8")
+    sources = read_chapter_sources(toc.with_name("chapters.csv"))
+    out.write_text(status_markdown(results, notebooks, sources), encoding="utf-8")
+    by_reading = out.with_name("status_readings.md")
+    by_reading.write_text(readings_markdown(results, notebooks, sources), encoding="utf-8")
     n_claims = sum(len(r.get("claims", [])) for r in results.values())
-    print(f"status: {len(results)} chapter(s) with results, {n_claims} claims -> {out}")
+    print(f"status: {len(results)} chapter(s) with results, {n_claims} claims -> {out}, {by_reading.name}")
     no_results = [nb.name for nb in notebooks if (results_chapter(nb) or nb.stem) not in results]
     if no_results:
         print(f"status: no results file from {', '.join(no_results)} (the chapter's last cell must call "
@@ -423,12 +770,92 @@ def api_markdown(modules: list[str]) -> str:
     return "\n".join(parts)
 
 
+#: The API reference's pages, one per layer of navlib, in the order the sidebar shows them: (page name,
+#: title, module prefixes).  A module matches the longest prefix; the book's build tooling comes last.
+API_LAYERS = (
+    ("sensors", "Sensors: simulators and exact error models", ("navlib.sensors",)),
+    ("methods", "Methods: estimators, networks, optimisers, filters", ("navlib.methods",)),
+    ("workbench", "Workbench: find the missing physical effect", ("navlib.workbench",)),
+    ("studies", "Studies: one module per source", ("navlib.studies",)),
+    ("data", "Data: loaders with validation", ("navlib.data", "navlib.paths")),
+    ("cli", "Command line", ("navlib.cli",)),
+    ("foundations", "Shared tools: verdicts, results, engine, seeds",
+     ("navlib.verdicts", "navlib.report", "navlib.engine", "navlib.seeding", "navlib.grid", "navlib.angles",
+      "navlib.errors", "navlib._optional")),
+    ("internals", "Build internals (the book's tooling, not part of the user API)", ("navlib.booktools",)),
+)
+
+
+def api_layer(module: str) -> str:
+    """The :data:`API_LAYERS` page of a module (the longest matching prefix); ``"foundations"`` for a
+    module no layer names."""
+    best, length = "foundations", -1
+    for name, _, prefixes in API_LAYERS:
+        for pre in prefixes:
+            if (module == pre or module.startswith(pre + ".")) and len(pre) > length:
+                best, length = name, len(pre)
+    return best
+
+
+def module_summary(module: str) -> str:
+    """The first sentence of a module's docstring (for the API pages' summary tables)."""
+    import importlib
+
+    try:
+        doc = importlib.import_module(module).__doc__ or ""
+    except ImportError as err:            # an optional extra missing: say so instead of failing the page
+        return f"(not importable here: {err})"
+    text = re.sub(r"\s+", " ", doc).strip()
+    first = text
+    for m in re.finditer(r"[.:](?=\s|$)", text):
+        word = re.search(r"(\S+)$", text[:m.start()])
+        if (word and word.group(1).lower() in _NOT_SENTENCE_ENDS) or text[m.start() - 1:m.start()] == ".":
+            continue                       # "Yu et al. 2012", "eq. 3", "e.g. a sensor"
+        first = text[:m.start()] + "."
+        break
+    first = re.sub(r":\w+:`~?([^`]+)`", r"``\1``", first).replace("*", "")    # roles -> literals
+    first = first.replace("``", "`")                                           # RST -> MyST literal
+    if len(first) > 200:                   # cut at a word, closing an open literal
+        first = first[:200].rsplit(" ", 1)[0]
+        first += ("`" if first.count("`") % 2 else "") + " ..."
+    elif first.count("`") % 2:             # the sentence ended inside a literal
+        first = first[:-1] + "`."
+    return first
+
+
+_NOT_SENTENCE_ENDS = {"al", "eq", "e.g", "i.e", "fig", "figs", "vs", "cf", "no", "sec"}
+
+
+def api_pages(modules: list[str]) -> dict[str, str]:
+    """The API reference as pages (MyST markdown), keyed by file stem: ``api_modules`` (the overview: one
+    row per layer with its modules) and ``api_<layer>`` per layer of :data:`API_LAYERS` (a summary table
+    of its modules, then one ``automodule`` section per module, :func:`api_markdown`)."""
+    groups = {name: [m for m in modules if api_layer(m) == name] for name, _, _ in API_LAYERS}
+    overview = ["| layer | modules |", "|---|---|"]
+    pages = {}
+    for name, title, _ in API_LAYERS:
+        mods = groups[name]
+        if not mods:                      # the table of contents lists every layer's page
+            pages[f"api_{name}"] = f"# {title}\n\nNo module of navlib belongs here yet.\n"
+            continue
+        overview.append(f"| {{doc}}`{title} </_generated/api_{name}>` | "
+                        + ", ".join(f"`{m}`" for m in mods) + " |")
+        table = ["| module | what it holds |", "|---|---|"]
+        table += [f"| {{py:mod}}`{m}` | {_md_cell(module_summary(m))} |" for m in mods]
+        pages[f"api_{name}"] = "\n".join([f"# {title}", ""] + table + ["", api_markdown(mods)])
+    pages["api_modules"] = "\n".join(overview) + "\n"
+    return pages
+
+
 def write_api(out: Path) -> int:
+    """Write the API overview to ``out`` and one page per layer beside it (``api_<layer>.md``)."""
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     mods = navlib_modules()
-    out.write_text(api_markdown(mods), encoding="utf-8")
-    print(f"api-modules: {len(mods)} modules -> {out}")
+    pages = api_pages(mods)
+    for stem, text in pages.items():
+        (out if stem == "api_modules" else out.with_name(f"{stem}.md")).write_text(text, encoding="utf-8")
+    print(f"api-modules: {len(mods)} modules on {len(pages) - 1} pages -> {out.parent}")
     return 0
 
 
@@ -506,6 +933,10 @@ def claim_problems(c: dict) -> list[str]:
             p.append(f"verdict {c.get('verdict')!r} disagrees with reproduced={c['reproduced']}")
         if c.get("basis") != basis:
             p.append(f"basis {c.get('basis')!r}, the rule gives {basis!r}")
+        elif "reason" in c:               # files written before the field have none
+            want_reason = verdicts.reason_category(basis, c.get("why") or "")
+            if c["reason"] != want_reason:
+                p.append(f"reason {c['reason']!r}, the basis {basis!r} and the why give {want_reason!r}")
     if c.get("reproduced") is None and not (isinstance(c.get("why"), str) and c["why"].strip()):
         p.append("cannot be judged without a why")
     return p
@@ -928,10 +1359,15 @@ def main(argv: list[str] | None = None) -> int:
                    help="re-execute the stored notebooks; store results in notebooks/results")
     ch = sub.add_parser("check-html", help="check the built pages")
     ch.add_argument("html_dir", type=Path)
+    ch.add_argument("--baseline", type=Path, default=None,
+                    help="known problems per page (JSON; default: check_html_baseline.json in the book "
+                         "folder, two levels above HTML_DIR, if present)")
     st = sub.add_parser("status", help="write the landing page's status table from the results files")
     st.add_argument("results_dir", type=Path)
     st.add_argument("--notebooks", type=Path, required=True, help="folder of the executed notebooks")
     st.add_argument("--out", type=Path, required=True)
+    st.add_argument("--toc", type=Path, default=None,
+                    help="the book's _toc.yml (chapter order; default: _toc.yml in OUT's parent folder)")
     api = sub.add_parser("api-modules", help="write the API page's automodule list")
     api.add_argument("--out", type=Path, required=True)
     cr = sub.add_parser("check-results", help="compare fresh results files with the committed references")
@@ -947,12 +1383,21 @@ def main(argv: list[str] | None = None) -> int:
     sc.add_argument("--width", type=int, default=1400)
     sc.add_argument("--chromium", default=None)
     args = ap.parse_args(argv)
+    try:
+        return _run(args)
+    except InputError as err:
+        print(f"booktools {args.cmd}: {err}", file=sys.stderr)
+        return 2
+
+
+def _run(args) -> int:
     if args.cmd == "execute":
         return execute(args.notebooks, args.out, args.in_place)
     if args.cmd == "check-html":
-        return check_html(args.html_dir)
+        default = Path(args.html_dir).absolute().parents[1] / BASELINE_FILE
+        return check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
     if args.cmd == "status":
-        return write_status(args.results_dir, args.notebooks, args.out)
+        return write_status(args.results_dir, args.notebooks, args.out, args.toc)
     if args.cmd == "api-modules":
         return write_api(args.out)
     if args.cmd == "compile":

@@ -302,6 +302,12 @@ class Claim:
     def verdict(self) -> str:
         return verdicts.verdict_name(self.reproduced)
 
+    @property
+    def verdict_label(self) -> str:
+        """The verdict with the case that applies: *cannot be judged: below our noise floor* and the like
+        (:func:`navlib.verdicts.verdict_label`)."""
+        return verdicts.verdict_label(self.reproduced, self.basis, self.reason)
+
     # -- display
     def _num(self, v) -> str:
         return fmt(v, self.spec) + (f" {self.unit}" if self.unit else "")
@@ -363,6 +369,7 @@ class Claim:
                                                           "needs": self.floor.needs},
                 "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
                 "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
+                "reason": verdicts.reason_category(self.basis, self.reason),
                 "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile)}
 
 
@@ -383,15 +390,73 @@ def tally(claims: Iterable[Claim]) -> str:
             f"{v.count('cannot be judged')} cannot be judged")
 
 
+#: Abbreviations of the results files' reading labels, spelled out on the landing page and in the glance
+#: boxes' folds (the glossary
+#: explains the methods' names).
+READING_WORDS = {r"\bval\. stop\b": "validation stop", r"\bsd\b": "standard deviations",
+                 r"\bKF\b": "Kalman filter", r"\bLOO\b": "leave-one-out"}
+
+
+def reading_label(reading: str) -> str:
+    """A reading's label as the landing page shows it: a leading number ("2: DE + trainlm, val. stop")
+    moves to the end ("DE + trainlm, validation stop (reading 2)"), abbreviations are spelled out
+    (:data:`READING_WORDS`) and the first letter is a capital."""
+    text = str(reading).strip()
+    m = re.match(r"^(\d+)\s*:\s*(.+)$", text)
+    if m:
+        text = f"{m.group(2)} (reading {m.group(1)})"
+    for pattern, words in READING_WORDS.items():
+        text = re.sub(pattern, words, text)
+    return text[:1].upper() + text[1:]
+
+
+#: The (claim, reading) pairs shown in a glance box in this process (:func:`write_results` warns about the
+#: claims it writes that none showed: the landing page counts them, the chapter's glance box would not).
+_GLANCED: set[tuple[str, str]] = set()
+#: A glance table with more rows than this is folded by reading on the page (one dropdown per reading).
+GLANCE_OPEN_ROWS = 12
+#: Where a chapter page's glance box links the definitions of the verdicts (the landing page's box).
+VERDICTS_HREF = "../intro.html#what-the-verdicts-mean"
+
+
+def _glance_html(claims: list[Claim], caption: str) -> str:
+    """One glance table in HTML: the verdict with the case that applies (*cannot be judged: below our
+    noise floor*, ...); more than :data:`GLANCE_OPEN_ROWS` claims are folded by reading, each reading a
+    ``<details>`` whose summary gives its counts."""
+    def frame(cs, with_reading=True):
+        rows = [{"claim": c.claim, "reading": c.reading, "paper": c.paper, GLANCE_COLUMNS[3]: c.ours_text,
+                 "boundary": c.boundary_text,
+                 "verdict": c.verdict_label + (f" ({c.reason})" if c.reason else "")} for c in cs]
+        cols = GLANCE_COLUMNS if with_reading else [k for k in GLANCE_COLUMNS if k != "reading"]
+        return pd.DataFrame(rows, columns=GLANCE_COLUMNS)[cols]
+
+    link = (f'<p class="navbook-glance-note">{html.escape(caption, quote=False)} (<a href="{VERDICTS_HREF}">what the '
+            f'verdicts mean</a>)</p>')
+    if len(claims) <= GLANCE_OPEN_ROWS:
+        return link + Table(frame(claims), index=False)._repr_html_()
+    readings = list(dict.fromkeys(c.reading for c in claims))
+    parts = [link]
+    for r in readings:
+        cs = [c for c in claims if c.reading == r]
+        parts.append(f"<details><summary>{html.escape(reading_label(r))}: {html.escape(tally(cs))}</summary>"
+                     + Table(frame(cs, with_reading=False), index=False)._repr_html_() + "</details>")
+    return "\n".join(parts)
+
+
 class Glance:
     """The Results-at-a-glance tables: the paper's claims and the book's own claims apart, each row with
     the claim, the reading, the paper's number, ours with its 95 % interval, the boundary and the verdict
-    with its reason."""
+    with its reason.  Give it every claim of the chapter (the list passed to :func:`write_results`): the
+    landing page counts that list, and a glance that shows fewer claims disagrees with it (``booktools
+    check-html`` compares the two).  On the page, a long list is folded by reading and each verdict says
+    which case applies (:func:`navlib.verdicts.verdict_label`); the plain text (what nbval compares) is
+    one table per source."""
 
     def __init__(self, claims: Iterable[Claim]):
         claims = list(claims)
         self.paper = [c for c in claims if c.source == "paper"]
         self.book = [c for c in claims if c.source == "book"]
+        _GLANCED.update((c.claim, c.reading) for c in claims)
 
     def tables(self) -> list[Table]:
         out = []
@@ -404,7 +469,12 @@ class Glance:
         return out
 
     def _repr_html_(self) -> str:
-        return "\n".join(t._repr_html_() for t in self.tables())
+        out = []
+        if self.paper:
+            out.append(_glance_html(self.paper, f"The paper's claims: {tally(self.paper)}"))
+        if self.book:
+            out.append(_glance_html(self.book, f"The book's own claims: {tally(self.book)}"))
+        return "\n".join(out)
 
     def __repr__(self) -> str:
         return "\n\n".join(repr(t) for t in self.tables())
@@ -484,6 +554,12 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
         dup = next(k for k in keys if keys.count(k) > 1)
         raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
     out["claims"] = [c.record() for c in claims]
+    unseen = [k for k in keys if k not in _GLANCED]
+    if _GLANCED and unseen:                 # a chapter that shows a glance box, but not all of its claims
+        import warnings
+        warnings.warn(f"write_results({chapter!r}): {len(unseen)} of the {len(keys)} claims are in no glance "
+                      f"box (first: {unseen[0][0]!r}, {unseen[0][1]!r}); the landing page counts every claim "
+                      f"written: pass them all to report.glance", stacklevel=2)
     if extra:
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}

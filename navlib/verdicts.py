@@ -264,3 +264,57 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
 
 def verdict_name(reproduced: bool | None) -> str:
     return {True: "reproduced", False: "not reproduced", None: "cannot be judged"}[reproduced]
+
+
+# ------------------------------------------------------------------------------------------ the reasons
+#: Why a claim *cannot be judged*, in the reader's words: the basis of :func:`decide` (or, for a claim
+#: without a statistic, what its reason says) -> (short label shown beside the verdict, definition).
+#: The book defines them once (the landing page's verdict box, the glossary) from this table.
+REASONS = {
+    "straddles": ("our interval contains the boundary",
+                  "the 95 % interval of our statistic contains (or touches) the claim's boundary: more runs "
+                  "or a less noisy experiment could decide it"),
+    "noise floor": ("below our noise floor",
+                    "the best value our experiment can show (the noise floor: sensor noise, the exact "
+                    "physical model) is not on the claim's side of the boundary, so no method could show "
+                    "the claim in our experiment; the reason names the assumption that sets the floor and "
+                    "the value it would need"),
+    "by construction": ("by construction of our simulator",
+                        "the statistic is true because we set it in our simulator, so our runs cannot test "
+                        "it"),
+    "no statistic": ("the paper gives no number",
+                     "the paper prints nothing we can compare our statistic with"),
+    "too few runs": ("too few runs for an interval",
+                     "our runs are too few for a 95 % interval of the statistic"),
+}
+#: The verdict labels of the book in order, each with its definition (the three verdicts of
+#: ``VERDICTS``, *cannot be judged* split by :data:`REASONS`).
+VERDICT_DEFINITIONS = {
+    "reproduced": "the whole 95 % interval of our statistic lies on the claim's side of its boundary",
+    "not reproduced": "the whole 95 % interval lies on the other side of the boundary",
+    **{f"cannot be judged: {label}": text for label, text in REASONS.values()},
+}
+
+
+def reason_category(basis: str | None, why: str = "") -> str | None:
+    """The key of :data:`REASONS` for a claim that cannot be judged (None for a decided claim, basis
+    ``"interval"``).  A claim without a statistic because :func:`attempt` found too few runs (its reason
+    starts with "no 95 % interval") is *too few runs*; any other claim without a statistic is *the paper
+    gives no number*."""
+    if basis in (None, "interval"):
+        return None
+    if basis not in BASES:
+        raise InputError(f"basis={basis!r}: must be one of {list(BASES)}")
+    if basis == "no statistic" and "no 95 % interval" in (why or ""):
+        return "too few runs"
+    return basis
+
+
+def verdict_label(reproduced: bool | None, basis: str | None = None, why: str = "") -> str:
+    """The verdict as the book shows it: *reproduced*, *not reproduced*, or *cannot be judged: <reason>*
+    (:data:`REASONS`; plain *cannot be judged* when the basis is unknown)."""
+    name = verdict_name(reproduced)
+    if reproduced is not None:
+        return name
+    cat = reason_category(basis, why) if basis is not None else None
+    return f"{name}: {REASONS[cat][0]}" if cat else name
