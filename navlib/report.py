@@ -93,7 +93,8 @@ def _breakable(text: str) -> str:
     return re.sub(r"([_/,])(?=\S)", r"\1<wbr>", html.escape(str(text), quote=False))
 
 
-#: Set by :func:`use_style`: tables show readable labels (:func:`readable`) unless asked otherwise.
+#: Set by :func:`navlib.report_style.use_style`: tables show readable labels (:func:`readable`) unless
+#: asked otherwise.
 READABLE_TABLES = False
 
 #: Unit suffixes of snake_case names and how a column header shows them.
@@ -162,9 +163,9 @@ class Table:
 
     ``formats`` maps column names to format strings (``"{:.3f}"``) or callables; unformatted float
     columns get 4 significant digits.  ``caption`` is shown above the table.  ``readable`` (default: on
-    after :func:`use_style`) shows the formatted table with readable labels (:func:`readable`: no
-    index-name row, flat row labels, units in parentheses) and no ``-0``; ``formats`` still name the
-    original columns."""
+    after :func:`navlib.report_style.use_style`) shows the formatted table with readable labels
+    (:func:`readable`: no index-name row, flat row labels, units in parentheses) and no ``-0``;
+    ``formats`` still name the original columns."""
 
     def __init__(self, frame: pd.DataFrame, formats: Mapping[str, Any] | None = None,
                  caption: str | None = None, index: bool = True, readable: bool | None = None):
@@ -274,7 +275,7 @@ from .report_style import (legend_below, legend_right, panel_grid, panels,  # no
 
 def style() -> None:
     """The older matplotlib defaults (10 pt at figures up to 12 in wide, shown shrunk); chapters move to
-    :func:`use_style` (figures drawn for the 756 px column, 11-12 pt, readable tables)."""
+    :func:`navlib.report_style.use_style` (figures for the 756 px column, 11-12 pt, readable tables)."""
     import matplotlib as mpl
 
     mpl.rcParams.update({"figure.dpi": 100, "savefig.dpi": 110, "font.size": 10, "axes.titlesize": 10,

@@ -42,11 +42,12 @@ PANEL_HEIGHT_IN = 3.2
 #: A figure displayed below this share of its natural width is flagged by ``booktools screenshots``.
 MIN_DISPLAY_SHARE = 0.75
 
+#: The matplotlib settings of the style (rcParams).
 RC = {"figure.dpi": DPI, "savefig.dpi": DPI, "figure.figsize": (MAX_WIDTH_IN, 3.6),
       "font.size": 11, "axes.titlesize": 12, "axes.labelsize": 11, "legend.fontsize": 11,
       "legend.title_fontsize": 11, "xtick.labelsize": 11, "ytick.labelsize": 11,
       "figure.titlesize": 12, "axes.grid": True, "grid.alpha": 0.3, "legend.frameon": False,
-      "figure.autolayout": False}
+      "figure.autolayout": False, "savefig.pad_inches": 0.02}
 
 
 def use_style() -> None:
@@ -76,16 +77,17 @@ def panel_grid(n_panels: int, width_in: float = MAX_WIDTH_IN, min_panel_in: floa
 
 
 def panels(n_panels: int = 1, *, width_in: float = MAX_WIDTH_IN, panel_height_in: float = PANEL_HEIGHT_IN,
-           sharex: bool = False, sharey: bool = False):
-    """A figure of ``n_panels`` axes laid out by :func:`panel_grid`, ``width_in`` wide (at most
-    :data:`MAX_WIDTH_IN`), each row ``panel_height_in`` high, with a constrained layout (room is kept for
-    legends placed by :func:`legend_below`).  Returns ``(fig, axes)``: one Axes for one panel, else a flat
-    list in reading order."""
+           stack: bool = False, sharex: bool = False, sharey: bool = False):
+    """A figure of ``n_panels`` axes laid out by :func:`panel_grid` (``stack=True``: one column whatever
+    the width, e.g. curves over a shared time axis), ``width_in`` wide (at most :data:`MAX_WIDTH_IN`), each
+    row ``panel_height_in`` high, with a constrained layout (room is kept for legends placed by
+    :func:`legend_below`).  Returns ``(fig, axes)``: one Axes for one panel, else a flat list in reading
+    order."""
     import matplotlib.pyplot as plt
 
     check_param("width_in", width_in, lo=0, lo_open=True, hi=MAX_WIDTH_IN)
     check_param("panel_height_in", panel_height_in, lo=0, lo_open=True, hi=12)
-    rows, cols = panel_grid(n_panels, width_in)
+    rows, cols = (int(n_panels), 1) if stack else panel_grid(n_panels, width_in)
     fig, axes = plt.subplots(rows, cols, figsize=(width_in, panel_height_in * rows), layout="constrained",
                              sharex=sharex, sharey=sharey, squeeze=False)
     flat = list(axes.ravel())
@@ -107,7 +109,7 @@ def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handl
     if ncol is None:
         fig_w = fig.get_size_inches()[0] * ax.get_position().width
         longest = max(len(str(t)) for t in labels)
-        per_col = 0.6 + 0.09 * longest                    # marker + text at 11 pt, in inches
+        per_col = 0.5 + 0.075 * longest                   # marker + text at 11 pt, in inches
         ncol = max(1, min(4, len(labels), int(fig_w // per_col)))
     # below the tick labels (as many lines as the longest has) and the x label, in points
     ticks = [t.get_text() for t in ax.get_xticklabels()]
@@ -138,6 +140,24 @@ def legend_right(ax, *, title: str | None = None):
 
 
 # ------------------------------------------------------------------------------------- the loop staircase
+def wrap_label(text: str, width: int) -> str:
+    """``text`` on lines of at most ``width`` characters where it can be broken: after spaces and after the
+    underscores of effect names (``scale_factor_temperature`` -> ``scale_factor_`` / ``temperature``); a
+    piece longer than ``width`` stays whole."""
+    import re
+
+    pieces = [p for p in re.split(r"(?<=[ _])", text) if p]
+    lines, cur = [], ""
+    for p in pieces:
+        if cur and len((cur + p).rstrip()) > width:
+            lines.append(cur.rstrip())
+            cur = p
+        else:
+            cur += p
+    lines.append(cur.rstrip())
+    return "\n".join(lines)
+
+
 def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequence[float] | None = None, *,
               floor: tuple[float, float] | None = None, floor_label: str = "noise floor", unit: str = "",
               title: str | None = None):
@@ -165,7 +185,14 @@ def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequenc
         ax.axhspan(lo, hi, color="C2", alpha=0.25, lw=0, label=floor_label)
     ax.set_yscale("log")
     ax.set_xlim(0, n)
-    ax.set_xticks(x[:-1] + 0.5, [str(t) for t in labels])
+    # labels wrapped to the step's width (about 6.6 pt a character at 11 pt); a word longer than the
+    # step gets a smaller font (down to 8 pt) rather than running into its neighbour
+    step_in = ax.get_figure(root=True).get_size_inches()[0] * ax.get_position().width / n
+    width = max(6, int(step_in * 72 / 6.6))
+    texts = [wrap_label(str(t).replace("+ ", "+\u00a0"), width).replace("\u00a0", " ") for t in labels]
+    longest = max(len(line) for t in texts for line in t.split("\n"))
+    size = max(9.0, min(11.0, 11.0 * width / longest))
+    ax.set_xticks(x[:-1] + 0.5, texts, fontsize=size)
     ax.tick_params(axis="x", length=0)
     ax.grid(axis="x", visible=False)
     for i, (v, t) in enumerate(zip(rms, labels)):

@@ -126,3 +126,33 @@ def test_readable_labels_units_flat_rows_no_index_name_no_negative_zero():
     assert len(repr(report.table(named)).splitlines()) == 3                    # the old table had one
     with pytest.raises(InputError, match="RMS"):
         report.readable(pd.DataFrame({"rms_deg": [1], "RMS (deg)": [2]}))
+
+
+def test_step_labels_wrap_after_spaces_and_underscores_only():
+    assert rs.wrap_label("+ scale_factor_temperature", 13) == "+ scale_\nfactor_\ntemperature"
+    assert rs.wrap_label("misalignment", 5) == "misalignment"                  # a word stays whole
+    assert rs.wrap_label("start: bias", 20) == "start: bias"
+
+
+def test_known_noise_band_holds_95_percent_of_correct_models_rms():
+    from navlib.workbench.loop import known_noise_band
+
+    rng = np.random.default_rng(7)
+    n, p, sigma = 60, 4, 0.3
+    X = rng.normal(size=(n, p))
+    lo, hi = known_noise_band(sigma, n, p)
+    y = (X @ rng.normal(size=p))[:, None] + sigma * rng.normal(size=(n, 2000))   # 2000 noisy data sets
+    resid = y - X @ np.linalg.lstsq(X, y, rcond=None)[0]
+    rms = np.sqrt(np.mean(resid ** 2, axis=0))
+    share = np.mean((rms >= lo) & (rms <= hi))
+    assert 0.93 < share < 0.97
+    with pytest.raises(InputError, match="n_params"):
+        known_noise_band(sigma, 5, 5)
+
+
+def test_unit_loop_names_the_units_it_has():
+    from navlib.workbench.accelerometer import unit_loop
+
+    frame = pd.DataFrame({"unit": ["A", "B"], "output_mg": [0.0, 0.0]})
+    with pytest.raises(InputError, match="unit='C'.*A, B"):
+        unit_loop(frame, "C")

@@ -172,19 +172,41 @@ def noise_band(result: LoopResult, level: float = 0.95) -> tuple[float, float] |
     return (lo, hi) if hi > 0 else None
 
 
-def staircase_figure(result: LoopResult, ax=None, title: str | None = None):
+def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -> tuple[float, float]:
+    """Where the rms of a correct model's residuals lies when the noise is known: white noise of standard
+    deviation ``sigma`` on ``n`` observations and ``p = n_params`` fitted parameters give
+    ``rms^2 = sigma^2 chi2(n - p) / n``; the band is its central ``level`` interval."""
+    from scipy.stats import chi2
+
+    check_param("sigma", sigma, lo=0, lo_open=True)
+    check_param("n_params", n_params, lo=0, hi=n - 1, integer=True)
+    tail, dof = (1.0 - level) / 2.0, n - n_params
+    return (float(sigma * np.sqrt(chi2.ppf(tail, dof) / n)), float(sigma * np.sqrt(chi2.ppf(1 - tail, dof) / n)))
+
+
+def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
+                     floor: tuple[float, float] | None = None, floor_label: str | None = None):
     """The loop as a picture, full column width: a staircase with one step per effect added (labelled
     with the effect), the rms after each step on a log axis, the held-out rms as a marker and the noise
-    floor (:func:`noise_band`) as a band (:func:`navlib.report_style.staircase`).  Draws on ``ax`` if
-    given; returns the figure."""
+    floor as a band (:func:`navlib.report_style.staircase`).  The band is ``floor`` when the noise is known
+    (e.g. :func:`known_noise_band` for simulated data), else :func:`noise_band` from the data, called the
+    noise floor when the loop ended consistent with noise and the richest model's residual otherwise (it
+    then holds the structure no effect explains).  Draws on ``ax`` if given; returns the figure."""
     from .. import report_style as rs
 
     if ax is None:
         fig, ax = rs.panels(1, panel_height_in=3.6)
-    band = noise_band(result)
+    if floor is None:
+        floor = noise_band(result)
+        floor_label = floor_label or ("noise floor (95 %)" if result.consistent_with_noise
+                                      else "richest model's residual (95 %)")
     rs.staircase(ax, step_labels(result), [f.rms for f in result.fits], [f.loo_rms for f in result.fits],
-                 floor=band, floor_label="noise floor (95 %)", unit=result.final.unit,
+                 floor=floor, floor_label=floor_label or "noise floor (95 %)", unit=result.final.unit,
                  title=title if title is not None else f"{result.final.system}: {result.outcome()}")
+    lines = max(t.get_text().count("\n") + 1 for t in ax.get_xticklabels())
+    if ax.get_figure(root=True) is ax.figure and lines > 2:          # a figure of its own: room for labels
+        w, h = ax.figure.get_size_inches()
+        ax.figure.set_size_inches(w, h + 0.2 * (lines - 2))
     rs.legend_below(ax)
     return ax.figure
 
