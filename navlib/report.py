@@ -146,6 +146,9 @@ def readable(frame: pd.DataFrame) -> pd.DataFrame:
     units in parentheses (:func:`label`).  Values are not touched."""
     out = frame.copy()
     if any(n is not None for n in out.index.names):
+        clash = [n for n in out.index.names if n is not None and n in out.columns]
+        if clash:
+            raise InputError(f"readable: the index name {clash[0]!r} is also a column's name")
         out = out.reset_index()
     else:
         out.index = [row_label(v) for v in out.index]

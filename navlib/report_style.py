@@ -111,22 +111,14 @@ def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handl
         longest = max(len(str(t)) for t in labels)
         per_col = 0.5 + 0.075 * longest                   # marker + text at 11 pt, in inches
         ncol = max(1, min(4, len(labels), int(fig_w // per_col)))
-    # below the tick labels (as many lines as the longest has) and the x label, in points
-    ticks = [t.get_text() for t in ax.get_xticklabels()]
-    lines = max([t.count("\n") + 1 for t in ticks if t] or [1])
-    tick_pt = _points(ax.xaxis.get_ticklabels()[0].get_fontsize() if ticks else 11)
-    drop = lines * 1.25 * tick_pt + 8
-    if ax.get_xlabel():
-        drop += 1.25 * _points(ax.xaxis.label.get_fontsize())
+    # below what hangs under the axes (tick labels, however many lines or slanted, and the x label),
+    # measured on a draw without rendering
+    fig.draw_without_rendering()
+    below = ax.get_tightbbox()
+    drop = max(0.0, (ax.bbox.y0 - below.y0) / fig.dpi * 72.0) + 6.0 if below is not None else 30.0
     anchor = ax.transAxes + ScaledTranslation(0, -drop / 72.0, fig.dpi_scale_trans)
     return ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=anchor,
                      ncol=ncol, title=title, borderaxespad=0.0, markerscale=markerscale)
-
-
-def _points(size) -> float:
-    from matplotlib.font_manager import FontProperties
-
-    return float(FontProperties(size=size).get_size_in_points())
 
 
 def legend_right(ax, *, title: str | None = None):
@@ -185,14 +177,16 @@ def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequenc
         ax.axhspan(lo, hi, color="C2", alpha=0.25, lw=0, label=floor_label)
     ax.set_yscale("log")
     ax.set_xlim(0, n)
-    # labels wrapped to the step's width (about 6.6 pt a character at 11 pt); a word longer than the
-    # step gets a smaller font (down to 8 pt) rather than running into its neighbour
+    # labels wrapped to the step's width (about 6.1 pt a character at 11 pt); when a word is longer than
+    # the step, the labels are written unwrapped at a slant instead of running into their neighbours
     step_in = ax.get_figure(root=True).get_size_inches()[0] * ax.get_position().width / n
-    width = max(6, int(step_in * 72 / 6.6))
-    texts = [wrap_label(str(t).replace("+ ", "+\u00a0"), width).replace("\u00a0", " ") for t in labels]
-    longest = max(len(line) for t in texts for line in t.split("\n"))
-    size = max(9.0, min(11.0, 11.0 * width / longest))
-    ax.set_xticks(x[:-1] + 0.5, texts, fontsize=size)
+    width = max(4, int(step_in * 72 / 6.1))
+    texts = [wrap_label(str(t), width) for t in labels]
+    if max(len(line) for t in texts for line in t.split("\n")) <= width:
+        ax.set_xticks(x[:-1] + 0.5, texts)
+    else:
+        ax.set_xticks(x[:-1] + 0.5, [str(t) for t in labels], rotation=30, ha="right",
+                      rotation_mode="anchor")
     ax.tick_params(axis="x", length=0)
     ax.grid(axis="x", visible=False)
     for i, (v, t) in enumerate(zip(rms, labels)):

@@ -38,7 +38,8 @@ def test_panel_grid_rejects_bad_input_naming_the_parameter():
         rs.panels(2, width_in=12)
 
 
-def test_style_fits_the_column_and_the_legend_sits_below_the_data():
+def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
+    monkeypatch.setattr(report, "READABLE_TABLES", False)          # restored after the test
     with plt.rc_context():
         rs.use_style()
         assert plt.rcParams["font.size"] >= 11 and plt.rcParams["figure.figsize"][0] <= rs.MAX_WIDTH_IN
@@ -55,7 +56,7 @@ def test_style_fits_the_column_and_the_legend_sits_below_the_data():
         label = axes[0].xaxis.label.get_window_extent(r)
         assert box.y1 < axes[0].get_window_extent(r).y0 and box.y1 <= label.y0   # under the x label
         assert fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN and ticks.y0 >= 0
-    report.READABLE_TABLES = False
+    assert report.READABLE_TABLES                                  # use_style turned readable tables on
 
 
 @pytest.fixture(scope="module")
@@ -90,6 +91,14 @@ def test_the_staircase_shows_every_step_on_a_log_axis_with_the_noise_band():
         t.get_text() for t in ax.get_legend().get_texts()}
     heights = ax.patches[0].get_data().values                 # the stairs
     assert np.allclose(heights, [f.rms for f in res.fits])
+    assert all(t.get_rotation() == 0 for t in ax.get_xticklabels())      # three steps: labels fit
+
+
+def test_staircase_slants_labels_that_do_not_fit_their_step():
+    fig, ax = rs.panels(1)
+    rs.staircase(ax, ["start: bias"] + [f"+ effect_number_{i}" for i in range(9)], np.geomspace(1, 0.1, 10))
+    assert {t.get_rotation() for t in ax.get_xticklabels()} == {30.0}
+    assert ax.get_xticklabels()[1].get_text() == "+ effect_number_0"
 
 
 def test_staircase_rejects_what_a_log_axis_cannot_show():

@@ -203,11 +203,13 @@ def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
     rs.staircase(ax, step_labels(result), [f.rms for f in result.fits], [f.loo_rms for f in result.fits],
                  floor=floor, floor_label=floor_label or "noise floor (95 %)", unit=result.final.unit,
                  title=title if title is not None else f"{result.final.system}: {result.outcome()}")
-    lines = max(t.get_text().count("\n") + 1 for t in ax.get_xticklabels())
-    if ax.get_figure(root=True) is ax.figure and lines > 2:          # a figure of its own: room for labels
+    ticks = ax.get_xticklabels()
+    lines = max(t.get_text().count("\n") + 1 for t in ticks)
+    extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
+    if ax.get_figure(root=True) is ax.figure and extra:             # a figure of its own: room for labels
         w, h = ax.figure.get_size_inches()
-        ax.figure.set_size_inches(w, h + 0.2 * (lines - 2))
-    rs.legend_below(ax)
+        ax.figure.set_size_inches(w, h + extra)
+    rs.legend_below(ax, ncol=3)
     return ax.figure
 
 
