@@ -1132,6 +1132,42 @@ _OVERFLOW_JS = r"""(() => {
   return out; })()"""
 
 
+# Every figure in the article: its natural width (the PNG's pixels) and the width the page shows it at.
+_FIGURES_JS = r"""(() => {
+  const art = document.querySelector('article') || document.body;
+  const heading = el => { let h = null;
+    document.querySelectorAll('h1, h2, h3').forEach(x => {
+      if (x.compareDocumentPosition(el) & Node.DOCUMENT_POSITION_FOLLOWING) h = x; });
+    return h ? h.textContent.replace(/[#\s]+$/, '').trim() : ''; };
+  return [...art.querySelectorAll('img')].map(el => ({heading: heading(el),
+    src: (el.getAttribute('src') || '').split('/').pop(), natural_px: el.naturalWidth,
+    shown_px: Math.round(el.getBoundingClientRect().width)}));
+})()"""
+
+
+def shrunk_figures(figures, min_share: float | None = None) -> list[dict]:
+    """The figures displayed below ``min_share`` (default
+    :data:`navlib.report_style.MIN_DISPLAY_SHARE`, 75 %) of their natural width, each
+    ``{"heading", "src", "natural_px", "shown_px", "share"}``, from records of the page's images
+    (``natural_px``: the image's own width; ``shown_px``: its width on the page).  Images not loaded or
+    not shown (a width of 0) are not figures on the page and are skipped."""
+    from .report_style import MIN_DISPLAY_SHARE
+
+    limit = MIN_DISPLAY_SHARE if min_share is None else float(min_share)
+    if not 0 < limit <= 1:
+        raise ValueError(f"min_share={min_share!r}: must be in (0, 1]")
+    out = []
+    for f in figures:
+        natural, shown = float(f.get("natural_px") or 0), float(f.get("shown_px") or 0)
+        if natural <= 0 or shown <= 0:
+            continue
+        share = shown / natural
+        if share < limit:
+            out.append({"heading": f.get("heading", ""), "src": f.get("src", ""),
+                        "natural_px": int(natural), "shown_px": int(shown), "share": round(share, 3)})
+    return out
+
+
 class _Chrome:
     """Headless Chromium driven over the DevTools protocol on a pipe (``--remote-debugging-pipe``: the
     browser reads JSON messages from fd 3 and writes to fd 4, each ending with a NUL byte)."""
@@ -1247,7 +1283,9 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
                 settle_s: float = 0.5) -> int:
     """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
     relative names, ``.png``; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
-    or tables wider than the content column, by page).  Returns 2 if Chromium is missing."""
+    or tables wider than the content column, by page) and ``shrunk.json`` (figures displayed below 75 % of
+    their natural width, :func:`shrunk_figures`, by page).  Returns 2 if Chromium is missing, 1 if a
+    figure is shown shrunk (every page is still rendered and listed), else 0."""
     binary = find_chromium(chromium)
     if binary is None:
         print(CHROMIUM_MISSING, file=sys.stderr)
@@ -1259,7 +1297,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
              and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
-    heights, overflow = [], {}
+    heights, overflow, shrunk = [], {}, {}
     try:
         for page in pages:
             rel = page.relative_to(html_dir)
@@ -1286,6 +1324,9 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
                         "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
             found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
                                 session=session)["result"].get("value") or []
+            small = shrunk_figures(chrome.send("Runtime.evaluate", {"expression": _FIGURES_JS,
+                                                                    "returnByValue": True},
+                                               session=session)["result"].get("value") or [])
             png = out_dir / rel.with_suffix(".png")
             png.parent.mkdir(parents=True, exist_ok=True)
             if h <= TILE_PX:
@@ -1306,7 +1347,10 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
             heights.append((str(rel), h))
             if found:
                 overflow[str(rel)] = found
+            if small:
+                shrunk[str(rel)] = small
             note = f"; {len(found)} block(s) wider than the content column" if found else ""
+            note += f"; {len(small)} figure(s) shown below 75 % of their width" if small else ""
             print(f"{rel}: {width} x {h} px -> {png}{note}", flush=True)
     finally:
         chrome.close()
@@ -1320,7 +1364,19 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         for it in items:
             print(f"  wider than the column: {page}: {it['what']} by {it['overflow_px']} px under "
                   f"'{it['heading']}': {html.unescape(it['text'])[:50]!r}", file=sys.stderr)
-    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json)")
+    (out_dir / "shrunk.json").write_text(json.dumps(shrunk, indent=1, ensure_ascii=False) + "\n",
+                                         encoding="utf-8")
+    for page, items in shrunk.items():
+        print(f"  figures shrunk on {page}: {len(items)}", file=sys.stderr)
+        for it in items:
+            print(f"    {it['src']} shown at {it['shown_px']} of {it['natural_px']} px "
+                  f"({100 * it['share']:.0f} %) under '{it['heading']}'", file=sys.stderr)
+    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json, shrunk.json)")
+    if shrunk:
+        print(f"screenshots: {sum(map(len, shrunk.values()))} figure(s) on {len(shrunk)} page(s) shown below "
+              f"75 % of their natural width (draw them at most 7.5 in wide: navlib.report.use_style, "
+              f"report.panels)", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -9,7 +9,9 @@ Commands:
   loop SYSTEM FILE.csv --model START [--effects FILE.py] [--json] [--report DIR] [--alpha A]
       the whole loop: diagnose, add the named effect, repeat until the residuals are consistent with noise
       or nothing more can be named.  --json prints {"steps": [...], "final": {...}}; --report DIR writes
-      loop.png and loop.md (never over existing files).
+      loop.png (the loop as a staircase: one step per effect added, log error axis, held-out rms, the
+      noise floor as a band; below it the measurement against the models and the residuals; 750 px wide)
+      and loop.md (never over existing files).
   rates SYSTEM [--trials N] [--noise X,X] [--ratio R,R] [--workers N] [--scheduler ADDR] [--json]
       how far to trust the loop on your set-up: the share of simulated trials in which a hidden effect of
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the

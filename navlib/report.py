@@ -4,7 +4,7 @@ figures, the chapter's claims with their verdicts, and the headline results file
 A chapter notebook uses it like this::
 
     from navlib import report
-    report.style()                                        # figure fonts readable at the displayed size
+    report.use_style()          # figures for the 756 px column, 11-12 pt; tables with readable labels
     report.table(df, formats={"rms (deg)": "{:.3f}"})     # an HTML table (text/plain kept for nbval)
     report.glue_number("ade_rms", 4.23, "{:.2f}")         # prose: {glue:text}`ade_rms`
     report.glue_figure("fig-compass-errors", fig)         # markdown: ```{glue:figure} fig-compass-errors
@@ -93,21 +93,92 @@ def _breakable(text: str) -> str:
     return re.sub(r"([_/,])(?=\S)", r"\1<wbr>", html.escape(str(text), quote=False))
 
 
+#: Set by :func:`navlib.report_style.use_style`: tables show readable labels (:func:`readable`) unless
+#: asked otherwise.
+READABLE_TABLES = False
+
+#: Unit suffixes of snake_case names and how a column header shows them.
+UNIT_SUFFIXES = {("deg", "h"): "deg/h", ("mg", "g"): "mg/g", ("m", "s"): "m/s", ("deg",): "deg",
+                 ("rad",): "rad", ("arcmin",): "arcmin", ("arcsec",): "arcsec", ("nmi",): "nmi",
+                 ("ug",): "ug", ("mg",): "mg", ("ut",): "uT", ("nt",): "nT", ("c",): "degC",
+                 ("s",): "s", ("h",): "h", ("pct",): "%", ("ppm",): "ppm"}
+#: Words written in capitals in a header.
+ACRONYMS = {"rms", "rmse", "mse", "sse", "loo", "maxe", "mare", "ins", "rbf", "ann", "fis", "anfis"}
+_NEG_ZERO = re.compile(r"^[-\u2212]([+]?0(?:\.0+)?(?:e[+-]?\d+)?)$")
+
+
+def label(name: Any) -> str:
+    """A readable header for a column name: a tuple is joined with spaces; a snake_case name becomes words
+    with its unit suffix in parentheses and acronyms in capitals (``median_rms_deg`` -> ``median RMS
+    (deg)``, ``drift_deg_h`` -> ``drift (deg/h)``); any other text is kept as it is."""
+    if isinstance(name, tuple):
+        return " ".join(label(n) for n in name if str(n).strip())
+    text = str(name)
+    if "_" not in text or " " in text:
+        return text
+    words = [w for w in text.split("_") if w]
+    unit = ""
+    for suffix, shown in UNIT_SUFFIXES.items():
+        k = len(suffix)
+        if len(words) > k and tuple(w.lower() for w in words[-k:]) == suffix:
+            unit, words = shown, words[:-k]
+            break
+    words = [w.upper() if w.lower() in ACRONYMS else w for w in words]
+    return " ".join(words) + (f" ({unit})" if unit else "")
+
+
+def row_label(value: Any) -> str:
+    """A flat row label: a tuple (from a MultiIndex or a groupby) is joined with ": "."""
+    if isinstance(value, tuple):
+        return ": ".join(str(v) for v in value)
+    return str(value)
+
+
+def no_negative_zero(text: str) -> str:
+    """``-0``, ``-0.000``, ``-0e+00`` (a value that rounds to zero) without its minus sign."""
+    m = _NEG_ZERO.match(text)
+    return m.group(1).lstrip("+") if m else text
+
+
+def readable(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with readable labels: named index levels become ordinary first columns (no index-name
+    row), tuple row labels are flattened (:func:`row_label`) and column names become headers with their
+    units in parentheses (:func:`label`).  Values are not touched."""
+    out = frame.copy()
+    if any(n is not None for n in out.index.names):
+        clash = [n for n in out.index.names if n is not None and n in out.columns]
+        if clash:
+            raise InputError(f"readable: the index name {clash[0]!r} is also a column's name")
+        out = out.reset_index()
+    else:
+        out.index = [row_label(v) for v in out.index]
+    cols = [label(c) for c in out.columns]
+    if len(set(cols)) != len(cols):
+        dup = next(c for c in cols if cols.count(c) > 1)
+        raise InputError(f"readable: two columns would both be shown as {dup!r}")
+    out.columns = cols
+    return out
+
+
 class Table:
     """A result table for the book: HTML (wrapping text, fitting the content column) for the page, and a
     rounded plain-text rendering no wider than :data:`PLAIN_WIDTH` characters for nbval and terminals.
 
     ``formats`` maps column names to format strings (``"{:.3f}"``) or callables; unformatted float
-    columns get 4 significant digits.  ``caption`` is shown above the table."""
+    columns get 4 significant digits.  ``caption`` is shown above the table.  ``readable`` (default: on
+    after :func:`navlib.report_style.use_style`) shows the formatted table with readable labels
+    (:func:`readable`: no index-name row, flat row labels, units in parentheses) and no ``-0``;
+    ``formats`` still name the original columns."""
 
     def __init__(self, frame: pd.DataFrame, formats: Mapping[str, Any] | None = None,
-                 caption: str | None = None, index: bool = True):
+                 caption: str | None = None, index: bool = True, readable: bool | None = None):
         if not isinstance(frame, pd.DataFrame):
             frame = pd.DataFrame(frame)
         self.frame = frame
         self.formats = dict(formats or {})
         self.caption = caption
-        self.index = index
+        self.readable = READABLE_TABLES if readable is None else bool(readable)
+        self.index = index and not (self.readable and any(n is not None for n in frame.index.names))
 
     def formatted(self) -> pd.DataFrame:
         """The table as strings, every number formatted."""
@@ -126,6 +197,8 @@ class Table:
                     continue
             fn = f if callable(f) else (lambda v, f=f: fmt(v, f))
             out[col] = s.map(fn)
+        if self.readable:
+            out = readable(out).map(no_negative_zero)
         out.index = out.index.map(str)
         out.columns = [str(c) for c in out.columns]
         return out
@@ -158,9 +231,9 @@ class Table:
 
 
 def table(frame: pd.DataFrame, formats: Mapping[str, Any] | None = None, caption: str | None = None,
-          index: bool = True) -> Table:
+          index: bool = True, readable: bool | None = None) -> Table:
     """Shorthand for :class:`Table`; the last expression of a cell displays it."""
-    return Table(frame, formats, caption, index)
+    return Table(frame, formats, caption, index, readable)
 
 
 # ----------------------------------------------------------------------------------------------- glue
@@ -198,9 +271,14 @@ def glue_figure(name: str, fig) -> None:
     plt.close(fig)
 
 
+# The book's figure style (navlib.report_style): use_style() in a chapter's first code cell.
+from .report_style import (legend_below, legend_right, panel_grid, panels,  # noqa: E402,F401
+                           staircase, use_style)
+
+
 def style() -> None:
-    """Matplotlib defaults for the book: figures are shown at about 700 px, so fonts of at least 9 pt at
-    that size; tight layouts; PNG output."""
+    """The older matplotlib defaults (10 pt at figures up to 12 in wide, shown shrunk); chapters move to
+    :func:`navlib.report_style.use_style` (figures for the 756 px column, 11-12 pt, readable tables)."""
     import matplotlib as mpl
 
     mpl.rcParams.update({"figure.dpi": 100, "savefig.dpi": 110, "font.size": 10, "axes.titlesize": 10,

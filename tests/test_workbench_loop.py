@@ -64,6 +64,8 @@ def test_loop_json_schema_and_report(tmp_path):
     assert out["final"]["rms"] < 0.15 < out["steps"][0]["rms"]
     md = (tmp_path / "rep" / "loop.md").read_text()
     assert "| 2 | misalignment + hard_iron + soft_iron |" in md and (tmp_path / "rep" / "loop.png").stat().st_size > 1000
+    png = (tmp_path / "rep" / "loop.png").read_bytes()
+    assert int.from_bytes(png[16:20], "big") == 750          # drawn for the book's column (7.5 in at 100 dpi)
     again = run_cli("loop", "compass", str(p), "--model", "misalignment", "--report", str(tmp_path / "rep"))
     assert again.returncode == 2 and "already exists" in again.stderr and len(again.stderr.strip().splitlines()) == 1
     assert (tmp_path / "rep" / "loop.md").read_text() == md

@@ -271,3 +271,20 @@ def detection_table(study: pd.DataFrame) -> pd.DataFrame:
         rows.append({"hidden effect": "(none)", "size (x noise)": 0.0, "rate": "false alarms",
                      "trials": len(none), "value": k / len(none), "95% low": lo, "95% high": hi})
     return pd.DataFrame(rows)
+
+
+def unit_loop(data: pd.DataFrame, unit: str = "A", start=("bias",), noise_ug: float | None = None):
+    """The workbench loop (:func:`navlib.workbench.loop.loop`) on one accelerometer of a tumble frame (its
+    rows, ``unit == unit``), from the model ``start``; with ``noise_ug`` (the noise per reading the data
+    were simulated with) also the band where a correct model's rms would lie
+    (:func:`navlib.workbench.loop.known_noise_band`, in mg).  Returns ``(LoopResult, band or None)``."""
+    from .loop import known_noise_band, loop
+
+    if "unit" in data and unit not in set(data["unit"]):
+        raise InputError(f"unit={unit!r}: the tumble frame holds {', '.join(map(str, dict.fromkeys(data['unit'])))}")
+    rows = data[data["unit"] == unit].reset_index(drop=True) if "unit" in data else data
+    result = loop(SYSTEM.name, rows, list(start))
+    band = None
+    if noise_ug is not None:
+        band = known_noise_band(float(noise_ug) / 1000.0, result.final.n, result.final.n_params)
+    return result, band

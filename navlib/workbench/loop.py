@@ -138,13 +138,103 @@ def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effe
     return LoopResult(fits, diagnoses, sc)
 
 
-def loop_figure(result: LoopResult):
-    """Three panels: measurement against the start and final models, residuals at each step, the error
-    falling (rms and held-out rms per step)."""
-    import matplotlib.pyplot as plt                 # only for the picture: the CLI's loop runs without it
+def step_labels(result: LoopResult) -> list[str]:
+    """One label per step of the loop: ``"start: <model>"`` (``"start (none)"``) for the first fit, then
+    ``"+ <effect>"`` with the effect that step added (the one the previous diagnosis named; a fit lists
+    its effects in catalogue order, so the last one listed is not necessarily the one added)."""
+    fits = result.fits
+    out = ["start: " + " + ".join(fits[0].effects) if fits[0].effects else "start (none)"]
+    for prev, f in zip(fits[:-1], fits[1:]):
+        added = [e for e in f.effects if e not in prev.effects]
+        out.append("+ " + " + ".join(added) if added else "(refit)")
+    return out
+
+
+def noise_band(result: LoopResult, level: float = 0.95) -> tuple[float, float] | None:
+    """The noise floor as a band: the ``level`` interval of the noise standard deviation from the
+    residuals of the screen's richest model (every testable effect),
+    ``sqrt(RSS / chi2_{(1+level)/2}(n - p)) .. sqrt(RSS / chi2_{(1-level)/2}(n - p))`` with ``n``
+    observations and ``p`` parameters (white noise assumed; never below the data's numerical floor).
+    None when the screen fitted no richer model or it leaves no degrees of freedom."""
+    from scipy.stats import chi2
+
+    sc = result.screening
+    rich = None if sc is None else sc.rich
+    if rich is None:
+        return None
+    dof = rich.n - rich.n_params
+    if dof < 1 or not np.isfinite(rich.rss):
+        return None
+    tail = (1.0 - level) / 2.0
+    lo = float(np.sqrt(rich.rss / chi2.ppf(1.0 - tail, dof)))
+    hi = float(np.sqrt(rich.rss / chi2.ppf(tail, dof)))
+    lo, hi = max(lo, sc.floor), max(hi, sc.floor)
+    return (lo, hi) if hi > 0 else None
+
+
+def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -> tuple[float, float]:
+    """Where the rms of a correct model's residuals lies when the noise is known: white noise of standard
+    deviation ``sigma`` on ``n`` observations and ``p = n_params`` fitted parameters give
+    ``rms^2 = sigma^2 chi2(n - p) / n``; the band is its central ``level`` interval."""
+    from scipy.stats import chi2
+
+    check_param("sigma", sigma, lo=0, lo_open=True)
+    check_param("n_params", n_params, lo=0, hi=n - 1, integer=True)
+    tail, dof = (1.0 - level) / 2.0, n - n_params
+    return (float(sigma * np.sqrt(chi2.ppf(tail, dof) / n)), float(sigma * np.sqrt(chi2.ppf(1 - tail, dof) / n)))
+
+
+def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
+                     floor: tuple[float, float] | None = None, floor_label: str | None = None):
+    """The loop as a picture, full column width: a staircase with one step per effect added (labelled
+    with the effect), the rms after each step on a log axis, the held-out rms as a marker and the noise
+    floor as a band (:func:`navlib.report_style.staircase`).  The band is ``floor`` when the noise is known
+    (e.g. :func:`known_noise_band` for simulated data), else :func:`noise_band` from the data, called the
+    noise floor when the loop ended consistent with noise and the richest model's residual otherwise (it
+    then holds the structure no effect explains).  Draws on ``ax`` if given; returns the figure."""
+    from .. import report_style as rs
+
+    if ax is None:
+        fig, ax = rs.panels(1, panel_height_in=3.6)
+    if floor is None:
+        floor = noise_band(result)
+        floor_label = floor_label or ("noise floor (95 %)" if result.consistent_with_noise
+                                      else "richest model's residual (95 %)")
+    rs.staircase(ax, step_labels(result), [f.rms for f in result.fits], [f.loo_rms for f in result.fits],
+                 floor=floor, floor_label=floor_label or "noise floor (95 %)", unit=result.final.unit,
+                 title=title if title is not None else f"{result.final.system}: {result.outcome()}")
+    ticks = ax.get_xticklabels()
+    lines = max(t.get_text().count("\n") + 1 for t in ticks)
+    extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
+    if ax.get_figure(root=True) is ax.figure and extra:             # a figure of its own: room for labels
+        w, h = ax.figure.get_size_inches()
+        ax.figure.set_size_inches(w, h + extra)
+    rs.legend_below(ax, ncol=3)
+    return ax.figure
+
+
+def report_figure(result: LoopResult):
+    """The ``--report`` picture: the staircase (:func:`staircase_figure`) across the top; below it the
+    measurement against the start and final models, and the residuals at each step."""
+    import matplotlib.pyplot as plt
+    from .. import report_style as rs
+
+    with plt.rc_context(rs.RC):
+        fig = plt.figure(figsize=(rs.MAX_WIDTH_IN, 8.2), layout="constrained")
+        top, bottom = fig.subfigures(2, 1, height_ratios=[1.1, 1.0])
+        staircase_figure(result, ax=top.subplots())
+        a1, a2 = bottom.subplots(1, 2)
+        _measurement_panel(a1, result)
+        for i, (f, lab) in enumerate(zip(result.fits, step_labels(result))):
+            a2.plot(f.residuals, ".", ms=2, label=f"{i}: {lab}")
+        a2.set(xlabel="observation", ylabel=f"residual ({result.final.unit})", title="residuals")
+        rs.legend_below(a1, ncol=1, markerscale=4)
+        rs.legend_below(a2, ncol=1, markerscale=4)
+    return fig
+
+
+def _measurement_panel(ax, result: LoopResult) -> None:
     fits, unit = result.fits, result.final.unit
-    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
-    ax = axes[0]
     data = fits[0].data
     if fits[0].system == "compass":
         h = data["true_heading_deg"].to_numpy(float)
@@ -161,6 +251,16 @@ def loop_figure(result: LoopResult):
         ax.plot(lim, lim, "k-", lw=0.8, label="measured = model")
         ax.set(xlabel=f"model ({unit})", ylabel=f"measured ({unit})")
     ax.set_title("measurement against model")
+
+
+def loop_figure(result: LoopResult):
+    """Three panels: measurement against the start and final models, residuals at each step, the error
+    falling (rms and held-out rms per step)."""
+    import matplotlib.pyplot as plt                 # only for the picture: the CLI's loop runs without it
+    fits, unit = result.fits, result.final.unit
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
+    ax = axes[0]
+    _measurement_panel(ax, result)
     ax.legend(fontsize=9)
     for i, f in enumerate(fits):
         axes[1].plot(f.residuals, ".", ms=2, label=f"step {i}")
@@ -169,8 +269,7 @@ def loop_figure(result: LoopResult):
     k = np.arange(len(fits))
     axes[2].semilogy(k, [f.rms for f in fits], "ko-", label="rms")
     axes[2].semilogy(k, [f.loo_rms for f in fits], "bs--", label="held-out rms")
-    axes[2].set_xticks(k, ["\n+ ".join(["start"] + list(f.effects[len(fits[0].effects):]))[:40] if i == 0 else
-                           "+ " + f.effects[-1] for i, f in enumerate(fits)], fontsize=9)
+    axes[2].set_xticks(k, [t.replace(": ", "\n")[:40] for t in step_labels(result)], fontsize=9)
     axes[2].set(ylabel=f"error ({unit})", title="the error falling")
     axes[2].legend(fontsize=9)
     for a in axes:
@@ -206,14 +305,16 @@ def check_report_folder(folder) -> tuple[Path, Path]:
 
 
 def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Path]:
-    """Write ``loop.png`` (:func:`loop_figure`) and ``loop.md`` (steps and outcome) into ``folder``;
-    never over an existing file (InputError)."""
+    """Write ``loop.png`` (:func:`report_figure`: the staircase, the measurement against the models, the
+    residuals; 750 px wide) and ``loop.md`` (steps and outcome) into ``folder``; never over an existing
+    file (InputError)."""
     folder = Path(folder)
     png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    import matplotlib.pyplot as plt                 # loop_figure made the figure through pyplot: release it
-    fig = loop_figure(result)
-    fig.savefig(png, dpi=110)
+    import matplotlib.pyplot as plt                 # report_figure made the figure through pyplot: release it
+    from ..report_style import DPI
+    fig = report_figure(result)
+    fig.savefig(png, dpi=DPI)
     plt.close(fig)
     unit = result.final.unit
     lines = [f"# Workbench loop: {result.final.system}" + (f" on `{source}`" if source else ""), "",
