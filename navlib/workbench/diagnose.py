@@ -508,6 +508,21 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
     ------
     InputError
         From the screen, when more than 5 % of the rows are outliers.
+
+    Examples
+    --------
+    A simulated compass with hard and soft iron hidden, fitted with hard iron only: the diagnosis names
+    the missing soft iron (the message gives the test, the variance it removes and the held-out error):
+
+    >>> from navlib.workbench.fit import fit_model, simulate
+    >>> data = simulate("compass", {"hard_x": 0.05, "soft_e": 0.02}, noise=0.05, seed=1)
+    >>> d = diagnose(fit_model("compass", data, ["hard_iron"]))
+    >>> d.missing
+    'soft_iron'
+    >>> d.message.split(":")[0]
+    "add 'soft_iron'"
+
+    From the command line: ``python -m navlib diagnose compass FILE --model hard_iron``.
     """
     alpha = DEFAULT_ALPHA if alpha is None else alpha
     check_param("alpha", alpha, lo=0, lo_open=True, hi=1, hi_open=True)
