@@ -261,18 +261,18 @@ def innovation_signatures(run: InsRun, result: FilterResult) -> dict[str, np.nda
     K = kf["K"]
     n, steps, d, m = K.shape
     period = float(result.t_s[1] - result.t_s[0])
-    out = {}
-    for name, (field, col, sgn, row) in CANDIDATES.items():
-        src = getattr(run, field)[:, 1:, :, col] * (sgn * period)       # (n, steps, 3)
-        e = np.zeros((n, d))
-        g = np.empty((n, steps, m))
-        for k in range(steps):
-            e = np.einsum("rij,rj->ri", result.phi[:, k], e)
-            e[:, row:row + 3] += src[:, k]
-            g[:, k] = e[:, :3]
-            e = e - np.einsum("rij,rj->ri", K[:, k], g[:, k])
-        out[name] = g
-    return out
+    names = list(CANDIDATES)
+    src = np.zeros((n, steps, len(names), d))                            # b_k T, every candidate at once
+    for j, name in enumerate(names):
+        field, col, sgn, row = CANDIDATES[name]
+        src[:, :, j, row:row + 3] = getattr(run, field)[:, 1:, :, col] * (sgn * period)
+    e = np.zeros((n, len(names), d))
+    g = np.empty((n, len(names), steps, m))
+    for k in range(steps):
+        e = np.einsum("rij,rcj->rci", result.phi[:, k], e) + src[:, k]
+        g[:, :, k] = e[..., :3]
+        e = e - np.einsum("rij,rcj->rci", K[:, k], g[:, :, k])
+    return {name: g[:, j] for j, name in enumerate(names)}
 
 
 @dataclass(frozen=True)
