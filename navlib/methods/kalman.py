@@ -244,6 +244,8 @@ def gain_features(result: FilterResult, kind: FeatureSet) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------- innovation test
+#: The candidate unmodelled effects: name -> (``InsRun`` field of ``C_b^n diag(.)``, body axis, sign, first
+#: state row it drives: 0 for the attitude, 3 for the velocity).
 CANDIDATES = {
     "gyro scale factor x": ("cw_b", 0, -1.0, 0), "gyro scale factor y": ("cw_b", 1, -1.0, 0),
     "gyro scale factor z": ("cw_b", 2, -1.0, 0),
@@ -419,7 +421,9 @@ def innovation_structure_per_run(run: InsRun, result: FilterResult, alpha: float
 
 
 # ------------------------------------------------------------------------------------------- the loop
+#: The loop's answer when neither test finds anything.
 NOTHING = "nothing missing"
+#: The loop's answer when structure is left that no candidate's state removes.
 NOT_EXPLAINED = "not explained by the candidates"
 
 
