@@ -25,6 +25,17 @@ from navlib.studies.paper_e import StudySpec
 QUIET = ImuSpec(gyro_drift_deg_h=0, gyro_arw_deg_rt_h=0, accel_bias_ug=0, accel_noise_ug_rt_hz=0)
 
 
+@pytest.fixture(scope="module", autouse=True)
+def one_torch_thread():
+    """The nets train on one thread, as in the chapter (two torch threads per test process on two cores
+    spin against each other: the MLP test took 100 s instead of a few under load)."""
+    import torch
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)
+
+
 @pytest.fixture(scope="module")
 def sturn():
     return generate(FlightProfile(kind="s_turns", duration_s=60.0, turn_period_s=8.0, manoeuvre_seed=3))
@@ -280,7 +291,8 @@ def test_notebook_stops_at_validation_with_one_line(tmp_path):
 
     with pytest.raises(pm.PapermillExecutionError) as err:
         pm.execute_notebook(str(NOTEBOOK_DIR / "celestial.ipynb"), str(tmp_path / "out.ipynb"),
-                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0}, progress_bar=False)
+                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0, "n_workers": 1},
+                            progress_bar=False)
     assert err.value.ename == "InputError"
     assert "star_rate_hz" in err.value.evalue and "\n" not in err.value.evalue
 
