@@ -25,6 +25,17 @@ from navlib.studies.paper_e import StudySpec
 QUIET = ImuSpec(gyro_drift_deg_h=0, gyro_arw_deg_rt_h=0, accel_bias_ug=0, accel_noise_ug_rt_hz=0)
 
 
+@pytest.fixture(scope="module", autouse=True)
+def one_torch_thread():
+    """The nets train on one thread, as in the chapter (two torch threads per test process on two cores
+    spin against each other: the MLP test took 100 s instead of a few under load)."""
+    import torch
+    n = torch.get_num_threads()
+    torch.set_num_threads(1)
+    yield
+    torch.set_num_threads(n)
+
+
 @pytest.fixture(scope="module")
 def sturn():
     return generate(FlightProfile(kind="s_turns", duration_s=60.0, turn_period_s=8.0, manoeuvre_seed=3))
@@ -253,6 +264,9 @@ def test_mlp_learns_a_smooth_map():
     ({"n_hidden": 2.5}, "n_hidden"), ({"epochs": 0}, "epochs"), ({"n_train_runs": 0}, "n_train_runs"),
     ({"yaw_amplitude_deg": -3}, "yaw_amplitude_deg"), ({"settle_s": 200}, "settle_s"),
     ({"n_timings": 0}, "n_timings"), ({"timing_epochs": 1.5}, "timing_epochs"),
+    ({"smear_levels_arcsec_per_deg_s": (0.0,)}, "smear_levels_arcsec_per_deg_s"),
+    ({"smear_levels_arcsec_per_deg_s": [2.0]}, "smear_levels_arcsec_per_deg_s"),
+    ({"star_smear_arcsec_per_deg_s": float("inf")}, "star_smear_arcsec_per_deg_s"),
 ])
 def test_bad_study_parameters_stop_with_one_line(kwargs, name):
     with pytest.raises(InputError) as err:
@@ -277,7 +291,8 @@ def test_notebook_stops_at_validation_with_one_line(tmp_path):
 
     with pytest.raises(pm.PapermillExecutionError) as err:
         pm.execute_notebook(str(NOTEBOOK_DIR / "celestial.ipynb"), str(tmp_path / "out.ipynb"),
-                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0}, progress_bar=False)
+                            cwd=str(NOTEBOOK_DIR), parameters={"star_rate_hz": 3.0, "n_workers": 1},
+                            progress_bar=False)
     assert err.value.ename == "InputError"
     assert "star_rate_hz" in err.value.evalue and "\n" not in err.value.evalue
 
@@ -286,7 +301,8 @@ def test_notebook_stops_at_validation_with_one_line(tmp_path):
 def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=0.5, aug_factor=0.5,
               bp9_worst=2.0, kf_worst=4.0, t45_over_t6=2.0, named=None, gyro_scale_ppm=100.0, permute=None,
               lm_ratio=12.0, sweep_factor=0.5, sweep_rate_factor=0.5, raw45_factor=0.8, resid_factor=0.95,
-              blind_named=None, blind_flagged=None, quiet_flagged=None, blind_left=None):
+              blind_named=None, blind_flagged=None, quiet_flagged=None, blind_left=None, loop_blind=None,
+              loop_smear=None, loop_quiet=None, loop_own=None):
     """A StudyData with hand-made per-run scores whose claims have known answers.  KF per-run errors vary
     from run to run; BPKF = factor x KF on the same run (``bp_factor`` per case and mode), 6 QR = qr_factor x
     45 raw, 6 QR + rates yaw = rate_factor x 6 QR yaw, augmented KF = aug_factor x 9-input BPKF; the worst
@@ -297,7 +313,9 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
     yaw, 45 raw = ``raw45_factor`` x 6 QR, at every level; residual features = ``resid_factor`` x KF; the
     innovation diagnosis: per run with a time offset what the candidate test names (``blind_named``) and
     whether the generalised test flags (``blind_flagged``) and still flags with the scale-factor states
-    (``blind_left``, test runs); ``quiet_flagged`` its flags with nothing missing."""
+    (``blind_left``, test runs); ``quiet_flagged`` its flags with nothing missing; the decision rule's answers
+    per run with the time offset (``loop_blind``), the rate-proportional error (``loop_smear``), nothing
+    missing (``loop_quiet``) and the study's scale factor (``loop_own``)."""
     spec = StudySpec(n_repeats=n_repeats, n_test_runs=n_runs, gyro_scale_ppm=gyro_scale_ppm,
                      sweep_repeats=min(2, n_repeats))
     bp_factor = {**{("level_raw45", "held-out"): 1.2, ("level_raw45", "same run"): 0.5,
@@ -366,11 +384,28 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
     blind_flagged = [True] * n_d if blind_flagged is None else blind_flagged
     blind_left = [True] * n_d if blind_left is None else blind_left
     quiet_flagged = [False] * n_d if quiet_flagged is None else quiet_flagged
-    diag = [{"level_ppm": 0.0, "latency_ms": 10.0, "repeat": 0, "runs": "test", "run": i, "named": nm, "chi2": 1.0,
-             "flagged": fl, "flagged_aug": float(lf)} for i, (nm, fl, lf) in enumerate(zip(blind_named, blind_flagged,
-                                                                                        blind_left))]
-    diag += [{"level_ppm": 0.0, "latency_ms": 0.0, "repeat": 0, "runs": "test", "run": i, "named": "none",
-              "chi2": 1.0, "flagged": fl, "flagged_aug": 0.0} for i, fl in enumerate(quiet_flagged)]
+    out, none = km.NOT_EXPLAINED, km.NOTHING
+    loop_blind = [out] * n_d if loop_blind is None else loop_blind
+    loop_smear = [out] * n_d if loop_smear is None else loop_smear
+    loop_quiet = [none] * n_d if loop_quiet is None else loop_quiet
+    loop_own = ["gyro scale factor z"] * n_d if loop_own is None else loop_own
+
+    def loop(decision, named):
+        return {"tried": named, "flagged_after": float(decision == out) if named != "none" else np.nan,
+                "decision": decision, "remains": "rate z" if decision == out else ""}
+
+    diag = [{"level_ppm": 0.0, "latency_ms": 10.0, "smear": 0.0, "repeat": 0, "runs": "test", "run": i, "named": nm,
+             "chi2": 1.0, "flagged": fl, "flagged_aug": float(lf), **loop(dc, nm)}
+            for i, (nm, fl, lf, dc) in enumerate(zip(blind_named, blind_flagged, blind_left, loop_blind))]
+    diag += [{"level_ppm": 0.0, "latency_ms": 0.0, "smear": 10.0, "repeat": 0, "runs": "test", "run": i,
+              "named": "gyro scale factor z", "chi2": 1.0, "flagged": True, "flagged_aug": 1.0,
+              **loop(dc, "gyro scale factor z")} for i, dc in enumerate(loop_smear)]
+    diag += [{"level_ppm": 0.0, "latency_ms": 0.0, "smear": 0.0, "repeat": 0, "runs": "test", "run": i, "named": "none",
+              "chi2": 1.0, "flagged": fl, "flagged_aug": 0.0, **loop(dc, "none")}
+             for i, (fl, dc) in enumerate(zip(quiet_flagged, loop_quiet))]
+    diag += [{"level_ppm": float(gyro_scale_ppm), "latency_ms": 0.0, "smear": 0.0, "repeat": 0, "runs": "test",
+              "run": i, "named": "gyro scale factor z", "chi2": 1.0, "flagged": True, "flagged_aug": 0.0,
+              **loop(dc, "gyro scale factor z")} for i, dc in enumerate(loop_own)]
     empty = pd.DataFrame()
     return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty, {}, lm,
                              pd.DataFrame(sw), pd.DataFrame(diag))
@@ -391,7 +426,8 @@ def test_claims_sources_sides_boundaries_and_keys():
     c = {c.key: c for c in cl}
     assert {k for k, v in c.items() if v.source == "book"} == {"cel_kf_within", "cel_innov", "cel_aug",
                                                                 "cel_raw45_sturn", "cel_blind_named", "cel_blind_flag",
-                                                                "cel_blind_quiet", "cel_blind_left"}
+                                                                "cel_blind_quiet", "cel_blind_left", "cel_loop_blind",
+                                                                "cel_loop_named", "cel_loop_quiet"}
     for k in ("cel_imp45_held", "cel_imp45_same", "cel_imp6_held", "cel_imp6_same"):
         assert c[k].boundary == paper["improvement_min_pct"] and c[k].holds_when == "above"
         assert c[k].estimate.rule == "paired ratio"
@@ -493,7 +529,7 @@ def test_too_few_runs_cannot_be_judged_with_the_reason():
 def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run():
     spec = StudySpec(duration_s=30.0, n_train_runs=2, n_test_runs=3, n_repeats=2, epochs=5, n_timings=6,
                      timing_epochs=2, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0),
-                     sweep_repeats=1, latency_ms_levels=(10.0,))
+                     sweep_repeats=1, latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=(10.0,))
     data = paper_e.simulate(spec)
     n = spec.n_repeats * spec.n_test_runs
     for mode in ("held-out", "same run"):
@@ -507,7 +543,12 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
     assert c["cel_time"].estimate.n == spec.n_timings
     assert c["cel_innov"].estimate.n == spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
     assert len(data.lm_timing) == 3 * spec.lm_timings and set(data.lm_timing["n_in"]) == {45, 6, 9}
-    assert set(zip(data.diagnosis["level_ppm"], data.diagnosis["latency_ms"])) == {(0, 0), (0, 10), (100, 0)}
+    d = data.diagnosis
+    assert set(zip(d["level_ppm"], d["latency_ms"], d["smear"])) == {(0, 0, 0), (0, 10, 0), (0, 0, 10), (100, 0, 0)}
+    assert len(paper_e.loop_runs(data)) == len(d) == 4 * (spec.n_train_runs + spec.n_test_runs) + (
+        spec.n_repeats - spec.sweep_repeats) * (spec.n_train_runs + spec.n_test_runs)
+    assert set(d["decision"]) <= {"gyro scale factor z", km.NOT_EXPLAINED, km.NOTHING} | set(km.CANDIDATES)
+    assert c["cel_loop_blind"].estimate.n == 2 * (spec.n_train_runs + spec.n_test_runs)
     # the sweep at the study's own level is the study's held-out S-turn scores (same draws, nets, filters)
     for method, case in (("KF", "sturn_qr6"), ("BPKF 6 QR + 3 rates", "sturn_qr6_rate"), ("BPKF 45 raw", "sturn_raw45")):
         own = paper_e.per_run(data, case, "held-out", method.split(" ")[0])
@@ -611,3 +652,99 @@ def test_generalised_innovation_test_flags_rate_structure_only_when_present():
     assert late.flagged and late.coef[2] == pytest.approx(-20.0, abs=3.0)
     with pytest.raises(InputError, match="shapes"):
         innovation_structure_test(white[:, :2], s, x)
+
+
+def test_star_sensor_rate_error_is_k_times_the_body_rate():
+    """Closed form: with a rate-proportional error k (arcsec per deg/s) the star sensor's attitude is off by
+    k w_ib^b about the body axes; in level S-turns w_ib^b is the yaw rate about z (the analytic derivative of
+    the three sines) plus Earth and transport rates (below 2e-4 rad/s)."""
+    from navlib.sensors.strapdown import dcm_to_rotvec
+    tr = generate(FlightProfile(kind="s_turns", duration_s=20.0, imu_rate_hz=100.0, manoeuvre_seed=3))
+    k = 10.0
+    run = strapdown(tr, [1], star=StarSensorSpec(smear_arcsec_per_deg_s=k), ideal=True)
+    err = dcm_to_rotvec(np.swapaxes(run.cbn_true[0], -1, -2) @ run.star_cbn[0]) / ARCSEC     # body axes, arcsec
+    amp, om, ph = tr.profile.yaw_terms()
+    yaw_rate_deg_s = np.cos(np.outer(run.t_s, om) + ph) @ (amp * om) / DEG
+    assert np.abs(yaw_rate_deg_s).max() > 3.0                                 # the manoeuvre is there
+    np.testing.assert_allclose(err[:, 2], k * yaw_rate_deg_s, atol=k * 2e-4 / DEG + 1e-3)
+    assert np.abs(err[:, :2]).max() < k * 2e-4 / DEG
+    # the opposite sign would be a time offset of k/3600 s: the error is not the truth delayed
+    assert np.abs(err[:, 2] + k * yaw_rate_deg_s).max() > 30.0
+    with pytest.raises(InputError, match="smear_arcsec_per_deg_s"):
+        StarSensorSpec(smear_arcsec_per_deg_s=float("nan"))
+
+
+def test_candidate_states_are_the_scale_factor_columns():
+    """A filter with the three gyro scale-factor candidates as states is the 18-state augmented filter."""
+    tr = generate(FlightProfile(kind="s_turns", duration_s=20.0, turn_period_s=8.0, manoeuvre_seed=2))
+    run = strapdown(tr, [3], ImuSpec(gyro_scale_ppm=300.0))
+    three = tuple(f"gyro scale factor {a}" for a in "xyz")
+    a = km.run_filter(run, km.FilterSpec(candidates=three))
+    b = km.run_filter(run, km.FilterSpec(scale_states=True))
+    np.testing.assert_allclose(a.att_err_arcsec, b.att_err_arcsec, atol=1e-9)
+    one = km.run_filter(run, km.FilterSpec(candidates=("accelerometer scale factor x",)))
+    assert one.kf["x"].shape[-1] == 16 and not np.allclose(one.att_err_arcsec, b.att_err_arcsec)
+    for bad in (("gyro scale factor w",), ["gyro scale factor z"]):
+        with pytest.raises(InputError, match="candidates"):
+            km.FilterSpec(candidates=bad)
+
+
+@pytest.fixture(scope="module")
+def loop_runs():
+    """Two 60-s S-turn runs each: a 300 ppm gyro scale factor, a 20 ms star-sensor time offset, nothing."""
+    tr = generate(FlightProfile(kind="s_turns", duration_s=60.0, turn_period_s=8.0, manoeuvre_seed=4))
+    out = {}
+    for name, imu, star in (("scale", ImuSpec(gyro_scale_ppm=300.0), StarSensorSpec()),
+                            ("offset", ImuSpec(), StarSensorSpec(latency_ms=20.0)),
+                            ("quiet", ImuSpec(), StarSensorSpec())):
+        run = strapdown(tr, [31, 32], imu, star)
+        out[name] = km.innovation_loop(run, km.run_filter(run))
+    return out
+
+
+def test_the_loop_names_a_candidate_only_when_its_state_removes_the_structure(loop_runs):
+    for d in loop_runs["scale"]:                        # named, added, structure gone
+        assert d.flagged and d.tried == "gyro scale factor z" and d.flagged_after is False
+        assert d.decision == "gyro scale factor z" and d.remains == ()
+    for d in loop_runs["offset"]:                       # the test names a wrong candidate: the loop refuses it
+        assert d.flagged and d.named_by_test is not None and d.named_by_test == d.tried
+        assert d.flagged_after is True and d.decision == km.NOT_EXPLAINED
+        assert "rate z" in d.remains and d.named_by_test in d.message and "rate z" in d.message
+    for d in loop_runs["quiet"]:
+        assert not d.flagged and d.tried is None and d.decision == km.NOTHING
+
+
+def test_loop_claims_are_wilson_rates_and_land_on_each_side():
+    out, none = km.NOT_EXPLAINED, km.NOTHING
+    c = by_key(fake_data())
+    assert c["cel_loop_blind"].estimate.n == 32 and c["cel_loop_blind"].estimate.value == 0
+    assert c["cel_loop_blind"].verdict == "cannot be judged" and "73 runs" in c["cel_loop_blind"].reason
+    assert "0/32" in c["cel_loop_blind"].ours and "candidate test alone names one in 32/32" in c["cel_loop_blind"].ours
+    assert c["cel_loop_named"].verdict == "reproduced" and c["cel_loop_quiet"].verdict == "cannot be judged"
+    c = by_key(fake_data(loop_smear=[out] * 64))                        # 80 runs, none named: resolved
+    assert c["cel_loop_blind"].verdict == "reproduced" and c["cel_loop_blind"].estimate.n == 80
+    c = by_key(fake_data(loop_blind=["accelerometer scale factor x"] * 8 + [out] * 8,
+                         loop_quiet=[out] * 8 + [none] * 8, loop_own=[out] * 12 + ["gyro scale factor z"] * 4))
+    for k in ("cel_loop_blind", "cel_loop_quiet", "cel_loop_named"):
+        assert c[k].verdict == "not reproduced" and c[k].estimate.rule == "wilson rate"
+    extra = paper_e.results_extra(fake_data(loop_blind=["gyro scale factor x"] + [out] * 15))
+    assert extra["loop_false_naming_n"] == 32 and extra["loop_false_naming_rate"] == pytest.approx(1 / 32)
+    assert extra["loop_false_naming_time_offset_rate"] == pytest.approx(1 / 16)
+    assert extra["loop_false_naming_lo"] < 1 / 32 < extra["loop_false_naming_hi"]
+    tab = paper_e.loop_table(fake_data()).set_index("case")
+    assert tab.loc["time offset 10 ms", "not explained"] == 16 and tab.loc["nothing missing", "nothing missing"] == 16
+    assert tab.loc["scale factor 100 ppm", "named"] == "16: gyro scale factor z"
+
+
+def test_runs_along_several_paths_are_each_run_flown_alone():
+    trs = [generate(FlightProfile(kind="s_turns", duration_s=10.0, turn_period_s=8.0, manoeuvre_seed=s))
+           for s in (5, 6)]
+    star = StarSensorSpec(latency_ms=5.0, smear_arcsec_per_deg_s=3.0)
+    both = strapdown(trs, [41, 42], ImuSpec(gyro_scale_ppm=100.0), star)
+    for i, (tr, seed) in enumerate(zip(trs, (41, 42))):
+        alone = strapdown(tr, [seed], ImuSpec(gyro_scale_ppm=100.0), star)
+        for name in ("cbn", "vn", "pos", "att_true", "cw_b", "star_cbn"):
+            np.testing.assert_array_equal(getattr(both, name)[i], getattr(alone, name)[0])
+    assert not np.allclose(both.att_true[0], both.att_true[1])
+    with pytest.raises(InputError, match="traj"):
+        strapdown(trs, [1, 2, 3])

@@ -77,7 +77,7 @@ def test_patent_b_paper_d_and_paper_e_studies_on_two_workers_equal_one():
                                   paper_d.errors_long(paper_d.run_study(dp, workers=2)))
     spec = paper_e.StudySpec(duration_s=20.0, n_train_runs=1, n_test_runs=1, n_repeats=2, epochs=3, n_timings=1,
                              timing_epochs=1, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0), sweep_repeats=1,
-                             latency_ms_levels=(10.0,))
+                             latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=())
     one, two = paper_e.simulate(spec, workers=1), paper_e.simulate(spec, workers=2)
     for name in ("scores", "glr", "glr_runs", "rate_corr", "traces", "sweep", "diagnosis"):
         pd.testing.assert_frame_equal(getattr(one, name), getattr(two, name))

@@ -10,11 +10,15 @@
 - :func:`qr_features` / :func:`gain_features` -- the 6 non-zero entries of ``R`` in ``K = Q R`` (diagonal
   made non-negative), the 45 raw entries, and the 6 + 3 angular-rate variant;
 - :func:`innovation_glr` -- a generalised-likelihood-ratio test (Willsky and Jones 1976) of the filter's
-  innovations against the signature of each candidate unmodelled effect.
+  innovations against the signature of each candidate unmodelled effect;
+- :func:`innovation_structure_test` -- the generalised test (innovations regressed on the body rates and their
+  derivatives), which names no candidate;
+- :func:`innovation_loop` -- the decision rule (the workbench's loop applied to the filter): name a candidate
+  only when adding its state removes the structure, otherwise say that the candidates do not explain it.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace as replace_spec
 from typing import Literal
 
 import numpy as np
@@ -57,15 +61,21 @@ class FilterSpec:
     bias_ug: float = 100.0
     scale_ppm: float = 300.0
     scale_states: bool = False
+    candidates: tuple = ()
 
     def __post_init__(self):
         for f in ("phi_level_arcsec", "phi_azimuth_arcsec", "vel_m_s", "pos_m", "drift_deg_h", "bias_ug",
                   "scale_ppm"):
             check_param(f, getattr(self, f), lo=0.0, lo_open=True)
+        c = self.candidates
+        if (not isinstance(c, tuple) or len(set(c)) != len(c) or any(n not in CANDIDATES for n in c)
+                or (self.scale_states and any(n.startswith("gyro") for n in c))):
+            raise InputError(f"parameter candidates={c!r}: a tuple of distinct names of {', '.join(CANDIDATES)}"
+                             " (no gyro scale factor with scale_states=True)")
 
     @property
     def n_states(self) -> int:
-        return N_BASE + (3 if self.scale_states else 0)
+        return N_BASE + (3 if self.scale_states else 0) + len(self.candidates)
 
     def p0(self, lat_rad: float) -> np.ndarray:
         r = 6.371e6
@@ -74,6 +84,7 @@ class FilterSpec:
         sd += [self.drift_deg_h * DEG / 3600] * 3 + [self.bias_ug * UG] * 3
         if self.scale_states:
             sd += [self.scale_ppm * 1e-6] * 3
+        sd += [self.scale_ppm * 1e-6] * len(self.candidates)     # one dimensionless scale factor each
         return np.diag(np.square(sd))
 
 
@@ -153,12 +164,21 @@ def run_filter(run: InsRun, spec: FilterSpec = FilterSpec()) -> FilterResult:
     """Run the open-loop Kalman filter on every run of ``run``: transition from the INS outputs at each
     epoch (:func:`navlib.sensors.ins15.system_matrix`, second-order discretisation), measurement noise
     ``R = C_b^n diag(s_c^2, s_c^2, s_b^2) C_n^b`` (the star sensor's body-frame noise in n), measurement
-    :func:`star_measurement`.  The corrected attitude is ``exp([phi_hat x]) C_ins``."""
+    :func:`star_measurement`.  The corrected attitude is ``exp([phi_hat x]) C_ins``.  Each name in
+    ``spec.candidates`` adds one constant state ``theta`` (prior ``scale_ppm``), the candidate of
+    :data:`CANDIDATES` entering the state derivative through its column ``b_k`` (gyro scale factor about
+    axis i: ``-C_b^n e_i w_i`` on ``phi``; accelerometer scale factor: ``+C_b^n e_i f_i`` on ``dv``)."""
     t = run.t_s
     period = float(t[1] - t[0])
     sl = slice(1, None)
     cw = run.cw_b[:, sl] if spec.scale_states else None
     F = system_matrix(run.pos[:, sl], run.vn[:, sl], run.fn[:, sl], run.cbn[:, sl], cw)
+    if spec.candidates:
+        d0 = F.shape[-1]
+        F = np.pad(F, [(0, 0)] * (F.ndim - 2) + [(0, len(spec.candidates))] * 2)
+        for j, name in enumerate(spec.candidates):
+            field, col, sgn, row = CANDIDATES[name]
+            F[..., row:row + 3, d0 + j] = sgn * getattr(run, field)[:, sl, :, col]
     phi = discretise(F, period)
     q = process_noise(run.imu, period, spec.n_states)
     h = np.zeros((3, spec.n_states))
@@ -224,6 +244,8 @@ def gain_features(result: FilterResult, kind: FeatureSet) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------- innovation test
+#: The candidate unmodelled effects: name -> (``InsRun`` field of ``C_b^n diag(.)``, body axis, sign, first
+#: state row it drives: 0 for the attitude, 3 for the velocity).
 CANDIDATES = {
     "gyro scale factor x": ("cw_b", 0, -1.0, 0), "gyro scale factor y": ("cw_b", 1, -1.0, 0),
     "gyro scale factor z": ("cw_b", 2, -1.0, 0),
@@ -241,18 +263,18 @@ def innovation_signatures(run: InsRun, result: FilterResult) -> dict[str, np.nda
     K = kf["K"]
     n, steps, d, m = K.shape
     period = float(result.t_s[1] - result.t_s[0])
-    out = {}
-    for name, (field, col, sgn, row) in CANDIDATES.items():
-        src = getattr(run, field)[:, 1:, :, col] * (sgn * period)       # (n, steps, 3)
-        e = np.zeros((n, d))
-        g = np.empty((n, steps, m))
-        for k in range(steps):
-            e = np.einsum("rij,rj->ri", result.phi[:, k], e)
-            e[:, row:row + 3] += src[:, k]
-            g[:, k] = e[:, :3]
-            e = e - np.einsum("rij,rj->ri", K[:, k], g[:, k])
-        out[name] = g
-    return out
+    names = list(CANDIDATES)
+    src = np.zeros((n, steps, len(names), d))                            # b_k T, every candidate at once
+    for j, name in enumerate(names):
+        field, col, sgn, row = CANDIDATES[name]
+        src[:, :, j, row:row + 3] = getattr(run, field)[:, 1:, :, col] * (sgn * period)
+    e = np.zeros((n, len(names), d))
+    g = np.empty((n, len(names), steps, m))
+    for k in range(steps):
+        e = np.einsum("rij,rcj->rci", result.phi[:, k], e) + src[:, k]
+        g[:, :, k] = e[..., :3]
+        e = e - np.einsum("rij,rcj->rci", K[:, k], g[:, :, k])
+    return {name: g[:, j] for j, name in enumerate(names)}
 
 
 @dataclass(frozen=True)
@@ -334,6 +356,23 @@ class StructureResult:
     p_value: float
     flagged: bool
     coef: np.ndarray
+    z: np.ndarray | None = None
+    alpha: float = 0.01
+
+    def terms(self, names=None) -> tuple[str, ...]:
+        """The regressors that carry the structure: those whose coefficient differs from zero on its own
+        (``|z| = |b_j| / se_j`` beyond the two-sided normal quantile at ``alpha / p``, Bonferroni over the
+        ``p`` regressors; ``se_j^2`` the diagonal of ``(A^T A)^-1``).  ``names`` default to
+        :data:`REGRESSOR_NAMES`; empty when nothing is flagged."""
+        if not self.flagged or self.z is None:
+            return ()
+        names = REGRESSOR_NAMES if names is None else names
+        crit = stats.norm.isf(self.alpha / (2 * len(self.z)))
+        return tuple(n for n, v in zip(names, self.z) if np.isfinite(v) and abs(v) > crit)
+
+
+#: The regressors of :func:`rate_regressors` (body axes), in column order.
+REGRESSOR_NAMES = tuple(f"rate {a}" for a in "xyz") + tuple(f"rate derivative {a}" for a in "xyz")
 
 
 def rate_regressors(cbn: np.ndarray, rate_b: np.ndarray, t_s: np.ndarray) -> np.ndarray:
@@ -368,7 +407,9 @@ def innovation_structure_test(nu, s, x, alpha: float = 0.01) -> StructureResult:
     chi2 = float(fit @ fit)
     p = int(np.linalg.matrix_rank(a))
     pv = float(stats.chi2.sf(chi2, p)) if p else 1.0
-    return StructureResult(chi2, p, pv, bool(pv < alpha), coef)
+    se = np.sqrt(np.clip(np.diag(np.linalg.pinv(a.T @ a)), 0.0, None))
+    z = np.divide(coef, se, out=np.full_like(coef, np.nan), where=se > 0)
+    return StructureResult(chi2, p, pv, bool(pv < alpha), coef, z, alpha)
 
 
 def innovation_structure_per_run(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[StructureResult]:
@@ -377,3 +418,86 @@ def innovation_structure_per_run(run: InsRun, result: FilterResult, alpha: float
     x = rate_regressors(run.cbn[:, 1:], result.rate_deg_s * DEG, result.t_s)
     nu, s = result.kf["innov"], result.kf["S"]
     return [innovation_structure_test(nu[i], s[i], x[i], alpha) for i in range(nu.shape[0])]
+
+
+# ------------------------------------------------------------------------------------------- the loop
+#: The loop's answer when neither test finds anything.
+NOTHING = "nothing missing"
+#: The loop's answer when structure is left that no candidate's state removes.
+NOT_EXPLAINED = "not explained by the candidates"
+
+
+@dataclass(frozen=True)
+class LoopDecision:
+    """The decision rule on one run (:func:`innovation_loop`).
+
+    ``named_by_test``: what the candidate test names (None: nothing significant); ``flagged``: the
+    generalised test on the filter as it is; ``tried``: the candidate whose state was added (the test's
+    name), ``flagged_after``: the generalised test on the filter with that state (None if nothing was
+    tried); ``decision``: the candidate's name, :data:`NOT_EXPLAINED` or :data:`NOTHING`; ``remains``: the
+    regressors that carry the structure left (``StructureResult.terms``), ``message`` one line."""
+
+    named_by_test: str | None
+    flagged: bool
+    chi2: float
+    tried: str | None
+    flagged_after: bool | None
+    chi2_after: float | None
+    decision: str
+    remains: tuple
+    message: str
+
+
+def _take(run: InsRun, idx) -> InsRun:
+    """The runs ``idx`` of ``run`` (every per-run array indexed on its first axis)."""
+    return replace_spec(run, **{f.name: getattr(run, f.name)[idx] for f in fields(run)
+                           if isinstance(getattr(run, f.name), np.ndarray) and getattr(run, f.name).ndim >= 2})
+
+
+def innovation_loop(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[LoopDecision]:
+    """The workbench's loop (:func:`navlib.workbench.diagnose.diagnose`) applied to the filter, on each run
+    alone: name what is missing, add the state, check what is left, and say so when nothing in the
+    catalogue fits.
+
+    1. the candidate test (:func:`innovation_glr_per_run`, Bonferroni at ``alpha``) names the most
+       significant of :data:`CANDIDATES`, or none;
+    2. the generalised test (:func:`innovation_structure_per_run`, ``alpha``) looks for structure in the
+       rates and their derivatives, whatever its cause;
+    3. if a candidate is named, the filter is run again with that candidate's state
+       (``FilterSpec.candidates``) and the generalised test repeated at the same ``alpha``.  The filter's
+       innovations are one-step-ahead predictions, each made before its measurement enters the filter, so
+       this is the augmented model's held-out check.  The candidate is named only if no structure is
+       left (as the workbench names a candidate only when the structure the residual showed is gone);
+
+    otherwise the answer is :data:`NOT_EXPLAINED`, with the regressors that carry the structure left (on
+    the augmented filter if a candidate was tried, else on the filter as it is), or :data:`NOTHING` when
+    neither test finds anything.  Returns one :class:`LoopDecision` per run, in run order."""
+    check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
+    named = [g.named for g in innovation_glr_per_run(run, result, alpha)]
+    base = innovation_structure_per_run(run, result, alpha)
+    after: dict[int, StructureResult] = {}
+    for cand in sorted({n for n in named if n is not None}):
+        idx = np.array([i for i, n in enumerate(named) if n == cand])
+        spec = replace_spec(result.spec, candidates=result.spec.candidates + (cand,))
+        sub = _take(run, idx)
+        for i, r in zip(idx, innovation_structure_per_run(sub, run_filter(sub, spec), alpha)):
+            after[int(i)] = r
+    out = []
+    for i, (nm, b) in enumerate(zip(named, base)):
+        a = after.get(i)
+        if nm is not None and not a.flagged:
+            decision, remains = nm, ()
+            msg = (f"add '{nm}': with its state the innovations show no structure (chi2 {a.chi2:.1f}, "
+                   f"{a.dof} dof" + (f"; before {b.chi2:.1f})" if b.flagged else ")"))
+        elif nm is None and not b.flagged:
+            decision, remains = NOTHING, ()
+            msg = "the innovations are consistent with the filter's model: no candidate, no structure"
+        else:
+            left = a if a is not None else b
+            decision, remains = NOT_EXPLAINED, left.terms()
+            msg = (f"{NOT_EXPLAINED}: structure in the {', '.join(remains) or 'rates and their derivatives'}"
+                   + (f" remains after adding '{nm}'" if nm is not None else "; no candidate is significant")
+                   + f" (chi2 {left.chi2:.1f}, {left.dof} dof)")
+        out.append(LoopDecision(nm, b.flagged, b.chi2, nm, None if a is None else a.flagged,
+                                None if a is None else a.chi2, decision, remains, msg))
+    return out

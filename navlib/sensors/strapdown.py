@@ -18,7 +18,13 @@ IMU model per sample interval ``T`` (increments): ``dtheta_m = (I + diag(s_g)) d
 ``C_s = exp([C_b^n dth_b x]) C_b^n`` with ``dth_b ~ N(0, diag(s_c^2, s_c^2, s_b^2))``.  With a time offset
 ``tau`` (``latency_ms``, an effect the filter does not model) the star sensor reports the attitude of
 ``tau`` earlier, ``C_b^n(t - tau)`` (spherical interpolation of the truth at the IMU rate), stamped ``t``:
-to first order an attitude error ``-w_nb^b tau`` about the body axes.
+to first order an attitude error ``-w_nb^b tau`` about the body axes.  With a rate-proportional error
+``k`` (``smear_arcsec_per_deg_s``, motion blur: the star images smear during the exposure and their
+centroids shift with the motion; also outside the filter's model) the star sensor's attitude is off by
+``dth_k = k w_ib^b`` about the body axes (arcsec for ``w`` in deg/s, the true body rate at the epoch),
+``C_s = C_b^n(t - tau) exp([dth_k x]) exp([dth_b x])``.  To first order it has the time offset's signature
+with ``tau = -k / 3600`` s (both are the body rate times a constant), so no test on the innovations tells
+the two apart; it stands for any rate-proportional error of the star sensor.
 
 Mechanisation (ENU, batched over runs, two speeds): at the IMU rate the body increments are chained,
 ``C <- C exp([dtheta_m x])``, and the velocity increments ``dv_m + dtheta_m x dv_m / 2`` rotated into the
@@ -81,15 +87,19 @@ class ImuSpec:
 @dataclass(frozen=True)
 class StarSensorSpec:
     """Star sensor: attitude noise (1 sigma) about the two cross-boresight axes and about the boresight
-    (body z), and its output rate (the filter's rate)."""
+    (body z), its output rate (the filter's rate), and two errors the filter does not model: a time offset
+    ``latency_ms`` and an attitude error proportional to the body rate, ``smear_arcsec_per_deg_s`` (see the
+    module docstring)."""
 
     cross_arcsec: float = 3.0
     boresight_arcsec: float = 15.0
     rate_hz: float = 10.0
     latency_ms: float = 0.0
+    smear_arcsec_per_deg_s: float = 0.0
 
     def __post_init__(self):
         check_param("latency_ms", self.latency_ms, lo=0.0, hi=1000.0)
+        check_param("smear_arcsec_per_deg_s", self.smear_arcsec_per_deg_s, lo=-3600.0, hi=3600.0)
         check_param("cross_arcsec", self.cross_arcsec, lo=0.0, lo_open=True, hi=3600.0)
         check_param("boresight_arcsec", self.boresight_arcsec, lo=0.0, lo_open=True, hi=3600.0)
         check_param("rate_hz", self.rate_hz, lo=0.0, lo_open=True, hi=200.0)
@@ -198,6 +208,16 @@ def delayed_attitude(traj: Trajectory, t_s, latency_ms: float) -> np.ndarray:
     return slerp(np.clip(t_s - 1e-3 * latency_ms, traj.t_s[0], traj.t_s[-1])).as_matrix()
 
 
+def smear_error(traj: Trajectory, idx, k_arcsec_per_deg_s: float) -> np.ndarray:
+    """The star sensor's rate-proportional attitude error ``k w_ib^b`` (rad, body axes) at the IMU samples
+    ``idx``: ``w`` the true body rate there (the mean of the rates at the midpoints of the two adjacent IMU
+    intervals; the nearest one at the ends), ``k`` in arcsec per deg/s."""
+    idx = np.asarray(idx)
+    r = traj.rate_b
+    w = 0.5 * (r[np.clip(idx - 1, 0, len(r) - 1)] + r[np.clip(idx, 0, len(r) - 1)])
+    return k_arcsec_per_deg_s * ARCSEC * w / DEG
+
+
 def decimation(traj: Trajectory, star: StarSensorSpec) -> int:
     """IMU samples per star-sensor epoch; the star rate must divide the IMU rate."""
     d = traj.profile.imu_rate_hz / star.rate_hz
@@ -207,9 +227,13 @@ def decimation(traj: Trajectory, star: StarSensorSpec) -> int:
     return int(round(d))
 
 
-def strapdown(traj: Trajectory, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = StarSensorSpec(),
+def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = StarSensorSpec(),
               init: InitialError = InitialError(), ideal: bool = False) -> InsRun:
     """Fly ``len(seeds)`` INS runs along ``traj`` with IMU errors and star-sensor fixes.
+
+    ``traj`` is one :class:`~navlib.sensors.trajectory.Trajectory` for every run, or a sequence of them, one
+    per seed (runs along different paths of the same timing, flown together: each run's numbers are those of
+    flying it alone).
 
     Each seed draws (``SeedSequence(seed).spawn(3)``) the initial attitude error, the IMU noise and the
     star-sensor noise; the device's constant errors (drift ``+eps`` on each axis, bias ``+nabla``, scale
@@ -224,6 +248,13 @@ def strapdown(traj: Trajectory, seeds, imu: ImuSpec = ImuSpec(), star: StarSenso
     seeds = [int(s) for s in np.atleast_1d(seeds)]
     if not seeds:
         raise InputError("parameter seeds: at least one run")
+    trajs = [traj] * len(seeds) if isinstance(traj, Trajectory) else list(traj)
+    if len(trajs) != len(seeds) or any(not isinstance(t, Trajectory) for t in trajs):
+        raise InputError(f"parameter traj: one Trajectory, or one per seed ({len(seeds)}), got {len(trajs)}")
+    traj = trajs[0]
+    if any(t.t_s.shape != traj.t_s.shape or not np.array_equal(t.t_s, traj.t_s) for t in trajs[1:]):
+        raise InputError("parameter traj: the trajectories must share their sample times (duration, IMU rate)")
+    one = all(t is traj for t in trajs)
     decim = decimation(traj, star)
     n, m = len(seeds), traj.profile.n_steps
     dt = traj.profile.dt_s
@@ -232,27 +263,29 @@ def strapdown(traj: Trajectory, seeds, imu: ImuSpec = ImuSpec(), star: StarSenso
     g_imu = [np.random.default_rng(r[1]) for r in rngs]
     g_star = [np.random.default_rng(r[2]) for r in rngs]
 
-    c_true0 = euler_to_dcm(traj.att[0])
+    c_true0 = euler_to_dcm(traj.att[0]) if one else euler_to_dcm(np.stack([t.att[0] for t in trajs]))
     if ideal:
         phi0 = np.zeros((n, 3))
     else:
         sd = np.array([init.level_arcsec, init.level_arcsec, init.azimuth_arcsec]) * ARCSEC
         phi0 = np.stack([g.standard_normal(3) * sd for g in g_init])
     c = rotvec_to_dcm(-phi0) @ c_true0                      # C = exp(-[phi x]) C_true
-    v = np.repeat(traj.vn[:1], n, 0).copy()
-    p = np.repeat(traj.pos[:1], n, 0).copy()
+    v = np.stack([t.vn[0] for t in trajs])
+    p = np.stack([t.pos[0] for t in trajs])
+    dtheta = traj.dtheta[None] if one else np.stack([t.dtheta for t in trajs])     # (1 or n, m, 3)
+    dvel = traj.dvel[None] if one else np.stack([t.dvel for t in trajs])
 
     # IMU errors (all samples at once)
     if ideal:
-        dth = np.broadcast_to(traj.dtheta, (n, m, 3)).copy()
-        dv = np.broadcast_to(traj.dvel, (n, m, 3)).copy()
+        dth = np.broadcast_to(dtheta, (n, m, 3)).copy()
+        dv = np.broadcast_to(dvel, (n, m, 3)).copy()
         scale = 0.0
     else:
         scale = imu.gyro_scale_ppm * 1e-6
         ng = np.stack([g.standard_normal((m, 3)) for g in g_imu]) * (imu.arw_rad_rt_s * np.sqrt(dt))
         na = np.stack([g.standard_normal((m, 3)) for g in g_imu]) * (imu.vrw_m_s_rt_s * np.sqrt(dt))
-        dth = (1 + scale) * traj.dtheta[None] + imu.drift_rad_s * dt + ng
-        dv = traj.dvel[None] + imu.bias_m_s2 * dt + na
+        dth = (1 + scale) * dtheta + imu.drift_rad_s * dt + ng
+        dv = dvel + imu.bias_m_s2 * dt + na
 
     n_ep = m // decim + 1
     tint = decim * dt
@@ -303,13 +336,20 @@ def strapdown(traj: Trajectory, seeds, imu: ImuSpec = ImuSpec(), star: StarSenso
         v = v_new
         out["cbn"][:, j], out["vn"][:, j], out["pos"][:, j] = c, v, p
     idx = np.arange(n_ep) * decim
-    att_true = traj.att[idx]
+    paths = [traj] if one else trajs
+    att_true = np.stack([t.att[idx] for t in paths])                        # (1 or n, n_ep, 3)
     cbn_true = euler_to_dcm(att_true)
     if ideal:
         dstar = np.zeros((n, n_ep, 3))
     else:
         dstar = np.stack([g.standard_normal((n_ep, 3)) for g in g_star]) * star.noise_rad
-    star_cbn = delayed_attitude(traj, traj.t_s[idx], star.latency_ms)[None] @ rotvec_to_dcm(dstar)  # noise about body axes
+    star_cbn = []
+    for t in paths:
+        c_star = delayed_attitude(t, t.t_s[idx], star.latency_ms)
+        if star.smear_arcsec_per_deg_s:
+            c_star = c_star @ rotvec_to_dcm(smear_error(t, idx, star.smear_arcsec_per_deg_s))
+        star_cbn.append(c_star)
+    star_cbn = np.stack(star_cbn) @ rotvec_to_dcm(dstar)                    # noise about body axes
     return InsRun(t_s=traj.t_s[idx], cbn=out["cbn"], att=dcm_to_euler(out["cbn"]), vn=out["vn"],
                   pos=out["pos"], cbn_true=np.broadcast_to(cbn_true, (n, n_ep, 3, 3)),
                   att_true=np.broadcast_to(att_true, (n, n_ep, 3)), fn=out["fn"], rate_b=out["rate_b"],

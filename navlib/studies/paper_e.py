@@ -21,16 +21,20 @@ Beyond the paper's tables (issue 22): the paper's "average time of one training"
 :mod:`navlib.methods.feedforward`) in ``lm_timings`` paired repetitions; the gyro scale factor swept over
 ``sweep_ppm`` on held-out S-turn runs (``_sweep``; the draws of the first ``sweep_repeats`` repeats at
 every level, the study's own level taken from its repeats); a blind effect outside the innovation test's
-candidates, a star-sensor time offset (``latency_ms_levels``, no scale factor), with the candidate test, the
-generalised test (:func:`navlib.methods.kalman.innovation_structure_test`) and the test again on the filter
-with the scale-factor states (``_diagnose``); and the filter-residual features the paper rejects
-(case ``level_resid3``).
+candidates, a star-sensor time offset (``latency_ms_levels``, no scale factor), and a second one, a
+star-sensor attitude error proportional to the body rate (``smear_levels_arcsec_per_deg_s``, motion blur),
+with the candidate test, the generalised test (:func:`navlib.methods.kalman.innovation_structure_test`), the
+test again on the filter with the scale-factor states, and the decision rule on every S-turn run
+(:func:`navlib.methods.kalman.innovation_loop`: a candidate is named only when adding its state removes the
+structure, otherwise "not explained by the candidates"; ``_diagnose``, :func:`loop_table`); and the
+filter-residual features the paper rejects (case ``level_resid3``).
 
 Claims (:func:`claims`) follow the one rule of :mod:`navlib.verdicts`: comparisons are paired over the same
 held-out runs (or the same timing repetitions), every statistic has a 95 % interval.
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field, fields, replace
 
@@ -99,6 +103,8 @@ class StudySpec:
     sweep_repeats: int = 2
     star_latency_ms: float = 0.0
     latency_ms_levels: tuple = (10.0, 50.0)
+    star_smear_arcsec_per_deg_s: float = 0.0
+    smear_levels_arcsec_per_deg_s: tuple = (2.0, 5.0, 10.0)
     seed: int = 0
 
     def __post_init__(self):
@@ -131,6 +137,15 @@ class StudySpec:
             raise InputError(f"parameter latency_ms_levels={self.latency_ms_levels!r}: a tuple of time offsets (ms)")
         for v in self.latency_ms_levels:
             check_param("latency_ms_levels", v, lo=0.0, lo_open=True, hi=1000.0)
+        check_param("star_smear_arcsec_per_deg_s", self.star_smear_arcsec_per_deg_s, lo=-3600.0, hi=3600.0)
+        if not isinstance(self.smear_levels_arcsec_per_deg_s, tuple):
+            raise InputError(f"parameter smear_levels_arcsec_per_deg_s={self.smear_levels_arcsec_per_deg_s!r}: "
+                             "a tuple of rate-proportional star-sensor errors (arcsec per deg/s)")
+        for v in self.smear_levels_arcsec_per_deg_s:
+            check_param("smear_levels_arcsec_per_deg_s", v, lo=-3600.0, hi=3600.0)
+            if v == 0:
+                raise InputError("parameter smear_levels_arcsec_per_deg_s: 0 is not an error (the quiet case is "
+                                 "the sweep's 0 ppm)")
         check_param("seed", self.seed, lo=0, integer=True)
         check_param("settle_s", self.settle_s, lo=0.0, hi=self.duration_s, hi_open=True)
         ratio = self.imu_rate_hz / self.star_rate_hz
@@ -154,7 +169,7 @@ class StudySpec:
     @property
     def star(self) -> StarSensorSpec:
         return StarSensorSpec(self.star_cross_arcsec, self.star_boresight_arcsec, self.star_rate_hz,
-                              self.star_latency_ms)
+                              self.star_latency_ms, self.star_smear_arcsec_per_deg_s)
 
     @property
     def filter(self) -> km.FilterSpec:
@@ -185,8 +200,9 @@ class StudyData:
     yaw_profile: pd.DataFrame            # t_s, yaw_deg, rate_deg_s (repeat 0 test path)
     seconds: dict = field(default_factory=dict)
     lm_timing: pd.DataFrame | None = None  # timing, n_in, n_weights, seconds, epochs, stop (whole trainlm trainings)
-    sweep: pd.DataFrame | None = None      # level_ppm, latency_ms, repeat, run, method, axis, rms_arcsec (held-out S-turns)
-    diagnosis: pd.DataFrame | None = None  # level_ppm, latency_ms, repeat, runs, run, named, flagged, flagged_aug
+    sweep: pd.DataFrame | None = None      # level_ppm, latency_ms, smear, repeat, run, method, axis, rms_arcsec
+    diagnosis: pd.DataFrame | None = None  # level_ppm, latency_ms, smear, repeat, runs, run, named, flagged,
+    #                                        flagged_aug, tried, flagged_after, decision, remains (per run)
 
 
 def _rms(err, mask):
@@ -233,22 +249,30 @@ def _paired_timings(spec: StudySpec, f_train) -> list[dict]:
 LM_NETS = {45: "raw45", 6: "qr6", 9: "qr6_rate"}
 
 
+@functools.lru_cache(maxsize=2)
+def _lm_training_set(spec: StudySpec) -> tuple[dict, np.ndarray]:
+    """The training set of the ``trainlm`` timings (the first level-flight training run of repeat 0): the
+    inputs per net and the targets, flown and filtered once per process (the timings time the trainings
+    only)."""
+    seed = seed_of(spec, 0, "noise", KINDS.index("level"), 0)
+    run = strapdown(generate(spec.profile("level", 0)), [seed], spec.imu, spec.star,
+                    InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec))
+    f = km.run_filter(run, spec.filter)
+    return {n_in: km.gain_features(f, feats)[0] for n_in, feats in LM_NETS.items()}, f.att_err_arcsec[0]
+
+
 def _lm_timing(spec: StudySpec, j: int) -> list[dict]:
     """One timing repetition of the whole ``trainlm`` training (:func:`navlib.methods.feedforward.
     train_feedforward`: MATLAB's defaults, ``dividerand`` 70/15/15, validation stop) of the 45-, 6- and
     9-input nets (paper E's logsig hidden layer, 10 units), in a rotating order, on the same training set:
     the first level-flight training run of repeat 0 (one 150 s run, one sample per filter epoch).  Each net's
     initial weights and split come from :func:`seed_of` (``trainlm``, ``j``, inputs)."""
-    seed = seed_of(spec, 0, "noise", KINDS.index("level"), 0)
-    run = strapdown(generate(spec.profile("level", 0)), [seed], spec.imu, spec.star,
-                    InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec))
-    f = km.run_filter(run, spec.filter)
-    y = f.att_err_arcsec[0]
+    xs, y = _lm_training_set(spec)
     order = list(LM_NETS)
     order = order[j % 3:] + order[:j % 3]
     rows = []
     for n_in in order:
-        x = km.gain_features(f, LM_NETS[n_in])[0]
+        x = xs[n_in]
         rng = np.random.default_rng(sequence(spec.seed, 0, SEED_PARTS["trainlm"], j, n_in))
         net = train_feedforward(x, y, spec.n_hidden, rng, activation="logsig")
         rows.append({"timing": j, "n_in": n_in, "n_weights": net.info["n_weights"], "seconds": net.train_time_s,
@@ -262,33 +286,41 @@ SWEEP_METHODS = {"KF": None, "BPKF 6 QR": "qr6", "BPKF 6 QR + 3 rates": "qr6_rat
 _SWEEP_CASE = {"BPKF 6 QR": "sturn_qr6", "BPKF 6 QR + 3 rates": "sturn_qr6_rate", "BPKF 45 raw": "sturn_raw45"}
 
 
-def _diagnose(rep: int, level_ppm: float, latency_ms: float, train, f_train, test, f_test, aug) -> list[dict]:
-    """The filter's innovations on each S-turn run alone: the candidate test (:func:`navlib.methods.kalman.
-    innovation_glr_per_run`: which catalogued effect it names, if any) and the generalised test
-    (:func:`navlib.methods.kalman.innovation_structure_per_run`: structure in the rates or their derivatives),
-    and on the test runs the generalised test again on the filter with the gyro scale-factor states
-    (``flagged_aug``: what is left once that state is added)."""
+def _diagnose(rep: int, level_ppm: float, latency_ms: float, smear: float, train, f_train, test, f_test,
+              aug) -> list[dict]:
+    """The filter's innovations on each S-turn run alone, through the decision rule
+    (:func:`navlib.methods.kalman.innovation_loop`): what the candidate test names (``named``), whether the
+    generalised test flags structure (``flagged``), the candidate whose state was added (``tried``), whether
+    structure is left with it (``flagged_after``), and the rule's answer (``decision``: the candidate,
+    "not explained by the candidates" or "nothing missing") with the regressors that carry what is left
+    (``remains``); on the test runs also the generalised test on the filter with the three gyro
+    scale-factor states (``flagged_aug``)."""
     rows = []
     for part, rr, ff, aa in (("train", train, f_train, None), ("test", test, f_test, aug)):
-        named = km.innovation_glr_per_run(rr, ff)
-        gen = km.innovation_structure_per_run(rr, ff)
-        gen_aug = km.innovation_structure_per_run(rr, aa) if aa is not None else [None] * len(gen)
-        for i, (g, s, sa) in enumerate(zip(named, gen, gen_aug)):
-            rows.append({"level_ppm": float(level_ppm), "latency_ms": float(latency_ms), "repeat": rep, "runs": part,
-                         "run": i, "named": g.named or "none", "chi2": s.chi2, "flagged": s.flagged,
-                         "flagged_aug": np.nan if sa is None else float(sa.flagged)})
+        loop = km.innovation_loop(rr, ff)
+        gen_aug = km.innovation_structure_per_run(rr, aa) if aa is not None else [None] * len(loop)
+        for i, (d, sa) in enumerate(zip(loop, gen_aug)):
+            rows.append({"level_ppm": float(level_ppm), "latency_ms": float(latency_ms), "smear": float(smear),
+                         "repeat": rep, "runs": part, "run": i, "named": d.named_by_test or "none",
+                         "chi2": d.chi2, "flagged": d.flagged,
+                         "flagged_aug": np.nan if sa is None else float(sa.flagged),
+                         "tried": d.tried or "none",
+                         "flagged_after": np.nan if d.flagged_after is None else float(d.flagged_after),
+                         "decision": d.decision, "remains": ", ".join(d.remains)})
     return rows
 
 
-def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0) -> dict:
+def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0, smear: float = 0.0) -> dict:
     """One repeat of the S-turn simulation with the gyro scale factor set to ``level_ppm`` (a task of
     :func:`simulate`): the held-out scores of the KF, the three BPKF and the augmented KF.  The draws are
     those of the study's repeat ``rep`` (:func:`seed_of` does not depend on the level), so the levels are
     paired run by run; the filters are the study's (the augmented KF's prior on the scale factor is not
     set from the level).  ``latency_ms``: the star sensor's time offset (an effect outside the innovation
-    test's candidates; then only the 9-input BPKF, the one with the rate inputs, is trained).  Returns the
-    score rows and the innovation diagnosis (``_diagnose``)."""
-    sp = replace(spec, gyro_scale_ppm=float(level_ppm), star_latency_ms=float(latency_ms))
+    test's candidates; then only the 9-input BPKF, the one with the rate inputs, is trained); ``smear``: the
+    star sensor's rate-proportional error (arcsec per deg/s; a second effect outside the candidates, treated
+    like the time offset).  Returns the score rows and the innovation diagnosis (``_diagnose``)."""
+    sp = replace(spec, gyro_scale_ppm=float(level_ppm), star_latency_ms=float(latency_ms),
+                 star_smear_arcsec_per_deg_s=float(smear))
     train, test, _ = _runs(sp, "s_turns", rep)
     f_train, f_test = km.run_filter(train, spec.filter), km.run_filter(test, spec.filter)
     mask = f_test.t_s >= spec.settle_s
@@ -296,7 +328,7 @@ def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0)
     errs = {"KF": f_test.att_err_arcsec, "augmented KF": aug.att_err_arcsec}
     net_seed = seed_of(spec, rep, "network")
     for method, feats in SWEEP_METHODS.items():
-        if feats is None or (latency_ms and feats != "qr6_rate"):     # with a time offset: the rate net only
+        if feats is None or ((latency_ms or smear) and feats != "qr6_rate"):   # blind effects: the rate net only
             continue
         net = train_mlp(km.gain_features(f_train, feats), f_train.att_err_arcsec,
                         bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs), seed=net_seed)
@@ -305,14 +337,15 @@ def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0)
     for method, err in errs.items():
         one = []
         _score_rows(one, rep, "s_turns", "held-out", method, err, mask)
-        rows += [dict(r, level_ppm=float(level_ppm), latency_ms=float(latency_ms)) for r in one]
-    return {"scores": rows, "diag": _diagnose(rep, level_ppm, latency_ms, train, f_train, test, f_test, aug)}
+        rows += [dict(r, level_ppm=float(level_ppm), latency_ms=float(latency_ms), smear=float(smear)) for r in one]
+    return {"scores": rows, "diag": _diagnose(rep, level_ppm, latency_ms, smear, train, f_train, test, f_test, aug)}
 
 
 def _runs(spec: StudySpec, kind: str, rep: int):
     """Training and test runs of one repeat.  Level flight: one path, different noise seeds.  S-turns: each
-    training run flies its own manoeuvre sequence, the test runs share another one.  Every run's noise and
-    every manoeuvre has its own seed (:func:`seed_of`)."""
+    training run flies its own manoeuvre sequence (flown together, :func:`navlib.sensors.strapdown.strapdown`
+    with one path per run), the test runs share another one.  Every run's noise and every manoeuvre has its
+    own seed (:func:`seed_of`)."""
     k = KINDS.index(kind)
     seeds = [seed_of(spec, rep, "noise", k, i) for i in range(spec.n_train_runs + spec.n_test_runs)]
     init = InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec)
@@ -320,18 +353,11 @@ def _runs(spec: StudySpec, kind: str, rep: int):
         tr = generate(spec.profile(kind, 0))
         both = strapdown(tr, seeds, spec.imu, spec.star, init)
         return _subset(both, slice(0, spec.n_train_runs)), _subset(both, slice(spec.n_train_runs, None)), tr
-    train = _concat([strapdown(generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 1 + i))), [seeds[i]],
-                               spec.imu, spec.star, init) for i in range(spec.n_train_runs)])
+    train = strapdown([generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 1 + i)))
+                       for i in range(spec.n_train_runs)], seeds[:spec.n_train_runs], spec.imu, spec.star, init)
     tr_test = generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 0)))
     test = strapdown(tr_test, seeds[spec.n_train_runs:], spec.imu, spec.star, init)
     return train, test, tr_test
-
-
-def _concat(runs):
-    first = runs[0]
-    arrays = {f.name: np.concatenate([getattr(r, f.name) for r in runs]) for f in fields(first)
-              if isinstance(getattr(first, f.name), np.ndarray) and getattr(first, f.name).ndim >= 2}
-    return replace(first, **arrays)
 
 
 def _subset(run, sl):
@@ -346,7 +372,7 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     if kind == "trainlm":
         t0 = time.perf_counter()
         return {"lm": _lm_timing(spec, rep), "secs": {"trainlm": time.perf_counter() - t0}}
-    if isinstance(kind, tuple):                 # (scale factor ppm, star-sensor latency ms)
+    if isinstance(kind, tuple):                 # (scale factor ppm, star-sensor latency ms, smear arcsec per deg/s)
         t0 = time.perf_counter()
         return {"sweep": _sweep(spec, rep, *kind), "secs": {"sweep": time.perf_counter() - t0}}
     out = {k: [] for k in ("score", "trace", "time", "glr", "glr_run", "corr", "timing", "diag")}
@@ -380,7 +406,8 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
         for i, gi in enumerate(km.innovation_glr_per_run(rr, ff)):
             out["glr_run"].append({"repeat": rep, "kind": kind, "runs": part, "run": i, "named": gi.named or "none"})
     if kind == "s_turns":
-        out["diag"] = _diagnose(rep, spec.gyro_scale_ppm, spec.star_latency_ms, train, f_train, test, f_test, aug)
+        out["diag"] = _diagnose(rep, spec.gyro_scale_ppm, spec.star_latency_ms, spec.star_smear_arcsec_per_deg_s,
+                                train, f_train, test, f_test, aug)
     r, p = km.rate_correlation(f_train)
     out["corr"].append({"repeat": rep, "kind": kind, "r": r, "p": p})
     secs["simulate_filter"] += time.perf_counter() - t0
@@ -432,10 +459,14 @@ def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | N
     cost += [4.0] * spec.lm_timings
     # the sweep: the study's own level is taken from its repeats (same draws, same filters and nets)
     levels = [float(v) for v in spec.sweep_ppm if float(v) != float(spec.gyro_scale_ppm)]
-    tasks += [(spec, rep, (v, float(spec.star_latency_ms))) for v in levels for rep in range(spec.sweep_repeats)]
-    # the blind effect: star-sensor time offsets with no scale factor
-    tasks += [(spec, rep, (0.0, float(v))) for v in spec.latency_ms_levels for rep in range(spec.sweep_repeats)]
-    n_sw = (len(levels) + len(spec.latency_ms_levels)) * spec.sweep_repeats
+    own_smear = float(spec.star_smear_arcsec_per_deg_s)
+    tasks += [(spec, rep, (v, float(spec.star_latency_ms), own_smear)) for v in levels
+              for rep in range(spec.sweep_repeats)]
+    # the blind effects: star-sensor time offsets, rate-proportional errors, with no scale factor
+    tasks += [(spec, rep, (0.0, float(v), 0.0)) for v in spec.latency_ms_levels for rep in range(spec.sweep_repeats)]
+    tasks += [(spec, rep, (0.0, 0.0, float(v))) for v in spec.smear_levels_arcsec_per_deg_s
+              for rep in range(spec.sweep_repeats)]
+    n_sw = (len(levels) + len(spec.latency_ms_levels) + len(spec.smear_levels_arcsec_per_deg_s)) * spec.sweep_repeats
     cost += [2.0] * n_sw
     every = engine.run(_repeat, tasks, workers=workers, scheduler=scheduler, cost=cost, label="paper E repeats")
     parts = [p for p in every if "lm" not in p and "sweep" not in p]
@@ -468,7 +499,7 @@ def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | N
                 sweep.append({"repeat": r.repeat, "case": "s_turns", "mode": "held-out",
                               "method": label[(r.case, r.method)], "run": r.run, "axis": r.axis,
                               "rms_arcsec": r.rms_arcsec, "level_ppm": float(spec.gyro_scale_ppm),
-                              "latency_ms": float(spec.star_latency_ms)})
+                              "latency_ms": float(spec.star_latency_ms), "smear": own_smear})
     sweep = pd.DataFrame(sweep)
     return StudyData(spec, scores, traces, pd.DataFrame(rows("time")), pd.DataFrame(rows("glr")),
                      pd.DataFrame(rows("glr_run")), pd.DataFrame(rows("timing")), pd.DataFrame(rows("corr")),
@@ -664,18 +695,22 @@ def _by_angle(s: pd.DataFrame, angle: str) -> pd.Series:
 
 
 def sweep_per_run(data: StudyData, level_ppm: float, method: str, angle: str = "all",
-                  latency_ms: float | None = None) -> pd.Series:
+                  latency_ms: float | None = None, smear: float | None = None) -> pd.Series:
     """Like :func:`per_run` for the scale-factor sweep: one method's held-out S-turn error per run at one
-    level (arcsec), indexed by (repeat, run)."""
+    level (arcsec), indexed by (repeat, run); ``latency_ms`` and ``smear`` (arcsec per deg/s) select the
+    star sensor's blind effects (default: the study's own)."""
     if method not in SWEEP_METHODS:
         raise InputError(f"parameter method={method!r}: must be one of {', '.join(SWEEP_METHODS)}")
     if angle not in _ANGLES:
         raise InputError(f"parameter angle={angle!r}: must be one of {', '.join(_ANGLES)}")
     latency_ms = data.spec.star_latency_ms if latency_ms is None else latency_ms
+    smear = data.spec.star_smear_arcsec_per_deg_s if smear is None else smear
     s = data.sweep
-    s = s[(s["level_ppm"] == float(level_ppm)) & (s["latency_ms"] == float(latency_ms)) & (s["method"] == method)]
+    s = s[(s["level_ppm"] == float(level_ppm)) & (s["latency_ms"] == float(latency_ms))
+          & (_smear(s) == float(smear)) & (s["method"] == method)]
     if s.empty:
-        raise InputError(f"parameter level_ppm={level_ppm!r}, latency_ms={latency_ms!r}: not in the sweep")
+        raise InputError(f"parameter level_ppm={level_ppm!r}, latency_ms={latency_ms!r}, smear={smear!r}: "
+                         "not in the sweep")
     return _by_angle(s, angle)
 
 
@@ -684,7 +719,10 @@ def sweep_table(data: StudyData) -> pd.DataFrame:
     RMS over the three angles (arcsec) with its 10th and 90th percentiles, the median yaw RMS, and the
     median paired improvement over the KF on the same runs (%)."""
     rows = []
-    for level in sorted(data.sweep.loc[data.sweep["latency_ms"] == float(data.spec.star_latency_ms), "level_ppm"].unique()):
+    sw = data.sweep
+    own = ((sw["latency_ms"] == float(data.spec.star_latency_ms))
+           & (_smear(sw) == float(data.spec.star_smear_arcsec_per_deg_s)))
+    for level in sorted(sw.loc[own, "level_ppm"].unique()):
         kf = sweep_per_run(data, level, "KF")
         for method in SWEEP_METHODS:
             v = sweep_per_run(data, level, method)
@@ -695,6 +733,11 @@ def sweep_table(data: StudyData) -> pd.DataFrame:
                          "improvement_pct": np.nan if method == "KF" else float(np.median(100 * (1 - a / b))),
                          "n_runs": int(v.size)})
     return pd.DataFrame(rows)
+
+
+def _smear(df: pd.DataFrame) -> pd.Series:
+    """The rate-proportional star-sensor error of each row (arcsec per deg/s; 0 where not recorded)."""
+    return df["smear"] if "smear" in df.columns else pd.Series(0.0, index=df.index)
 
 
 def _level_key(level: float) -> str:
@@ -960,38 +1003,173 @@ def claims(data: StudyData) -> list[report.Claim]:
         statistic=f"median over held-out runs of the paired difference RMS 9-input BPKF - RMS augmented KF, {rms3}, arcsec",
         estimate=est, boundary=0.0, holds_when="above", unit="arcsec", decided_by=(device, star, trainer),
         why=why, key="cel_aug"))
+    out += _loop_claims(data, star)
     return out
 
 
+def _loop_claims(data: StudyData, star: str) -> list[report.Claim]:
+    """The book's claims on the decision rule (:func:`navlib.methods.kalman.innovation_loop`), each a Wilson
+    rate over S-turn runs each alone (train and test runs): with an effect outside the candidates (time
+    offset, rate-proportional error) it names none; with the study's gyro scale factor it names it; with
+    nothing missing it answers "nothing missing"."""
+    sp = data.spec
+    out = []
+    rule = "the decision rule (name a candidate only if adding its state removes the structure), alpha 0.01"
+    blind, lat, sm = _blind(data), _blind(data, "latency"), _blind(data, "smear")
+    k, n = int(_named(blind).sum()), int(len(blind))
+    kc = int((blind["named"] != "none").sum())
+    lat_txt = ", ".join(f"{v:g}" for v in sp.latency_ms_levels)
+    sm_txt = ", ".join(f"{v:g}" for v in sp.smear_levels_arcsec_per_deg_s)
+    est = verdicts.wilson(k, n) if n else None
+    out.append(report.Claim(
+        "With effects outside its candidates the filter loop names none of them", "(not in the paper)",
+        source="book",
+        reading=(f"star-sensor time offset ({lat_txt} ms) and rate-proportional error ({sm_txt} arcsec per "
+                 "deg/s), no scale factor; the loop on each S-turn run alone"),
+        statistic=f"rate of runs in which {rule} names a candidate (every name is wrong)",
+        estimate=est, boundary=FALSE_NAMING_BOUNDARY, holds_when="below",
+        ours=(f"{k}/{n} runs (time offset {int(_named(lat).sum())}/{len(lat)}, rate error "
+              f"{int(_named(sm).sum())}/{len(sm)}; the candidate test alone names one in {kc}/{n})"),
+        decided_by=("the six candidates of the innovation test (gyro and accelerometer scale factors)",
+                    f"yaw S-manoeuvre +-{sp.yaw_amplitude_deg:g} deg", star),
+        why=_runs_needed(k, n, FALSE_NAMING_BOUNDARY, "below") if n else "no runs with a blind effect",
+        key="cel_loop_blind"))
+    own = data.diagnosis
+    own = own[(own["level_ppm"] == float(sp.gyro_scale_ppm)) & (own["latency_ms"] == float(sp.star_latency_ms))
+              & (_smear(own) == float(sp.star_smear_arcsec_per_deg_s))]
+    expected = MISSING_EFFECT if sp.gyro_scale_ppm else km.NOTHING
+    k, n = int((own["decision"] == expected).sum()), int(len(own))
+    out.append(report.Claim(
+        "The filter loop names the gyro scale factor and its state removes the structure", "(not in the paper)",
+        source="book", reading=f"gyro scale factor {sp.gyro_scale_ppm:g} ppm; the loop on each S-turn run alone",
+        statistic=f"rate of runs in which {rule} answers {expected}",
+        estimate=verdicts.wilson(k, n) if n else None, boundary=NAMED_RATE_BOUNDARY, holds_when="above",
+        ours=f"{k}/{n} runs", decided_by=(f"gyro scale factor {sp.gyro_scale_ppm:g} ppm",
+                                         f"yaw S-manoeuvre +-{sp.yaw_amplitude_deg:g} deg", star),
+        why="" if n else "no S-turn runs", key="cel_loop_named"))
+    quiet = _diag(data, False)
+    k, n = int((quiet["decision"] != km.NOTHING).sum()), int(len(quiet))
+    out.append(report.Claim(
+        "With nothing missing the filter loop answers nothing missing", "(not in the paper)", source="book",
+        reading="no scale factor, no star-sensor error; the loop on each S-turn run alone",
+        statistic=f"rate of runs in which {rule} names a candidate or finds structure (false alarms)",
+        estimate=verdicts.wilson(k, n) if n else None, boundary=FALSE_NAMING_BOUNDARY, holds_when="below",
+        ours=f"{k}/{n} runs", decided_by=("the 15-state filter's model of our simulator",),
+        why=_runs_needed(k, n, FALSE_NAMING_BOUNDARY, "below") if n else "0 ppm is not in the sweep",
+        key="cel_loop_quiet"))
+    return out
+
+
+def case_label(level_ppm: float, latency_ms: float = 0.0, smear: float = 0.0) -> str:
+    """A diagnosis case in words: the gyro scale factor, the star sensor's time offset and rate-proportional
+    error, or nothing missing."""
+    parts = [f"scale factor {level_ppm:g} ppm"] if level_ppm else []
+    parts += [f"time offset {latency_ms:g} ms"] if latency_ms else []
+    parts += [f"rate error {smear:g} arcsec per deg/s"] if smear else []
+    return ", ".join(parts) or "nothing missing"
+
+
+def _cases(d: pd.DataFrame):
+    """The diagnosis rows grouped by case (scale factor, time offset, rate error), in a fixed order."""
+    d = d.assign(smear=_smear(d))
+    for (level, lat, sm), g in d.groupby(["level_ppm", "latency_ms", "smear"], sort=True):
+        yield (float(level), float(lat), float(sm)), g
+
+
 def blind_effect_table(data: StudyData) -> pd.DataFrame:
-    """The innovation diagnosis per case (gyro scale factor, star-sensor time offset): over the S-turn runs
-    (training and test runs, each alone) the effect the candidate test names most often and how often it
-    names any, how often the generalised test flags structure, on the test runs how often structure is left
-    once the gyro scale-factor states are in the filter, and the median RMS (three angles, arcsec) of the
-    KF, the 9-input BPKF and the augmented KF on the held-out runs (first ``sweep_repeats`` repeats)."""
-    d = data.diagnosis
+    """The innovation diagnosis per case (gyro scale factor, star-sensor time offset or rate-proportional
+    error): over the S-turn runs (training and test runs, each alone) the effect the candidate test names
+    most often and how often it names any, how often the generalised test flags structure, on the test runs
+    how often structure is left once the three gyro scale-factor states are in the filter, and the median RMS
+    (three angles, arcsec) of the KF, the 9-input BPKF and the augmented KF on the held-out runs (first
+    ``sweep_repeats`` repeats)."""
     rows = []
-    for (level, lat), g in d.groupby(["level_ppm", "latency_ms"], sort=True):
+    for (level, lat, sm), g in _cases(data.diagnosis):
         test = g[g["runs"] == "test"]
         named = g["named"][g["named"] != "none"]
-        row = {"scale_ppm": level, "latency_ms": lat, "runs": len(g),
+        row = {"case": case_label(level, lat, sm), "runs": len(g),
                "named_most": named.mode().iloc[0] if len(named) else "none",
                "named_any": f"{len(named)}/{len(g)}", "generalised_flags": f"{int(g['flagged'].sum())}/{len(g)}",
                "left_after_scale_states": f"{int(test['flagged_aug'].sum())}/{len(test)}"}
         for method in ("KF", "BPKF 6 QR + 3 rates", "augmented KF"):
             try:
-                row[f"{method} (arcsec)"] = float(sweep_per_run(data, level, method, latency_ms=lat).median())
+                row[f"{method} (arcsec)"] = float(sweep_per_run(data, level, method, latency_ms=lat, smear=sm).median())
             except InputError:
                 row[f"{method} (arcsec)"] = np.nan
         rows.append(row)
     return pd.DataFrame(rows)
 
 
+def loop_table(data: StudyData) -> pd.DataFrame:
+    """The decision rule (:func:`navlib.methods.kalman.innovation_loop`) per case, over the S-turn runs each
+    alone: the candidate whose state was added (the candidate test's name, most often) and in how many runs,
+    in how many of those structure was left, and the rule's answers: a candidate named (which, most often),
+    "not explained by the candidates", "nothing missing", with the regressors that carry the structure left
+    (most often)."""
+    rows = []
+    for (level, lat, sm), g in _cases(data.diagnosis):
+        tried = g[g["tried"] != "none"]
+        named = g[~g["decision"].isin([km.NOT_EXPLAINED, km.NOTHING])]
+        left = g.loc[g["decision"] == km.NOT_EXPLAINED, "remains"]
+        rows.append({"case": case_label(level, lat, sm), "runs": len(g),
+                     "state added": tried["tried"].mode().iloc[0] if len(tried) else "none",
+                     "added in": len(tried), "left after": int(tried["flagged_after"].sum()),
+                     "named": f"{len(named)}: {named['decision'].mode().iloc[0]}" if len(named) else "0",
+                     "not explained": int((g["decision"] == km.NOT_EXPLAINED).sum()),
+                     "nothing missing": int((g["decision"] == km.NOTHING).sum()),
+                     "structure left in": (left.mode().iloc[0] or "-") if len(left) else "-"})
+    return pd.DataFrame(rows)
+
+
+def loop_runs(data: StudyData) -> list[dict]:
+    """The decision rule per run (for the results file): case, repeat, train or test runs, run, what the
+    candidate test named, whether the generalised test flagged, the state added and whether structure was left
+    with it, the decision and the regressors carrying what is left."""
+    out = []
+    for (level, lat, sm), g in _cases(data.diagnosis):
+        for r in g.sort_values(["repeat", "runs", "run"]).itertuples():
+            out.append({"case": case_label(level, lat, sm), "repeat": int(r.repeat), "runs": r.runs, "run": int(r.run),
+                        "named_by_test": r.named, "flagged": bool(r.flagged), "tried": r.tried,
+                        "flagged_after": None if pd.isna(r.flagged_after) else bool(r.flagged_after),
+                        "decision": r.decision, "remains": r.remains})
+    return out
+
+
 def _diag(data: StudyData, latency: bool) -> pd.DataFrame:
-    """The diagnosis rows without a scale factor: with a star-sensor time offset, or with nothing missing."""
+    """The diagnosis rows without a scale factor or rate-proportional error: with a star-sensor time offset,
+    or with nothing missing."""
     d = data.diagnosis
     sel = (d["latency_ms"] > 0) if latency else (d["latency_ms"] == 0)
+    return d[sel & (d["level_ppm"] == 0) & (_smear(d) == 0)]
+
+
+def _blind(data: StudyData, which: str = "both") -> pd.DataFrame:
+    """The diagnosis rows with an effect outside the candidates and no scale factor: ``"latency"`` (time
+    offset), ``"smear"`` (rate-proportional error) or ``"both"``."""
+    d = data.diagnosis
+    lat, sm = d["latency_ms"] > 0, _smear(d) != 0
+    sel = {"latency": lat & ~sm, "smear": sm & ~lat, "both": lat | sm}[which]
     return d[sel & (d["level_ppm"] == 0)]
+
+
+def _named(d: pd.DataFrame) -> pd.Series:
+    """Whether the decision rule named a candidate in each row."""
+    return ~d["decision"].isin([km.NOT_EXPLAINED, km.NOTHING])
+
+
+def _runs_needed(k: int, n: int, boundary: float, holds_when: str) -> str:
+    """Why a Wilson rate with no (or every) event cannot resolve its boundary: the runs it would need."""
+    est = verdicts.wilson(k, n)
+    z2 = 3.841458820694124                                           # chi2(1) 95 % quantile
+    if holds_when == "below" and k == 0 and est.hi >= boundary:
+        need = int(np.floor(z2 * (1 - boundary) / boundary)) + 1
+        return (f"no event in {n} runs, yet the Wilson interval reaches {est.hi:.3f}: a {boundary:g} bound "
+                f"needs at least {need} runs without one")
+    if holds_when == "above" and k == n and est.lo <= boundary:
+        need = int(np.floor(z2 * boundary / (1 - boundary))) + 1
+        return (f"an event in all {n} runs, yet the Wilson interval reaches {est.lo:.3f}: a {boundary:g} bound "
+                f"needs at least {need} runs")
+    return ""
 
 
 def sweep_verdicts(data: StudyData) -> pd.DataFrame:
@@ -1010,7 +1188,10 @@ def sweep_verdicts(data: StudyData) -> pd.DataFrame:
 def results_extra(data: StudyData) -> dict:
     """The results file's ``extra``: our time ratios (45 / 6 inputs; per Adam pass, and of a whole
     ``trainlm`` training with its 95 % interval) and the paper's (the timing claims themselves are stored
-    with the claims, marked ``volatile``: a rerun must give their verdicts, not their numbers)."""
+    with the claims, marked ``volatile``: a rerun must give their verdicts, not their numbers); the
+    candidate and generalised tests with the time offset; the decision rule's rates with their Wilson
+    intervals (``loop_*``: false naming with the blind effects, pooled and each, false alarms with nothing
+    missing, correct naming with the study's scale factor; per run in :func:`loop_runs`)."""
     ratio = time_ratio(data)
     out = {"time_ratio_45_over_6": ratio["ours"], "time_ratio_paper": ratio["paper"]}
     lat = _diag(data, True)
@@ -1021,6 +1202,20 @@ def results_extra(data: StudyData) -> dict:
                     "blind_named_most": str(named.mode().iloc[0]) if len(named) else "none",
                     "blind_generalised_flag_rate": float(lat["flagged"].mean()),
                     "blind_left_after_scale_states": float(lat.loc[lat["runs"] == "test", "flagged_aug"].mean())})
+    for name, rows, hit in (("loop_false_naming", _blind(data), _named),
+                            ("loop_false_naming_time_offset", _blind(data, "latency"), _named),
+                            ("loop_false_naming_rate_error", _blind(data, "smear"), _named),
+                            ("loop_false_alarm", _diag(data, False), lambda d: d["decision"] != km.NOTHING)):
+        if len(rows):
+            w = verdicts.wilson(int(hit(rows).sum()), int(len(rows)))
+            out.update({f"{name}_rate": w.value, f"{name}_lo": w.lo, f"{name}_hi": w.hi, f"{name}_n": w.n})
+    d = data.diagnosis
+    own = d[(d["level_ppm"] == float(data.spec.gyro_scale_ppm)) & (d["latency_ms"] == float(data.spec.star_latency_ms))
+            & (_smear(d) == float(data.spec.star_smear_arcsec_per_deg_s))]
+    if len(own) and data.spec.gyro_scale_ppm:
+        w = verdicts.wilson(int((own["decision"] == MISSING_EFFECT).sum()), int(len(own)))
+        out.update({"loop_correct_naming_rate": w.value, "loop_correct_naming_lo": w.lo,
+                    "loop_correct_naming_hi": w.hi, "loop_correct_naming_n": w.n})
     est, _ = verdicts.attempt(verdicts.paired_ratio, *lm_timing_pairs(data))
     if est is not None:
         out.update({"trainlm_time_ratio_45_over_6": est.value, "trainlm_time_ratio_lo": est.lo,
