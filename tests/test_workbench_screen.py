@@ -35,7 +35,7 @@ def steps(result):
 # ------------------------------------------------------------------------------------------- outliers
 @pytest.fixture(scope="module")
 def trial05():
-    return wb.load_trial(wb.CALIBRATION_TRIAL, 3)
+    return wb.load_trial(wb.CALIBRATION_TRIAL, 6)
 
 
 WILD_ROW = 40
@@ -49,7 +49,7 @@ def trial05_clean_loops(trial05):
 
 
 @REAL
-@pytest.mark.parametrize("value", [300.0, 1e6, 1e10])
+@pytest.mark.parametrize("value", [300.0, 1e10])
 def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_clean_answer(
         trial05, trial05_clean_loops, value):
     row = WILD_ROW
