@@ -53,12 +53,13 @@ screenshots: $(STAMP)
 
 test: test-lib test-notebooks test-results
 
-# Two pytest processes (pytest-xdist), each test file whole in one of them (module fixtures computed once);
+# Two pytest processes (pytest-xdist), each test file whole in one of them (module fixtures computed once),
+# the longest files first (tests/conftest.py) so the two finish together;
 # TEST_WORKERS=1 runs them in this process.
 TEST_WORKERS ?= 2
 test-lib: $(STAMP)
 	@if [ "$(TEST_WORKERS)" = 1 ]; then $(PY) -m pytest -q tests -p no:cacheprovider; \
-	 else $(PY) -m pytest -q tests -p no:cacheprovider -n $(TEST_WORKERS) --dist loadfile; fi
+	 else $(PY) -m pytest -q tests -p no:cacheprovider -n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder; fi
 
 # nbval re-executes every notebook; each chapter's last cell rewrites $(GENERATED)/results/<chapter>.json.
 # The folder is cleared first so a stale file cannot pass test-results.  Two notebooks run at a time
@@ -69,7 +70,7 @@ test-notebooks: $(STAMP)
 	@$(PY) -m navlib.booktools compile
 	@NAVBOOK_RESULTS_DIR=$(CURDIR)/$(GENERATED)/results $(PY) -m pytest -q -p no:cacheprovider --nbval \
 	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks \
-	    $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile)
+	    $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # The fresh results files against the committed references notebooks/results/<chapter>.json (make notebooks).
 test-results: $(STAMP)
