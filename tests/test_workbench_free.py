@@ -104,6 +104,14 @@ def test_projected_whitening_is_the_inverse_of_colouring():
     cov = colour(np.eye(2 * n), (0.8,), ser, 2 * n)
     K = cov @ cov.T
     assert K[0, 3] == pytest.approx(0.8 * d[0] @ d[3]) and K[0, 0] == pytest.approx(1.0)
+    # an irregular clock (block times with jitter): only kappa >= 0 is a valid correlation
+    from dataclasses import replace
+    from navlib.workbench.serial import regular_clock
+    jittered = replace(ser, projection=Projection(d, np.repeat(np.arange(n) + 0.1 * rng.random(n), 2)))
+    assert regular_clock(ser) and not regular_clock(jittered)
+    assert np.allclose(whiten(colour(u, (0.8,), jittered, 2 * n), (0.8,), jittered), u)
+    with pytest.raises(ValueError, match="regular clock"):
+        colour(u, (-0.5,), jittered, 2 * n)
 
 
 def _with_site(frame, **cols):

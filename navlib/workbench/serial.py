@@ -180,6 +180,13 @@ _KEEP_FACTORS = 6
 _FACTORS: dict = {}
 
 
+def regular_clock(series: Series) -> bool:
+    """Whether a projected series is sampled on whole steps (then a negative lag-1 correlation is an AR(1)
+    process; on an irregular clock only ``kappa >= 0``, ``kappa^|dt|``, is a valid correlation)."""
+    c = series.projection.clock
+    return bool(np.allclose(c, np.round(c), atol=1e-6))
+
+
 def _projected_factor(kappa, series: Series) -> np.ndarray:
     """Lower Cholesky factor of the projected model's correlation matrix (module docstring) over the
     observations of ``series``, in series order (AR(1): ``kappa[0]``); the last few are kept."""
@@ -194,10 +201,20 @@ def _projected_factor(kappa, series: Series) -> np.ndarray:
     lag = np.abs(t[:, None] - t[None, :])
     rho = np.abs(k) ** lag
     if k < 0:
+        if not regular_clock(series):
+            raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
         rho = rho * np.where(np.round(lag) % 2 == 1, -1.0, 1.0)
     K = rho * (d @ d.T)
-    K[np.diag_indices_from(K)] += 1e-10 * np.mean(np.diag(K))       # round-off only
-    L = np.linalg.cholesky(K)
+    jitter = 1e-10 * np.mean(np.diag(K))                            # round-off only
+    for _ in range(4):
+        K[np.diag_indices_from(K)] += jitter
+        try:
+            L = np.linalg.cholesky(K)
+            break
+        except np.linalg.LinAlgError:                               # near the bound: numerically singular
+            jitter *= 100.0
+    else:
+        raise np.linalg.LinAlgError("projected noise covariance is not positive definite")
     if len(_FACTORS) >= _KEEP_FACTORS:
         _FACTORS.pop(next(iter(_FACTORS)))
     _FACTORS[key] = (series, L)
@@ -582,10 +599,12 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
         logliks.append(best[1])
         max_order = 0                                  # skip the forward search
+    # the lowest kappa_1: -KAPPA_MAX, or 0 for a projected series on an irregular clock
+    low = 0.0 if series.projection is not None and not regular_clock(series) else -np.arctanh(KAPPA_MAX)
     for p in range(1, max_order + 1):
         if p == 1:
             sol = minimize_scalar(lambda a: -loglik((np.tanh(a),)),
-                                  bounds=(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX)), method="bounded",
+                                  bounds=(low, np.arctanh(KAPPA_MAX)), method="bounded",
                                   options={"xatol": 1e-4})
             kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
         else:
@@ -617,7 +636,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
             return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
 
         ends = []
-        for edge in (-lim, lim):
+        for edge in (min(low, a0), lim):
             if a0 == edge or gap(edge) <= 0:
                 ends.append(float(np.tanh(edge)))
             else:
@@ -733,7 +752,7 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
     correlation of each vector."""
     qb, qe = bases.base, bases.extra
     if series.projection is not None:
-        grid = PROJECTED_GRID
+        grid = PROJECTED_GRID if regular_clock(series) else PROJECTED_GRID[PROJECTED_GRID >= 0]
         parts = projected_grid(E, [q for q in (qb, qe) if q is not None], series, grid)
         rb, mb = parts[0]
         re_, me = parts[-1]
