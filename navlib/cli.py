@@ -20,8 +20,9 @@ Commands:
   field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
       the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
       loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
-      estimates with it and flags a local anomaly when they differ beyond the uncertainty.
-  calibrate magnetometer FILE.csv [--model hard_iron,scale,soft_iron] --out CAL.json
+      estimates with it and flags a local anomaly when they differ beyond the uncertainty; without
+      --site the file's columns lat_deg, lon_deg (height_m, date) say where and when, if it has them.
+  calibrate magnetometer FILE.csv [--model hard_iron,scale,soft_iron] --out CAL.json [--site ...] [--date D]
       fit the reference-free magnetometer model (no attitude needed) and write the correction in magcal's
       convention, m_corrected = (m - b) A, with the expected field strength and every parameter's
       uncertainty (navlib.workbench.calibration).
@@ -42,7 +43,8 @@ SYSTEM is compass, drift, magnetometer, magnetometer_free or accelerometer:
   magnetometer columns: mag_x_ut, mag_y_ut, mag_z_ut, q_w, q_x, q_y, q_z (reference attitude, body FRD to
   NED); optional time_s, gyr_*_dps, pos_*_m.
   magnetometer_free columns: mag_x_ut, mag_y_ut, mag_z_ut (no attitude); optional acc_x_ms2, acc_y_ms2,
-  acc_z_ms2 (still or slow), time_s, temperature_c.
+  acc_z_ms2 (still or slow), time_s, temperature_c, and the site: lat_deg, lon_deg, height_m (one
+  site per file: spread at most 0.1 deg and 500 m) and date (ISO 8601, within a year).
   accelerometer columns (one unit's tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
   output_mg (output / nominal scale factor), unit; optional set_point_c.  Extra columns are ignored.
 
@@ -68,7 +70,7 @@ from dataclasses import replace
 from . import engine
 from .data.tables import write_new_csv
 from .errors import InputError, UserCodeError
-from .sensors.compass import CompassErrors, simulate_train_test
+from .sensors.compass import PAPER_A_EARTH, CompassErrors, simulate_train_test
 from .workbench import SYSTEMS, get_system, load_effects
 from .workbench.diagnose import diagnose
 from .workbench.effects import resolve
@@ -120,6 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--model", default=",".join(DEFAULT_MODEL),
                      help=f"comma-separated effects (default {','.join(DEFAULT_MODEL)}: the full ellipsoid)")
     cal.add_argument("--out", required=True, help="calibration JSON to write (never overwritten)")
+    _site_options(cal, required=False)
     app = sub.add_parser("apply", help="apply a calibration to a measurement file",
                          description="correct the field columns of FILE with a calibration of `navlib calibrate`")
     app.add_argument("calibration", help="calibration JSON written by `navlib calibrate`")
@@ -156,22 +159,28 @@ def build_parser() -> argparse.ArgumentParser:
 def _site_options(cmd, required: bool) -> None:
     cmd.add_argument("--site", required=required, default=None, metavar="LAT,LON[,HEIGHT_M]",
                      help="geodetic latitude and longitude (deg) and height above the WGS84 ellipsoid (m, default 0)"
-                          + ("" if required else "; magnetometer_free: the loop compares the estimated local "
-                             "field with IGRF-14 there and flags a local anomaly"))
-    cmd.add_argument("--date", default=None, metavar="YYYY-MM-DD", help="date of the field (default 2025-01-01)")
+                          + ("" if required else "; magnetometer_free: the estimated local field is compared "
+                             "with IGRF-14 there (a local anomaly is flagged); overrides the file's lat_deg, "
+                             "lon_deg, height_m columns"))
+    cmd.add_argument("--date", default=None, metavar="YYYY-MM-DD",
+                     help="date of the field (default: the file's date column, else 2025-01-01)")
+
+
+def _site_values(args):
+    """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None."""
+    site = None
+    if args.site is not None:
+        site = _numbers("--site", args.site, None)
+        if len(site) not in (2, 3):
+            raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
+    return site, args.date
 
 
 def _site(args):
-    """The :class:`navlib.sensors.earth_field.Site` of --site/--date, or None without --site."""
+    """The :class:`navlib.sensors.earth_field.Site` of --site/--date (``field``: --site required)."""
     from .sensors.earth_field import Site
-    if args.site is None:
-        if args.date is not None:
-            raise InputError("parameter --date: give --site LAT,LON[,HEIGHT_M] with it")
-        return None
-    v = _numbers("--site", args.site, None)
-    if len(v) not in (2, 3):
-        raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
-    return Site(v[0], v[1], v[2] if len(v) == 3 else 0.0, args.date or "2025-01-01")
+    v, date = _site_values(args)
+    return Site(v[0], v[1], v[2] if len(v) == 3 else 0.0, *((date,) if date is not None else ()))
 
 
 def _field(args) -> int:
@@ -192,7 +201,7 @@ def _simulate_compass(args) -> int:
     errors = CompassErrors()
     if args.noise_ut is not None:
         errors = replace(errors, noise_ut=args.noise_ut)
-    frame = simulate_train_test(errors, seed=args.seed)
+    frame = simulate_train_test(errors, PAPER_A_EARTH, seed=args.seed)
     path = write_new_csv(frame, args.out, overwrite=args.overwrite)
     print(f"wrote {len(frame)} readings ({frame.sweep.nunique()} sweeps) to {path}")
     return 0
@@ -226,16 +235,15 @@ def _diagnose(args) -> int:
 def _loop(args) -> int:
     if args.report:
         check_report_folder(args.report)            # refuse before the work, not after it
-    site = _site(args)
-    if site is not None and args.system != "magnetometer_free":
-        raise InputError(f"parameter --site: the field check is made by the magnetometer_free system, not "
-                         f"{args.system}")
+    site, date = _site_values(args)
+    system = get_system(args.system)
+    if (site is not None or date is not None) and system.final_check is None:
+        raise InputError(f"parameter {'--site' if site is not None else '--date'}: the system {system.name} makes no "
+                         f"field check ({', '.join(n for n, s in SYSTEMS.items() if s.final_check is not None)} do)")
     system, users, names, data = _prepare(args)
     result = loop(system, data, names, user_effects=users, alpha=args.alpha)
-    check = None
-    if system.name == "magnetometer_free":
-        from .workbench.calibration import field_check, field_lines
-        check = field_check(result.final, site, result.screening.noise if result.screening else None)
+    # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
+    check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
     if args.report:
         png, md = write_report(result, args.report, source=str(args.file))
     if args.json:
@@ -249,8 +257,8 @@ def _loop(args) -> int:
         print(result.final_diagnosis.message)
         for u in result.untested:
             print(f"not tested: {u['effect']} ({u['why']})")
-        if check is not None:
-            print("\n".join(field_lines(check)))
+        if lines:
+            print("\n".join(lines))
         if args.report:
             print(f"report: {md} and {png}")
     return 0
@@ -258,7 +266,8 @@ def _loop(args) -> int:
 
 def _calibrate(args) -> int:
     names = [e.name for e in resolve(FREE_EFFECTS, args.model.split(","), None, "magnetometer_free")]
-    path, cal = calibrate_file(args.file, names, args.out)
+    site, date = _site_values(args)
+    path, cal = calibrate_file(args.file, names, args.out, site=site, date=date)
     mc = cal["magcal"]
     print(f"model: {' + '.join(cal['model'])}   rows: {cal['rows']}   residual rms: {cal['residual_rms_ut']:.4g} uT")
     print(f"expected field strength: {mc['expected_field_strength_ut']:.4g} "
@@ -266,6 +275,9 @@ def _calibrate(args) -> int:
           (f"   dip: {cal['dip_deg']:.2f} deg" if "dip_deg" in cal else ""))
     print("b (uT): " + ", ".join(f"{v:.4g} +- {e:.2g}" for v, e in zip(mc["b_ut"], mc["b_std_ut"])))
     print("A: " + "; ".join(", ".join(f"{v:.5f}" for v in row) for row in mc["A"]))
+    if "field" in cal:
+        from .workbench.calibration import field_lines
+        print("\n".join(field_lines(cal["field"])))
     print(f"wrote {path}")
     return 0
 

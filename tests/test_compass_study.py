@@ -11,7 +11,7 @@ import pytest
 
 from navlib.data.compass_sweeps import split_sweeps
 
-from navlib.sensors.compass import SweepConfig, simulate_train_test
+from navlib.sensors.compass import PAPER_A_EARTH, SweepConfig, simulate_train_test
 from navlib.methods.compensator import HeadingTarget
 from navlib.methods.de import DEParams
 from navlib import verdicts
@@ -32,7 +32,7 @@ from navlib.paths import data_path
 
 @pytest.fixture(scope="module")
 def frames():
-    return split_sweeps(simulate_train_test(seed=2024))
+    return split_sweeps(simulate_train_test(earth=PAPER_A_EARTH, seed=2024))
 
 
 @pytest.fixture(scope="module")
@@ -341,7 +341,7 @@ def test_prepare_patent_data_bad_input(frames):
 
 
 def test_glitch_study_preparation_helps():
-    train, test = split_sweeps(simulate_train_test(config=SweepConfig(glitch_prob=0.05), seed=7))
+    train, test = split_sweeps(simulate_train_test(earth=PAPER_A_EARTH, config=SweepConfig(glitch_prob=0.05), seed=7))
     assert train.glitch.sum() >= 3
     runs = glitch_study(train, test, seeds=range(2), method="elm")
     assert set(runs.variant) == set(GLITCH_VARIANTS) and len(runs) == 2 * len(GLITCH_VARIANTS)
@@ -604,7 +604,7 @@ def test_compasses_are_drawn_by_the_stated_rule():
 
 def simulate_sweep_errors(e):
     from navlib.sensors.compass import simulate_sweep
-    return simulate_sweep(e, seed=0).heading_error_deg.to_numpy()
+    return simulate_sweep(e, PAPER_A_EARTH, seed=0).heading_error_deg.to_numpy()
 
 
 def test_robustness_table_marks_verdicts_that_change_with_the_compass():

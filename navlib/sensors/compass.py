@@ -36,21 +36,40 @@ series (:mod:`navlib.methods.smith`) is its first-order harmonic approximation.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
 
 from ..angles import heading_deg, wrap_deg
 from ..errors import InputError, check_param
+from .earth_field import Site, igrf_field
+
+#: Where and when the simulator's default field is taken: Shenyang (41.8 N, 123.4 E, where paper A's
+#: authors work), at sea level, on 2020-01-01.
+COMPASS_SITE = Site(41.8, 123.4, 0.0, "2020-01-01")
+
+
+@lru_cache(maxsize=1)
+def _site_field() -> tuple[float, float]:
+    f = igrf_field(COMPASS_SITE)
+    return f.intensity_ut, f.dip_deg
+
 
 @dataclass(frozen=True)
 class EarthField:
-    """The local geomagnetic field. Defaults: Shenyang (41.8 N, 123.4 E), where paper A's authors work:
-    about 54 uT total intensity with 60 deg dip (IGRF order of magnitude)."""
+    """The local geomagnetic field: total intensity (uT) and dip (deg, positive downward).  Defaults: the
+    IGRF-14 main field at :data:`COMPASS_SITE` (:func:`navlib.sensors.earth_field.igrf_field`, computed by
+    ppigrf on first use, offline).  Paper A's chapter keeps the round field it was built with,
+    :data:`PAPER_A_EARTH`, explicitly."""
 
-    total_ut: float = 54.0
-    dip_deg: float = 60.0
+    total_ut: float = field(default_factory=lambda: _site_field()[0])
+    dip_deg: float = field(default_factory=lambda: _site_field()[1])
+
+    def __post_init__(self):
+        check_param("total_ut", self.total_ut, lo=0, lo_open=True, hi=1e6)
+        check_param("dip_deg", self.dip_deg, lo=-90, hi=90)
 
     @property
     def horizontal_ut(self) -> float:
@@ -59,6 +78,12 @@ class EarthField:
     @property
     def vertical_ut(self) -> float:
         return self.total_ut * np.sin(np.radians(self.dip_deg))
+
+
+#: The field paper A's simulations were built with, before the default came from IGRF (54.3 uT and 60.05
+#: deg there): a round 54 uT at 60 deg dip.  Paper A's study, the stored sweeps (``data/compass_sweeps.csv``)
+#: and ``navlib simulate-compass`` pass it explicitly, so that none of their numbers moves.
+PAPER_A_EARTH = EarthField(total_ut=54.0, dip_deg=60.0)
 
 
 @dataclass(frozen=True)
@@ -173,13 +198,15 @@ def heading_from_field(m_xyz) -> np.ndarray:
     return heading_deg(m[..., 0], m[..., 1])
 
 
-def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField = EarthField(),
+def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField | None = None,
                    config: SweepConfig = SweepConfig(), seed: int | None = 0,
                    sweep: int = 1) -> pd.DataFrame:
     """One turntable sweep. Returns a frame with ``true_heading_deg``, ``measured_heading_deg`` (in [0, 360)),
     ``heading_error_deg`` (wrapped measured - true), the raw field ``mag_x_ut, mag_y_ut, mag_z_ut``, the
     accelerometer ``acc_x_ms2, acc_y_ms2, acc_z_ms2`` (specific force, sensor frame), ``temperature_c``,
-    ``glitch`` (1 where a spike was injected) and ``sweep``."""
+    ``glitch`` (1 where a spike was injected) and ``sweep``; ``earth`` None: :class:`EarthField`'s IGRF
+    default."""
+    earth = EarthField() if earth is None else earth
     rng = np.random.default_rng(seed)
     psi = config.start_deg + config.step_deg * np.arange(config.n_points)
     true = np.where(psi == 360.0, 360.0, np.mod(psi, 360.0))   # paper A reads 0..360 inclusive
@@ -209,10 +236,12 @@ def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField = 
     })
 
 
-def simulate_train_test(errors: CompassErrors = CompassErrors(), earth: EarthField = EarthField(),
+def simulate_train_test(errors: CompassErrors = CompassErrors(), earth: EarthField | None = None,
                         config: SweepConfig = SweepConfig(), seed: int = 2024) -> pd.DataFrame:
     """Paper A's experiment: the same carrier swept twice with independent noise; ``sweep`` 1 trains,
-    ``sweep`` 2 tests. Both are drawn deterministically from ``seed``."""
+    ``sweep`` 2 tests. Both are drawn deterministically from ``seed``; ``earth`` None: the IGRF default
+    (paper A's own sweeps pass :data:`PAPER_A_EARTH`)."""
+    earth = EarthField() if earth is None else earth
     s1, s2 = np.random.SeedSequence(seed).spawn(2)
     return pd.concat([simulate_sweep(errors, earth, config, seed=np.random.default_rng(s1), sweep=1),
                       simulate_sweep(errors, earth, config, seed=np.random.default_rng(s2), sweep=2)],

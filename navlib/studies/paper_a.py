@@ -41,7 +41,7 @@ from ..methods.seeding import generators, sequence
 from ..methods.smith import eight_position_indices, fit_smith
 from .. import verdicts
 from ..report import Claim, method_stats
-from ..sensors.compass import CompassErrors, EarthField, simulate_sweep, simulate_train_test
+from ..sensors.compass import PAPER_A_EARTH, CompassErrors, simulate_sweep, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
 from ..sensors.planar import fit_planar_model
 from .. import engine
@@ -632,7 +632,8 @@ def floor_curve(errors: CompassErrors = CompassErrors(), sim_seed: int = 2024,
     rows = []
     for noise in np.asarray(grid_ut, dtype=float):
         check_param("noise level", noise, lo=0)
-        sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=float(noise)), seed=sim_seed)))
+        sw = Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=float(noise)), PAPER_A_EARTH,
+                                                      seed=sim_seed)))
         e = test_errors(_Planar().fit(sw.x_train, sw.t_train).correct(sw.x_test), sw)
         rows.append({"noise_ut": float(noise), **error_stats(e), "width_deg": float(e.max() - e.min())})
     return pd.DataFrame(rows, columns=["noise_ut", "min_deg", "max_deg", "rms_deg", "width_deg"])
@@ -680,7 +681,8 @@ def noise_study(levels_ut, params: StudyParams = StudyParams(), seeds=range(5), 
     def level_seeds(noise):
         return next((v for k, v in own.items() if np.isclose(k, noise)), seeds)
 
-    studies = [(Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), seed=sim_seed))),
+    studies = [(Sweeps(*split_sweeps(simulate_train_test(replace(errors, noise_ut=noise), PAPER_A_EARTH,
+                                                         seed=sim_seed))),
                 params, level_seeds(noise), methods) for noise in levels]
     frames = seed_studies(studies, workers=workers, scheduler=scheduler)
     return pd.concat([f.assign(noise_ut=noise) for noise, f in zip(levels, frames)], ignore_index=True)
@@ -1192,7 +1194,7 @@ class CompassDrawRule:
 def draw_compass(rule: CompassDrawRule, k: int, noise_ut: float) -> CompassErrors:
     """Draw ``k`` of :class:`CompassDrawRule` (its own ``SeedSequence`` spawn key)."""
     g = np.random.default_rng(sequence(rule.seed, k))
-    h = EarthField().horizontal_ut * g.uniform(*rule.hard_frac)
+    h = PAPER_A_EARTH.horizontal_ut * g.uniform(*rule.hard_frac)
     ang = g.uniform(0.0, 2 * np.pi)
     hz = g.uniform(-rule.hard_z_ut, rule.hard_z_ut)
     return CompassErrors(hard_iron_ut=(h * np.cos(ang), h * np.sin(ang), hz),
@@ -1215,12 +1217,12 @@ def draw_compasses(rule: CompassDrawRule, paper_min_deg: float, paper_max_deg: f
     rows = []
     for k in range(rule.max_draws):
         e = draw_compass(rule, k, 0.0)
-        err = simulate_sweep(e, seed=0).heading_error_deg.to_numpy()
+        err = simulate_sweep(e, PAPER_A_EARTH, seed=0).heading_error_deg.to_numpy()
         lo, hi = float(err.min()), float(err.max())
         if abs(lo - paper_min_deg) <= rule.tolerance_deg and abs(hi - paper_max_deg) <= rule.tolerance_deg:
             rows.append({"compass": f"C{len(rows) + 1}", "draw": k, "errors": replace(e, noise_ut=float(noise_ut)),
                          "min_deg": lo, "max_deg": hi,
-                         "hard_frac": float(np.hypot(*e.hard_iron_ut[:2]) / EarthField().horizontal_ut),
+                         "hard_frac": float(np.hypot(*e.hard_iron_ut[:2]) / PAPER_A_EARTH.horizontal_ut),
                          "soft_max": float(np.abs(np.asarray(e.soft_iron)).max()),
                          "tilt_deg": float(max(abs(e.misalignment_deg[0]), abs(e.misalignment_deg[1]))),
                          "yaw_deg": float(e.misalignment_deg[2])})
@@ -1245,7 +1247,7 @@ def robustness_study(compasses: pd.DataFrame, paper: pd.DataFrame, params: Study
     compass (``sim_seed``, the chapter's noise), :func:`seed_study` of ``methods`` over ``seeds`` (all
     compasses' tasks on the engine at once), the claims at that noise.  Returns ``(runs, verdicts)``:
     the runs with a ``compass`` column, and one row per (compass, claim, reading) with the verdict."""
-    studies = [(Sweeps(*split_sweeps(simulate_train_test(e, seed=sim_seed))), params, seeds, methods)
+    studies = [(Sweeps(*split_sweeps(simulate_train_test(e, PAPER_A_EARTH, seed=sim_seed))), params, seeds, methods)
                for e in compasses.errors]
     frames = seed_studies(studies, workers=workers, scheduler=scheduler)
     rows, allruns = [], []

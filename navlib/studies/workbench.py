@@ -286,7 +286,7 @@ NOT_IN_PAPER = "(not in the paper)"
 #: The level files' claims: file -> (glue key, reading); the other real-data keys: wb_attached, wb_stationary.
 LEVEL_CLAIMS = {"broad_trial05_level.csv": ("wb_level_trial05", "BROAD trial 05, level sweeps"),
                 "broad_trials_level_by_trial.csv": ("wb_level_by_trial", "BROAD trials 2, 3, 5, 7, level")}
-REALDATA_KEYS = tuple(k for k, _ in LEVEL_CLAIMS.values()) + ("wb_attached", "wb_stationary")
+REALDATA_KEYS = tuple(k for k, _ in LEVEL_CLAIMS.values()) + ("wb_attached", "wb_stationary", "wb_free_heading")
 
 
 @dataclass(frozen=True)
@@ -399,14 +399,16 @@ def _rate_claim(claim: str, cases: list[Case], target: float, holds_when: str, *
 
 
 def glance_claims(studies: dict, ooc: pd.DataFrame, level: LevelLoops | None,
-                  magnets: MagnetStudy | None, alpha: float | None = None) -> list[Claim]:
+                  magnets: MagnetStudy | None, alpha: float | None = None,
+                  free_heads: pd.DataFrame | None = None) -> list[Claim]:
     """The chapter's claims: the book's own (our users' targets, not a paper's), each judged by the one
     rule of :mod:`navlib.verdicts`.
 
     ``studies``: data label -> :func:`navlib.workbench.trials.hidden_effect_study` table (the data sets
     the targets are claimed for); ``ooc``: :func:`navlib.workbench.trials.out_of_catalogue_study` table;
     ``level`` and ``magnets``: the real-data studies (None when ``../shared/realdata`` is absent: the
-    claims on real data are then left out); ``alpha``: the level of ``diagnose`` in the real-data loops.
+    claims on real data are then left out); ``alpha``: the level of ``diagnose`` in the real-data loops;
+    ``free_heads``: :func:`reference_free_headings` (its claim, :func:`free_vs_reference_claim`, is added).
 
     Rates are judged on the 95 % Wilson interval of the worst case (one data set and hidden effect; one
     data set; one kind of error): every case must meet the target.  Within a case the trials of both
@@ -481,6 +483,8 @@ def glance_claims(studies: dict, ooc: pd.DataFrame, level: LevelLoops | None,
         statistic="share of stationary-magnet trials reported as a field changing with position, %",
         reading="BROAD trials 28-31 (moving blocks)",
         decided_by=(real_a, "the trial-05 calibration, shared by every trial", "moving blocks only")))
+    if free_heads is not None:
+        claims.append(free_vs_reference_claim(free_heads))
     return claims
 
 
@@ -557,3 +561,107 @@ def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.Data
     out.attrs["field_ut"] = cal["expected_field_strength_ut"]["value"]
     out.attrs["dip_deg"] = cal.get("dip_deg", float("nan"))
     return out
+
+
+# ------------------------------------------------------------------------- issue 23: without a reference
+#: Where BROAD was recorded, as its README states it: it gives no site or date, so the reference-free
+#: loop's local field is not compared with IGRF on BROAD (the CLI does it wherever a site is known).
+BROAD_SITE = None
+#: Every this-many 0.1 s blocks of a BROAD trial in the reference-free loops (about 1 Hz: the projected
+#: noise model factors a matrix of the whole series, and the chapter's time is bounded).
+FREE_ROW_STEP = 9
+
+
+def _free_frame(d: pd.DataFrame) -> pd.DataFrame:
+    from ..workbench.magnetometer_free import ACC, with_invariants
+    return with_invariants(d[list(MAG) + list(ACC) + ["time_s"]])
+
+
+def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float | None = None) -> dict:
+    """The reference-free loop (:mod:`navlib.workbench.magnetometer_free`: field and accelerometer only,
+    the optical reference ignored) from the local field alone on one undisturbed BROAD trial, every
+    ``row_step``-th block: what it ends with -- rows, rows set aside, the noise model, the effects added,
+    the final rms, the outcome, and the local field it estimates (intensity and dip with their 95 %
+    half-widths; the system's ``final_check`` without a site, :data:`BROAD_SITE`); a trial the system
+    refuses (e.g. too few distinct orientations at this row step) says so in ``outcome``."""
+    from ..workbench.magnetometer_free import SYSTEM as FREE
+    data = _free_frame(load_trial(name, row_step))
+    label = name.replace("broad_", "").replace(".csv", "").replace("_", " ")
+    try:
+        res = loop(FREE, data, [], alpha=alpha)
+    except InputError as err:          # what the CLI would refuse (e.g. too few distinct orientations)
+        return {"trial": label, "rows": len(data), "rows set aside": 0, "noise model": "-", "effects added": "-",
+                "final rms (uT)": float("nan"), "outcome": "refused: " + str(err).split(": ", 1)[-1][:60],
+                "field (uT)": float("nan"), "field 95% (uT)": float("nan"), "dip (deg)": float("nan"),
+                "dip 95% (deg)": float("nan")}
+    check, _ = FREE.final_check(res, BROAD_SITE, None)
+    noise = res.screening.noise
+    return {"trial": label, "rows": len(data),
+            "rows set aside": len(res.screening.rows_set_aside),
+            "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
+            "effects added": added(res), "final rms (uT)": res.final.rms, "outcome": res.outcome(),
+            "field (uT)": check["intensity_ut"], "field 95% (uT)": 1.96 * check["intensity_std_ut"],
+            "dip (deg)": check["dip_deg"], "dip 95% (deg)": 1.96 * check["dip_std_deg"]}
+
+
+def free_undisturbed_loops(row_step: int = FREE_ROW_STEP, alpha: float | None = None, workers: int = 1,
+                           scheduler: str | None = None) -> pd.DataFrame | None:
+    """:func:`free_undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data
+    are absent)."""
+    names = undisturbed_trials()
+    if not names:
+        return None
+    check_param("row_step", row_step, lo=1, integer=True)
+    rows = engine.run(free_undisturbed_loop, [(n, row_step, alpha) for n in names], workers=workers,
+                      scheduler=scheduler, label="BROAD reference-free loops",
+                      cost=[float((MAG_DIR / n).stat().st_size) for n in names])
+    return pd.DataFrame(rows).set_index("trial")
+
+
+def free_vs_reference_claim(heads: pd.DataFrame) -> Claim:
+    """The book's claim on :func:`reference_free_headings`: without the optical reference the calibration
+    is as good for heading as the reference-based one -- the RMS heading error with the reference-free
+    calibration minus that with the reference-based one, paired over the undisturbed trials (median and its
+    order-statistic interval, :func:`navlib.verdicts.paired_difference`), at most 0 deg."""
+    free = heads["reference-free calibration (deg)"].to_numpy(float)
+    ref = heads["reference-based calibration (deg)"].to_numpy(float)
+    est = verdicts.paired_difference(free, ref)
+    return Claim("without the reference, the calibration's heading error is no larger than with it",
+                 NOT_IN_PAPER, reading=f"BROAD undisturbed trials ({len(heads)}), both calibrated on trial 05",
+                 source="book",
+                 statistic="RMS heading error against the optical reference, reference-free minus reference-"
+                           "based calibration, paired over trials (median), deg",
+                 estimate=est, boundary=0.0, holds_when="below", unit="deg",
+                 decided_by=("full ellipsoid (hard iron, scale, soft iron) without reference",
+                             "the reference-based loop's final model on trial 05",
+                             "each trial's mean heading offset removed"),
+                 key="wb_free_heading",
+                 ours=f"median {np.median(free):.2f} vs {np.median(ref):.2f} deg")
+
+
+def conventions_example() -> pd.DataFrame:
+    """The library's heading and rotation conventions on one worked example, computed by navlib: the
+    quaternion of a 90 deg yaw (scalar first, rotating body FRD into NED, as the ``magnetometer`` systems
+    and BROAD's files use it), the body's forward axis it turns into NED, the body field a level compass
+    sees there and its heading (:func:`navlib.angles.heading_deg`, deg clockwise from north), and the same
+    turn in paper E's convention (:mod:`navlib.sensors.trajectory`: yaw in rad counter-clockwise from north,
+    body x right, y forward, z up, navigation frame ENU), whose forward axis it also turns east."""
+    from ..angles import DEG, heading_deg
+    from ..sensors.trajectory import euler_to_dcm
+    from ..workbench.magnetometer import QUAT, body_from_nav
+    yaw = 90.0
+    q = np.array([np.cos(yaw * DEG / 2), 0.0, 0.0, np.sin(yaw * DEG / 2)])
+    C_nb = body_from_nav(pd.DataFrame([q], columns=list(QUAT)))[0]      # NED -> body
+    forward_ned = C_nb.T @ np.array([1.0, 0.0, 0.0])
+    field_ned = np.array([20.0, 0.0, 40.0])                                # north and down, uT
+    field_body = C_nb @ field_ned
+    e_yaw = -yaw * DEG                                                     # the same turn, paper E's way
+    e_forward = euler_to_dcm(np.array([0.0, 0.0, e_yaw])) @ np.array([0.0, 1.0, 0.0])   # C_b^n, ENU
+    rows = [("yaw (compass, workbench, BROAD)", f"{yaw:g} deg, clockwise from north (east of north)"),
+            ("quaternion q_w, q_x, q_y, q_z", ", ".join(f"{v:.4f}" for v in q)),
+            ("body x (forward) in NED", ", ".join(f"{v:+.3f}" for v in forward_ned) + "  (points east)"),
+            ("field N, E, D = 20, 0, 40 uT seen in body axes", ", ".join(f"{v:+.2f}" for v in field_body)),
+            ("compass heading atan2(-m_y, m_x)", f"{float(heading_deg(field_body[0], field_body[1])):.1f} deg"),
+            ("paper E's yaw (rad, counter-clockwise, ENU)", f"{e_yaw:+.4f} rad"),
+            ("paper E: body y (forward) in ENU", ", ".join(f"{v:+.3f}" for v in e_forward) + "  (points east)")]
+    return pd.DataFrame(rows, columns=["quantity", "value"]).set_index("quantity")

@@ -35,7 +35,7 @@ from ..data.tables import read_table, write_new, write_new_csv
 from ..errors import InputError
 from .fit import fit_model
 from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, check_units, correction_matrix,
-                                field_summary, free_columns, full_params, has_acc, load_free)
+                                field_summary, free_columns, full_params, has_acc, load_free, site_of)
 from .screen import screen
 
 FORMAT = "navlib calibration"
@@ -43,9 +43,12 @@ VERSION = 1
 DEFAULT_MODEL = ("hard_iron", "scale", "soft_iron")
 
 
-def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "") -> dict:
+def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=None, date=None) -> dict:
     """The calibration of ``data`` (a frame of :func:`navlib.workbench.magnetometer_free.load_free`) with
-    the effects ``model``, as a JSON-ready dict (module docstring)."""
+    the effects ``model``, as a JSON-ready dict (module docstring); where the site is known (``site`` =
+    ``(lat, lon[, height_m])``, ``date``, or the data's site columns:
+    :func:`navlib.workbench.magnetometer_free.site_of`) also ``"field"``, the estimated local field against
+    IGRF-14 there (:func:`field_check`)."""
     fit = fit_model(SYSTEM, data, list(model))
     sc = screen(fit)
     fit = sc.refit(fit)
@@ -90,6 +93,9 @@ def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "") -> dict
     }
     if "dip (deg)" in summary:
         out["dip_deg"] = summary["dip (deg)"]
+    where = site_of(data, site, date, source or "data")
+    if where is not None:
+        out["field"] = field_check(fit, where, noise)
     return out
 
 
@@ -156,14 +162,14 @@ def apply_file(cal_path, data_path, out_path) -> tuple[Path, int]:
     return write_new_csv(apply_calibration(cal, frame), out_path), len(frame)
 
 
-def calibrate_file(data_path, model, out_path) -> tuple[Path, dict]:
+def calibrate_file(data_path, model, out_path, site=None, date=None) -> tuple[Path, dict]:
     """Load a file (:func:`navlib.workbench.magnetometer_free.load_free`), calibrate it with ``model`` and write the JSON to ``out_path``
     (existing files refused before the work)."""
     out_path = Path(out_path)
     if out_path.exists() or out_path.is_symlink():
         raise InputError(f"{out_path}: already exists; not overwritten (choose another --out)")
     data = load_free(data_path)
-    cal = calibrate(data, model, source=Path(data_path).name)
+    cal = calibrate(data, model, source=Path(data_path).name, site=site, date=date)
     return write_calibration(cal, out_path), cal
 
 

@@ -404,8 +404,11 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order)   # with the basis-only blocks
     U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
     minima = np.empty(0)
-    for start in range(0, B, _BATCH):
-        E = colour(U[:, start:start + _BATCH], noise.kappa, ser, fit.n)
+    # a projected noise model (:class:`navlib.workbench.serial.Projection`) re-estimates every replicate on
+    # one grid of Cholesky factors: all replicates in one batch
+    batch = B if ser.projection is not None else _BATCH
+    for start in range(0, B, batch):
+        E = colour(U[:, start:start + batch], noise.kappa, ser, fit.n)
         minima = np.r_[minima, family.minima(E, bases, noise, sc.regressors)]
         if np.sum(minima <= p_min) >= K:
             return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", len(minima), True)

@@ -136,6 +136,18 @@ class System:
         fitted shape into the amplitude reported (``sqrt 2`` for a sinusoid, ``2`` for a step).
     meaning : str
         One sentence: what is measured and what the residual is.
+    noise_directions : callable or None
+        ``noise_directions(fit) -> (n_obs, 3)``: for residuals that are scalars computed from a 3-axis
+        sensor along a direction that turns with it (the reference-free magnetometer's invariants), each
+        residual's gradient with respect to the raw axes; the screen then models the noise on the sensor's
+        axes, seen through these directions (:class:`navlib.workbench.serial.Projection`).  None: the
+        residuals are the sensor's own axes (an AR model of the residuals).
+    final_check : callable or None
+        ``final_check(loop_result, site, date) -> (dict, list of str)``: what the system reports at the end
+        of a loop besides the diagnosis (the reference-free magnetometer: the estimated local field against
+        the Earth-field model at the site, ``site`` = ``(lat, lon[, height_m])`` and ``date`` from the
+        command line or None); the CLI prints the lines and puts the dict under ``"field"`` in ``--json``.
+        None: nothing more (and ``--site``/``--date`` are refused).
     """
 
     name: str
@@ -145,6 +157,8 @@ class System:
     fit: Callable
     structure: Callable
     meaning: str = ""
+    noise_directions: Callable | None = None
+    final_check: Callable | None = None
 
 
 #: Every system, by name (filled by the system modules as they are imported; the package imports them all).

@@ -40,13 +40,22 @@ Relation to the ``magnetometer`` system: there ``m = A C m_n + b`` with ``A = R 
 here ``M`` is the correction, ``M = A^-1`` up to the rotation the invariants cannot see and the overall
 scale: ``(I + S)^-1 = I - S + S^2 ...``, so ``K ~ -S`` for small soft iron.
 
+Serial correlation: the invariants are the sensor's axis noise seen along the field's direction (and the
+dip's), which turns with the hand; an AR model of the invariants themselves is misspecified (with AR(1)
+noise of 0.9 on the axes its estimate runs to the bound and false alarms rise to about 14 %).  The system
+therefore gives the screen each residual's gradient with respect to the raw axes (:func:`noise_directions`,
+the ``System.noise_directions`` hook) and the workbench models the noise on the axes
+(:class:`navlib.workbench.serial.Projection`: exact GLS, the same bootstrap-calibrated tests).
+
 Structure tests (shapes no catalogued effect produces): the magnitude changing in time (an offset per
 10 % of the recording, per residual column), and the magnitude depending on the direction of the sample on
 the sphere beyond the ellipsoid (the seven third-degree harmonics of the field's direction: an ellipsoid
 is of degree <= 2).
 
 Files: ``mag_x_ut, mag_y_ut, mag_z_ut``; optional ``acc_x_ms2, acc_y_ms2, acc_z_ms2``, ``time_s``,
-``temperature_c``, ``gyr_*_dps``; other columns ignored.  :func:`load_free` refuses bad input in one line.
+``temperature_c``, ``gyr_*_dps``, and where and when (:data:`SITE_COLUMNS`: ``lat_deg``, ``lon_deg``,
+``height_m``, ``date``; :func:`site_of`), which the loop's field check and ``calibrate`` use for the IGRF
+field; other columns ignored.  :func:`load_free` refuses bad input in one line.
 """
 from __future__ import annotations
 
@@ -103,12 +112,80 @@ _PARAMS = [p for e in FREE_EFFECTS.values() for p in e.params]
 SIM_FIELD_UT, SIM_DIP_DEG = 43.54, 69.56
 
 
+#: Optional columns that say where and when the recording was made (:func:`site_of`): geodetic latitude
+#: and longitude (deg, WGS84), height above the ellipsoid (m), and ``date`` (ISO 8601 text: a date
+#: ``2021-03-04`` or a date-time ``2021-03-04T10:15:00Z``; the day is used).
+SITE_COLUMNS = ("lat_deg", "lon_deg", "height_m", "date")
+#: Largest spread within one file of latitude or longitude (deg) and height (m): one site per file.  0.1 deg
+#: (about 11 km) and 500 m move the IGRF main field by well under the 0.3 uT crustal tolerance of the
+#: field check (:data:`navlib.workbench.calibration.CRUST_TOL_UT`).
+SITE_TOL_DEG, HEIGHT_TOL_M = 0.1, 500.0
+#: Largest spread of the ``date`` column (days): the main field changes by up to about 0.1 uT a year.
+DATE_TOL_DAYS = 366
+
+
 def free_columns() -> list[Column]:
     return ([Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT) for c in MAG]
             + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4) for c in ACC]
             + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10),
                Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0)]
-            + [Column(c, "deg/s", required=False, checked=False) for c in GYR])
+            + [Column(c, "deg/s", required=False, checked=False) for c in GYR]
+            + [Column("lat_deg", "deg", required=False, lo=-90.0, hi=90.0),
+               Column("lon_deg", "deg", required=False, lo=-180.0, hi=360.0),
+               Column("height_m", "m", required=False, lo=-1e4, hi=1e6)])
+
+
+def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str) -> float:
+    v = frame[col].to_numpy(float)
+    spread = float(np.ptp(v)) if len(v) else 0.0
+    if spread > tol:
+        raise InputError(f"{name}: column '{col}' varies by {spread:.4g} {unit} within the file (more than "
+                         f"{tol:g} {unit}): one site per file")
+    return float(np.median(v))
+
+
+def _date_of(frame: pd.DataFrame, name: str) -> str:
+    text = frame["date"].astype(str).str.strip()
+    when = pd.to_datetime(text, utc=True, format="ISO8601", errors="coerce")
+    bad = np.flatnonzero(when.isna().to_numpy() | ~text.str.match(r"\d{4}-\d{2}-\d{2}").to_numpy())
+    if bad.size:
+        raise InputError(f"{name}: column 'date', row {bad[0] + 1}: {str(frame['date'].iloc[bad[0]])[:40]!r} is not an "
+                         f"ISO 8601 date (YYYY-MM-DD or YYYY-MM-DDTHH:MM:SSZ)")
+    days = (when.max() - when.min()).total_seconds() / 86400.0
+    if days > DATE_TOL_DAYS:
+        raise InputError(f"{name}: column 'date' spans {days:.0f} days (more than {DATE_TOL_DAYS}): one recording per "
+                         f"file")
+    return (when.min() + (when.max() - when.min()) / 2).date().isoformat()
+
+
+def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str = "data"):
+    """The :class:`navlib.sensors.earth_field.Site` of a recording, or None when nothing says where it was
+    made.  ``site`` (``(lat, lon)`` or ``(lat, lon, height_m)``, e.g. from ``--site``) and ``date`` (from
+    ``--date``) override the columns :data:`SITE_COLUMNS`; otherwise latitude, longitude and height are the
+    columns' medians and the date the middle of the ``date`` column (default: the Site's).  One-line
+    InputError: only one of ``lat_deg``/``lon_deg``; a position spread beyond :data:`SITE_TOL_DEG` or
+    :data:`HEIGHT_TOL_M`, dates spanning more than :data:`DATE_TOL_DAYS` or not ISO 8601; a ``date`` with
+    no site (out-of-range values are refused by the loader, naming column and row)."""
+    from ..sensors.earth_field import Site
+    if site is None:
+        have = [c for c in ("lat_deg", "lon_deg") if c in frame]
+        if len(have) == 1:
+            raise InputError(f"{name}: column '{have[0]}' without "
+                             f"'{({'lat_deg', 'lon_deg'} - set(have)).pop()}': give both, or --site")
+        if have:
+            site = (_one_value(frame, "lat_deg", SITE_TOL_DEG, "deg", name),
+                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name))
+            if "height_m" in frame:
+                site += (_one_value(frame, "height_m", HEIGHT_TOL_M, "m", name),)
+    if date is None and "date" in frame:
+        date = _date_of(frame, name)
+    if site is None:
+        if date is not None:
+            raise InputError("parameter --date: a date without a site: give --site LAT,LON[,HEIGHT_M] or the "
+                             "columns lat_deg, lon_deg")
+        return None
+    site = tuple(float(v) for v in site)
+    return Site(site[0], site[1], site[2] if len(site) > 2 else 0.0, *((date,) if date is not None else ()))
 
 
 def has_acc(frame: pd.DataFrame) -> bool:
@@ -159,12 +236,16 @@ def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
     stuck axis; a unit other than uT (the median ``|m|`` must lie in 10-150 uT: the Earth's field is 22-67 uT; the
     message names gauss, mG, nT, mT or T when one of them brings it there); an accelerometer in g (the
     median ``|a|`` must lie in 5-15 m/s^2; near 1 names g); too few distinct orientations
-    (``check_orientations``).  Adds the derived columns of :func:`with_invariants`."""
+    (``check_orientations``); site columns that disagree (:func:`site_of`).  Adds the derived columns of :func:`with_invariants`."""
     name = Path(path).name
     frame = read_table(path, free_columns(), min_rows=min_rows, kind="magnetometer file")
     require_variation(frame, MAG, name, "a magnetometer turned through many orientations")
     check_units(frame, name)
     check_orientations(frame, name)
+    if "lat_deg" in frame or "lon_deg" in frame:        # the site columns, checked at load
+        site_of(frame, name=name)
+    elif "date" in frame:
+        _date_of(frame, name)
     return with_invariants(frame)
 
 
@@ -328,11 +409,43 @@ def free_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     return out
 
 
+def noise_directions(fit: Fit) -> np.ndarray:
+    """Each residual's gradient with respect to the raw field axes, (n_obs, 3) in observation order (the
+    system's ``noise_directions`` hook): the magnitude residual ``e = |u| - F`` moves by ``n . M' u/|u|``
+    for axis noise ``n``, the dip residual by ``n . M' (R' a/|a| - c u/|u|) / sqrt(1 - c^2)``; unit vectors
+    for ``M = I`` and a field at the dip ``c``.  The noise of the invariants is the sensor's axis noise seen
+    along these turning directions (:class:`navlib.workbench.serial.Projection`)."""
+    d = fit.data
+    p = full_params(fit.params)
+    M = correction_matrix(p)
+    u = corrected(p, d, fit.model.get("temperature_centre_c", 0.0))
+    uh = u / np.linalg.norm(u, axis=1, keepdims=True)
+    cols = [uh @ M]
+    if has_acc(d):
+        a = d[list(ACC)].to_numpy(float)
+        R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
+        c = float(np.clip(p.get("field_down_ut", 0.0) / max(p.get("field_ut", 0.0), 1e-9), -0.99, 0.99))
+        ga = (a / np.linalg.norm(a, axis=1, keepdims=True)) @ R @ M
+        cols.append((ga - c * cols[0]) / np.sqrt(1.0 - c * c))
+    return np.stack(cols, axis=1).reshape(-1, 3)
+
+
+def loop_field_check(result, site=None, date: str | None = None) -> tuple[dict, list[str]]:
+    """The system's ``final_check`` hook: the local field the loop's final model estimates, beside the
+    IGRF-14 field at the recording's site (:func:`site_of`: ``site``/``date`` or the data's columns;
+    :func:`navlib.workbench.calibration.field_check`), as a dict and report lines."""
+    from .calibration import field_check, field_lines
+    check = field_check(result.final, site_of(result.final.data, site, date),
+                        result.screening.noise if result.screening is not None else None)
+    return check, field_lines(check)
+
+
 MEASURED["magnetometer_free"] = (DERIVED, False)
 SYSTEM = register_system(System(
     "magnetometer_free", "uT", FREE_EFFECTS, load_free, _fit_free, free_structure,
     "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
-    "and (with an accelerometer) its component along gravity - D, uT"))
+    "and (with an accelerometer) its component along gravity - D, uT", noise_directions=noise_directions,
+    final_check=loop_field_check))
 
 
 def field_summary(fit: Fit) -> dict:

@@ -65,7 +65,7 @@ from scipy import stats
 from ..errors import InputError
 from .effects import testable
 from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
-from .serial import NoiseModel, select, series_of
+from .serial import NoiseModel, select, series_of, with_projection
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
 #: 2e-9; real sensor noise has heavier tails (the slow undisturbed BROAD trials reach 5.8) and stays below,
@@ -283,6 +283,8 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     regressors = None
     if serial and rich is not None and rich.rms > floor:
         ser = series_of(rich.data, rich.n, rich.system)
+        if ser is not None and rich.spec.noise_directions is not None:     # residuals see axis-wise noise
+            ser = with_projection(ser, rich.data, rich.spec.noise_directions(rich))
         if ser is not None:
             if zk is not None:                         # the noise model describes the bulk of the data
                 ser = ser.without(np.abs(zk.ravel()) > Z_NOISE)

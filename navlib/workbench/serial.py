@@ -23,6 +23,25 @@ predicted from the previous ``min(t, p)`` with the Durbin-Levinson coefficients 
 by the square root of the prediction-error variance (Brockwell and Davis 1991, *Time Series: Theory and
 Methods*, sections 5.2 and 8.7), so ``W e`` has independent samples of one variance.
 
+**The projected model.**  Some systems' residuals are not the sensor's axes but scalars computed from
+them along a direction that turns with the sensor: the reference-free magnetometer's invariants (the field
+magnitude, ``e = n . u/|u|``, and the dip) see the axis-wise noise ``n`` through the field's direction,
+which turns by tens of degrees within a correlation time of the noise when the sensor is turned by hand.
+Their correlation in time is then ``rho(k) (d_t . d_(t+k))``, not an AR process of the residual, and an AR
+model fitted to it is misspecified (on AR(1) noise of 0.9 its REML estimate runs to the bound
+:data:`KAPPA_MAX`, the whitened tests and their bootstrap then describe a random walk, and data with nothing
+missing fail the tests far more often than ``alpha``).  For such a system the series carries a
+:class:`Projection` (the system's ``noise_directions`` hook gives ``d_i``, the gradient of each residual
+with respect to the raw axes) and the noise model is the sensor's: AR(1) on each axis, continuous in time
+(``rho(k) = kappa^|k|``, ``k`` in sampling steps, so gaps and rows set aside need no segments), seen
+through the directions::
+
+    Cov(x_i, x_j) = s^2 kappa^|t_i - t_j| (d_i . d_j)          (positive definite: a Schur product)
+
+Whitening and colouring use the Cholesky factor of this matrix (exact GLS for the invariants), and its REML
+likelihood is computed from the same factor; the order is 0 or 1 (AIC), the rest of the machinery --
+tests, bootstrap, intervals -- unchanged.
+
 **The estimate.**  The kappas maximise the *restricted* (REML) log likelihood of the residual ``r`` given
 the regressors ``X`` (the columns a least-squares fit has already taken out of it: the model's Jacobian
 and the structure shapes), with ``R`` the AR correlation matrix and ``W' W = R^-1``::
@@ -45,6 +64,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 from scipy import stats
+from scipy.linalg import solve_triangular
 from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
@@ -65,15 +85,29 @@ SELECT_PENALTY = np.log
 FILE_ORDER_SYSTEMS = {"magnetometer"}
 
 
+@dataclass(frozen=True, eq=False)
+class Projection:
+    """How the residuals see a noise that lives on the sensor's axes: each observation ``i`` is
+    ``x_i = d_i . n(t_i)`` with ``n`` the sensor's 3-axis noise (the same AR process on each axis,
+    independent between axes) and ``d_i`` a unit vector (``directions``, observation order); ``clock`` is
+    each observation's time in sampling steps.  Then ``Cov(x_i, x_j) = s^2 rho(|t_i - t_j|) (d_i . d_j)``
+    (module docstring: the projected model)."""
+
+    directions: np.ndarray
+    clock: np.ndarray
+
+
 @dataclass(frozen=True)
 class Series:
     """Where the observations of a residual vector sit in time: ``order`` lists observation indices axis by
     axis, each axis in time order; ``pos`` is each ordered observation's place in its segment (0 starts a
-    segment); ``source`` says what ordered them (``"time_s"`` or ``"file order"``)."""
+    segment); ``source`` says what ordered them (``"time_s"`` or ``"file order"``); ``projection``: the
+    residuals are a turning projection of axis-wise noise (:class:`Projection`), or None."""
 
     order: np.ndarray
     pos: np.ndarray
     source: str
+    projection: Projection | None = None
 
     @property
     def segments(self) -> int:
@@ -90,7 +124,7 @@ class Series:
         start = start[~gone]
         seg = np.cumsum(start) - 1
         first = np.flatnonzero(start)
-        return Series(self.order[~gone], np.arange(len(seg)) - first[seg], self.source)
+        return Series(self.order[~gone], np.arange(len(seg)) - first[seg], self.source, self.projection)
 
 
 def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
@@ -120,6 +154,71 @@ def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
     order = np.concatenate([rows * axes + j for j in range(axes)])
     pos = np.tile(pos_rows, axes)
     return Series(order, pos, source)
+
+
+def with_projection(series: Series | None, data: pd.DataFrame, directions: np.ndarray) -> Series | None:
+    """``series`` with the :class:`Projection` of residuals that see axis-wise noise along ``directions``
+    ((n_obs, 3), observation order, rows flattened as the systems do): each observation's clock is its
+    row's ``time_s`` over the median time step (a series in file order: the row number)."""
+    if series is None:
+        return None
+    d = np.asarray(directions, float)
+    n = len(data)
+    axes = len(d) // n
+    if series.source == "time_s":
+        t = data["time_s"].to_numpy(float)
+        steps = np.diff(np.sort(t))
+        steps = steps[steps > 0]
+        t = (t - t.min()) / (float(np.median(steps)) if steps.size else 1.0)
+    else:
+        t = np.arange(n, dtype=float)
+    return replace(series, projection=Projection(d, np.repeat(t, axes)))
+
+
+#: Cholesky factors of projected correlation matrices kept (:func:`_projected_factor`).
+_KEEP_FACTORS = 6
+_FACTORS: dict = {}
+
+
+def regular_clock(series: Series) -> bool:
+    """Whether a projected series is sampled on whole steps (then a negative lag-1 correlation is an AR(1)
+    process; on an irregular clock only ``kappa >= 0``, ``kappa^|dt|``, is a valid correlation)."""
+    c = series.projection.clock
+    return bool(np.allclose(c, np.round(c), atol=1e-6))
+
+
+def _projected_factor(kappa, series: Series) -> np.ndarray:
+    """Lower Cholesky factor of the projected model's correlation matrix (module docstring) over the
+    observations of ``series``, in series order (AR(1): ``kappa[0]``); the last few are kept."""
+    k = float(kappa[0])
+    key = (id(series), k)
+    hit = _FACTORS.get(key)
+    if hit is not None and hit[0] is series:
+        return hit[1]
+    pr = series.projection
+    d = pr.directions[series.order]
+    t = pr.clock[series.order]
+    lag = np.abs(t[:, None] - t[None, :])
+    rho = np.abs(k) ** lag
+    if k < 0:
+        if not regular_clock(series):
+            raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
+        rho = rho * np.where(np.round(lag) % 2 == 1, -1.0, 1.0)
+    K = rho * (d @ d.T)
+    jitter = 1e-10 * np.mean(np.diag(K))                            # round-off only
+    for _ in range(4):
+        K[np.diag_indices_from(K)] += jitter
+        try:
+            L = np.linalg.cholesky(K)
+            break
+        except np.linalg.LinAlgError:                               # near the bound: numerically singular
+            jitter *= 100.0
+    else:
+        raise np.linalg.LinAlgError("projected noise covariance is not positive definite")
+    if len(_FACTORS) >= _KEEP_FACTORS:
+        _FACTORS.pop(next(iter(_FACTORS)))
+    _FACTORS[key] = (series, L)
+    return L
 
 
 def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) -> np.ndarray:
@@ -160,6 +259,8 @@ def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
     p = len(kappa)
     if p == 0:
         return xo
+    if series.projection is not None:
+        return solve_triangular(_projected_factor(kappa, series), xo, lower=True, check_finite=False)
     phi, v = levinson(kappa)
     m = len(xo)
     out = xo.copy()
@@ -191,6 +292,9 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     out = np.zeros((n_obs,) + u.shape[1:])
     if p == 0:
         out[series.order] = u
+        return out
+    if series.projection is not None:
+        out[series.order] = _projected_factor(kappa, series) @ u
         return out
     phi, v = levinson(kappa)
     x = np.empty_like(u)
@@ -281,7 +385,9 @@ class NoiseModel:
             return f"no serial correlation found (AR order 0 by AIC; series in {self.series.source})"
         slow = (f"a slow shape sees about {self.effective_samples:.0f} independent samples of {self.n_obs}"
                 if self.inflation > 1 else "neighbouring samples anti-correlated")
-        return (f"serially correlated, AR({self.order}) with lag-1 correlation {self.lag1:.2f} "
+        seen = (" on the sensor's axes, seen along the residuals' turning directions"
+                if self.series.projection is not None else "")
+        return (f"serially correlated, AR({self.order}){seen} with lag-1 correlation {self.lag1:.2f} "
                 f"(interval {self.bounds[0]:.2f}..{self.bounds[1]:.2f}; series in {self.series.source}): tests "
                 f"on whitened residuals, {slow}")
 
@@ -377,6 +483,47 @@ class _Restricted:
         return rss, logdet_r, logdet_g
 
 
+class _ProjectedLik:
+    """:class:`_Restricted` for a series with a :class:`Projection`: the same REML and plain likelihoods,
+    from the Cholesky factor of the projected correlation matrix (AR order 0 or 1)."""
+
+    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series):
+        self.r = np.asarray(r, float)[series.order]
+        self.Q = np.asarray(Q, float)[series.order]
+        self.series = series
+        self.n, self.k = len(self.r), self.Q.shape[1]
+
+    def __call__(self, kappa) -> float:
+        rss, logdet_r, logdet_g = self._parts(kappa)
+        return -0.5 * ((self.n - self.k) * np.log(max(rss, 1e-300)) + logdet_r + logdet_g)
+
+    def ml(self, kappa) -> float:
+        rss, logdet_r, _ = self._parts(kappa)
+        return -0.5 * (self.n * np.log(max(rss, 1e-300) / self.n) + logdet_r)
+
+    def _parts(self, kappa):
+        if len(kappa) > 1:
+            raise ValueError("the projected noise model is of order 0 or 1")
+        if len(kappa):
+            L = _projected_factor(kappa, self.series)
+            w = solve_triangular(L, np.column_stack([self.Q, self.r]), lower=True, check_finite=False)
+            logdet_r = 2.0 * float(np.sum(np.log(np.diag(L))))
+        else:
+            w, logdet_r = np.column_stack([self.Q, self.r]), 0.0
+        rss, logdet_g = _rss_g(w.T @ w, self.k)
+        return rss, logdet_r, logdet_g
+
+
+def _rss_g(M: np.ndarray, k: int) -> tuple[float, float]:
+    """From the Gram matrix of whitened ``[Q, r]``: the whitened RSS of ``r`` after the regressors and
+    ``log det`` of the regressors' Gram matrix."""
+    if not k:
+        return float(M[0, 0]), 0.0
+    ev, U = np.linalg.eigh(M[:k, :k])
+    ev = np.maximum(ev, 1e-300)
+    return float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev)), float(np.sum(np.log(ev)))
+
+
 def _restricted_loglik(kappa, r: np.ndarray, Q: np.ndarray, series: Series) -> float:
     """The REML log likelihood computed directly (whitening every column): the reference
     :class:`_Restricted` is tested against."""
@@ -434,7 +581,11 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         return NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation")
     if order is not None:
         max_order = int(order)
-    loglik = _Restricted(r, Q, series, max(max_order, 1), prepared)
+    if series.projection is not None:                   # the sensor's AR(1), seen through the directions
+        max_order = min(max_order, 1)
+        loglik = _ProjectedLik(r, Q, series)
+    else:
+        loglik = _Restricted(r, Q, series, max(max_order, 1), prepared)
     best = ((), loglik(()))
     logliks = [best[1]]
     aic_best = -2 * best[1] if order is None else np.inf
@@ -448,10 +599,12 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
         logliks.append(best[1])
         max_order = 0                                  # skip the forward search
+    # the lowest kappa_1: -KAPPA_MAX, or 0 for a projected series on an irregular clock
+    low = 0.0 if series.projection is not None and not regular_clock(series) else -np.arctanh(KAPPA_MAX)
     for p in range(1, max_order + 1):
         if p == 1:
             sol = minimize_scalar(lambda a: -loglik((np.tanh(a),)),
-                                  bounds=(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX)), method="bounded",
+                                  bounds=(low, np.arctanh(KAPPA_MAX)), method="bounded",
                                   options={"xatol": 1e-4})
             kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
         else:
@@ -483,7 +636,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
             return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
 
         ends = []
-        for edge in (-lim, lim):
+        for edge in (min(low, a0), lim):
             if a0 == edge or gap(edge) <= 0:
                 ends.append(float(np.tanh(edge)))
             else:
@@ -543,7 +696,7 @@ def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_o
     likelihood parts for that AR order."""
     qb = basis_on(base, series, n_obs)
     qe = basis_on(np.column_stack([base, extra]), series, n_obs) if extra is not None and np.size(extra) else None
-    if order is None:
+    if order is None or series.projection is not None:
         return Bases(qb, qe)
     P = max(int(order), 1)
     return Bases(qb, qe, _Prepared(qb, series, P), _Prepared(qe, series, P) if qe is not None else None)
@@ -598,13 +751,55 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
     correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
     correlation of each vector."""
     qb, qe = bases.base, bases.extra
-    rb, mb = ar1_grid(E, qb, series, grid, bases.prepared_base)
+    if series.projection is not None:
+        grid = PROJECTED_GRID if regular_clock(series) else PROJECTED_GRID[PROJECTED_GRID >= 0]
+        parts = projected_grid(E, [q for q in (qb, qe) if q is not None], series, grid)
+        rb, mb = parts[0]
+        re_, me = parts[-1]
+    else:
+        rb, mb = ar1_grid(E, qb, series, grid, bases.prepared_base)
     ib = np.argmax(rb, axis=0)
     cols = np.arange(E.shape[1])
     if qe is None:
         return grid[ib]
-    re_, me = ar1_grid(E, qe, series, grid, bases.prepared_extra)
+    if series.projection is None:
+        re_, me = ar1_grid(E, qe, series, grid, bases.prepared_extra)
     ie = np.argmax(re_, axis=0)
     n = len(series.order)
     better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(mb[ib, cols], qb.shape[1] + 1, n)
     return np.where(better, grid[ie], grid[ib])
+
+
+#: The grid of lag-1 correlations of the projected model's bootstrap re-estimates (:func:`projected_grid`):
+#: every fourth point of :data:`AR1_GRID` (spacing 0.1 in ``atanh(kappa)``, 0.02 in ``kappa`` near 0.9),
+#: since each point costs a Cholesky factor of the whole series.
+PROJECTED_GRID = AR1_GRID[::4]
+
+
+def projected_grid(E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID) -> list:
+    """:func:`ar1_grid` for a series with a :class:`Projection`: for each regressor basis of ``bases``,
+    ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one Cholesky factor per grid point, shared."""
+    Ze = np.asarray(E, float)[series.order]
+    Qs = [np.asarray(Q, float)[series.order] for Q in bases]
+    n, B = Ze.shape
+    out = [(np.empty((len(grid), B)), np.empty((len(grid), B))) for _ in Qs]
+    for g, phi in enumerate(grid):
+        L = _projected_factor((float(phi),), series)
+        logdet_r = 2.0 * float(np.sum(np.log(np.diag(L))))
+        we = solve_triangular(L, Ze, lower=True, check_finite=False)
+        ee = np.einsum("ij,ij->j", we, we)
+        for (reml, ml), Q in zip(out, Qs):
+            k = Q.shape[1]
+            if k:
+                wq = solve_triangular(L, Q, lower=True, check_finite=False)
+                ev, U = np.linalg.eigh(wq.T @ wq)
+                ev = np.maximum(ev, 1e-300)
+                z = (U.T @ (wq.T @ we)) / np.sqrt(ev)[:, None]
+                rss = ee - np.einsum("ij,ij->j", z, z)
+                logdet_g = float(np.sum(np.log(ev)))
+            else:
+                rss, logdet_g = ee, 0.0
+            rss = np.maximum(rss, 1e-300)
+            reml[g] = -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
+            ml[g] = -0.5 * (n * np.log(rss / n) + logdet_r)
+    return out
