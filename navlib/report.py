@@ -134,8 +134,10 @@ def row_label(value: Any) -> str:
     return str(value)
 
 
-def no_negative_zero(text: str) -> str:
-    """``-0``, ``-0.000``, ``-0e+00`` (a value that rounds to zero) without its minus sign."""
+def no_negative_zero(text: Any) -> str:
+    """``-0``, ``-0.000``, ``-0e+00`` (a value that rounds to zero) without its minus sign; a value that
+    is not text yet (an index level moved into the columns by :func:`readable`) is shown as ``str``."""
+    text = text if isinstance(text, str) else str(text)
     m = _NEG_ZERO.match(text)
     return m.group(1).lstrip("+") if m else text
 

@@ -133,6 +133,8 @@ def test_readable_labels_units_flat_rows_no_index_name_no_negative_zero():
     lines = repr(report.table(named, readable=True)).splitlines()
     assert len(lines) == 2 and lines[0].split() == ["quantity", "value"]      # no index-name row
     assert len(repr(report.table(named)).splitlines()) == 3                    # the old table had one
+    steps = pd.DataFrame({"rms_deg": [0.5]}, index=pd.Index([0], name="step"))  # a numeric index level
+    assert repr(report.table(steps, readable=True)).splitlines()[1].split() == ["0", "0.5"]
     with pytest.raises(InputError, match="RMS"):
         report.readable(pd.DataFrame({"rms_deg": [1], "RMS (deg)": [2]}))
 
