@@ -92,6 +92,9 @@ def test_the_staircase_shows_every_step_on_a_log_axis_with_the_noise_band():
     heights = ax.patches[0].get_data().values                 # the stairs
     assert np.allclose(heights, [f.rms for f in res.fits])
     assert all(t.get_rotation() == 0 for t in ax.get_xticklabels())      # three steps: labels fit
+    long = staircase_figure(res, title="compass: unexplained structure: heading harmonic 3; " * 3)
+    lines = long.axes[0].get_title().splitlines()      # a long outcome wraps: the figure stays in the column
+    assert len(lines) > 1 and max(map(len, lines)) <= 70
 
 
 def test_staircase_slants_labels_that_do_not_fit_their_step():

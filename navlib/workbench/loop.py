@@ -5,6 +5,8 @@ consistent with noise or nothing more can be named.  The CLI command ``loop`` an
 """
 from __future__ import annotations
 
+import textwrap
+
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -200,6 +202,10 @@ def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -
     return (float(sigma * np.sqrt(chi2.ppf(tail, dof) / n)), float(sigma * np.sqrt(chi2.ppf(1 - tail, dof) / n)))
 
 
+#: Characters per line of a staircase's title (the loop's outcome can be long): it stays within the column.
+TITLE_WIDTH = 70
+
+
 def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
                      floor: tuple[float, float] | None = None, floor_label: str | None = None):
     """The loop as a picture, full column width: a staircase with one step per effect added (labelled
@@ -218,7 +224,8 @@ def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
                                       else "richest model's residual (95 %)")
     rs.staircase(ax, step_labels(result), [f.rms for f in result.fits], [f.loo_rms for f in result.fits],
                  floor=floor, floor_label=floor_label or "noise floor (95 %)", unit=result.final.unit,
-                 title=title if title is not None else f"{result.final.system}: {result.outcome()}")
+                 title=textwrap.fill(title if title is not None else f"{result.final.system}: {result.outcome()}",
+                                     TITLE_WIDTH))
     ticks = ax.get_xticklabels()
     lines = max(t.get_text().count("\n") + 1 for t in ticks)
     extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
