@@ -4,7 +4,8 @@ figures, the chapter's claims with their verdicts, and the headline results file
 A chapter notebook uses it like this::
 
     from navlib import report
-    report.use_style()          # figures for the 756 px column, 11-12 pt; tables with readable labels
+    report.use_style()          # figures for the 756 px column, 11-12 pt;
+                                # tables with readable labels
     report.table(df, formats={"rms (deg)": "{:.3f}"})     # an HTML table (text/plain kept for nbval)
     report.glue_number("ade_rms", 4.23, "{:.2f}")         # prose: {glue:text}`ade_rms`
     report.glue_figure("fig-compass-errors", fig)         # markdown: ```{glue:figure} fig-compass-errors
@@ -600,7 +601,9 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
          "p90_rms_<unit>", "median_min_<unit>", "median_max_<unit>", "n_seeds"}},
-         "claims": [{"claim", "paper", "ours", "reproduced", "verdict", "reading", "why"}], "extra": {...}}
+         "claims": [{"claim", "paper", "ours", "reproduced", "verdict", "reading",
+                     "why"}],
+         "extra": {...}}
 
     ``methods`` maps a display label to :func:`method_stats`-style keys (without unit suffix); the unit
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6

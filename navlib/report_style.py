@@ -5,11 +5,13 @@ loop drawn as a staircase.
 A chapter applies it with one call in its first code cell::
 
     from navlib import report
-    report.use_style()          # fonts, sizes and DPI below; tables with readable labels (report.readable)
+    report.use_style()          # fonts, sizes and DPI below;
+                                # tables with readable labels (report.readable)
 
 and draws its figures with::
 
-    fig, axes = report.panels(3)            # one row if three panels fit the column, else stacked
+    fig, axes = report.panels(3)            # one row if three panels fit the column,
+                                            # else stacked
     report.legend_below(axes[0])            # the legend under the axes, never over the data
 
 **Sizes.**  The book's content column is :data:`COLUMN_PX` = 756 px wide at 1400 px; a figure is shown at

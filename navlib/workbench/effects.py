@@ -36,7 +36,8 @@ top level of the file is loaded)::
 
     quadrantal = Effect(
         "quadrantal", ("q3_sin_deg", "q3_cos_deg"), ("deg", "deg"),
-        "A three-cycle heading error (e.g. a sensor nonlinearity): three maxima per revolution.",
+        "A three-cycle heading error (e.g. a sensor nonlinearity): "
+        "three maxima per revolution.",
         system="compass",
         contribution=lambda p, d: (p["q3_sin_deg"] * np.sin(np.radians(3 * d["true_heading_deg"]))
                                    + p["q3_cos_deg"] * np.cos(np.radians(3 * d["true_heading_deg"]))))

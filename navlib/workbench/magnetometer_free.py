@@ -7,7 +7,8 @@ The sensor model is written, as magcal and the field's calibration scripts write
 
     u_i = M (m_i - b - k (T_i - T_c)),      M = I + K   (K symmetric, trace-free)
     e_i = |u_i| - F,     g_i = a_i/|a_i| . R(theta) u_i - D,     c = D / F
-    residual_i = ( e_i ,  (g_i - c e_i) / sqrt(1 - c^2) )      [uT; the second only with an accelerometer]
+    residual_i = ( e_i ,  (g_i - c e_i) / sqrt(1 - c^2) )
+                                  [uT; the second only with an accelerometer]
 
 The second residual is the dot-product misfit with its share of the magnitude misfit taken out: the same
 sensor noise ``n`` enters ``e ~ n . u/|u|`` and ``g ~ n . a/|a|``, which are correlated by ``c`` (0.94 at a

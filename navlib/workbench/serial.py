@@ -36,7 +36,8 @@ with respect to the raw axes) and the noise model is the sensor's: AR(1) on each
 (``rho(k) = kappa^|k|``, ``k`` in sampling steps, so gaps and rows set aside need no segments), seen
 through the directions::
 
-    Cov(x_i, x_j) = s^2 kappa^|t_i - t_j| (d_i . d_j)          (positive definite: a Schur product)
+    Cov(x_i, x_j) = s^2 kappa^|t_i - t_j| (d_i . d_j)
+                                     (positive definite: a Schur product)
 
 Whitening and colouring use the Cholesky factor of this matrix (exact GLS for the invariants), and its REML
 likelihood is computed from the same factor; the order is 0 or 1 (AIC), the rest of the machinery --
