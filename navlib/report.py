@@ -4,16 +4,21 @@ figures, the chapter's claims with their verdicts, and the headline results file
 A chapter notebook uses it like this::
 
     from navlib import report
-    report.use_style()          # figures for the 756 px column, 11-12 pt;
-                                # tables with readable labels
-    report.table(df, formats={"rms (deg)": "{:.3f}"})     # an HTML table (text/plain kept for nbval)
-    report.glue_number("ade_rms", 4.23, "{:.2f}")         # prose: {glue:text}`ade_rms`
-    report.glue_figure("fig-compass-errors", fig)         # markdown: ```{glue:figure} fig-compass-errors
-    d = verdicts.paired_difference(rms_de, rms_ade)           # the same seeds
-    claims = [report.Claim("ADE-BP beats DE-BP", "-0.22..0.20 vs -0.31..0.25 deg", reading="pure DE",
-                           statistic="RMS DE-BP - RMS ADE-BP, deg", estimate=d, boundary=0.0,
-                           holds_when="above", unit="deg")]
-    report.glue_table("compass_glance", report.glance(claims))   # Results at a glance (chapter top)
+    report.use_style()      # figures for the 756 px column, 11-12 pt;
+                            # tables with readable labels
+    # an HTML table (text/plain kept for nbval)
+    report.table(df, formats={"rms (deg)": "{:.3f}"})
+    # prose: {glue:text}`ade_rms`
+    report.glue_number("ade_rms", 4.23, "{:.2f}")
+    # markdown: ```{glue:figure} fig-compass-errors
+    report.glue_figure("fig-compass-errors", fig)
+    d = verdicts.paired_difference(rms_de, rms_ade)       # the same seeds
+    claims = [report.Claim(
+        "ADE-BP beats DE-BP", "-0.22..0.20 vs -0.31..0.25 deg", reading="pure DE",
+        statistic="RMS DE-BP - RMS ADE-BP, deg", estimate=d, boundary=0.0,
+        holds_when="above", unit="deg")]
+    # Results at a glance (chapter top)
+    report.glue_table("compass_glance", report.glance(claims))
     report.write_results("compass", claims=claims, unit="deg",
                          methods={"ADE-BP": report.method_stats(rms, mins, maxs)})
 

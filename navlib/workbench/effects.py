@@ -39,8 +39,9 @@ top level of the file is loaded)::
         "A three-cycle heading error (e.g. a sensor nonlinearity): "
         "three maxima per revolution.",
         system="compass",
-        contribution=lambda p, d: (p["q3_sin_deg"] * np.sin(np.radians(3 * d["true_heading_deg"]))
-                                   + p["q3_cos_deg"] * np.cos(np.radians(3 * d["true_heading_deg"]))))
+        contribution=lambda p, d: (
+            p["q3_sin_deg"] * np.sin(np.radians(3 * d["true_heading_deg"]))
+            + p["q3_cos_deg"] * np.cos(np.radians(3 * d["true_heading_deg"]))))
 """
 from __future__ import annotations
 
