@@ -294,21 +294,21 @@ class _PageScan(HTMLParser):
             self.problems.append(f"visible nbval marker '{m.group(0).strip()}' {self._where()}: use the cell "
                                  f"tag nbval-ignore-output (or nbval-skip) instead of the comment")
 
-    def _check_pre(self, text: str):
+    def _check_width(self, text: str, limit: int, what: str, shown: int, advice: str):
+        """The first line of a block wider than ``limit`` characters, as one problem (one per block)."""
         for line in text.splitlines():
-            if len(line.rstrip()) > MAX_PRE_CHARS:
-                self.problems.append(
-                    f"output line of {len(line.rstrip())} characters (max {MAX_PRE_CHARS}) {self._where()}: "
-                    f"'{line.strip()[:70]}...': show a report.table(...) or shorten the printed text")
-                return      # one message per block
+            if len(line.rstrip()) > limit:
+                self.problems.append(f"{what} of {len(line.rstrip())} characters (max {limit}) {self._where()}: "
+                                     f"'{line.strip()[:shown]}...': {advice}")
+                return
+
+    def _check_pre(self, text: str):
+        self._check_width(text, MAX_PRE_CHARS, "output line", 70,
+                          "show a report.table(...) or shorten the printed text")
 
     def _check_code(self, text: str):
-        for line in text.splitlines():
-            if len(line.rstrip()) > MAX_CODE_CHARS:
-                self.problems.append(
-                    f"wide code line of {len(line.rstrip())} characters (max {MAX_CODE_CHARS}) {self._where()}: "
-                    f"'{line.strip()[:60]}...': break the line (or fold the cell: tag hide-input)")
-                return      # one message per block
+        self._check_width(text, MAX_CODE_CHARS, "wide code line", 60,
+                          "break the line (or fold the cell: tag hide-input)")
 
     def _check_header_row(self, table: dict, row: list[tuple[bool, str]]):
         """A header row of a result table: pandas' index-name row (the index's name alone, the column

@@ -284,17 +284,6 @@ from .report_style import (legend_below, legend_right, panel_grid, panels,  # no
                            staircase, use_style)
 
 
-def style() -> None:
-    """The older matplotlib defaults (10 pt at figures up to 12 in wide, shown shrunk); chapters move to
-    :func:`navlib.report_style.use_style` (figures for the 756 px column, 11-12 pt, readable tables)."""
-    import matplotlib as mpl
-
-    mpl.rcParams.update({"figure.dpi": 100, "savefig.dpi": 110, "font.size": 10, "axes.titlesize": 10,
-                         "axes.labelsize": 10, "legend.fontsize": 9, "xtick.labelsize": 9,
-                         "ytick.labelsize": 9, "figure.autolayout": False, "axes.grid": True,
-                         "grid.alpha": 0.3})
-
-
 # ----------------------------------------------------------------------------------------------- claims
 @dataclass(frozen=True)
 class Claim:

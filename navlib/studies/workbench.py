@@ -174,13 +174,18 @@ def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: in
     """:func:`undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data are
     absent); ``workers``, ``scheduler``: where they run (:mod:`navlib.engine`, the largest files first; the
     workers read the files, so a remote cluster needs them at the same path)."""
+    return _on_undisturbed(undisturbed_loop, row_step, alpha, workers, scheduler, "BROAD loops")
+
+
+def _on_undisturbed(fn, row_step, alpha, workers, scheduler, label) -> pd.DataFrame | None:
+    """``fn(name, row_step, alpha)`` on every undisturbed BROAD 3-D trial on the engine (the longest
+    recordings first), one row each indexed by ``trial``; None if the data are absent."""
     names = undisturbed_trials()
     if not names:
         return None
     check_param("row_step", row_step, lo=1, integer=True)
-    rows = engine.run(undisturbed_loop, [(n, row_step, alpha) for n in names], workers=workers,
-                      scheduler=scheduler, label="BROAD loops",
-                      cost=[float((MAG_DIR / n).stat().st_size) for n in names])     # the longest recordings first
+    rows = engine.run(fn, [(n, row_step, alpha) for n in names], workers=workers, scheduler=scheduler,
+                      label=label, cost=[float((MAG_DIR / n).stat().st_size) for n in names])
     return pd.DataFrame(rows).set_index("trial")
 
 
@@ -608,14 +613,8 @@ def free_undisturbed_loops(row_step: int = FREE_ROW_STEP, alpha: float | None = 
                            scheduler: str | None = None) -> pd.DataFrame | None:
     """:func:`free_undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data
     are absent)."""
-    names = undisturbed_trials()
-    if not names:
-        return None
-    check_param("row_step", row_step, lo=1, integer=True)
-    rows = engine.run(free_undisturbed_loop, [(n, row_step, alpha) for n in names], workers=workers,
-                      scheduler=scheduler, label="BROAD reference-free loops",
-                      cost=[float((MAG_DIR / n).stat().st_size) for n in names])
-    return pd.DataFrame(rows).set_index("trial")
+    return _on_undisturbed(free_undisturbed_loop, row_step, alpha, workers, scheduler,
+                           "BROAD reference-free loops")
 
 
 def free_vs_reference_claim(heads: pd.DataFrame) -> Claim:
