@@ -349,6 +349,8 @@ def check_page(text: str, content: bool = True) -> list[str]:
 
 
 GLANCE = "Results at a glance"
+#: The admonition that closes every chapter (:func:`navlib.report.showed`).
+SHOWED = "What this chapter showed"
 #: The known problems of the :data:`LAYOUT_KINDS` per page, in the book folder (``book/``).
 BASELINE_FILE = "check_html_baseline.json"
 
@@ -363,6 +365,29 @@ def check_chapter_opening(text: str) -> list[str]:
     first_cell = text.find('<div class="cell docutils container')
     if 0 <= first_cell < m.start():
         return [f"the '{GLANCE}' admonition comes after a code cell: move it right after the title and intro"]
+    return []
+
+
+def check_chapter_closing(text: str) -> list[str]:
+    """A chapter page must close with the *What this chapter showed* admonition, after its last code cell,
+    and that box must count the same claims as the chapter's *Results at a glance* box."""
+    m = None
+    for m in re.finditer(r'<p class="admonition-title">\s*' + SHOWED, text):
+        pass
+    if m is None:
+        return [f"chapter without a '{SHOWED}' admonition: close the chapter with report.showed(claims) "
+                f"glued into a ':::{{admonition}} {SHOWED}' block"]
+    if text.find('<div class="cell docutils container', m.end()) >= 0:
+        return [f"the '{SHOWED}' admonition is not at the chapter's end: a code cell follows it"]
+    box = html.unescape(re.sub(r"<[^>]+>", " ", text[m.end():]))
+    shown = {}
+    for t in _TALLY.finditer(re.sub(r"\s+", " ", box)):
+        shown.setdefault("paper" if t.group(1) == "paper's" else "book", (int(t.group(2)), int(t.group(4)),
+                                                                           int(t.group(5))))
+    glance = glance_counts(text)
+    if glance is not None and shown != glance:
+        return [f"the '{SHOWED}' box counts {shown} but the glance box {glance}: build both from the same "
+                f"claims"]
     return []
 
 
@@ -454,7 +479,7 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
         rel = page.relative_to(html_dir)
         found += [(rel.as_posix(), p) for p in check_page(text, content=rel.parts[0] != "_modules")]
         if is_chapter_page(rel):                       # the chapters (executed notebooks)
-            found += [(rel.as_posix(), p) for p in check_chapter_opening(text)]
+            found += [(rel.as_posix(), p) for p in check_chapter_opening(text) + check_chapter_closing(text)]
             chapter_pages[rel.as_posix()] = text
         landing.update(landing_counts(text))
     found += count_problems(landing, chapter_pages)

@@ -32,8 +32,9 @@ import hashlib
 import html
 import json
 import math
-import re
 import os
+import re
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Mapping
@@ -176,12 +177,18 @@ class Table:
     columns get 4 significant digits.  ``caption`` is shown above the table.  ``readable`` (default: on
     after :func:`navlib.report_style.use_style`) shows the formatted table with readable labels
     (:func:`readable`: no index-name row, flat row labels, units in parentheses) and no ``-0``;
-    ``formats`` still name the original columns."""
+    ``formats`` still name the original columns.  ``fold`` (a summary line, or True for the caption) puts a
+    secondary table in a dropdown on the page, closed until the reader opens it (the plain text is the
+    same)."""
 
     def __init__(self, frame: pd.DataFrame, formats: Mapping[str, Any] | None = None,
-                 caption: str | None = None, index: bool = True, readable: bool | None = None):
+                 caption: str | None = None, index: bool = True, readable: bool | None = None,
+                 fold: bool | str = False):
         if not isinstance(frame, pd.DataFrame):
             frame = pd.DataFrame(frame)
+        if fold is True and not caption:
+            raise InputError("report.table: fold=True needs a caption (it is the dropdown's summary)")
+        self.fold = (caption if fold is True else str(fold)) if fold else None
         self.frame = frame
         self.formats = dict(formats or {})
         self.caption = caption
@@ -224,8 +231,11 @@ class Table:
         styler = styler.set_table_attributes(f'class="navbook-table" style="{_CSS}"')
         styler = styler.set_table_styles([{"selector": "th", "props": _CELL + "text-align:left;"},
                                           {"selector": "td", "props": _CELL}])
-        if self.caption:
+        if self.caption and not self.fold:
             styler = styler.set_caption(self.caption)
+        if self.fold:
+            return (f'<details class="navbook-fold"><summary>{html.escape(self.fold, quote=False)}</summary>'
+                    f"{styler.to_html()}</details>")
         return styler.to_html()
 
     def __repr__(self) -> str:
@@ -239,9 +249,120 @@ class Table:
 
 
 def table(frame: pd.DataFrame, formats: Mapping[str, Any] | None = None, caption: str | None = None,
-          index: bool = True, readable: bool | None = None) -> Table:
-    """Shorthand for :class:`Table`; the last expression of a cell displays it."""
-    return Table(frame, formats, caption, index, readable)
+          index: bool = True, readable: bool | None = None, fold: bool | str = False) -> Table:
+    """Shorthand for :class:`Table`; the last expression of a cell displays it (``fold``: in a dropdown)."""
+    return Table(frame, formats, caption, index, readable, fold)
+
+
+# ----------------------------------------------------------------------------------------------- parameters
+#: Unit suffixes of parameter names beyond :data:`UNIT_SUFFIXES` (which also label table columns).
+PARAMETER_UNITS = {("deg", "rt", "h"): "deg/sqrt(h)", ("hz",): "Hz", ("m",): "m", ("ms2",): "m/s^2",
+                   ("dps",): "deg/s", ("ppm",): "ppm", ("g",): "g"}
+
+
+def unit_of(name: str) -> str:
+    """The unit a snake_case name carries in its suffix (``noise_ut`` -> ``uT``, ``gyro_arw_deg_rt_h`` ->
+    ``deg/sqrt(h)``, ``t_start_c`` -> ``degC``), or "" when it carries none (``n_seeds``)."""
+    words = [w.lower() for w in str(name).split("_") if w]
+    best = ""
+    best_len = 0
+    for table_ in (PARAMETER_UNITS, UNIT_SUFFIXES):
+        for suffix, shown in table_.items():
+            k = len(suffix)
+            if len(words) > k and tuple(words[-k:]) == suffix and k > best_len:
+                best, best_len = shown, k
+    return best
+
+
+def _parameters_cell(notebook: str | os.PathLike) -> str:
+    path = Path(notebook)
+    try:
+        nb = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such notebook") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputError(f"{path}: not a notebook ({type(err).__name__})") from None
+    for cell in nb.get("cells", []):
+        if cell.get("cell_type") == "code" and "parameters" in cell.get("metadata", {}).get("tags", []):
+            src = cell.get("source", "")
+            return "".join(src) if isinstance(src, list) else str(src)
+    raise InputError(f"{path}: no cell tagged 'parameters'")
+
+
+def parameter_rows(source: str) -> list[dict]:
+    """The assignments of a notebook's parameters cell, in order: ``name``, ``default`` (the literal
+    assigned; a tuple assignment gives one row per name) and ``meaning`` (the comment on the
+    assignment's lines, after the block of comment lines right above it; an assignment without a comment
+    right under another one shares its meaning)."""
+    import ast
+    import io
+    import tokenize
+
+    try:
+        tree = ast.parse(source)
+    except SyntaxError as err:
+        raise InputError(f"parameters cell, line {err.lineno}: {err.msg}") from None
+    comments: dict[int, str] = {}
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        if tok.type == tokenize.COMMENT:
+            comments[tok.start[0]] = tok.string.lstrip("#").strip()
+    lines = source.splitlines()
+    code_lines = {n for node in tree.body for n in range(node.lineno, node.end_lineno + 1)}
+    rows: list[dict] = []
+    prev_end = -1
+    for node in tree.body:
+        if not isinstance(node, ast.Assign) or len(node.targets) != 1:
+            continue
+        above, n = [], node.lineno - 1
+        while n >= 1 and n in comments and n not in code_lines and lines[n - 1].lstrip().startswith("#"):
+            above.insert(0, comments[n])
+            n -= 1
+        beside = [comments[k] for k in range(node.lineno, node.end_lineno + 1) if k in comments]
+        meaning = "; ".join(x for x in (" ".join(above), " ".join(beside)) if x)
+        if not meaning and rows and prev_end == node.lineno - 1:
+            meaning = rows[-1]["meaning"]          # a pair under one comment (ade_f_min, ade_f_max)
+        prev_end = node.end_lineno
+        target, value = node.targets[0], node.value
+        if isinstance(target, ast.Tuple) and isinstance(value, ast.Tuple) and len(target.elts) == len(value.elts):
+            pairs = list(zip(target.elts, value.elts))
+        else:
+            pairs = [(target, value)]
+        for t, v in pairs:
+            if isinstance(t, ast.Name):
+                try:
+                    default = ast.literal_eval(v)
+                except ValueError:
+                    default = ast.get_source_segment(source, v)
+                rows.append({"name": t.id, "default": default, "meaning": meaning})
+    return rows
+
+
+def _show_value(v: Any) -> str:
+    if isinstance(v, tuple):
+        v = list(v)
+    return repr(v)
+
+
+def parameter_table(notebook: str | os.PathLike, namespace: Mapping[str, Any], fold: bool | str = True,
+                    caption: str = "Parameters of this run") -> Table:
+    """The parameters cell of ``notebook`` (the code cell tagged ``parameters``, which papermill and
+    ``navlib grid`` override) as a table of name, value, unit and meaning: the value is this run's (from
+    ``namespace``, the notebook's ``globals()``), with the cell's default beside it where the run changed
+    it; the unit comes from the name's suffix (:func:`unit_of`), the meaning from the cell's comments.  In
+    a dropdown unless ``fold=False``."""
+    rows = []
+    for r in parameter_rows(_parameters_cell(notebook)):
+        name = r["name"]
+        value = namespace.get(name, r["default"])
+        shown = _show_value(value)
+        if shown != _show_value(r["default"]):
+            shown += f" (default {_show_value(r['default'])})"
+        rows.append({"parameter": name, "value": shown, "unit": unit_of(name) or "–", "meaning": r["meaning"]})
+    changed = sum("(default " in row["value"] for row in rows)
+    summary = f"{caption}: {len(rows)} parameters" + (f", {changed} changed from the defaults" if changed else
+                                                      ", all at their defaults")
+    return Table(pd.DataFrame(rows, columns=["parameter", "value", "unit", "meaning"]), index=False,
+                 caption=summary, readable=False, fold=summary if fold is True else fold)
 
 
 # ----------------------------------------------------------------------------------------------- glue
@@ -265,9 +386,9 @@ def glue_text(name: str, text: str) -> str:
     return str(text)
 
 
-def glue_table(name: str, tab: "Table | Glance | pd.DataFrame") -> None:
+def glue_table(name: str, tab: "Table | Glance | Showed | pd.DataFrame") -> None:
     """Glue a table for a MyST ``{glue:}`` directive (e.g. inside the Results-at-a-glance admonition)."""
-    _glue(name, tab if isinstance(tab, (Table, Glance)) else Table(tab))
+    _glue(name, tab if isinstance(tab, (Table, Glance, Showed)) else Table(tab))
 
 
 def glue_figure(name: str, fig) -> None:
@@ -558,6 +679,97 @@ class Glance:
 def glance(claims: Iterable[Claim]) -> Glance:
     """The Results-at-a-glance tables (see :class:`Glance`)."""
     return Glance(claims)
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    claim: str
+    reading: str
+    source: str
+    verdict: str
+    category: str | None      # the key of verdicts.REASONS of a claim that cannot be judged
+
+
+def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
+    """A claim or a results file's claim record, reduced to what the summary boxes need."""
+    if isinstance(c, Claim):
+        return _Outcome(c.claim, c.reading, c.source, c.verdict,
+                        verdicts.reason_category(c.basis, c.reason) if c.verdict == "cannot be judged" else None)
+    try:
+        return _Outcome(str(c["claim"]), str(c.get("reading", "")), str(c["source"]), str(c["verdict"]),
+                        c.get("reason") if c["verdict"] == "cannot be judged" else None)
+    except (KeyError, TypeError, AttributeError):
+        raise InputError(f"a claim record without claim, source and verdict: {str(c)[:80]}") from None
+
+
+def _reason_counts(cs: list[_Outcome]) -> str:
+    cats = [c.category for c in cs if c.verdict == "cannot be judged"]
+    counts = {k: cats.count(k) for k in dict.fromkeys(cats) if k in verdicts.REASONS}
+    return ", ".join(f"{n} {verdicts.REASONS[k][0]}" for k, n in counts.items())
+
+
+def _claim_outcome(cs: list[_Outcome]) -> str:
+    """One claim's verdicts over its readings in words: the verdict when there is one reading or every
+    reading agrees, else how many readings give each verdict."""
+    v = [c.verdict for c in cs]
+    if len(set(v)) == 1:
+        head = v[0] if len(v) == 1 else f"{v[0]} in all {len(v)} readings"
+        if v[0] == "cannot be judged":
+            why = _reason_counts(cs)
+            head += f" ({why})" if why else ""
+        return head
+    parts = [f"{name} in {v.count(name)}" for name in verdicts.VERDICTS if v.count(name)]
+    return ", ".join(parts) + f" of {len(v)} readings"
+
+
+def _tally(cs: list[_Outcome]) -> str:
+    v = [c.verdict for c in cs]
+    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
+            f"{v.count('cannot be judged')} cannot be judged")
+
+
+class Showed:
+    """The *What this chapter showed* box at a chapter's end, built from the same claims as the glance box
+    and the landing page (:class:`Claim` objects or the claim records of a results file): per source (the
+    paper's claims, the book's own), the tally with the reasons of the claims that cannot be judged, and
+    one line per claim with its verdicts over the readings."""
+
+    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"]):
+        outs = [_outcome(c) for c in claims]
+        parts = [(title, [c for c in outs if c.source == src])
+                 for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims"))]
+        self.parts = [(t, cs) for t, cs in parts if cs]
+
+    @staticmethod
+    def _rows(cs: list[_Outcome]) -> pd.DataFrame:
+        names = list(dict.fromkeys(c.claim for c in cs))
+        return pd.DataFrame([{"claim": n, "what we found": _claim_outcome([c for c in cs if c.claim == n])}
+                             for n in names], columns=["claim", "what we found"])
+
+    @staticmethod
+    def _lead(title: str, cs: list[_Outcome]) -> str:
+        why = _reason_counts(cs)
+        return f"{title}: {_tally(cs)}" + (f" ({why})" if why else "")
+
+    def _repr_html_(self) -> str:
+        out = []
+        for title, cs in self.parts:
+            out.append(f'<p class="navbook-showed">{html.escape(self._lead(title, cs), quote=False)}</p>')
+            out.append(Table(self._rows(cs), index=False, readable=False)._repr_html_())
+        return "\n".join(out)
+
+    def __repr__(self) -> str:
+        out = []
+        for title, cs in self.parts:
+            out.extend(textwrap.wrap(self._lead(title, cs), PLAIN_WIDTH))
+            out.append(repr(Table(self._rows(cs), index=False, readable=False)))
+        return "\n".join(out)
+
+
+def showed(claims: Iterable[Claim]) -> Showed:
+    """The *What this chapter showed* box (see :class:`Showed`); glue it into a ``:::{admonition} What
+    this chapter showed`` block at the chapter's end."""
+    return Showed(claims)
 
 
 def glue_claims(claims: Iterable[Claim]) -> None:

@@ -278,6 +278,30 @@ def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
     assert "_generated/gyro.html: chapter without" in err and "intro.html" not in err
 
 
+def test_chapter_pages_must_close_with_what_the_chapter_showed():
+    from navlib.booktools import check_chapter_closing
+
+    def box(title, paper, book=None):
+        tallies = f"<p>The paper's claims: {paper[0]} of {sum(paper)} reproduced, {paper[1]} not reproduced, " \
+                  f"{paper[2]} cannot be judged</p>"
+        if book:
+            tallies += f"<p>The book's own claims: {book[0]} of {sum(book)} reproduced, {book[1]} not " \
+                       f"reproduced, {book[2]} cannot be judged</p>"
+        return f'<div class="admonition"><p class="admonition-title">{title}</p>{tallies}</div>'
+
+    cell = '<div class="cell docutils container"><pre>x = 1</pre></div>'
+    glance = box("Results at a glance", (2, 1, 3), (1, 0, 0))
+    good = page(glance + cell + box("What this chapter showed", (2, 1, 3), (1, 0, 0)))
+    assert check_chapter_closing(good) == []
+    assert "without a 'What this chapter showed'" in check_chapter_closing(page(glance + cell))[0]
+    late = page(glance + box("What this chapter showed", (2, 1, 3), (1, 0, 0)) + cell)
+    assert "not at the chapter's end" in check_chapter_closing(late)[0]
+    other = page(glance + cell + box("What this chapter showed", (3, 0, 3), (1, 0, 0)))
+    assert "counts" in check_chapter_closing(other)[0]
+    no_book = page(glance + cell + box("What this chapter showed", (2, 1, 3)))
+    assert "counts" in check_chapter_closing(no_book)[0]
+
+
 def test_compare_results_checks_intervals_except_for_a_volatile_timing():
     ref = _results()
     moved = json.loads(json.dumps(ref))

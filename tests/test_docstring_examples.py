@@ -3,10 +3,11 @@ import doctest
 
 import pytest
 
+from navlib.workbench import calibration as calibration_module
 from navlib.workbench import diagnose as diagnose_module
 from navlib.workbench import loop as loop_module
 
-EXAMPLES = [loop_module.loop, diagnose_module.diagnose]
+EXAMPLES = [loop_module.loop, diagnose_module.diagnose, calibration_module.calibrate]
 
 
 @pytest.mark.parametrize("fn", EXAMPLES, ids=lambda f: f.__qualname__)

@@ -163,3 +163,103 @@ def test_table_html_escapes_text_and_lets_identifiers_wrap():
     assert "temperature_<wbr>change_<wbr>c" in h and "needs_<wbr>columns" in h
     assert "&lt;b&gt;x" in h and "<b>x</b>" not in h
     assert "temperature_change_c" in repr(tab)            # the text twin (nbval) is unchanged
+
+
+# ----------------------------------------------------------------------------------------------- fold, parameters, showed
+def test_a_folded_table_is_a_dropdown_with_the_same_text():
+    df = pd.DataFrame({"rms_deg": [0.1234]})
+    open_ = report.table(df, caption="Secondary numbers")
+    folded = report.table(df, caption="Secondary numbers", fold=True)
+    assert repr(open_) == repr(folded)
+    h = folded._repr_html_()
+    assert h.startswith('<details class="navbook-fold"><summary>Secondary numbers</summary>')
+    assert h.endswith("</details>") and "<caption>" not in h
+    assert "<details" not in open_._repr_html_()
+    assert "<summary>Open me</summary>" in report.table(df, fold="Open me")._repr_html_()
+    with pytest.raises(InputError, match="fold=True needs a caption"):
+        report.table(df, fold=True)
+
+
+@pytest.mark.parametrize("name, unit", [("noise_ut", "uT"), ("gyro_arw_deg_rt_h", "deg/sqrt(h)"),
+                                        ("drift_deg_h", "deg/h"), ("t_start_c", "degC"),
+                                        ("imu_rate_hz", "Hz"), ("n_seeds", ""), ("alpha", ""),
+                                        ("duration_s", "s")])
+def test_unit_of_reads_the_name_suffix(name, unit):
+    assert report.unit_of(name) == unit
+
+
+CELL = '''# first: a comment block
+# over two lines
+first_ut = 0.5
+second = "x"   # beside it
+# a pair under one comment
+lo_deg, hi_deg = -1.0, 2.0
+shares_it = 3
+
+pair_a = 1
+pair_b = 2
+
+lonely = [1, 2]
+'''
+
+
+def test_parameter_rows_read_names_defaults_and_comments():
+    rows = report.parameter_rows(CELL)
+    assert [r["name"] for r in rows] == ["first_ut", "second", "lo_deg", "hi_deg", "shares_it", "pair_a",
+                                          "pair_b", "lonely"]
+    by = {r["name"]: r for r in rows}
+    assert by["first_ut"]["meaning"] == "first: a comment block over two lines"
+    assert by["first_ut"]["default"] == 0.5
+    assert by["second"]["meaning"] == "beside it"
+    assert by["lo_deg"]["default"] == -1.0 and by["hi_deg"]["default"] == 2.0
+    assert by["hi_deg"]["meaning"] == by["shares_it"]["meaning"] == "a pair under one comment"
+    assert by["pair_b"]["meaning"] == by["pair_a"]["meaning"] == ""
+    assert by["lonely"]["default"] == [1, 2]
+    with pytest.raises(InputError, match="line 1"):
+        report.parameter_rows("x = = 1")
+
+
+def test_parameter_table_shows_this_runs_values_beside_the_defaults(tmp_path):
+    nb = tmp_path / "ch.ipynb"
+    nb.write_text(json.dumps({"cells": [
+        {"cell_type": "markdown", "metadata": {}, "source": "# t"},
+        {"cell_type": "code", "metadata": {"tags": ["parameters"]}, "source": CELL.splitlines(True)}]}))
+    t = report.parameter_table(nb, {"first_ut": 0.5, "second": "y"})
+    f = t.frame.set_index("parameter")
+    assert f.loc["first_ut", "value"] == "0.5" and f.loc["first_ut", "unit"] == "uT"
+    assert f.loc["second", "value"] == "'y' (default 'x')"
+    assert f.loc["lonely", "value"] == "[1, 2]" and f.loc["lonely", "unit"] == "–"
+    assert "8 parameters, 1 changed" in t.fold and "<details" in t._repr_html_()
+    assert "all at their defaults" in report.parameter_table(nb, {}).fold
+    nb2 = tmp_path / "none.ipynb"
+    nb2.write_text(json.dumps({"cells": [{"cell_type": "code", "metadata": {}, "source": "x = 1"}]}))
+    with pytest.raises(InputError, match="no cell tagged 'parameters'"):
+        report.parameter_table(nb2, {})
+    with pytest.raises(InputError, match="no such notebook"):
+        report.parameter_table(tmp_path / "missing.ipynb", {})
+    (tmp_path / "bad.ipynb").write_text("{not json")
+    with pytest.raises(InputError, match="not a notebook"):
+        report.parameter_table(tmp_path / "bad.ipynb", {})
+
+
+def test_showed_summarises_each_claim_over_its_readings():
+    def c(name, reading, value, source="paper"):
+        return report.Claim(name, "p", reading=reading, source=source, statistic="d, deg",
+                            estimate=verdicts.Estimate(value, value - 0.1, value + 0.1, "median over runs", 20),
+                            boundary=0.0, holds_when="above", unit="deg")
+    claims = [c("A beats B", "r1", 1.0), c("A beats B", "r2", -1.0), c("A beats B", "r3", 0.05),
+              c("C beats D", "r1", 1.0), c("C beats D", "r2", 2.0), c("ours", "-", 0.0, "book")]
+    s = report.showed(claims)
+    text = repr(s)
+    assert "The paper's claims: 3 of 5 reproduced, 1 not reproduced, 1 cannot be judged" in text
+    assert "(1 our interval contains the boundary)" in " ".join(text.split())
+    rows = dict(s._rows(s.parts[0][1]).values)
+    assert rows["A beats B"] == "reproduced in 1, not reproduced in 1, cannot be judged in 1 of 3 readings"
+    assert rows["C beats D"] == "reproduced in all 2 readings"
+    assert dict(s._rows(s.parts[1][1]).values)["ours"].startswith("cannot be judged (1 ")
+    # the claim records of a results file give the same box
+    recs = [cl.record() for cl in claims]
+    assert repr(report.showed(recs)) == text
+    assert "The book's own claims" in s._repr_html_()
+    with pytest.raises(InputError, match="claim record"):
+        report.showed([{"claim": "x"}])

@@ -1231,7 +1231,7 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
                               for name, e in est.items()], ignore_index=True)
     q = _quantities([("k_R", k_rate, "(deg/h) per (C/h)"), ("simulated hot net neurons", sim_hot_net.n_neurons, ""),
                      ("simulated cold net neurons", sim_cold_net.n_neurons, ""),
-                     ("Fig 4 run: simulated final drift", q_drift, "deg/h")])
+                     ("paper Fig 4 run: simulated final drift", q_drift, "deg/h")])
     return Table5(pd.DataFrame(rows), fig4, q, pd.concat(per_run, ignore_index=True))
 
 
@@ -1466,7 +1466,7 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     goal_nmi = fact("position_goal")
     floor_nmi = float(np.median(f3.runs["best_nmi"]))
     out.append(Claim(
-        f"position error after identification below {goal_nmi:g} nmi/72 h (Table 3, Fig 3)",
+        f"position error after identification below {goal_nmi:g} nmi/72 h (Table 3, paper Fig 3)",
         ", ".join(f"{x:g}" for x in f3.table["paper after"]) + " nmi", reading="our RBF on the measured latitudes",
         statistic=f"median over {len(f3.runs)} simulated runs (Table 3's tests x {s.n_seeds} draws) of the worst "
                   f"72 h position error after identification, nmi",
