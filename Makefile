@@ -51,7 +51,14 @@ screenshots: $(STAMP)
 	@command -v chromium > /dev/null || { echo "chromium is missing: install it with 'apt-get install -y chromium' (Debian package chromium)" >&2; exit 2; }
 	@$(PY) -m navlib.booktools screenshots book/_build/html book/_build/screenshots --width 1400
 
-test: test-lib test-notebooks test-results
+# The library tests and nbval run at the same time (each is CPU-bound only part of the time: together they
+# keep both cores busy; each one's output is printed when it ends), then the results files are compared.
+# TEST_WORKERS=1: one after the other, each in this process.
+test: $(STAMP)
+	@echo "== library tests and nbval, at the same time (each prints its report when it ends)"
+	@if [ "$(TEST_WORKERS)" = 1 ]; then $(MAKE) --no-print-directory test-lib test-notebooks; \
+	 else $(MAKE) --no-print-directory -j2 --output-sync=target test-lib test-notebooks; fi
+	@$(MAKE) --no-print-directory test-results
 
 # Two pytest processes (pytest-xdist), each test file whole in one of them (module fixtures computed once),
 # the longest files first (tests/conftest.py) so the two finish together;
