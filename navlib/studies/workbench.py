@@ -107,11 +107,15 @@ def steps_frame(result: LoopResult, label: str = "") -> pd.DataFrame:
 
 
 # ------------------------------------------------------------------------------------ bring your own data
-#: The file each system's section of "Bring your own data" samples: shipped in ``data/`` or BROAD trial 05
-#: in ``../shared/realdata`` (read there, never copied).
+# The file each system's section of "Bring your own data" samples: shipped in ``data/`` or BROAD trial 05
+# in ``../shared/realdata`` (read there, never copied; no doc comment: the API page would print this
+# machine's folders).
 OWN_DATA_FILES = {"compass": data_path("compass_sweeps.csv"), "drift": data_path("gyro_drift_measurements.csv"),
                   "magnetometer": MAG_DIR / CALIBRATION_TRIAL, "magnetometer_free": MAG_DIR / CALIBRATION_TRIAL,
                   "accelerometer": data_path("accel_tumble.csv")}
+#: The file a command names where the sample file itself would be refused: the workbench fits one
+#: accelerometer per file, and ``data/accel_tumble.csv`` holds two (units A and B).
+OWN_DATA_COMMAND_FILES = {"accelerometer": "accel_tumble_A.csv"}
 #: How many rows of each sample file are shown.
 SAMPLE_ROWS = 5
 
@@ -163,8 +167,9 @@ def wrap_report(text: str, width: int = 88) -> str:
 
 
 def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
-    """The columns table, ``rows`` sample rows of :data:`OWN_DATA_FILES` and the one command
-    (``navlib loop SYSTEM FILE --report DIR``) for ``system``."""
+    """The columns table, ``rows`` sample rows of ``OWN_DATA_FILES`` and the one command
+    (``navlib loop SYSTEM FILE --report DIR``) for ``system``; the command names the sample file, or
+    the file of :data:`OWN_DATA_COMMAND_FILES` where the sample file must be split first."""
     from ..workbench.effects import columns_table
     check_param("rows", rows, lo=1, integer=True)
     if system not in OWN_DATA_FILES:
@@ -180,12 +185,13 @@ def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
         sample.index.name = "column"
     shown = _shown_path(path)
     return OwnData(system, cols, sample, shown,
-                   shell_command(["navlib", "loop", system, shown, "--report", f"out_{system}/"]))
+                   shell_command(["navlib", "loop", system, OWN_DATA_COMMAND_FILES.get(system, shown),
+                                  "--report", f"out_{system}/"]))
 
 
 def own_data_report(folder, system: str = "compass", start_model=()) -> tuple[Path, Path]:
     """What ``navlib loop SYSTEM FILE --report FOLDER`` writes for the sample file of ``system``
-    (:data:`OWN_DATA_FILES`): the system's loader, :func:`navlib.workbench.loop.loop` from ``start_model``
+    (``OWN_DATA_FILES``): the system's loader, :func:`navlib.workbench.loop.loop` from ``start_model``
     and the CLI's own :func:`navlib.workbench.loop.write_report` (never over existing files).  Returns the
     paths of ``loop.png`` and ``loop.md``."""
     from ..workbench.loop import write_report

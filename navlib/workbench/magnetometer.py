@@ -94,8 +94,8 @@ TRIM = 5.0
 
 
 _AXES = {"x": "x forward", "y": "y right", "z": "z down"}
-#: The file schema of the ``magnetometer`` system (what :func:`load_magnetometer` reads; the data
-#: dictionary of :func:`navlib.data.tables.schema_table`).
+# The file schema of the ``magnetometer`` system (what :func:`load_magnetometer` reads; the data
+# dictionary of :func:`navlib.data.tables.schema_table`).
 MAGNETOMETER_COLUMNS = tuple(
     [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]} (FRD)")
      for c in MAG]
@@ -123,7 +123,7 @@ MAGNETOMETER_COLUMNS = tuple(
 
 
 def quaternion_columns() -> list[Column]:
-    """The columns of :data:`MAGNETOMETER_COLUMNS`, as a list."""
+    """The columns of ``MAGNETOMETER_COLUMNS``, as a list."""
     return list(MAGNETOMETER_COLUMNS)
 
 

@@ -126,8 +126,8 @@ DATE_TOL_DAYS = 366
 
 
 _AXES = {"x": "x forward", "y": "y right", "z": "z down"}
-#: The file schema of the ``magnetometer_free`` system (what :func:`load_free` reads; the data dictionary
-#: of :func:`navlib.data.tables.schema_table`).
+# The file schema of the ``magnetometer_free`` system (what :func:`load_free` reads; the data dictionary
+# of :func:`navlib.data.tables.schema_table`).
 FREE_COLUMNS = tuple(
     [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]}") for c in MAG]
     + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4,
@@ -145,7 +145,7 @@ FREE_COLUMNS = tuple(
 
 
 def free_columns() -> list[Column]:
-    """The columns of :data:`FREE_COLUMNS`, as a list."""
+    """The columns of ``FREE_COLUMNS``, as a list."""
     return list(FREE_COLUMNS)
 
 
