@@ -194,6 +194,7 @@ def test_a_staircase_summary_draws_the_same_picture_and_pickles():
     grid = staircase_grid({"trial one": res, "trial two": st, "trial three": bare})
     axes = [x for x in grid.axes if x.get_visible() and x.axison]
     assert len(axes) == 3 and grid.get_size_inches()[0] <= rs.MAX_WIDTH_IN
+    assert grid.get_size_inches()[1] <= 2 * 2.6 + 0.5 + 1e-9           # two rows: panels do not grow it
     assert all(x.get_legend() is None for x in axes) and len(grid.legends) == 1
     assert axes[0].get_title().startswith("trial one") and "+" not in axes[0].get_xticklabels()[1].get_text()
     with pytest.raises(InputError, match="no loop"):

@@ -254,7 +254,8 @@ def staircase_figure(result, ax=None, title: str | None = None,
     from .. import report_style as rs
 
     st = result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
-    if ax is None:
+    own = ax is None
+    if own:
         fig, ax = rs.panels(1, panel_height_in=3.6)
     rs.staircase(ax, list(st.labels), list(st.rms), None if st.held_out is None else list(st.held_out),
                  floor=st.floor, floor_label=st.floor_label, unit=st.unit,
@@ -262,7 +263,7 @@ def staircase_figure(result, ax=None, title: str | None = None,
     ticks = ax.get_xticklabels()
     lines = max(t.get_text().count("\n") + 1 for t in ticks)
     extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
-    if ax.get_figure(root=True) is ax.figure and extra:             # a figure of its own: room for labels
+    if own and extra:                                  # a figure of its own: room for the labels
         w, h = ax.figure.get_size_inches()
         ax.figure.set_size_inches(w, h + extra)
     if legend:
@@ -274,7 +275,7 @@ def staircase_figure(result, ax=None, title: str | None = None,
 GRID_TITLE_WIDTH = 34
 
 
-def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.9):
+def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
     """Small multiples: one staircase (:func:`staircase_figure`) per loop, ``staircases`` a mapping of
     panel title to :class:`Staircase` or :class:`LoopResult` (e.g. one per trial), ``ncols`` panels a row
     across the column width, one legend below the grid; tick labels are the effects added (without the
