@@ -272,7 +272,7 @@ def staircase_figure(result, ax=None, title: str | None = None,
 
 
 #: Characters per line of a small-multiple staircase's title.
-GRID_TITLE_WIDTH = 34
+GRID_TITLE_WIDTH = 30
 
 
 def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
