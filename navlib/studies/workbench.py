@@ -349,8 +349,7 @@ def magnet_staircases(study: MagnetStudy) -> dict:
     out = {"05 undisturbed (calibration)": study.calibration}
     for name in MAGNET_STAIRCASES:
         if name in study.loops:
-            out[name.replace("broad_", "").replace(".csv", "").replace("_", " ") + " (calibrated)"] = \
-                study.loops[name]
+            out[name.replace("broad_", "").replace(".csv", "").replace("_", " ")] = study.loops[name]
     return out
 
 
