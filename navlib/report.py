@@ -400,6 +400,16 @@ def glue_figure(name: str, fig) -> None:
     plt.close(fig)
 
 
+def glue_png(name: str, path) -> None:
+    """Glue a PNG file (e.g. the figure ``navlib loop --report`` wrote) for a MyST ``{glue:figure}``
+    directive; the image is read now, so the file may be removed afterwards."""
+    from pathlib import Path
+
+    from IPython.display import Image
+
+    _glue(name, Image(data=Path(path).read_bytes(), format="png"))
+
+
 # The book's figure style (navlib.report_style): use_style() in a chapter's first code cell.
 from .report_style import (legend_below, legend_right, panel_grid, panels,  # noqa: E402,F401
                            staircase, use_style)

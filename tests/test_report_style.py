@@ -170,3 +170,48 @@ def test_unit_loop_names_the_units_it_has():
     frame = pd.DataFrame({"unit": ["A", "B"], "output_mg": [0.0, 0.0]})
     with pytest.raises(InputError, match="unit='C'.*A, B"):
         unit_loop(frame, "C")
+
+
+def test_a_staircase_summary_draws_the_same_picture_and_pickles():
+    """The Staircase a worker sends back draws what the LoopResult draws; a loop without a held-out set
+    draws no markers; small multiples keep one legend below the grid."""
+    import pickle
+
+    from navlib.workbench.loop import Staircase, staircase_grid, staircase_of
+
+    data = simulate("compass", {"yaw_deg": 1.0, "hard_x": 0.2, "soft_e": 0.04}, noise=0.1, seed=0)
+    res = loop("compass", data, ["misalignment"])
+    st = pickle.loads(pickle.dumps(staircase_of(res)))
+    assert st.labels == tuple(step_labels(res)) and st.floor == pytest.approx(noise_band(res))
+    assert st.outcome == res.outcome() and st.floor_label == "noise floor (95 %)"
+    a, b = staircase_figure(res).axes[0], staircase_figure(st).axes[0]
+    assert np.allclose(a.patches[0].get_data().values, b.patches[0].get_data().values)
+    assert [t.get_text() for t in a.get_xticklabels()] == [t.get_text() for t in b.get_xticklabels()]
+    assert len(b.lines) == 1                                               # the held-out markers
+    bare = Staircase(st.labels, st.rms, None, None, "", st.unit, "no held-out set")
+    ax = staircase_figure(bare).axes[0]
+    assert len(ax.lines) == 0 and {t.get_text() for t in ax.get_legend().get_texts()} == {"rms"}
+    grid = staircase_grid({"trial one": res, "trial two": st, "trial three": bare})
+    axes = [x for x in grid.axes if x.get_visible() and x.axison]
+    assert len(axes) == 3 and grid.get_size_inches()[0] <= rs.MAX_WIDTH_IN
+    assert grid.get_size_inches()[1] <= 2 * 2.6 + 0.5 + 1e-9           # two rows: panels do not grow it
+    assert all(x.get_legend() is None for x in axes) and len(grid.legends) == 1
+    assert axes[0].get_title().startswith("trial one") and "+" not in axes[0].get_xticklabels()[1].get_text()
+    with pytest.raises(InputError, match="no loop"):
+        staircase_grid({})
+
+
+def test_report_figure_panels_span_the_column():
+    """The --report picture: staircase, measurement and residual panels one above the other, each as wide
+    as the column allows (short legend labels below them)."""
+    from navlib.workbench.loop import report_figure
+
+    data = simulate("compass", {"yaw_deg": 1.0, "hard_x": 0.2, "soft_e": 0.04}, noise=0.1, seed=0)
+    res = loop("compass", data, [])
+    fig = report_figure(res)
+    fig.draw_without_rendering()
+    boxes = [ax.get_position() for ax in fig.axes]
+    assert len(boxes) == 3 and fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN
+    assert all(b.width > 0.8 for b in boxes)                                # stacked, not side by side
+    labels = [t.get_text() for ax in fig.axes[1:] for t in ax.get_legend().get_texts()]
+    assert max(map(len, labels)) <= 22 and "step 0" in labels

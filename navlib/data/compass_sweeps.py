@@ -19,14 +19,23 @@ from .tables import Column, read_table, require_variation, where
 # (about 32 years).  The raw field and accelerometer columns are informational: no model of the compass
 # reads them, so they are converted where they parse and never refused.
 SWEEP_COLUMNS = [
-    Column("true_heading_deg", "deg", lo=0.0, hi=360.0),
-    Column("measured_heading_deg", "deg", lo=0.0, hi=360.0),
-    Column("sweep", "", required=False, lo=0, hi=1e6, integer=True),
-    Column("temperature_c", "degC", required=False, lo=-80, hi=150),
-    Column("time_s", "s", required=False, lo=0, hi=1e9),
-    *[Column(c, u, required=False, checked=False)
-      for c, u in (("mag_x_ut", "uT"), ("mag_y_ut", "uT"), ("mag_z_ut", "uT"),
-                   ("acc_x_ms2", "m/s^2"), ("acc_y_ms2", "m/s^2"), ("acc_z_ms2", "m/s^2"))],
+    Column("true_heading_deg", "deg", lo=0.0, hi=360.0,
+           meaning="true (reference) heading, clockwise from magnetic north"),
+    Column("measured_heading_deg", "deg", lo=0.0, hi=360.0,
+           meaning="heading the compass reads, clockwise from magnetic north"),
+    Column("sweep", "", required=False, lo=0, hi=1e6, integer=True,
+           meaning="sweep number (1 = train, 2 = test); one sweep if absent"),
+    Column("temperature_c", "degC", required=False, lo=-80, hi=150,
+           meaning="carrier temperature at the reading (the temperature effect needs it)"),
+    Column("time_s", "s", required=False, lo=0, hi=1e9,
+           meaning="time of the reading (a trend in time; the noise model's time series)"),
+    *[Column(c, u, required=False, checked=False, meaning=m)
+      for c, u, m in (("mag_x_ut", "uT", "raw field, x forward (information only)"),
+                      ("mag_y_ut", "uT", "raw field, y right (information only)"),
+                      ("mag_z_ut", "uT", "raw field, z down (information only)"),
+                      ("acc_x_ms2", "m/s^2", "specific force, x forward (information only)"),
+                      ("acc_y_ms2", "m/s^2", "specific force, y right (information only)"),
+                      ("acc_z_ms2", "m/s^2", "specific force, z down (information only)"))],
 ]
 #: A measured heading that follows the true one keeps the error ``measured - true`` in one direction:
 #: the mean resultant length of the error is above 0.7 even with the largest hard iron the compass model

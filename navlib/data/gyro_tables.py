@@ -128,10 +128,14 @@ def load_cold_test(path=None) -> pd.DataFrame:
 
 #: The columns of a user's drift table (what ``python -m navlib loop drift FILE`` reads), with their limits.
 USER_COLUMNS = [
-    Column("latitude_error_deg", "deg", lo=-1.0, hi=1.0),
-    Column("drift_deg_h", "deg/h", lo=-1.0, hi=1.0),
-    Column("temperature_c", "degC", required=False, lo=-60.0, hi=120.0),
-    Column("temperature_change_c", "degC", required=False, lo=-180.0, hi=180.0),
+    Column("latitude_error_deg", "deg", lo=-1.0, hi=1.0,
+           meaning="12 h latitude error of the test, indicated - true"),
+    Column("drift_deg_h", "deg/h", lo=-1.0, hi=1.0,
+           meaning="axial gyro drift identified for the test"),
+    Column("temperature_c", "degC", required=False, lo=-60.0, hi=120.0,
+           meaning="mean temperature while the drift is identified"),
+    Column("temperature_change_c", "degC", required=False, lo=-180.0, hi=180.0,
+           meaning="temperature rise during the alignment (a cold start)"),
 ]
 
 

@@ -45,7 +45,11 @@ class Column:
     present, and the closed range ``[lo, hi]`` its values must lie in (``-LIMIT..LIMIT`` where not given).
 
     ``checked=False`` marks an *informational* column that the table's users read if they can but no model
-    relies on: its cells are converted to numbers where they parse (NaN elsewhere) and never refused."""
+    relies on: its cells are converted to numbers where they parse (NaN elsewhere) and never refused.
+    ``text=True`` marks a column of names (e.g. an accelerometer's ``unit``): its presence is checked when
+    it is required, its cells are kept as text and checked by the loader that reads it.  ``meaning`` says
+    what the column holds, for the data dictionary of each file schema
+    (:func:`schema_table`)."""
 
     name: str
     unit: str = ""
@@ -54,6 +58,8 @@ class Column:
     hi: float | None = None
     integer: bool = False
     checked: bool = True
+    meaning: str = ""
+    text: bool = False
 
 
 def where(path: str | os.PathLike, column: str, row: int, frame: pd.DataFrame | None = None) -> str:
@@ -206,7 +212,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
                 hint += f"; the file seems to use {sep[0]} as the separator, a CSV {kind} uses commas"
             found = ", ".join(show(n) for n in names)
             found = found if len(found) <= 300 else found[:300] + " ..."
-            raise InputError(f"{p.name}: missing column '{col.name}' ({col.unit or 'no unit'}); "
+            raise InputError(f"{p.name}: missing column '{col.name}' ({_what(col)}); "
                              f"found {found}{hint}")
     located = pd.DataFrame(index=pd.RangeIndex(len(rows)))
     jumps = _jumps(lines)
@@ -218,7 +224,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     for name in names:
         text = [v.strip() for v in cells[name]]
         col = described.get(name)
-        if col is None:                               # not described: kept as text, never checked
+        if col is None or col.text:                   # not described or names: kept as text, never checked
             if any(_BAD_BYTES.search(v) for v in text):
                 text = [v.encode("utf-8", "surrogateescape").decode("utf-8", "replace") for v in text]
             out[name] = pd.Series(text, dtype=str)
@@ -234,6 +240,37 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
         raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
                          f"a {kind} needs at least {min_rows}")
     return frame
+
+
+def _what(col: Column) -> str:
+    """How a missing column is described: its unit, or for a text column what it names."""
+    if col.text:
+        return col.meaning or "text"
+    return col.unit or "no unit"
+
+
+def schema_table(columns) -> pd.DataFrame:
+    """A file schema as a data dictionary: one row per described column, in the order the schema lists
+    them, with ``column``, ``unit`` (``-`` where it has none; ``text`` for a column of names),
+    ``required`` (``yes``/``no``), ``limits`` (the closed range a checked column's values must lie in,
+    ``whole`` for whole numbers; ``not checked`` for an informational column) and ``meaning``.  It is
+    derived from the very :class:`Column` list a loader gives :func:`read_table`, so it lists exactly what
+    the loader requires."""
+    rows = []
+    for c in columns:
+        if c.text:
+            limits = "text, not empty" if c.required else "text"
+        elif not c.checked:
+            limits = "not checked"
+        else:
+            lo = "" if c.lo is None else f"{c.lo:g}"
+            hi = "" if c.hi is None else f"{c.hi:g}"
+            limits = f"{lo}..{hi}" if (lo or hi) else "finite"
+            if c.integer:
+                limits += ", whole"
+        rows.append({"column": c.name, "unit": "text" if c.text else (c.unit or "-"),
+                     "required": "yes" if c.required else "no", "limits": limits, "meaning": c.meaning})
+    return pd.DataFrame(rows, columns=["column", "unit", "required", "limits", "meaning"])
 
 
 def _check(p: Path, col: Column, text: list[str], values: np.ndarray, located: pd.DataFrame) -> None:

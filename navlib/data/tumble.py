@@ -18,11 +18,16 @@ from ..paths import data_path
 from .tables import Column, read_table, where
 
 TUMBLE_FILE = data_path("accel_tumble.csv")
-COLUMNS = [Column("temperature_c", "degC", lo=-60.0, hi=130.0),
-           Column("position_deg", "deg", lo=0.0, hi=360.0),
-           Column("output_mg", "mg", lo=-5000.0, hi=5000.0),
-           Column("set_point_c", "degC", required=False, lo=-60.0, hi=130.0),
-           Column("true_output_mg", "mg", required=False, lo=-5000.0, hi=5000.0)]
+COLUMNS = [Column("temperature_c", "degC", lo=-60.0, hi=130.0, meaning="sensor temperature at the reading"),
+           Column("position_deg", "deg", lo=0.0, hi=360.0,
+                  meaning="dividing-head angle q, on the head's 15-deg grid (input a = cos q)"),
+           Column("output_mg", "mg", lo=-5000.0, hi=5000.0,
+                  meaning="output / nominal scale factor (a perfect sensor reads 1000 cos q)"),
+           Column("unit", required=True, text=True, meaning="accelerometer name"),
+           Column("set_point_c", "degC", required=False, lo=-60.0, hi=130.0,
+                  meaning="chamber set point (the temperature rounded to 0.5 degC if absent)"),
+           Column("true_output_mg", "mg", required=False, lo=-5000.0, hi=5000.0,
+                  meaning="noise-free output (simulations only; not read by the models)")]
 
 
 def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -> pd.DataFrame:
@@ -37,8 +42,6 @@ def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -
         raise InputError(f"parameter grid_deg={grid_deg!r}: must be in (0, 180]")
     df = read_table(path, COLUMNS, min_rows=3, kind="tumble file")
     name = os.path.basename(str(path))
-    if "unit" not in df.columns:
-        raise InputError(f"{name}: missing column 'unit' (accelerometer name); found {', '.join(df.columns)}")
     unit = df["unit"].astype(str).str.strip()
     empty = np.flatnonzero(unit.to_numpy() == "")
     if empty.size:

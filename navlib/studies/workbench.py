@@ -9,6 +9,7 @@ return None and the chapter says so).
 """
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,13 +20,13 @@ from scipy.optimize import least_squares
 from ..angles import wrap_deg
 from ..errors import InputError, check_param
 from ..data.gyro_tables import drift_measurements
-from ..paths import ROOT
+from ..paths import ROOT, data_path
 from .. import engine, verdicts
 from ..report import Claim
 from ..workbench.diagnose import DEFAULT_ALPHA, diagnose
 from ..workbench.effects import CATALOGUES
 from ..workbench.fit import effect_rms, fit_model, load, simulate
-from ..workbench.loop import LoopResult, loop
+from ..workbench.loop import LoopResult, loop, staircase_of
 from ..workbench.magnetometer import (MAG, apply_calibration, correct_field, ellipsoid_fit, field_summary,
                                       heading_error_deg)
 from ..workbench.trials import random_params, scale_effect
@@ -105,6 +106,100 @@ def steps_frame(result: LoopResult, label: str = "") -> pd.DataFrame:
     return t
 
 
+# ------------------------------------------------------------------------------------ bring your own data
+# The file each system's section of "Bring your own data" samples: shipped in ``data/`` or BROAD trial 05
+# in ``../shared/realdata`` (read there, never copied; no doc comment: the API page would print this
+# machine's folders).
+OWN_DATA_FILES = {"compass": data_path("compass_sweeps.csv"), "drift": data_path("gyro_drift_measurements.csv"),
+                  "magnetometer": MAG_DIR / CALIBRATION_TRIAL, "magnetometer_free": MAG_DIR / CALIBRATION_TRIAL,
+                  "accelerometer": data_path("accel_tumble.csv")}
+#: The file a command names where the sample file itself would be refused: the workbench fits one
+#: accelerometer per file, and ``data/accel_tumble.csv`` holds two (units A and B).
+OWN_DATA_COMMAND_FILES = {"accelerometer": "accel_tumble_A.csv"}
+#: How many rows of each sample file are shown.
+SAMPLE_ROWS = 5
+
+
+@dataclass
+class OwnData:
+    """One system's part of "Bring your own data": the columns its loader reads (``columns``,
+    :func:`navlib.workbench.effects.columns_table`), the first rows of a sample file (``sample``: one
+    row per column of the schema the file holds, one column per row of the file, the cells as written; None
+    where the file is absent), the file as a path relative to the repository's folder (``file``) and the
+    command that runs the loop on it with a report (``command``)."""
+
+    system: str
+    columns: pd.DataFrame
+    sample: pd.DataFrame | None
+    file: str
+    command: str
+
+
+def _shown_path(path: Path) -> str:
+    """A sample file as the reader types it from the repository's folder: ``data/NAME`` for a shipped
+    file, ``../shared/realdata/...`` for the third-party recordings."""
+    from ..paths import DATA_DIR
+    if path.parent == DATA_DIR:
+        return f"data/{path.name}"
+    try:
+        return str(Path("..") / path.relative_to(ROOT.parent))
+    except ValueError:
+        return str(path)
+
+
+def shell_command(words, width: int = 80) -> str:
+    """``words`` as one shell command, continued with a backslash onto indented lines where a line would
+    pass ``width`` characters (a command shown in the book stays within the column)."""
+    lines, line = [], ""
+    for w in words:
+        if line and len(line) + 1 + len(w) > width:
+            lines.append(line + " \\")
+            line = "    " + w
+        else:
+            line = f"{line} {w}" if line else w
+    return "\n".join(lines + [line])
+
+
+def wrap_report(text: str, width: int = 88) -> str:
+    """A report's text with lines longer than ``width`` wrapped (tables and short lines as written)."""
+    return "\n".join(textwrap.fill(ln, width) if len(ln) > width and not ln.startswith("|") else ln
+                     for ln in text.splitlines())
+
+
+def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
+    """The columns table, ``rows`` sample rows of ``OWN_DATA_FILES`` and the one command
+    (``navlib loop SYSTEM FILE --report DIR``) for ``system``; the command names the sample file, or
+    the file of :data:`OWN_DATA_COMMAND_FILES` where the sample file must be split first."""
+    from ..workbench.effects import columns_table
+    check_param("rows", rows, lo=1, integer=True)
+    if system not in OWN_DATA_FILES:
+        raise InputError(f"parameter system={system!r}: one of {', '.join(OWN_DATA_FILES)}")
+    path = OWN_DATA_FILES[system]
+    cols = columns_table(system)
+    sample = None
+    if path.is_file():
+        head = pd.read_csv(path, nrows=rows, dtype=str, keep_default_na=False)
+        names = [c for c in cols["column"] if c in head.columns]
+        sample = head[names].T
+        sample.columns = [f"row {i + 1}" for i in range(len(head))]
+        sample.index.name = "column"
+    shown = _shown_path(path)
+    return OwnData(system, cols, sample, shown,
+                   shell_command(["navlib", "loop", system, OWN_DATA_COMMAND_FILES.get(system, shown),
+                                  "--report", f"out_{system}/"]))
+
+
+def own_data_report(folder, system: str = "compass", start_model=()) -> tuple[Path, Path]:
+    """What ``navlib loop SYSTEM FILE --report FOLDER`` writes for the sample file of ``system``
+    (``OWN_DATA_FILES``): the system's loader, :func:`navlib.workbench.loop.loop` from ``start_model``
+    and the CLI's own :func:`navlib.workbench.loop.write_report` (never over existing files).  Returns the
+    paths of ``loop.png`` and ``loop.md``."""
+    from ..workbench.loop import write_report
+    path = OWN_DATA_FILES[system]
+    result = loop(system, load(system, path), list(start_model))
+    return write_report(result, folder, source=_shown_path(path))
+
+
 # ------------------------------------------------------------------------------------ real level sweeps
 @dataclass
 class LevelLoops:
@@ -157,7 +252,8 @@ def undisturbed_trials() -> list[str]:
 def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -> dict:
     """The loop from the local field alone on one undisturbed trial (:func:`load_trial`): what it ends
     with -- rows used and set aside as outliers, the noise model, the effects added, the final rms, the
-    outcome and the largest unexplained structure."""
+    outcome and the largest unexplained structure -- and ``staircase``, the loop's
+    :class:`navlib.workbench.loop.Staircase`."""
     data = load_trial(name, row_step)
     res = loop("magnetometer", data, [], alpha=alpha)
     noise = res.screening.noise
@@ -166,7 +262,7 @@ def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -
             "rows set aside": len(res.screening.rows_set_aside),
             "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
             "effects added": added(res), "final rms (uT)": res.final.rms,
-            "largest structure (uT)": amp, "outcome": res.outcome()}
+            "largest structure (uT)": amp, "outcome": res.outcome(), "staircase": staircase_of(res)}
 
 
 def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1,
@@ -179,14 +275,21 @@ def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: in
 
 def _on_undisturbed(fn, row_step, alpha, workers, scheduler, label) -> pd.DataFrame | None:
     """``fn(name, row_step, alpha)`` on every undisturbed BROAD 3-D trial on the engine (the longest
-    recordings first), one row each indexed by ``trial``; None if the data are absent."""
+    recordings first), one row each indexed by ``trial``; each row's ``staircase`` (a loop's
+    :class:`navlib.workbench.loop.Staircase`) goes into ``attrs["staircases"]`` (trial -> Staircase), not
+    into the table.  None if the data are absent."""
     names = undisturbed_trials()
     if not names:
         return None
     check_param("row_step", row_step, lo=1, integer=True)
     rows = engine.run(fn, [(n, row_step, alpha) for n in names], workers=workers, scheduler=scheduler,
                       label=label, cost=[float((MAG_DIR / n).stat().st_size) for n in names])
-    return pd.DataFrame(rows).set_index("trial")
+    stairs = {r["trial"]: r.pop("staircase") for r in rows if r.get("staircase") is not None}
+    for r in rows:
+        r.pop("staircase", None)
+    out = pd.DataFrame(rows).set_index("trial")
+    out.attrs["staircases"] = stairs
+    return out
 
 
 @dataclass
@@ -231,6 +334,23 @@ def magnet_study(row_step: int = 3, alpha: float | None = None) -> MagnetStudy |
         if name in ATTACHED:
             heads.append(_headings(short, raw, None, None, calibrated=cal.final, result=res))
     return MagnetStudy(cal, field, pd.DataFrame(rows).set_index("trial"), loops, pd.DataFrame(heads).set_index("trial"))
+
+
+#: The loops of :func:`magnet_study` drawn as staircases: the calibration, the nearest and the farthest
+#: attached magnet, and the first stationary magnet.
+MAGNET_STAIRCASES = ("broad_32_attached_magnet_1cm.csv", "broad_36_attached_magnet_5cm.csv",
+                     "broad_28_stationary_magnet_A.csv")
+
+
+def magnet_staircases(study: MagnetStudy) -> dict:
+    """Representative loops of :func:`magnet_study` for :func:`navlib.workbench.loop.staircase_grid`,
+    panel title -> LoopResult: the calibration on trial 05 and the trials of :data:`MAGNET_STAIRCASES`
+    (after the trial-05 calibration)."""
+    out = {"05 undisturbed (calibration)": study.calibration}
+    for name in MAGNET_STAIRCASES:
+        if name in study.loops:
+            out[name.replace("broad_", "").replace(".csv", "").replace("_", " ")] = study.loops[name]
+    return out
 
 
 def _headings(label, raw, params, fit, calibrated=None, result=None) -> dict:
@@ -505,12 +625,14 @@ class DriftStudy:
     diagnoses: dict               # "cold tests only" / "hot and cold tests" -> Diagnosis (earth_rate + bias)
     loo: pd.DataFrame             # held-out rms (1e-4 deg/h) of cold and hot tests per model
     temperature_change_coef: float
+    loop: LoopResult | None = None  # the loop on every test (hot and cold) from no effect
 
 
 def drift_study(alpha: float | None = None) -> DriftStudy:
     """The loop on paper C's Tables 2-4 (``data/gyro_drift_measurements.csv``): the Table 1 Earth-rate
-    model fitted on the hot tests, diagnoses of the cold and pooled tests from ``earth_rate + bias``, and
-    the exact leave-one-out RMS of cold and hot tests as effects are added."""
+    model fitted on the hot tests, diagnoses of the cold and pooled tests from ``earth_rate + bias``, the
+    exact leave-one-out RMS of cold and hot tests as effects are added, and the whole loop on all tests
+    from no effect (``loop``, drawn as a staircase by the chapter)."""
     allrows = drift_measurements()
     hot, cold = allrows[allrows.state == "hot"], allrows[allrows.state == "cold"]
     hot_fit = fit_model("drift", hot, ["earth_rate"])
@@ -524,7 +646,20 @@ def drift_study(alpha: float | None = None) -> DriftStudy:
                                     "hot tests, held-out rms (1e-4 deg/h)": np.sqrt(np.mean(r[~is_cold] ** 2)) * 1e4}
     full = fit_model("drift", allrows, ["earth_rate", "bias", "temperature_change"])
     return DriftStudy(hot, cold, hot_fit, diagnose(hot_fit, alpha=alpha), diags, pd.DataFrame(loo).T,
-                      full.params["temperature_change_coef_deg_h_per_c"])
+                      full.params["temperature_change_coef_deg_h_per_c"],
+                      loop("drift", allrows, [], alpha=alpha))
+
+
+def accelerometer_loop(unit: str = "A", start=("bias",), alpha: float | None = None) -> LoopResult:
+    """The workbench loop on one accelerometer of the shipped tumble file ``data/accel_tumble.csv``
+    (:func:`navlib.data.tumble.read_tumble`; its rows of ``unit``), from the model ``start``: what
+    ``python -m navlib loop accelerometer FILE --model bias`` does on a file of that unit alone."""
+    from ..data.tumble import TUMBLE_FILE, read_tumble
+    data = read_tumble(TUMBLE_FILE)
+    if unit not in set(data["unit"]):
+        raise InputError(f"parameter unit={unit!r}: {TUMBLE_FILE.name} holds units "
+                         f"{', '.join(dict.fromkeys(data['unit']))}")
+    return loop("accelerometer", data[data["unit"] == unit].reset_index(drop=True), list(start), alpha=alpha)
 
 
 def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.DataFrame | None:
@@ -587,8 +722,9 @@ def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float
     the optical reference ignored) from the local field alone on one undisturbed BROAD trial, every
     ``row_step``-th block: what it ends with -- rows, rows set aside, the noise model, the effects added,
     the final rms, the outcome, and the local field it estimates (intensity and dip with their 95 %
-    half-widths; the system's ``final_check`` without a site, :data:`BROAD_SITE`); a trial the system
-    refuses (e.g. too few distinct orientations at this row step) says so in ``outcome``."""
+    half-widths; the system's ``final_check`` without a site, :data:`BROAD_SITE`), and ``staircase`` (the
+    loop's :class:`navlib.workbench.loop.Staircase`); a trial the system refuses (e.g. too few distinct
+    orientations at this row step) says so in ``outcome`` and has no staircase."""
     from ..workbench.magnetometer_free import SYSTEM as FREE
     data = _free_frame(load_trial(name, row_step))
     label = name.replace("broad_", "").replace(".csv", "").replace("_", " ")
@@ -606,7 +742,8 @@ def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float
             "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
             "effects added": added(res), "final rms (uT)": res.final.rms, "outcome": res.outcome(),
             "field (uT)": check["intensity_ut"], "field 95% (uT)": 1.96 * check["intensity_std_ut"],
-            "dip (deg)": check["dip_deg"], "dip 95% (deg)": 1.96 * check["dip_std_deg"]}
+            "dip (deg)": check["dip_deg"], "dip 95% (deg)": 1.96 * check["dip_std_deg"],
+            "staircase": staircase_of(res)}
 
 
 def free_undisturbed_loops(row_step: int = FREE_ROW_STEP, alpha: float | None = None, workers: int = 1,

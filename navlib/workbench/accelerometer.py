@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from ..data.tables import require_variation
-from ..data.tumble import read_tumble, require_levels
+from ..data.tumble import COLUMNS as TUMBLE_COLUMNS, read_tumble, require_levels
 from ..errors import InputError
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, fit_linear, fit_model, user_columns
@@ -174,7 +174,8 @@ def accelerometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
 MEASURED["accelerometer"] = (("output_mg",), False)
 SYSTEM = register_system(System(
     "accelerometer", "mg", ACCELEROMETER_EFFECTS, load_accelerometer, _fit_accelerometer, accelerometer_structure,
-    "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg"))
+    "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg",
+    columns=tuple(TUMBLE_COLUMNS)))
 
 
 # ------------------------------------------------------------------------------------------ trials

@@ -57,7 +57,7 @@ from typing import Callable, Mapping
 import numpy as np
 import pandas as pd
 
-from ..data.tables import show
+from ..data.tables import schema_table, show
 from ..errors import InputError, UserCodeError
 from ..sensors.planar import PLANAR_EFFECTS
 
@@ -150,6 +150,9 @@ class System:
         the Earth-field model at the site, ``site`` = ``(lat, lon[, height_m])`` and ``date`` from the
         command line or None); the CLI prints the lines and puts the dict under ``"field"`` in ``--json``.
         None: nothing more (and ``--site``/``--date`` are refused).
+    columns : tuple of Column
+        The file schema ``load`` reads (:class:`navlib.data.tables.Column`: name, unit, required, limits,
+        meaning); :func:`columns_table` derives the system's data dictionary from it.
     """
 
     name: str
@@ -161,6 +164,7 @@ class System:
     meaning: str = ""
     noise_directions: Callable | None = None
     final_check: Callable | None = None
+    columns: tuple = ()
 
 
 #: Every system, by name (filled by the system modules as they are imported; the package imports them all).
@@ -410,6 +414,17 @@ CATALOGUES = {"compass": COMPASS_EFFECTS, "drift": DRIFT_EFFECTS}
 def catalogue_table(system: str) -> pd.DataFrame:
     """The catalogue of a registered system as a table (see :func:`catalogue_frame`)."""
     return catalogue_frame(get_system(system).catalogue)
+
+
+def columns_table(system: str) -> pd.DataFrame:
+    """The columns a file of ``system`` must or may have: ``column``, ``unit``, ``required`` (yes/no),
+    ``limits`` and ``meaning``, one row per column, derived from the schema the system's loader reads
+    (``System.columns``, :func:`navlib.data.tables.schema_table`): a required column listed here is one
+    the loader refuses a file without."""
+    s = get_system(system)
+    if not s.columns:
+        raise InputError(f"system {s.name!r} declares no file schema (System.columns)")
+    return schema_table(s.columns)
 
 
 def check_effects(system: str, names, data: pd.DataFrame | None = None) -> tuple[str, ...]:

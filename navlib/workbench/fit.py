@@ -18,7 +18,7 @@ import pandas as pd
 from scipy.optimize import least_squares
 
 from ..angles import heading_deg, wrap_deg
-from ..data.compass_sweeps import load_sweeps
+from ..data.compass_sweeps import SWEEP_COLUMNS, load_sweeps
 from ..data.gyro_tables import USER_COLUMNS
 from ..data.tables import read_table, require_variation
 from ..errors import InputError
@@ -478,9 +478,11 @@ def load_drift(path) -> pd.DataFrame:
 
 SYSTEMS_BASE = {
     "compass": System("compass", "deg", COMPASS_EFFECTS, load_compass, _fit_compass, compass_structure,
-                      "level compass heading; residual = measured - model heading, wrapped, deg"),
+                      "level compass heading; residual = measured - model heading, wrapped, deg",
+                      columns=tuple(SWEEP_COLUMNS)),
     "drift": System("drift", "deg/h", DRIFT_EFFECTS, load_drift, _fit_drift, drift_structure,
-                    "axial gyro drift of a rotating INS; residual = measured - model drift, deg/h"),
+                    "axial gyro drift of a rotating INS; residual = measured - model drift, deg/h",
+                    columns=tuple(USER_COLUMNS)),
 }
 for _s in SYSTEMS_BASE.values():
     register_system(_s)

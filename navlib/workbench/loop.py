@@ -206,70 +206,155 @@ def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -
 TITLE_WIDTH = 70
 
 
-def staircase_figure(result: LoopResult, ax=None, title: str | None = None,
-                     floor: tuple[float, float] | None = None, floor_label: str | None = None):
-    """The loop as a picture, full column width: a staircase with one step per effect added (labelled
-    with the effect), the rms after each step on a log axis, the held-out rms as a marker and the noise
-    floor as a band (:func:`navlib.report_style.staircase`).  The band is ``floor`` when the noise is known
-    (e.g. :func:`known_noise_band` for simulated data), else :func:`noise_band` from the data, called the
-    noise floor when the loop ended consistent with noise and the richest model's residual otherwise (it
-    then holds the structure no effect explains).  Draws on ``ax`` if given; returns the figure."""
-    from .. import report_style as rs
+@dataclass(frozen=True)
+class Staircase:
+    """What a staircase shows of one loop, small enough to send back from a worker process: the step
+    labels (:func:`step_labels`), the rms and held-out rms after each step (``held_out`` None for a loop
+    without a held-out set; NaN where a step has none), the band (``floor``, ``(low, high)`` or None), its
+    label, the unit and a title.  :func:`staircase_of` makes one from a :class:`LoopResult`."""
 
-    if ax is None:
-        fig, ax = rs.panels(1, panel_height_in=3.6)
+    labels: tuple
+    rms: tuple
+    held_out: tuple | None
+    floor: tuple | None
+    floor_label: str
+    unit: str
+    title: str
+    outcome: str = ""
+
+
+def staircase_of(result: LoopResult, title: str | None = None, floor: tuple[float, float] | None = None,
+                 floor_label: str | None = None) -> Staircase:
+    """The :class:`Staircase` of a loop: the band is ``floor`` when the noise is known (e.g.
+    :func:`known_noise_band` for simulated data), else :func:`noise_band` from the data, called the noise
+    floor when the loop ended consistent with noise and the richest model's residual otherwise (it then
+    holds the structure no effect explains).  The title defaults to ``"<system>: <outcome>"``."""
     if floor is None:
         floor = noise_band(result)
         floor_label = floor_label or ("noise floor (95 %)" if result.consistent_with_noise
                                       else "richest model's residual (95 %)")
-    rs.staircase(ax, step_labels(result), [f.rms for f in result.fits], [f.loo_rms for f in result.fits],
-                 floor=floor, floor_label=floor_label or "noise floor (95 %)", unit=result.final.unit,
-                 title=textwrap.fill(title if title is not None else f"{result.final.system}: {result.outcome()}",
-                                     TITLE_WIDTH))
+    held = [f.loo_rms for f in result.fits]
+    held = None if not np.any(np.isfinite(np.asarray(held, float))) else tuple(float(v) for v in held)
+    return Staircase(tuple(step_labels(result)), tuple(float(f.rms) for f in result.fits), held,
+                     None if floor is None else (float(floor[0]), float(floor[1])),
+                     floor_label or "noise floor (95 %)", result.final.unit,
+                     title if title is not None else f"{result.final.system}: {result.outcome()}",
+                     result.outcome())
+
+
+def staircase_figure(result, ax=None, title: str | None = None,
+                     floor: tuple[float, float] | None = None, floor_label: str | None = None,
+                     legend: bool = True):
+    """The loop as a picture, full column width: a staircase with one step per effect added (labelled
+    with the effect), the rms after each step on a log axis, the held-out rms as a marker (none for a loop
+    without a held-out set) and the noise floor as a band (:func:`navlib.report_style.staircase`).
+    ``result`` is a :class:`LoopResult` (the band as in :func:`staircase_of`) or a :class:`Staircase`
+    (``title`` then replaces its title).  Draws on ``ax`` if given (``legend=False``: no legend, e.g. for
+    :func:`staircase_grid`); returns the figure."""
+    from .. import report_style as rs
+
+    st = result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
+    own = ax is None
+    if own:
+        fig, ax = rs.panels(1, panel_height_in=3.6)
+    rs.staircase(ax, list(st.labels), list(st.rms), None if st.held_out is None else list(st.held_out),
+                 floor=st.floor, floor_label=st.floor_label, unit=st.unit,
+                 title=textwrap.fill(title if title is not None else st.title, TITLE_WIDTH))
     ticks = ax.get_xticklabels()
     lines = max(t.get_text().count("\n") + 1 for t in ticks)
     extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
-    if ax.get_figure(root=True) is ax.figure and extra:             # a figure of its own: room for labels
+    if own and extra:                                  # a figure of its own: room for the labels
         w, h = ax.figure.get_size_inches()
         ax.figure.set_size_inches(w, h + extra)
-    rs.legend_below(ax, ncol=3)
+    if legend:
+        rs.legend_below(ax, ncol=3)
     return ax.figure
 
 
+#: Characters per line of a small-multiple staircase's title.
+GRID_TITLE_WIDTH = 30
+
+
+def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
+    """Small multiples: one staircase (:func:`staircase_figure`) per loop, ``staircases`` a mapping of
+    panel title to :class:`Staircase` or :class:`LoopResult` (e.g. one per trial), ``ncols`` panels a row
+    across the column width, one legend below the grid; tick labels are the effects added (without the
+    ``+``), slanted where they do not fit.  Returns the figure."""
+    import matplotlib.pyplot as plt
+    from .. import report_style as rs
+
+    items = [(k, v if isinstance(v, Staircase) else staircase_of(v)) for k, v in dict(staircases).items()]
+    if not items:
+        raise InputError("staircase_grid: no loop to draw")
+    check_param("ncols", ncols, lo=1, hi=3, integer=True)
+    ncols = min(ncols, len(items))
+    nrows = -(-len(items) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(rs.MAX_WIDTH_IN, panel_height_in * nrows + 0.5),
+                             layout="constrained", squeeze=False)
+    handles, bands = {}, {st.floor_label for _, st in items if st.floor is not None}
+    band = bands.pop() if len(bands) == 1 else "noise floor or richest model's residual (95 %)"
+    for ax, (name, st) in zip(axes.ravel(), items):
+        short = Staircase(tuple(lab.replace("+ ", "").replace("start (none)", "none")
+                                .replace("start: ", "") for lab in st.labels),
+                          st.rms, st.held_out, st.floor, st.floor_label, st.unit, st.title, st.outcome)
+        title = name if not st.outcome else f"{name}: {st.outcome}"
+        staircase_figure(short, ax=ax, title=textwrap.shorten(title, 2 * GRID_TITLE_WIDTH, placeholder=" ..."),
+                         legend=False)
+        ax.title.set_text(textwrap.fill(ax.title.get_text(), GRID_TITLE_WIDTH))
+        ax.set_xlabel("")
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            key = "band" if lab in bands or lab == band or lab == st.floor_label else lab
+            handles.setdefault(key, (h, band if key == "band" else lab))
+    for ax in axes.ravel()[len(items):]:
+        ax.set_axis_off()
+    hs, ls = zip(*handles.values())
+    fig.legend(hs, ls, loc="outside lower center", ncol=3)
+    return fig
+
+
 def report_figure(result: LoopResult):
-    """The ``--report`` picture: the staircase (:func:`staircase_figure`) across the top; below it the
-    measurement against the start and final models, and the residuals at each step."""
+    """The ``--report`` picture, one column of full-width panels: the staircase
+    (:func:`staircase_figure`) on top; below it the measurement against the start and final models, and
+    below that the residuals at each step (legends below each panel, short labels: the steps are named on
+    the staircase)."""
     import matplotlib.pyplot as plt
     from .. import report_style as rs
 
     with plt.rc_context(rs.RC):
-        fig = plt.figure(figsize=(rs.MAX_WIDTH_IN, 8.2), layout="constrained")
-        top, bottom = fig.subfigures(2, 1, height_ratios=[1.1, 1.0])
+        fig = plt.figure(figsize=(rs.MAX_WIDTH_IN, 10.6), layout="constrained")
+        top, bottom = fig.subfigures(2, 1, height_ratios=[1.0, 1.45])
         staircase_figure(result, ax=top.subplots())
-        a1, a2 = bottom.subplots(1, 2)
-        _measurement_panel(a1, result)
-        for i, (f, lab) in enumerate(zip(result.fits, step_labels(result))):
-            a2.plot(f.residuals, ".", ms=2, label=f"{i}: {lab}")
-        a2.set(xlabel="observation", ylabel=f"residual ({result.final.unit})", title="residuals")
-        rs.legend_below(a1, ncol=1, markerscale=4)
-        rs.legend_below(a2, ncol=1, markerscale=4)
+        a1, a2 = bottom.subplots(2, 1)
+        _measurement_panel(a1, result, short=True)
+        for i, f in enumerate(result.fits):
+            a2.plot(f.residuals, ".", ms=2, label=f"step {i}")
+        a2.set(xlabel="observation", ylabel=f"residual ({result.final.unit})", title="residuals after each step")
+        rs.legend_below(a1, ncol=3, markerscale=4)
+        rs.legend_below(a2, ncol=min(4, len(result.fits)), markerscale=4)
     return fig
 
 
-def _measurement_panel(ax, result: LoopResult) -> None:
+def _measurement_panel(ax, result: LoopResult, short: bool = False) -> None:
+    """Measured against the start and final models; ``short``: the models labelled "start model (step
+    0)" and "final model (step n)" instead of their effects."""
     fits, unit = result.fits, result.final.unit
     data = fits[0].data
+
+    def label(i, f):
+        if short:
+            return "start model (step 0)" if i == 0 else f"final model (step {len(fits) - 1})"
+        return f"model: {' + '.join(f.effects) or '(none)'}"
+
     if fits[0].system == "compass":
         h = data["true_heading_deg"].to_numpy(float)
         ax.plot(h, wrap_deg(data["measured_heading_deg"].to_numpy(float) - h), "k.", ms=3, label="measured")
-        for f, style in ((fits[0], "r."), (result.final, "b.")):
-            ax.plot(h, wrap_deg(f.predict(data) - h), style, ms=2,
-                    label=f"model: {' + '.join(f.effects) or '(none)'}")
+        for i, (f, style) in enumerate(((fits[0], "r."), (result.final, "b."))):
+            ax.plot(h, wrap_deg(f.predict(data) - h), style, ms=2, label=label(i, f))
         ax.set(xlabel="true heading (deg)", ylabel="heading error (deg)")
     else:
         obs = fits[0].residuals + np.ravel(fits[0].predict(data))
-        for f, style in ((fits[0], "r."), (result.final, "b.")):
-            ax.plot(np.ravel(f.predict(data)), obs, style, ms=2, label=f"model: {' + '.join(f.effects) or '(none)'}")
+        for i, (f, style) in enumerate(((fits[0], "r."), (result.final, "b."))):
+            ax.plot(np.ravel(f.predict(data)), obs, style, ms=2, label=label(i, f))
         lim = [float(np.min(obs)), float(np.max(obs))]
         ax.plot(lim, lim, "k-", lw=0.8, label="measured = model")
         ax.set(xlabel=f"model ({unit})", ylabel=f"measured ({unit})")

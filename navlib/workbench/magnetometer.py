@@ -93,15 +93,38 @@ MIN_EXPLAINED = 0.25
 TRIM = 5.0
 
 
+_AXES = {"x": "x forward", "y": "y right", "z": "z down"}
+# The file schema of the ``magnetometer`` system (what :func:`load_magnetometer` reads; the data
+# dictionary of :func:`navlib.data.tables.schema_table`).
+MAGNETOMETER_COLUMNS = tuple(
+    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]} (FRD)")
+     for c in MAG]
+    + [Column(c, "", lo=-1.5, hi=1.5,
+              meaning=("reference attitude, unit quaternion, scalar first, body FRD to NED"
+                       if c == "q_w" else "reference attitude quaternion, vector part"))
+       for c in QUAT]
+    + [Column(c, "deg/s", required=False, lo=-1e5, hi=1e5,
+              meaning=f"angular rate, {_AXES[c[4]]} (the time_lag effect needs all three)") for c in GYR]
+    + [Column(c, "m", required=False, lo=-1e7, hi=1e7,
+              meaning=f"position, {d} (a field that changes with position)")
+       for c, d in zip(POS, ("north", "east", "down"))]
+    + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10,
+              meaning="time of the sample (a field that changes in time)")]
+    + [Column(c, u, required=False, checked=False, meaning=m)
+       for c, u, m in (("moving", "0/1", "1 while the sensor moves (information only)"),
+                       ("magnet_attached", "-1/0/1", "BROAD's magnet flag (information only)"),
+                       ("att_blur", "-", "attitude blur of a block mean (information only)"),
+                       ("acc_x_ms2", "m/s^2", "specific force, x forward (information only)"),
+                       ("acc_y_ms2", "m/s^2", "specific force, y right (information only)"),
+                       ("acc_z_ms2", "m/s^2", "specific force, z down (information only)"),
+                       ("ref_roll_deg", "deg", "reference roll (information only)"),
+                       ("ref_pitch_deg", "deg", "reference pitch (information only)"),
+                       ("ref_heading_deg", "deg", "reference heading (information only)"))])
+
+
 def quaternion_columns() -> list[Column]:
-    return ([Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT) for c in MAG]
-            + [Column(c, "", lo=-1.5, hi=1.5) for c in QUAT]
-            + [Column(c, "deg/s", required=False, lo=-1e5, hi=1e5) for c in GYR]
-            + [Column(c, "m", required=False, lo=-1e7, hi=1e7) for c in POS]
-            + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10)]
-            + [Column(c, "", required=False, checked=False)
-               for c in ("moving", "magnet_attached", "att_blur", "acc_x_ms2", "acc_y_ms2", "acc_z_ms2",
-                         "ref_roll_deg", "ref_pitch_deg", "ref_heading_deg")])
+    """The columns of ``MAGNETOMETER_COLUMNS``, as a list."""
+    return list(MAGNETOMETER_COLUMNS)
 
 
 def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
@@ -115,7 +138,7 @@ def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
     :func:`check_field` (a stuck axis, a field that does not follow the attitude, axes in another frame
     than FRD, a unit other than uT) and :func:`check_rates` (gyro rates in another unit than deg/s).  Informational columns (``moving``, ``magnet_attached``,
     ``att_blur``, ``acc_*_ms2``, ``ref_*_deg``) and columns not named here are never refused."""
-    frame = read_table(path, quaternion_columns(), min_rows=min_rows, kind="magnetometer file")
+    frame = read_table(path, MAGNETOMETER_COLUMNS, min_rows=min_rows, kind="magnetometer file")
     q = frame[list(QUAT)].to_numpy(float)
     norm = np.linalg.norm(q, axis=1)
     bad = np.flatnonzero(np.abs(norm - 1.0) > QUAT_TOL)
@@ -504,7 +527,8 @@ def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
 MEASURED["magnetometer"] = (MAG, False)
 SYSTEM = register_system(System(
     "magnetometer", "uT", MAGNETOMETER_EFFECTS, load_magnetometer, _fit_magnetometer, magnetometer_structure,
-    "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT"))
+    "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT",
+    columns=MAGNETOMETER_COLUMNS))
 
 
 def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, seed=0) -> pd.DataFrame:

@@ -125,15 +125,28 @@ SITE_TOL_DEG, HEIGHT_TOL_M = 0.1, 500.0
 DATE_TOL_DAYS = 366
 
 
+_AXES = {"x": "x forward", "y": "y right", "z": "z down"}
+# The file schema of the ``magnetometer_free`` system (what :func:`load_free` reads; the data dictionary
+# of :func:`navlib.data.tables.schema_table`).
+FREE_COLUMNS = tuple(
+    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]}") for c in MAG]
+    + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4,
+              meaning=f"specific force, {_AXES[c[4]]} (all three or none; misalignment needs them)")
+       for c in ACC]
+    + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10, meaning="time of the sample"),
+       Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0,
+              meaning="sensor temperature (the temperature effect needs it)")]
+    + [Column(c, "deg/s", required=False, checked=False, meaning="angular rate (information only)")
+       for c in GYR]
+    + [Column("lat_deg", "deg", required=False, lo=-90.0, hi=90.0, meaning="site latitude (WGS84)"),
+       Column("lon_deg", "deg", required=False, lo=-180.0, hi=360.0, meaning="site longitude"),
+       Column("height_m", "m", required=False, lo=-1e4, hi=1e6, meaning="site height above the ellipsoid"),
+       Column("date", required=False, text=True, meaning="date of the recording (ISO 8601)")])
+
+
 def free_columns() -> list[Column]:
-    return ([Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT) for c in MAG]
-            + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4) for c in ACC]
-            + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10),
-               Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0)]
-            + [Column(c, "deg/s", required=False, checked=False) for c in GYR]
-            + [Column("lat_deg", "deg", required=False, lo=-90.0, hi=90.0),
-               Column("lon_deg", "deg", required=False, lo=-180.0, hi=360.0),
-               Column("height_m", "m", required=False, lo=-1e4, hi=1e6)])
+    """The columns of ``FREE_COLUMNS``, as a list."""
+    return list(FREE_COLUMNS)
 
 
 def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str) -> float:
@@ -239,7 +252,7 @@ def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
     median ``|a|`` must lie in 5-15 m/s^2; near 1 names g); too few distinct orientations
     (``check_orientations``); site columns that disagree (:func:`site_of`).  Adds the derived columns of :func:`with_invariants`."""
     name = Path(path).name
-    frame = read_table(path, free_columns(), min_rows=min_rows, kind="magnetometer file")
+    frame = read_table(path, FREE_COLUMNS, min_rows=min_rows, kind="magnetometer file")
     require_variation(frame, MAG, name, "a magnetometer turned through many orientations")
     check_units(frame, name)
     check_orientations(frame, name)
@@ -446,7 +459,7 @@ SYSTEM = register_system(System(
     "magnetometer_free", "uT", FREE_EFFECTS, load_free, _fit_free, free_structure,
     "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
     "and (with an accelerometer) its component along gravity - D, uT", noise_directions=noise_directions,
-    final_check=loop_field_check))
+    final_check=loop_field_check, columns=FREE_COLUMNS))
 
 
 def field_summary(fit: Fit) -> dict:
