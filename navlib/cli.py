@@ -45,8 +45,9 @@ SYSTEM is compass, drift, magnetometer, magnetometer_free or accelerometer:
   magnetometer_free columns: mag_x_ut, mag_y_ut, mag_z_ut (no attitude); optional acc_x_ms2, acc_y_ms2,
   acc_z_ms2 (still or slow), time_s, temperature_c, and the site: lat_deg, lon_deg, height_m (one
   site per file: spread at most 0.1 deg and 500 m) and date (ISO 8601, within a year).
-  accelerometer columns (one unit's tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
+  accelerometer columns (a tumble test): temperature_c, position_deg (dividing-head grid, 15 deg),
   output_mg (output / nominal scale factor), unit; optional set_point_c.  Extra columns are ignored.
+  A file of several units: --unit NAME fits one.
 
 --effects FILE.py adds your own effects (every navlib.workbench.effects.Effect defined in the file whose
 system matches), usable in --model and named by diagnose like catalogued ones.
@@ -105,6 +106,8 @@ def build_parser() -> argparse.ArgumentParser:
         cmd.add_argument("--effects", default=None, help="Python file defining your own effects")
         cmd.add_argument("--json", action="store_true", help="print one JSON object")
         cmd.add_argument("--alpha", type=float, default=None, help="family-wise false-alarm level (default 0.025)")
+        cmd.add_argument("--unit", default=None, metavar="NAME",
+                         help="accelerometer: the unit (column 'unit') to fit when the file holds several")
         if name == "loop":
             cmd.add_argument("--report", default=None, help="folder for loop.png and loop.md (never overwritten)")
             _site_options(cmd, required=False)
@@ -213,7 +216,10 @@ def _prepare(args):
     users = load_effects(args.effects, system.name, system.catalogue) if args.effects else ()
     available = {**system.catalogue, **{e.name: e for e in users}}
     names = [e.name for e in resolve(available, args.model.split(","), None, system.name)]
-    data = system.load(args.file)
+    unit = getattr(args, "unit", None)
+    if unit is not None and system.name != "accelerometer":
+        raise InputError(f"parameter --unit={unit!r}: only the accelerometer system has units")
+    data = system.load(args.file) if unit is None else system.load(args.file, unit=unit)
     return system, users, names, data
 
 

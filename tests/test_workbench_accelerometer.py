@@ -86,3 +86,24 @@ def test_cli_bad_input_exit_2(tmp_path):
     d.to_csv(bad, index=False)
     r = run_cli("diagnose", "accelerometer", str(bad), "--model", "bias")
     assert r.returncode == 2 and "column 'position_deg', row 4 (file line 5): 7.5 is not on" in r.stderr
+
+
+def test_unit_picks_one_accelerometer_of_a_file_that_holds_several(tmp_path):
+    both = A.load_accelerometer(TUMBLE_FILE, unit="B")
+    assert set(both["unit"]) == {"B"} and len(both) == int((pd.read_csv(TUMBLE_FILE)["unit"] == "B").sum())
+    one = _one_unit(tmp_path)
+    assert A.load_accelerometer(one).equals(A.load_accelerometer(TUMBLE_FILE, unit="A"))
+    with pytest.raises(InputError, match=r"no rows of unit 'C' in column 'unit' \(it names A, B\)"):
+        A.load_accelerometer(TUMBLE_FILE, unit="C")
+    with pytest.raises(InputError, match="choose it with --unit"):
+        A.load_accelerometer(TUMBLE_FILE)
+    r = run_cli("diagnose", "accelerometer", str(TUMBLE_FILE), "--model", "bias", "--unit", "A", "--json")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == run_cli("diagnose", "accelerometer", str(one), "--model", "bias",
+                                       "--json").stdout.strip()
+    for args, says in ((("--unit", "C"), "no rows of unit 'C'"),
+                       ((), "choose it with --unit")):
+        r = run_cli("loop", "accelerometer", str(TUMBLE_FILE), "--model", "bias", *args)
+        assert r.returncode == 2 and says in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    r = run_cli("loop", "compass", str(TUMBLE_FILE), "--unit", "A")
+    assert r.returncode == 2 and "only the accelerometer system has units" in r.stderr

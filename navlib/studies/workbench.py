@@ -113,9 +113,9 @@ def steps_frame(result: LoopResult, label: str = "") -> pd.DataFrame:
 OWN_DATA_FILES = {"compass": data_path("compass_sweeps.csv"), "drift": data_path("gyro_drift_measurements.csv"),
                   "magnetometer": MAG_DIR / CALIBRATION_TRIAL, "magnetometer_free": MAG_DIR / CALIBRATION_TRIAL,
                   "accelerometer": data_path("accel_tumble.csv")}
-#: The file a command names where the sample file itself would be refused: the workbench fits one
-#: accelerometer per file, and ``data/accel_tumble.csv`` holds two (units A and B).
-OWN_DATA_COMMAND_FILES = {"accelerometer": "accel_tumble_A.csv"}
+#: Options a system's command needs on its sample file: the workbench fits one accelerometer, and
+#: ``data/accel_tumble.csv`` holds two (units A and B), so the command picks one.
+OWN_DATA_COMMAND_OPTIONS = {"accelerometer": ["--unit", "A"]}
 #: How many rows of each sample file are shown.
 SAMPLE_ROWS = 5
 
@@ -168,8 +168,8 @@ def wrap_report(text: str, width: int = 88) -> str:
 
 def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
     """The columns table, ``rows`` sample rows of ``OWN_DATA_FILES`` and the one command
-    (``navlib loop SYSTEM FILE --report DIR``) for ``system``; the command names the sample file, or
-    the file of :data:`OWN_DATA_COMMAND_FILES` where the sample file must be split first."""
+    (``navlib loop SYSTEM FILE --report DIR``) for ``system`` on the sample file, with the options of
+    :data:`OWN_DATA_COMMAND_OPTIONS` it needs."""
     from ..workbench.effects import columns_table
     check_param("rows", rows, lo=1, integer=True)
     if system not in OWN_DATA_FILES:
@@ -185,7 +185,7 @@ def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
         sample.index.name = "column"
     shown = _shown_path(path)
     return OwnData(system, cols, sample, shown,
-                   shell_command(["navlib", "loop", system, OWN_DATA_COMMAND_FILES.get(system, shown),
+                   shell_command(["navlib", "loop", system, shown, *OWN_DATA_COMMAND_OPTIONS.get(system, []),
                                   "--report", f"out_{system}/"]))
 
 
@@ -653,7 +653,7 @@ def drift_study(alpha: float | None = None) -> DriftStudy:
 def accelerometer_loop(unit: str = "A", start=("bias",), alpha: float | None = None) -> LoopResult:
     """The workbench loop on one accelerometer of the shipped tumble file ``data/accel_tumble.csv``
     (:func:`navlib.data.tumble.read_tumble`; its rows of ``unit``), from the model ``start``: what
-    ``python -m navlib loop accelerometer FILE --model bias`` does on a file of that unit alone."""
+    ``python -m navlib loop accelerometer FILE --unit A --model bias`` does."""
     from ..data.tumble import TUMBLE_FILE, read_tumble
     data = read_tumble(TUMBLE_FILE)
     if unit not in set(data["unit"]):

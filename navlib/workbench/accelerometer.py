@@ -87,18 +87,25 @@ def output_slope(df: pd.DataFrame) -> float:
     return float(coef[0])
 
 
-def load_accelerometer(path: str | os.PathLike) -> pd.DataFrame:
+def load_accelerometer(path: str | os.PathLike, unit: str | None = None) -> pd.DataFrame:
     """A tumble file of ONE accelerometer (:func:`navlib.data.tumble.read_tumble`: temperature -60..130
-    degC, position on the 15-deg grid, output within +-5000 mg; at least 5 positions), with plausibility
+    degC, position on the 15-deg grid, output within +-5000 mg; at least 5 positions), or the rows of the
+    accelerometer ``unit`` (the ``unit`` column) of a file that holds several, with plausibility
     checks of the output: it must vary (a stuck sensor), and its slope against the input ``a = cos q``
     (:func:`output_slope`) must be 1000 mg/g within a factor of 2 (``SCALE_BAND``): a slope near 1 names g, near 9.8
     m/s^2, near 31 ft/s^2, a negative one a reversed input axis."""
     df = read_tumble(path)
     name = os.path.basename(str(path))
     units = list(dict.fromkeys(df["unit"]))
-    if len(units) != 1:
+    if unit is not None:
+        if str(unit) not in units:
+            raise InputError(f"{name}: no rows of unit {str(unit)!r} in column 'unit' (it names "
+                             f"{', '.join(units)})")
+        df = df[df["unit"] == str(unit)].reset_index(drop=True)
+    elif len(units) != 1:
         raise InputError(f"{name}: column 'unit' names {len(units)} accelerometers "
-                         f"({', '.join(units)}); the workbench fits one: give a file with one unit")
+                         f"({', '.join(units)}); the workbench fits one: choose it with --unit "
+                         f"(python: unit=...)")
     require_levels(df, positions=5, what="the accelerometer model", name=name)
     require_variation(df, ["output_mg"], path, "a tumble test")
     slope = output_slope(df)
