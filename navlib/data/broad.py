@@ -57,6 +57,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy.spatial.transform import Rotation
 
 from ..angles import wrap_deg
 from ..errors import InputError
@@ -149,41 +150,21 @@ def output_name(path) -> str:
 
 # ------------------------------------------------------------------------------------------ rotations
 def quat_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(n, 3, 3)`` of unit quaternions ``(n, 4)``, scalar first (normalised here)."""
-    q = np.asarray(q, float)
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-                     np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-                     np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
+    """Rotation matrices ``(n, 3, 3)`` of unit quaternions ``(n, 4)``, scalar first (normalised here;
+    :class:`scipy.spatial.transform.Rotation`)."""
+    return Rotation.from_quat(np.asarray(q, float)[:, [1, 2, 3, 0]]).as_matrix()
 
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``(n, 4)``, scalar first and non-negative, of rotation matrices ``(n, 3, 3)``
-    (the largest-component method, stable for every rotation)."""
-    R = np.asarray(R, float).reshape(-1, 3, 3)
-    K = np.empty((len(R), 4, 4))
-    K[:, 0, 0] = R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2]
-    K[:, 1, 1] = R[:, 0, 0] - R[:, 1, 1] - R[:, 2, 2]
-    K[:, 2, 2] = -R[:, 0, 0] + R[:, 1, 1] - R[:, 2, 2]
-    K[:, 3, 3] = -R[:, 0, 0] - R[:, 1, 1] + R[:, 2, 2]
-    K[:, 0, 1] = K[:, 1, 0] = R[:, 2, 1] - R[:, 1, 2]
-    K[:, 0, 2] = K[:, 2, 0] = R[:, 0, 2] - R[:, 2, 0]
-    K[:, 0, 3] = K[:, 3, 0] = R[:, 1, 0] - R[:, 0, 1]
-    K[:, 1, 2] = K[:, 2, 1] = R[:, 1, 0] + R[:, 0, 1]
-    K[:, 1, 3] = K[:, 3, 1] = R[:, 0, 2] + R[:, 2, 0]
-    K[:, 2, 3] = K[:, 3, 2] = R[:, 2, 1] + R[:, 1, 2]
-    _, vec = np.linalg.eigh(K / 3.0)                 # Bar-Itzhack: the eigenvector of the largest eigenvalue
-    q = vec[:, :, -1]
+    """Unit quaternions ``(n, 4)``, scalar first and non-negative, of rotation matrices ``(n, 3, 3)``."""
+    q = Rotation.from_matrix(np.asarray(R, float).reshape(-1, 3, 3)).as_quat()[:, [3, 0, 1, 2]]
     return q * np.where(q[:, :1] < 0, -1.0, 1.0)
 
 
 def euler_zyx_deg(R: np.ndarray) -> np.ndarray:
     """Roll, pitch, heading (deg; heading in [0, 360)) of ``C_b^n`` matrices ``(n, 3, 3)``, z-y-x order."""
-    roll = np.degrees(np.arctan2(R[:, 2, 1], R[:, 2, 2]))
-    pitch = np.degrees(-np.arcsin(np.clip(R[:, 2, 0], -1.0, 1.0)))
-    heading = np.mod(np.degrees(np.arctan2(R[:, 1, 0], R[:, 0, 0])), 360.0)
-    return np.column_stack([roll, pitch, heading])
+    heading, pitch, roll = Rotation.from_matrix(np.asarray(R, float)).as_euler("ZYX", degrees=True).T
+    return np.column_stack([roll, pitch, np.mod(heading, 360.0)])
 
 
 def attitude_frd_ned(opt_quat: np.ndarray) -> np.ndarray:
