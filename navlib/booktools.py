@@ -379,11 +379,7 @@ def check_chapter_closing(text: str) -> list[str]:
                 f"glued into a ':::{{admonition}} {SHOWED}' block"]
     if text.find('<div class="cell docutils container', m.end()) >= 0:
         return [f"the '{SHOWED}' admonition is not at the chapter's end: a code cell follows it"]
-    box = html.unescape(re.sub(r"<[^>]+>", " ", text[m.end():]))
-    shown = {}
-    for t in _TALLY.finditer(re.sub(r"\s+", " ", box)):
-        shown.setdefault("paper" if t.group(1) == "paper's" else "book", (int(t.group(2)), int(t.group(4)),
-                                                                           int(t.group(5))))
+    shown = _box_counts(text[m.end():])
     glance = glance_counts(text)
     if glance is not None and shown != glance:
         return [f"the '{SHOWED}' box counts {shown} but the glance box {glance}: build both from the same "
@@ -403,11 +399,17 @@ def glance_counts(text: str) -> dict[str, tuple[int, int, int]] | None:
     if not m:
         return None
     end = text.find('<div class="cell docutils container', m.end())
-    box = html.unescape(re.sub(r"<[^>]+>", " ", text[m.end(): end if end >= 0 else len(text)]))
+    return _box_counts(text[m.end(): end if end >= 0 else len(text)])
+
+
+def _box_counts(fragment: str) -> dict[str, tuple[int, int, int]]:
+    """The tallies ("The paper's claims: k of n reproduced, m not reproduced, j cannot be judged") in an
+    HTML fragment, by source: the first of each."""
+    box = re.sub(r"\s+", " ", html.unescape(re.sub(r"<[^>]+>", " ", fragment)))
     out = {}
-    for t in _TALLY.finditer(re.sub(r"\s+", " ", box)):
-        src = "paper" if t.group(1) == "paper's" else "book"
-        out.setdefault(src, (int(t.group(2)), int(t.group(4)), int(t.group(5))))
+    for t in _TALLY.finditer(box):
+        out.setdefault("paper" if t.group(1) == "paper's" else "book", (int(t.group(2)), int(t.group(4)),
+                                                                         int(t.group(5))))
     return out
 
 

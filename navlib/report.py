@@ -114,6 +114,19 @@ ACRONYMS = {"rms", "rmse", "mse", "sse", "loo", "maxe", "mare", "ins", "rbf", "a
 _NEG_ZERO = re.compile(r"^[-\u2212]([+]?0(?:\.0+)?(?:e[+-]?\d+)?)$")
 
 
+def _unit_suffix(words: list[str], tables) -> tuple[str, int]:
+    """The longest unit suffix of ``words`` (a snake_case name split at "_") found in ``tables`` (mappings
+    of word tuples to the unit shown) and its length in words; ``("", 0)`` when there is none."""
+    low = [w.lower() for w in words]
+    best, best_len = "", 0
+    for table_ in tables:
+        for suffix, shown in table_.items():
+            k = len(suffix)
+            if best_len < k < len(low) and tuple(low[-k:]) == suffix:
+                best, best_len = shown, k
+    return best, best_len
+
+
 def label(name: Any) -> str:
     """A readable header for a column name: a tuple is joined with spaces; a snake_case name becomes words
     with its unit suffix in parentheses and acronyms in capitals (``median_rms_deg`` -> ``median RMS
@@ -124,12 +137,8 @@ def label(name: Any) -> str:
     if "_" not in text or " " in text:
         return text
     words = [w for w in text.split("_") if w]
-    unit = ""
-    for suffix, shown in UNIT_SUFFIXES.items():
-        k = len(suffix)
-        if len(words) > k and tuple(w.lower() for w in words[-k:]) == suffix:
-            unit, words = shown, words[:-k]
-            break
+    unit, k = _unit_suffix(words, (UNIT_SUFFIXES,))
+    words = words[:len(words) - k]
     words = [w.upper() if w.lower() in ACRONYMS else w for w in words]
     return " ".join(words) + (f" ({unit})" if unit else "")
 
@@ -263,15 +272,7 @@ PARAMETER_UNITS = {("deg", "rt", "h"): "deg/sqrt(h)", ("hz",): "Hz", ("m",): "m"
 def unit_of(name: str) -> str:
     """The unit a snake_case name carries in its suffix (``noise_ut`` -> ``uT``, ``gyro_arw_deg_rt_h`` ->
     ``deg/sqrt(h)``, ``t_start_c`` -> ``degC``), or "" when it carries none (``n_seeds``)."""
-    words = [w.lower() for w in str(name).split("_") if w]
-    best = ""
-    best_len = 0
-    for table_ in (PARAMETER_UNITS, UNIT_SUFFIXES):
-        for suffix, shown in table_.items():
-            k = len(suffix)
-            if len(words) > k and tuple(words[-k:]) == suffix and k > best_len:
-                best, best_len = shown, k
-    return best
+    return _unit_suffix([w for w in str(name).split("_") if w], (PARAMETER_UNITS, UNIT_SUFFIXES))[0]
 
 
 def _parameters_cell(notebook: str | os.PathLike) -> str:
@@ -403,8 +404,6 @@ def glue_figure(name: str, fig) -> None:
 def glue_png(name: str, path) -> None:
     """Glue a PNG file (e.g. the figure ``navlib loop --report`` wrote) for a MyST ``{glue:figure}``
     directive; the image is read now, so the file may be removed afterwards."""
-    from pathlib import Path
-
     from IPython.display import Image
 
     _glue(name, Image(data=Path(path).read_bytes(), format="png"))
@@ -703,8 +702,7 @@ class _Outcome:
 def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
     """A claim or a results file's claim record, reduced to what the summary boxes need."""
     if isinstance(c, Claim):
-        return _Outcome(c.claim, c.reading, c.source, c.verdict,
-                        verdicts.reason_category(c.basis, c.reason) if c.verdict == "cannot be judged" else None)
+        c = c.record()
     try:
         return _Outcome(str(c["claim"]), str(c.get("reading", "")), str(c["source"]), str(c["verdict"]),
                         c.get("reason") if c["verdict"] == "cannot be judged" else None)
@@ -732,12 +730,6 @@ def _claim_outcome(cs: list[_Outcome]) -> str:
     return ", ".join(parts) + f" of {len(v)} readings"
 
 
-def _tally(cs: list[_Outcome]) -> str:
-    v = [c.verdict for c in cs]
-    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
-            f"{v.count('cannot be judged')} cannot be judged")
-
-
 class Showed:
     """The *What this chapter showed* box at a chapter's end, built from the same claims as the glance box
     and the landing page (:class:`Claim` objects or the claim records of a results file): per source (the
@@ -759,7 +751,7 @@ class Showed:
     @staticmethod
     def _lead(title: str, cs: list[_Outcome]) -> str:
         why = _reason_counts(cs)
-        return f"{title}: {_tally(cs)}" + (f" ({why})" if why else "")
+        return f"{title}: {tally(cs)}" + (f" ({why})" if why else "")
 
     def _repr_html_(self) -> str:
         out = []
