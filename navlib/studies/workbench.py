@@ -284,9 +284,7 @@ def _on_undisturbed(fn, row_step, alpha, workers, scheduler, label) -> pd.DataFr
     check_param("row_step", row_step, lo=1, integer=True)
     rows = engine.run(fn, [(n, row_step, alpha) for n in names], workers=workers, scheduler=scheduler,
                       label=label, cost=[float((MAG_DIR / n).stat().st_size) for n in names])
-    stairs = {r["trial"]: r.pop("staircase") for r in rows if r.get("staircase") is not None}
-    for r in rows:
-        r.pop("staircase", None)
+    stairs = {r["trial"]: st for r in rows if (st := r.pop("staircase", None)) is not None}
     out = pd.DataFrame(rows).set_index("trial")
     out.attrs["staircases"] = stairs
     return out
@@ -652,14 +650,11 @@ def drift_study(alpha: float | None = None) -> DriftStudy:
 
 def accelerometer_loop(unit: str = "A", start=("bias",), alpha: float | None = None) -> LoopResult:
     """The workbench loop on one accelerometer of the shipped tumble file ``data/accel_tumble.csv``
-    (:func:`navlib.data.tumble.read_tumble`; its rows of ``unit``), from the model ``start``: what
+    (:func:`navlib.workbench.accelerometer.load_accelerometer` with ``unit``), from the model ``start``: what
     ``python -m navlib loop accelerometer FILE --unit A --model bias`` does."""
-    from ..data.tumble import TUMBLE_FILE, read_tumble
-    data = read_tumble(TUMBLE_FILE)
-    if unit not in set(data["unit"]):
-        raise InputError(f"parameter unit={unit!r}: {TUMBLE_FILE.name} holds units "
-                         f"{', '.join(dict.fromkeys(data['unit']))}")
-    return loop("accelerometer", data[data["unit"] == unit].reset_index(drop=True), list(start), alpha=alpha)
+    from ..data.tumble import TUMBLE_FILE
+    from ..workbench.accelerometer import load_accelerometer
+    return loop("accelerometer", load_accelerometer(TUMBLE_FILE, unit=unit), list(start), alpha=alpha)
 
 
 def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.DataFrame | None:

@@ -303,7 +303,7 @@ def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
         ax.title.set_text(textwrap.fill(ax.title.get_text(), GRID_TITLE_WIDTH))
         ax.set_xlabel("")
         for h, lab in zip(*ax.get_legend_handles_labels()):
-            key = "band" if lab in bands or lab == band or lab == st.floor_label else lab
+            key = "band" if lab == st.floor_label else lab
             handles.setdefault(key, (h, band if key == "band" else lab))
     for ax in axes.ravel()[len(items):]:
         ax.set_axis_off()

@@ -93,18 +93,19 @@ MIN_EXPLAINED = 0.25
 TRIM = 5.0
 
 
-_AXES = {"x": "x forward", "y": "y right", "z": "z down"}
+#: The body axes (FRD) in words, for the file schemas' meanings.
+AXES = {"x": "x forward", "y": "y right", "z": "z down"}
 # The file schema of the ``magnetometer`` system (what :func:`load_magnetometer` reads; the data
 # dictionary of :func:`navlib.data.tables.schema_table`).
 MAGNETOMETER_COLUMNS = tuple(
-    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]} (FRD)")
+    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]} (FRD)")
      for c in MAG]
     + [Column(c, "", lo=-1.5, hi=1.5,
               meaning=("reference attitude, unit quaternion, scalar first, body FRD to NED"
                        if c == "q_w" else "reference attitude quaternion, vector part"))
        for c in QUAT]
     + [Column(c, "deg/s", required=False, lo=-1e5, hi=1e5,
-              meaning=f"angular rate, {_AXES[c[4]]} (the time_lag effect needs all three)") for c in GYR]
+              meaning=f"angular rate, {AXES[c[4]]} (the time_lag effect needs all three)") for c in GYR]
     + [Column(c, "m", required=False, lo=-1e7, hi=1e7,
               meaning=f"position, {d} (a field that changes with position)")
        for c, d in zip(POS, ("north", "east", "down"))]

@@ -71,7 +71,7 @@ from ..errors import InputError, check_param
 from ..methods.preprocess import field_gravity_dot
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
-from .magnetometer import FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
+from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
 from .serial import ar1_noise
 
 ACC = ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2")
@@ -125,13 +125,12 @@ SITE_TOL_DEG, HEIGHT_TOL_M = 0.1, 500.0
 DATE_TOL_DAYS = 366
 
 
-_AXES = {"x": "x forward", "y": "y right", "z": "z down"}
 # The file schema of the ``magnetometer_free`` system (what :func:`load_free` reads; the data dictionary
 # of :func:`navlib.data.tables.schema_table`).
 FREE_COLUMNS = tuple(
-    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {_AXES[c[4]]}") for c in MAG]
+    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]}") for c in MAG]
     + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4,
-              meaning=f"specific force, {_AXES[c[4]]} (all three or none; misalignment needs them)")
+              meaning=f"specific force, {AXES[c[4]]} (all three or none; misalignment needs them)")
        for c in ACC]
     + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10, meaning="time of the sample"),
        Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0,
