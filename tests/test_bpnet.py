@@ -187,3 +187,55 @@ def test_compiled_fitness_matches_double_precision_on_evolved_like_nets():
     pop = np.random.default_rng(7).uniform(-10, 10, (500, 19))
     np.testing.assert_allclose(obj32(pop), obj64(pop), rtol=2e-5)
     np.testing.assert_allclose(obj32(pop[:1]), obj64(pop[:1]), rtol=2e-5)    # any population size
+
+
+def test_parent_cached_fitness_equals_the_full_evaluation_bit_for_bit():
+    """LogsigSSE.trials reuses a parent's hidden units whose weights a trial kept; every fitness equals the
+    plain call's exactly, whichever units were changed (none, some, all, the output weights only)."""
+    x = np.linspace(0, 360, 121)
+    t = x + 15 * np.sin(np.radians(x)) + 3 * np.cos(2 * np.radians(x))
+    obj, _, _ = sse_objective(x, t, 6)
+    rng = np.random.default_rng(3)
+    pop = rng.uniform(-10, 10, (200, 19))
+    np.testing.assert_array_equal(obj.start(pop), obj(pop))
+    trial = pop.copy()
+    mask = rng.random(pop.shape) < rng.uniform(0, 1, (200, 1))     # each trial changes its own share of genes
+    mask[:20] = False                                               # identical to the parent
+    mask[20:40] = False
+    mask[20:40, 12:] = True                                         # only the output layer changed
+    trial[mask] = rng.uniform(-10, 10, mask.sum())
+    np.testing.assert_array_equal(obj.trials(trial, pop), obj(trial))
+    kept_unit = ~(mask[:, :6] | mask[:, 6:12])
+    assert kept_unit.any() and (~kept_unit).any()
+    # accept every other trial: the kept hidden layers follow, and a next generation still matches
+    accepted = np.arange(200) % 2 == 0
+    obj.accept(accepted)
+    pop[accepted] = trial[accepted]
+    trial2 = pop.copy()
+    trial2[:, 3] += 0.5                                             # unit 3's input weight: every trial
+    np.testing.assert_array_equal(obj.trials(trial2, pop), obj(trial2))
+    rows = np.arange(200) < 95                                      # a finished run leaves the batch
+    obj.keep(rows)
+    np.testing.assert_array_equal(obj.trials(trial2[rows], pop[rows]), obj(trial2[rows]))
+
+
+@pytest.mark.parametrize("adaptive,cr_rule,target", [(False, "value", 0.0), (True, "value", 0.0),
+                                                     (True, "rank", 0.0), (False, "value", 2e5)])
+def test_evolution_with_the_parent_cache_equals_plain_evaluation(adaptive, cr_rule, target):
+    """evolve_many through the cache protocol gives the runs a plain callable gives, bit for bit (also when
+    runs reach the target at different generations and leave the batch)."""
+    from navlib.methods.de import DEParams, evolve_many
+    from navlib.methods.seeding import generators
+
+    x = np.linspace(0, 360, 121)
+    t = x + 15 * np.sin(np.radians(x)) + 3 * np.cos(2 * np.radians(x))
+    obj, _, _ = sse_objective(x, t, 6)
+    p = DEParams(pop_size=20, max_generations=300, target_fitness=target, adaptive=adaptive, cr_rule=cr_rule)
+    cached = evolve_many(obj, 19, p, generators([0, 1, 2]))
+    plain = evolve_many(lambda th: obj(th), 19, p, generators([0, 1, 2]))
+    if target:
+        assert len({r.generations for r in plain}) > 1                # runs left the batch at different times
+    for a, b in zip(cached, plain):
+        assert a.generations == b.generations and a.fitness == b.fitness
+        np.testing.assert_array_equal(a.population, b.population)
+        np.testing.assert_array_equal(a.history, b.history)

@@ -36,7 +36,7 @@ from scipy.optimize import least_squares
 from .._optional import require
 from ..errors import InputError, check_choice, check_param
 from .de import DEParams, DEResult, evolve_many
-from .jit import LM_STOPS, lm_1m1, logsig_sse
+from .jit import LM_STOPS, hidden_accept, lm_1m1, logsig_sse, logsig_sse_keep, logsig_sse_trials
 from .lm import LMParams, LMResult, dividerand, levenberg_marquardt
 from .scaling import MinMax
 
@@ -116,11 +116,53 @@ class BPNet:
                                                        activation=self.activation)[0])
 
 
+class LogsigSSE:
+    """The float32 fitness of :func:`sse_objective` (:func:`navlib.methods.jit.logsig_sse`): call it on
+    ``(K, 3M+1)`` parameter vectors.  It also offers :func:`navlib.methods.de.evolve_many`'s parent-cache
+    protocol (``start``, ``trials``, ``accept``, ``keep``): it keeps the current population's hidden-layer
+    outputs and evaluates each trial from its parent's, recomputing only the hidden units whose weights the
+    trial changed (:func:`navlib.methods.jit.logsig_sse_trials`); every fitness is the call's, bit for bit."""
+
+    def __init__(self, xn, t, lo: float, span: float, n_hidden: int):
+        self.xn, self.t, self.lo, self.span, self.m = xn, t, lo, span, int(n_hidden)
+        self._hidden = self._trial_hidden = self._changed = None
+
+    def __call__(self, thetas: np.ndarray) -> np.ndarray:
+        return logsig_sse(np.ascontiguousarray(np.atleast_2d(thetas), dtype=float), self.xn, self.t, self.lo,
+                          self.span, self.m)
+
+    def start(self, pop: np.ndarray) -> np.ndarray:
+        """Fitness of a population ``(K, 3M+1)``, keeping its hidden layers."""
+        pop = np.ascontiguousarray(pop, dtype=float)
+        self._hidden = np.empty((pop.shape[0], self.m, len(self.xn)), np.float32)
+        self._trial_hidden = np.empty_like(self._hidden)
+        self._changed = np.zeros((pop.shape[0], self.m), np.bool_)
+        return logsig_sse_keep(pop, self.xn, self.t, self.lo, self.span, self.m, self._hidden)
+
+    def trials(self, trial: np.ndarray, pop: np.ndarray) -> np.ndarray:
+        """Fitness of trial ``k`` made from individual ``k`` of the population last passed to ``start`` (as
+        updated by ``accept`` and ``keep``); ``pop`` is that population."""
+        return logsig_sse_trials(np.ascontiguousarray(trial, dtype=float), np.ascontiguousarray(pop, dtype=float),
+                                 self._hidden, self.xn, self.t, self.lo, self.span, self.m, self._trial_hidden,
+                                 self._changed)
+
+    def accept(self, accepted: np.ndarray) -> None:
+        """Trials ``accepted (K,)`` replaced their parents."""
+        hidden_accept(self._hidden, self._trial_hidden, self._changed, np.asarray(accepted, dtype=np.bool_))
+
+    def keep(self, rows: np.ndarray) -> None:
+        """Only the individuals ``rows (K,)`` (bool) stay in the population."""
+        rows = np.asarray(rows, dtype=np.bool_)
+        self._hidden = np.ascontiguousarray(self._hidden[rows])
+        self._trial_hidden = np.ascontiguousarray(self._trial_hidden[rows])
+        self._changed = np.ascontiguousarray(self._changed[rows])
+
+
 def sse_objective(x, t, n_hidden: int, dtype=np.float32):
     """Vectorised fitness ``J(theta) = sum_k (d_k - o_k)^2`` (deg^2) of paper A's net over the training set,
     plus the scalers.
 
-    ``dtype=np.float32`` (the default, used during evolution): the compiled kernel
+    ``dtype=np.float32`` (the default, used during evolution): :class:`LogsigSSE`, the compiled kernel
     :func:`navlib.methods.jit.logsig_sse`, hidden layer in single precision (output error ~1e-3 deg per
     point, far below the 0.1 deg noise floor; about 5x faster than numpy's float32 ``tanh``).
     ``dtype=np.float64``: numpy in double precision, for re-scoring final networks and as the reference
@@ -131,9 +173,7 @@ def sse_objective(x, t, n_hidden: int, dtype=np.float32):
     lo, span = float(ts.lo[0]), float(ts.span[0])
     m, n = int(n_hidden), len(xn)
     if dtype == np.float32:
-        def objective(thetas: np.ndarray) -> np.ndarray:
-            return logsig_sse(np.ascontiguousarray(np.atleast_2d(thetas), dtype=float), xn, t, lo, span, m)
-        return objective, xs, ts
+        return LogsigSSE(xn, t, lo, span, m), xs, ts
     X = 0.5 * np.stack([xn, np.ones_like(xn)])                            # sigmoid(z) = (1 + tanh(z/2))/2
 
     def objective(thetas: np.ndarray) -> np.ndarray:

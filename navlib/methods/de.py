@@ -211,7 +211,14 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
     initial population, then the seed of its xoshiro256** stream), so its result does not depend on which
     other runs share the batch.
     A run stops at ``max_generations`` or when its best fitness is <= ``target_fitness``; stopped runs
-    leave the batch.  ``initial``: optional ``(S, NP, D)`` starting populations."""
+    leave the batch.  ``initial``: optional ``(S, NP, D)`` starting populations.
+
+    Parent cache (optional): an ``objective`` that also has ``start(pop)`` (fitness of the initial
+    population, remembering what it needs), ``trials(trial, pop)`` (fitness of trial ``k``, made from
+    individual ``k`` of ``pop``), ``accept(mask)`` (the trials that replaced their parents) and
+    ``keep(rows)`` (the individuals of runs still in the batch) is evaluated through them: a trial keeps
+    part of its parent's genes, and the objective may reuse the parent's partial results for them
+    (:class:`navlib.methods.bpnet.LogsigSSE` does).  It must return exactly what calling it returns."""
     check_param("dim", dim, lo=1, integer=True)
     rngs = list(rngs)
     if not rngs:
@@ -224,7 +231,9 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
         pop = np.array(initial, dtype=float)
         if pop.shape != (n_runs, n, dim):
             raise InputError(f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}")
-    fit = np.ascontiguousarray(np.asarray(objective(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n))
+    cached = all(callable(getattr(objective, a, None)) for a in ("start", "trials", "accept", "keep"))
+    first = objective.start if cached else objective
+    fit = np.ascontiguousarray(np.asarray(first(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n))
     history = np.full((n_runs, gmax), np.nan)
     results: list = [None] * n_runs
     ids = np.arange(n_runs)                 # run index of each row still in the batch
@@ -254,6 +263,8 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
             keep = ~done
             if not keep.any():
                 break
+            if cached:
+                objective.keep(np.repeat(keep, n))
             ids, pop, fit = ids[keep], np.ascontiguousarray(pop[keep]), np.ascontiguousarray(fit[keep])
             state = np.ascontiguousarray(state[keep])
             trial, best = trial[:keep.sum()], best[:keep.sum()]
@@ -263,7 +274,12 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
                            float(params.cr_min), float(params.cr_max), F_RULES.index(params.f_rule),
                            params.cr_rule == "rank", f_i, cr_i)
         de_trials(pop, state, f_i, cr_i, b, trial)
-        tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(ids.size, n)
+        if cached:
+            tfit = np.asarray(objective.trials(trial.reshape(-1, dim), pop.reshape(-1, dim)),
+                              dtype=float).reshape(ids.size, n)
+            objective.accept((tfit <= fit).ravel())                         # before fit is updated
+        else:
+            tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(ids.size, n)
         de_select(pop, fit, trial, tfit, best)                             # greedy selection, in place
         history[ids, g] = best
         g += 1

@@ -9,6 +9,9 @@ it says which); the tests compare each kernel with that numpy reference.
   (Moshier 1992: range reduction to ``y = k + f``, ``|f| <= 1/2``, degree-6 polynomial for ``2^f``, and the
   exponent ``k`` written into the float's bits), so the loop over the training points vectorises (libm's
   ``expf`` does not): absolute error of the sigmoid <= 2e-7 over all inputs, the accuracy of float32.
+- :func:`logsig_sse_keep`, :func:`logsig_sse_trials`, :func:`hidden_accept`: the same fitness evaluated
+  from a DE trial's parent (:class:`navlib.methods.bpnet.LogsigSSE`): a hidden unit whose weights the
+  trial kept has its parent's outputs, which are kept, not recomputed; the same numbers bit for bit.
 - :func:`de_trials`, :func:`de_select`: one generation of DE/rand/1/bin (with per-individual F and CR) for
   all runs of a batch (:func:`navlib.methods.de.evolve_many`), each run drawing from its own xoshiro256**
   stream (:func:`xoshiro_states`, seeded from the run's numpy Generator).
@@ -141,6 +144,92 @@ def logsig_sse(thetas, xn, t, lo, span, n_hidden):
             s += e * e
         out[p] = s
     return out
+
+
+@njit(fastmath=FASTMATH, error_model="numpy", cache=True)
+def logsig_sse_keep(thetas, xn, t, lo, span, n_hidden, hidden):
+    """:func:`logsig_sse` that also keeps every net's hidden-layer outputs, ``hidden (P, M, N)`` float32
+    (written): the parents' layers that :func:`logsig_sse_trials` reuses.  The same numbers as
+    :func:`logsig_sse`, operation for operation."""
+    m = n_hidden
+    n_pop, n = thetas.shape[0], xn.shape[0]
+    out = np.empty(n_pop)
+    x32 = np.empty(n, np.float32)
+    for k in range(n):
+        x32[k] = xn[k]
+    acc = np.empty(n, np.float32)
+    for p in range(n_pop):
+        for k in range(n):
+            acc[k] = 0.0
+        for j in range(m):
+            w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
+            for k in range(n):
+                h = logsig32(w * x32[k] + b)
+                hidden[p, j, k] = h
+                acc[k] += v * h
+        c = lo + span * thetas[p, 3 * m]
+        s = 0.0
+        for k in range(n):
+            e = c + span * np.float64(acc[k]) - t[k]
+            s += e * e
+        out[p] = s
+    return out
+
+
+@njit(fastmath=FASTMATH, error_model="numpy", cache=True)
+def logsig_sse_trials(trials, parents, hidden, xn, t, lo, span, n_hidden, trial_hidden, changed):
+    """:func:`logsig_sse` of DE's trial nets ``trials (P, 3M+1)``, trial ``p`` made from parent ``p`` of
+    ``parents``, whose hidden-layer outputs are ``hidden (P, M, N)`` (:func:`logsig_sse_keep`).
+
+    A hidden unit whose input weight and bias are, in float32, the parent's has the parent's outputs
+    (the sigmoid sees the same ``w x' + b``), so they are read, not recomputed; only the other units'
+    sigmoids are evaluated (into ``trial_hidden``, with ``changed[p, j] = True``).  The output sum runs
+    over the units in the same order with the same operations, so every fitness equals
+    :func:`logsig_sse`'s bit for bit.  DE's crossover keeps a gene of the parent with probability
+    ``1 - CR``, so both genes of a unit with ``(1 - CR)^2``: 0.16 of the sigmoids at DE's CR = 0.6, most
+    of them at ADE's CR near ``CR_min`` = 0.1."""
+    m = n_hidden
+    n_pop, n = trials.shape[0], xn.shape[0]
+    out = np.empty(n_pop)
+    x32 = np.empty(n, np.float32)
+    for k in range(n):
+        x32[k] = xn[k]
+    acc = np.empty(n, np.float32)
+    for p in range(n_pop):
+        for k in range(n):
+            acc[k] = 0.0
+        for j in range(m):
+            w, b, v = _F(trials[p, j]), _F(trials[p, m + j]), _F(trials[p, 2 * m + j])
+            if w == _F(parents[p, j]) and b == _F(parents[p, m + j]):
+                changed[p, j] = False
+                for k in range(n):
+                    acc[k] += v * hidden[p, j, k]
+            else:
+                changed[p, j] = True
+                for k in range(n):
+                    h = logsig32(w * x32[k] + b)
+                    trial_hidden[p, j, k] = h
+                    acc[k] += v * h
+        c = lo + span * trials[p, 3 * m]
+        s = 0.0
+        for k in range(n):
+            e = c + span * np.float64(acc[k]) - t[k]
+            s += e * e
+        out[p] = s
+    return out
+
+
+@njit(cache=True)
+def hidden_accept(hidden, trial_hidden, changed, accepted):
+    """Trial ``p`` replaced its parent (``accepted[p]``): its recomputed hidden units
+    (``changed[p, j]``) become the parent's in ``hidden``."""
+    n_pop, m, n = hidden.shape
+    for p in range(n_pop):
+        if accepted[p]:
+            for j in range(m):
+                if changed[p, j]:
+                    for k in range(n):
+                        hidden[p, j, k] = trial_hidden[p, j, k]
 
 
 # ----------------------------------------------------------------------------------------------- random
