@@ -21,52 +21,32 @@ it says which); the tests compare each kernel with that numpy reference.
   :func:`blas_matmul`), without fast-math: the same numbers as the numpy loop (bit for bit on our machine).
 
 Kernels are compiled on first use and cached on disk (``cache=True``; about 1 s per kernel the first
-time).  ``error_model='numpy'``: a float division never raises (it cannot divide by zero here), which
-lets the compiler vectorise it.  Only the fast-math flags that do not reorder arithmetic are used
-(``nnan``, ``ninf``, ``nsz``, ``arcp``, ``contract``, ``afn``), and none in the ELM kernels.
+time), for the machine they run on (numba's default: AVX2 vectors of 8 floats, or AVX-512 vectors of 16
+where the processor has them).  ``error_model='numpy'``: a float division never raises (it cannot divide
+by zero here), which lets the compiler vectorise it.
+
+Same numbers on every machine: every floating-point operation of the kernels is exactly rounded IEEE
+arithmetic in a fixed order (:data:`FASTMATH`; none at all in the ELM kernels), so the vector width and
+the split between vectorised loop and scalar tail do not change a bit; a test compiles the kernels for
+LLVM's ``haswell`` (AVX2) and for the host and compares DE runs bit for bit.  The fused multiply-add
+(``contract``) needs an FMA unit (every x86-64 processor since 2013): on a machine without one the DE runs,
+which are chaotic, differ.  Earlier versions allowed an approximate reciprocal (``arcp``), which
+the compiler used in the vectorised sigmoid but not in its scalar tail; its rounding follows the
+processor (the ``rcpps`` estimate is not specified by the instruction set), so the kernels were pinned to
+``haswell`` and still could differ between processor makers.
 """
 from __future__ import annotations
 
-import os
-
 import numpy as np
-from llvmlite import binding as _llvm
 from llvmlite import ir
-from numba.core import config as _numba_config
+from numba import njit, types
+from numba.extending import intrinsic
 
-#: The instruction set the kernels are compiled for: one fixed target, LLVM's ``haswell`` (AVX2 and FMA,
-#: which every x86-64 machine since 2013 has), not the host's.  Compiled for the host, the vector width
-#: follows the machine (8 floats with AVX2, 16 with AVX-512), the rounding of the vectorised float32
-#: sigmoid and sums differs in the last bit, and DE's chaotic runs diverge: ADE-BP pure's median RMS over
-#: 20 seeds was 4.213 deg on an AVX2 machine and 4.302 deg on an AVX-512 one.  With the fixed target every
-#: AVX2 machine gives the same numbers.  Set ``NAVLIB_NUMBA_HOST=1`` (or numba's own ``NUMBA_CPU_NAME``) to
-#: compile for the host instead; on a machine without AVX2 the host target is used (numbers may differ).
-TARGET_CPU = "haswell"
-TARGET_FEATURES = ("+64bit,+avx,+avx2,+bmi,+bmi2,+cmov,+cx16,+f16c,+fma,+fsgsbase,+lzcnt,+mmx,+movbe,"
-                   "+pclmul,+popcnt,+rdrnd,+sahf,+sse,+sse2,+sse3,+sse4.1,+sse4.2,+ssse3,+xsave,+xsaveopt")
-
-
-def _pin_target() -> bool:
-    """Point numba's code generator at :data:`TARGET_CPU` before the first kernel is declared (numba
-    reads the target when its CPU context is first created, which the first ``@njit`` does); True if
-    pinned."""
-    if os.environ.get("NAVLIB_NUMBA_HOST") or os.environ.get("NUMBA_CPU_NAME") or \
-            os.environ.get("NUMBA_CPU_FEATURES"):
-        return False
-    host = _llvm.get_host_cpu_features()
-    if not (host.get("avx2") and host.get("fma")) or _llvm.get_process_triple().split("-")[0] != "x86_64":
-        return False
-    _numba_config.CPU_NAME, _numba_config.CPU_FEATURES = TARGET_CPU, TARGET_FEATURES
-    return True
-
-
-PINNED = _pin_target()
-
-from numba import njit, types  # noqa: E402  (after the target is pinned)
-from numba.extending import intrinsic  # noqa: E402
-
-#: Fast-math flags that keep the order of operations (no reassociation).
-FASTMATH = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}
+#: Fast-math flags that keep every operation exactly rounded: no reassociation, no approximate reciprocal
+#: (``arcp``) or functions (``afn``); only the fused multiply-add (``contract``) and the promises of no NaN,
+#: no infinity and no signed zero that matters.  So a vectorised loop computes each element as its scalar
+#: tail does, whatever the vector width, and the numbers do not follow the machine (module docstring).
+FASTMATH = {"nnan", "ninf", "nsz", "contract"}
 
 _F = np.float32
 _LOG2E = _F(1.4426950408889634)
