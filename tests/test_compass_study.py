@@ -545,6 +545,21 @@ def test_family_of_one_de_stage_equals_each_method_alone(sw):
                                       fit_method(mid, sw.x_train, sw.t_train, p, seeds=[1])[0].net.theta)
     with pytest.raises(InputError, match="share one DE stage"):
         fit_family(("ade_bp_pure", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
+    with pytest.raises(InputError, match="share one DE stage"):
+        fit_family(("de_bp_hybrid_trainlm", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
+    # reading 2's stage (stopped early at the normalised target), shared by trainlm with and without the stop
+    for hybrid_target, gens in (("normalised", 3000), ("deg2", 30)):
+        ph = replace(p, hybrid_target=hybrid_target, de=DEParams(max_generations=gens))
+        mids = ("de_bp_hybrid_trainlm", "de_bp_hybrid_trainlm_val")
+        fam = fit_family(mids, sw.x_train, sw.t_train, ph, seeds=[0, 2])
+        for mid in mids:
+            alone = fit_method(mid, sw.x_train, sw.t_train, ph, seeds=[0, 2])
+            for a, b in zip(fam[mid], alone):
+                np.testing.assert_array_equal(a.net.theta, b.net.theta)
+                assert a.info["de_generations"] == b.info["de_generations"]
+                assert a.info["epochs"] == b.info["epochs"] and a.info["stop"] == b.info["stop"]
+        if hybrid_target == "normalised":                           # the stage stopped at the target
+            assert all(0 < f.info["de_generations"] < 3000 for f in fam["de_bp_hybrid_trainlm"])
 
 
 def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):

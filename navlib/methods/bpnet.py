@@ -433,9 +433,11 @@ FAMILY_VARIANTS = ("pure", "trainlm", "trainlm_val")
 
 
 def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
-                    variants=FAMILY_VARIANTS) -> dict[str, list[BPNet]]:
-    """One DE / ADE stage run to its own stop (the paper's target read in deg^2: in practice the full
-    ``max_generations``), and from it every training in ``variants``:
+                    variants=FAMILY_VARIANTS, target: Literal["deg2", "normalised"] = "deg2"
+                    ) -> dict[str, list[BPNet]]:
+    """One DE / ADE stage run to its own stop (``target='deg2'``: the paper's target read in deg^2, in
+    practice the full ``max_generations``; ``'normalised'``: read as :func:`train_hybrid_many` reads it,
+    reached early), and from it every training in ``variants``:
 
     - ``'pure'``: the stage's best individual (:func:`train_de_many`, paper A's first reading);
     - ``'trainlm'``: ``trainlm`` from it on all readings (:func:`train_hybrid_many` with
@@ -444,13 +446,18 @@ def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = 
       each run's generator after the stage.
 
     Each variant equals what its own trainer gives with the same generators (the stage draws first, only
-    ``'trainlm_val'`` draws after it), at the cost of one DE stage.  Returns ``{variant: nets}``."""
+    ``'trainlm_val'`` draws after it), at the cost of one DE stage (with ``target='normalised'``, the
+    trainlm variants equal :func:`train_hybrid_many`'s, pure DE is not offered).  Returns
+    ``{variant: nets}``."""
     variants = tuple(variants)
     for v in variants:
         check_choice("variant", v, FAMILY_VARIANTS)
+    check_choice("target", target, ("deg2", "normalised"))
+    if target == "normalised" and "pure" in variants:
+        raise InputError("train_de_family: pure DE shares only the full stage (target='deg2')")
     x, t = _check_xy(x, t, n_hidden)
     rngs = _rngs(rngs)
-    de_nets, _ = train_de_many(x, t, n_hidden, params, rngs)
+    de_nets, _ = train_de_many(x, t, n_hidden, _stage(params, t, target), rngs)
     out: dict[str, list[BPNet]] = {}
     if "pure" in variants:
         out["pure"] = de_nets
@@ -459,8 +466,20 @@ def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = 
         if v in variants:
             validation = v == "trainlm_val"
             out[v] = _trainlm_from_stage(x, t, n_hidden, de_nets, rngs, lm, validation,
+                                         _hybrid_name(name, validation) if target == "normalised" else
                                          name + " full DE + trainlm" + (", val. stop" if validation else ""))
     return out
+
+
+def _stage(params: DEParams, t, target: str) -> DEParams:
+    """The DE stage's settings under a reading of the paper's target (:func:`train_hybrid_many`)."""
+    if target == "deg2":
+        return params
+    return replace(params, target_fitness=params.target_fitness * float(np.ptp(t)) ** 2)
+
+
+def _hybrid_name(name: str, validation: bool) -> str:
+    return name + " hybrid (trainlm" + (", val. stop)" if validation else ")")
 
 
 def _trainlm_from_stage(x, t, n_hidden: int, de_nets: list, rngs, lm: LMParams, validation: bool,
@@ -494,9 +513,6 @@ def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams 
     check_choice("target", target, ("deg2", "normalised"))
     x, t = _check_xy(x, t, n_hidden)
     rngs = _rngs(rngs)
-    span = float(np.ptp(t))
-    stage = params if target == "deg2" else replace(params, target_fitness=params.target_fitness * span ** 2)
-    de_nets, _ = train_de_many(x, t, n_hidden, stage, rngs)
-    name = ("ADE-BP" if params.adaptive else "DE-BP") + " hybrid (trainlm" + (", val. stop)" if validation
-                                                                              else ")")
+    de_nets, _ = train_de_many(x, t, n_hidden, _stage(params, t, target), rngs)
+    name = _hybrid_name("ADE-BP" if params.adaptive else "DE-BP", validation)
     return _trainlm_from_stage(x, t, n_hidden, de_nets, rngs, lm, validation, name)

@@ -223,7 +223,9 @@ class MethodSpec:
     stochastic: bool
     paper_row: str | None = None
     reading: str = ""
-    family: tuple | None = None     # ((adaptive, f_rule, cr_rule), variant): runs sharing one full DE stage
+    #: runs sharing one DE stage: ``((adaptive, f_rule, cr_rule), variant)`` for the full stage,
+    #: ``((adaptive, f_rule, cr_rule, "hybrid"), variant)`` for reading 2's stage (``hybrid_target``)
+    family: tuple | None = None
 
 
 #: ADE's default rules (:class:`navlib.methods.de.DEParams`): F by generation, CR by value.
@@ -298,12 +300,14 @@ METHODS: dict[str, MethodSpec] = {
         lambda x, t, g: [train_least_squares(x, t, p.n_hidden, r) for r in g], p.target), True),
     "de_bp_pure": MethodSpec("DE-BP pure", _pure(False), True, "DE-BP", R1, (_DE0, "pure")),
     "ade_bp_pure": MethodSpec("ADE-BP pure", _pure(True), True, "ADE-BP", R1, (_ADE0, "pure")),
-    "de_bp_hybrid_trainlm": MethodSpec("DE-BP hybrid (trainlm)", _hybrid(False, False), True, "DE-BP", R2),
-    "ade_bp_hybrid_trainlm": MethodSpec("ADE-BP hybrid (trainlm)", _hybrid(True, False), True, "ADE-BP", R2),
+    "de_bp_hybrid_trainlm": MethodSpec("DE-BP hybrid (trainlm)", _hybrid(False, False), True, "DE-BP", R2,
+                                       (_DE0 + ("hybrid",), "trainlm")),
+    "ade_bp_hybrid_trainlm": MethodSpec("ADE-BP hybrid (trainlm)", _hybrid(True, False), True, "ADE-BP", R2,
+                                        (_ADE0 + ("hybrid",), "trainlm")),
     "de_bp_hybrid_trainlm_val": MethodSpec("DE-BP hybrid (trainlm, val. stop)", _hybrid(False, True), True,
-                                           "DE-BP", R2V),
+                                           "DE-BP", R2V, (_DE0 + ("hybrid",), "trainlm_val")),
     "ade_bp_hybrid_trainlm_val": MethodSpec("ADE-BP hybrid (trainlm, val. stop)", _hybrid(True, True), True,
-                                            "ADE-BP", R2V),
+                                            "ADE-BP", R2V, (_ADE0 + ("hybrid",), "trainlm_val")),
     "de_bp_full_trainlm": MethodSpec("DE-BP full DE + trainlm", _full(False, False), True, "DE-BP", R4,
                                      (_DE0, "trainlm")),
     "ade_bp_full_trainlm": MethodSpec("ADE-BP full DE + trainlm", _full(True, False), True, "ADE-BP", R4,
@@ -404,9 +408,10 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
 
 def fit_family(methods, x, reference, params: StudyParams = StudyParams(), seeds=(0,),
                base_seed: int = 0) -> dict[str, list]:
-    """Fit methods that share one full DE stage (the same ``family`` key of :class:`MethodSpec`: pure DE
-    and full DE + trainlm, with and without the validation stop, of one DE / ADE rule) from one stage per
-    seed (:func:`navlib.methods.bpnet.train_de_family`): the same fitted compensators as
+    """Fit methods that share one DE stage (the same ``family`` key of :class:`MethodSpec`: pure DE and
+    full DE + trainlm, with and without the validation stop, of one DE / ADE rule; or reading 2's DE +
+    trainlm with and without the validation stop) from one stage per seed
+    (:func:`navlib.methods.bpnet.train_de_family`): the same fitted compensators as
     :func:`fit_method` gives for each method alone, at the cost of one stage.  ``{method id: fitted}``."""
     mids = [method_id(m) for m in methods]
     fams = [METHODS[m].family for m in mids]
@@ -414,12 +419,13 @@ def fit_family(methods, x, reference, params: StudyParams = StudyParams(), seeds
         raise InputError(f"fit_family: {', '.join(mids)} do not share one DE stage")
     if params.pure_target != "deg2" and any(f[1] == "pure" for f in fams):
         raise InputError("fit_family: pure DE shares the full stage only with pure_target='deg2'")
-    adaptive, f_rule, cr_rule = fams[0][0]
+    adaptive, f_rule, cr_rule = fams[0][0][:3]
     d = replace(params.de, adaptive=adaptive, f_rule=f_rule, cr_rule=cr_rule)
     xx = np.asarray(x, dtype=float)
     tgt = params.target
     nets = train_de_family(xx, tgt.target(xx, reference), params.n_hidden, d, generators(seeds, base_seed),
-                           params.lm, [f[1] for f in fams])
+                           params.lm, [f[1] for f in fams],
+                           params.hybrid_target if len(fams[0][0]) > 3 else "deg2")
     return {m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
             for m, f in zip(mids, fams)}
 
@@ -471,8 +477,9 @@ MAX_TASK_S = 2.0
 
 
 def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
-    """The methods grouped into fitting units: the methods sharing one full DE stage (``family``; pure DE
-    only with ``pure_target='deg2'``) form one unit, every other method its own."""
+    """The methods grouped into fitting units: the methods sharing one DE stage (``family``: the full
+    stage, pure DE only with ``pure_target='deg2'``; or reading 2's stage) form one unit, every other
+    method its own."""
     units, at = [], {}
     for m in methods:
         mid = method_id(m)
@@ -489,7 +496,9 @@ def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
 def _unit_cost(unit, params: StudyParams) -> float:
     """Estimated CPU seconds per seed of a fitting unit (:data:`RUN_COST_S`)."""
     fams = [METHODS[m].family for m in unit]
-    if all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
+    if len(unit) > 1 and len(fams[0][0]) > 3:                 # reading 2's stage: the costliest member's
+        c = max(RUN_COST_S.get(m, 0.001) for m in unit) + RUN_COST_S["trainlm"] * (len(unit) - 1)
+    elif all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
         c = RUN_COST_S["de_stage"] + RUN_COST_S["trainlm"] * sum(f[1] != "pure" for f in fams)
     else:
         c = RUN_COST_S.get(unit[0], 0.001)
@@ -527,7 +536,8 @@ def seed_study(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
 def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers: int = 1,
                  scheduler: str | None = None) -> list[pd.DataFrame]:
     """Several :func:`seed_study` at once, ``studies`` a list of ``(sweeps, params, seeds, methods)``: all
-    their tasks share the engine's workers (the expensive ones start first), one frame per study."""
+    their tasks share the engine's workers (the expensive ones start first), one frame per study, its rows
+    in the order of ``methods`` (and of the seeds within a method)."""
     tasks, cost, owner = [], [], []
     for k, (sw, params, seeds, methods) in enumerate(studies):
         t, c = _tasks(sw, params, [int(v) for v in seeds], methods, base_seed, keep_errors)
@@ -537,8 +547,12 @@ def seed_studies(studies, base_seed: int = 0, keep_errors: bool = False, workers
     parts = engine.run(_method_runs, tasks, workers=workers, scheduler=scheduler, cost=cost,
                        label="seed study", weight=[len(t[3]) * (1 if isinstance(t[2], str) else len(t[2]))
                                                    for t in tasks])
-    return [pd.DataFrame([row for o, part in zip(owner, parts) if o == k for row in part])
-            for k in range(len(studies))]
+    frames = []
+    for k, (_, _, _, methods) in enumerate(studies):
+        rows = [row for o, part in zip(owner, parts) if o == k for row in part]
+        at = {m: i for i, m in enumerate(dict.fromkeys(method_id(m) for m in methods))}
+        frames.append(pd.DataFrame(sorted(rows, key=lambda r: at[r["method"]])))      # stable: seeds stay in order
+    return frames
 
 
 def summarize(runs: pd.DataFrame) -> pd.DataFrame:
