@@ -24,7 +24,7 @@ for n in (121, 128):                                   # with and without a scal
     out[f"fitness{n}"] = obj(pop).tobytes().hex()
     for adaptive in (False, True):
         p = DEParams(pop_size=20, max_generations=150, adaptive=adaptive)
-        nets = train_de_family(x, t, 6, p, generators([0, 1]), variants=("pure", "trainlm"))
+        nets = train_de_family(x, t, 6, p, generators([0, 1]), variants=("pure",))
         out[f"de{n}{adaptive}"] = [n_.theta.tobytes().hex() for v in nets.values() for n_ in v]
 print(json.dumps(out))
 """
@@ -53,7 +53,7 @@ def test_fast_math_flags_keep_every_operation_exactly_rounded():
 
 
 def test_kernels_compiled_for_avx2_and_for_the_host_give_the_same_bits():
-    """DE runs (and the trainlm after them) compiled for LLVM's 'haswell' (AVX2: 8 floats a vector) equal the
+    """DE runs and the fitness compiled for LLVM's 'haswell' (AVX2: 8 floats a vector) equal the
     ones compiled for this machine (16 with AVX-512 where it has them), bit for bit: no result depends on the
     vector width.  With the approximate reciprocal (``arcp``) they differed on an AVX-512 machine."""
     from llvmlite import binding
