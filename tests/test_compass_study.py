@@ -528,36 +528,31 @@ def test_third_order_ls_on_eight_readings_reproduces_a_third_order_error_exactly
         fit_smith(m[:6], true[:6], 3)
 
 
+def _family_equals_alone(sw, mids, p, seeds):
+    """fit_family(mids) gives each method's networks (and trainer info) as fit_method alone; the family."""
+    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=seeds)
+    for mid in mids:
+        for a, b in zip(fam[mid], fit_method(mid, sw.x_train, sw.t_train, p, seeds=seeds)):
+            np.testing.assert_array_equal(a.net.theta, b.net.theta)
+            for key in ("de_generations", "epochs", "stop"):
+                assert a.info.get(key) == b.info.get(key)
+    return fam
+
+
 def test_family_of_one_de_stage_equals_each_method_alone(sw):
     """Pure DE and full DE + trainlm (with and without the validation stop) fitted from one shared DE stage
-    give the same networks as each method fitted alone with the same seeds."""
+    give the same networks as each method fitted alone with the same seeds; so do reading 2's DE +
+    trainlm with and without the validation stop from their own (shorter) stage."""
     p = StudyParams(de=DEParams(max_generations=30), lm=replace(StudyParams().lm, epochs=15))
-    mids = ("ade_bp_pure_f_ind", "ade_bp_full_trainlm_f_ind")
-    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=[3, 4])
-    for mid in mids:
-        alone = fit_method(mid, sw.x_train, sw.t_train, p, seeds=[3, 4])
-        for a, b in zip(fam[mid], alone):
-            np.testing.assert_array_equal(a.net.theta, b.net.theta)
-    mids = ("ade_bp_pure", "ade_bp_full_trainlm", "ade_bp_full_trainlm_val")
-    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=[1])
-    for mid in mids:
-        np.testing.assert_array_equal(fam[mid][0].net.theta,
-                                      fit_method(mid, sw.x_train, sw.t_train, p, seeds=[1])[0].net.theta)
+    _family_equals_alone(sw, ("ade_bp_pure_f_ind", "ade_bp_full_trainlm_f_ind"), p, [3, 4])
+    _family_equals_alone(sw, ("ade_bp_pure", "ade_bp_full_trainlm", "ade_bp_full_trainlm_val"), p, [1])
     with pytest.raises(InputError, match="share one DE stage"):
         fit_family(("ade_bp_pure", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
     with pytest.raises(InputError, match="share one DE stage"):
         fit_family(("de_bp_hybrid_trainlm", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
-    # reading 2's stage (stopped early at the normalised target), shared by trainlm with and without the stop
     for hybrid_target, gens in (("normalised", 3000), ("deg2", 30)):
         ph = replace(p, hybrid_target=hybrid_target, de=DEParams(max_generations=gens))
-        mids = ("de_bp_hybrid_trainlm", "de_bp_hybrid_trainlm_val")
-        fam = fit_family(mids, sw.x_train, sw.t_train, ph, seeds=[0, 2])
-        for mid in mids:
-            alone = fit_method(mid, sw.x_train, sw.t_train, ph, seeds=[0, 2])
-            for a, b in zip(fam[mid], alone):
-                np.testing.assert_array_equal(a.net.theta, b.net.theta)
-                assert a.info["de_generations"] == b.info["de_generations"]
-                assert a.info["epochs"] == b.info["epochs"] and a.info["stop"] == b.info["stop"]
+        fam = _family_equals_alone(sw, ("de_bp_hybrid_trainlm", "de_bp_hybrid_trainlm_val"), ph, [0, 2])
         if hybrid_target == "normalised":                           # the stage stopped at the target
             assert all(0 < f.info["de_generations"] < 3000 for f in fam["de_bp_hybrid_trainlm"])
 

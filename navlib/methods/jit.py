@@ -103,57 +103,18 @@ def logsig_sse(thetas, xn, t, lo, span, n_hidden):
     Single-threaded on purpose: on a machine whose cores are shared, numba's thread barrier waited for
     descheduled threads (a 2-thread run was up to 15x slower than 1 thread under load); the chapters use
     processes where they run things in parallel."""
-    m = n_hidden
-    n_pop, n = thetas.shape[0], xn.shape[0]
-    out = np.empty(n_pop)
-    x32 = np.empty(n, np.float32)
-    for k in range(n):
-        x32[k] = xn[k]
-    acc = np.empty(n, np.float32)
-    for p in range(n_pop):
-        for k in range(n):
-            acc[k] = 0.0
-        for j in range(m):
-            w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
-            for k in range(n):
-                acc[k] += v * logsig32(w * x32[k] + b)
-        c = lo + span * thetas[p, 3 * m]
-        s = 0.0
-        for k in range(n):
-            e = c + span * np.float64(acc[k]) - t[k]
-            s += e * e
-        out[p] = s
-    return out
+    none = np.empty((0, n_hidden, xn.shape[0]), np.float32)
+    changed = np.empty((thetas.shape[0], n_hidden), np.bool_)
+    return logsig_sse_trials(thetas, thetas[:0], none, xn, t, lo, span, n_hidden, none, changed)
 
 
 @njit(fastmath=FASTMATH, error_model="numpy", cache=True)
 def logsig_sse_keep(thetas, xn, t, lo, span, n_hidden, hidden):
     """:func:`logsig_sse` that also keeps every net's hidden-layer outputs, ``hidden (P, M, N)`` float32
-    (written): the parents' layers that :func:`logsig_sse_trials` reuses.  The same numbers as
-    :func:`logsig_sse`, operation for operation."""
-    m = n_hidden
-    n_pop, n = thetas.shape[0], xn.shape[0]
-    out = np.empty(n_pop)
-    x32 = np.empty(n, np.float32)
-    for k in range(n):
-        x32[k] = xn[k]
-    acc = np.empty(n, np.float32)
-    for p in range(n_pop):
-        for k in range(n):
-            acc[k] = 0.0
-        for j in range(m):
-            w, b, v = _F(thetas[p, j]), _F(thetas[p, m + j]), _F(thetas[p, 2 * m + j])
-            for k in range(n):
-                h = logsig32(w * x32[k] + b)
-                hidden[p, j, k] = h
-                acc[k] += v * h
-        c = lo + span * thetas[p, 3 * m]
-        s = 0.0
-        for k in range(n):
-            e = c + span * np.float64(acc[k]) - t[k]
-            s += e * e
-        out[p] = s
-    return out
+    (written): the parents' layers that :func:`logsig_sse_trials` reuses.  :func:`logsig_sse_trials`
+    without parents: every unit computed."""
+    changed = np.empty((thetas.shape[0], n_hidden), np.bool_)
+    return logsig_sse_trials(thetas, thetas[:0], hidden, xn, t, lo, span, n_hidden, hidden, changed)
 
 
 @njit(fastmath=FASTMATH, error_model="numpy", cache=True)
@@ -167,9 +128,11 @@ def logsig_sse_trials(trials, parents, hidden, xn, t, lo, span, n_hidden, trial_
     over the units in the same order with the same operations, so every fitness equals
     :func:`logsig_sse`'s bit for bit.  DE's crossover keeps a gene of the parent with probability
     ``1 - CR``, so both genes of a unit with ``(1 - CR)^2``: 0.16 of the sigmoids at DE's CR = 0.6, most
-    of them at ADE's CR near ``CR_min`` = 0.1."""
+    of them at ADE's CR near ``CR_min`` = 0.1.  With no parents (``parents`` of 0 rows) every unit is
+    computed (:func:`logsig_sse_keep`); with ``trial_hidden`` of 0 rows none is kept (:func:`logsig_sse`)."""
     m = n_hidden
     n_pop, n = trials.shape[0], xn.shape[0]
+    reuse, store = parents.shape[0] > 0, trial_hidden.shape[0] > 0
     out = np.empty(n_pop)
     x32 = np.empty(n, np.float32)
     for k in range(n):
@@ -180,16 +143,20 @@ def logsig_sse_trials(trials, parents, hidden, xn, t, lo, span, n_hidden, trial_
             acc[k] = 0.0
         for j in range(m):
             w, b, v = _F(trials[p, j]), _F(trials[p, m + j]), _F(trials[p, 2 * m + j])
-            if w == _F(parents[p, j]) and b == _F(parents[p, m + j]):
+            if reuse and w == _F(parents[p, j]) and b == _F(parents[p, m + j]):
                 changed[p, j] = False
                 for k in range(n):
                     acc[k] += v * hidden[p, j, k]
             else:
                 changed[p, j] = True
-                for k in range(n):
-                    h = logsig32(w * x32[k] + b)
-                    trial_hidden[p, j, k] = h
-                    acc[k] += v * h
+                if store:
+                    for k in range(n):
+                        h = logsig32(w * x32[k] + b)
+                        trial_hidden[p, j, k] = h
+                        acc[k] += v * h
+                else:
+                    for k in range(n):
+                        acc[k] += v * logsig32(w * x32[k] + b)
         c = lo + span * trials[p, 3 * m]
         s = 0.0
         for k in range(n):
