@@ -249,6 +249,7 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
 
     trial = np.empty_like(pop)
     best = np.empty(n_runs)
+    accepted = np.empty((n_runs, n), np.bool_)
     # every individual's F and CR (:func:`ade_rates`, compiled as :func:`navlib.methods.jit.ade_rates_into`)
     f_all, cr_all = np.full((n_runs, n), float(params.f)), np.full((n_runs, n), float(params.cr))
     f_schedule = ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None
@@ -267,7 +268,7 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
                 objective.keep(np.repeat(keep, n))
             ids, pop, fit = ids[keep], np.ascontiguousarray(pop[keep]), np.ascontiguousarray(fit[keep])
             state = np.ascontiguousarray(state[keep])
-            trial, best = trial[:keep.sum()], best[:keep.sum()]
+            trial, best, accepted = trial[:keep.sum()], best[:keep.sum()], accepted[:keep.sum()]
         f_i, cr_i = f_all[:ids.size], cr_all[:ids.size]
         if params.adaptive:
             ade_rates_into(fit, float(f_schedule[g]), float(params.f_min), float(params.f_max),
@@ -275,12 +276,13 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
                            params.cr_rule == "rank", f_i, cr_i)
         de_trials(pop, state, f_i, cr_i, b, trial)
         if cached:
-            tfit = np.asarray(objective.trials(trial.reshape(-1, dim), pop.reshape(-1, dim)),
-                              dtype=float).reshape(ids.size, n)
-            objective.accept((tfit <= fit).ravel())                         # before fit is updated
+            tfit = objective.trials(trial.reshape(-1, dim), pop.reshape(-1, dim))
         else:
-            tfit = np.asarray(objective(trial.reshape(-1, dim)), dtype=float).reshape(ids.size, n)
-        de_select(pop, fit, trial, tfit, best)                             # greedy selection, in place
+            tfit = objective(trial.reshape(-1, dim))
+        tfit = np.asarray(tfit, dtype=float).reshape(ids.size, n)
+        de_select(pop, fit, trial, tfit, best, accepted)                   # greedy selection, in place
+        if cached:
+            objective.accept(accepted.ravel())
         history[ids, g] = best
         g += 1
     return results

@@ -329,13 +329,15 @@ def ade_rates_into(fit, f_gen, f_min, f_max, cr_min, cr_max, f_mode, cr_rank, f_
 
 
 @njit(cache=True)
-def de_select(pop, fit, trial, tfit, best):
-    """Greedy selection ``x_i <- u_i if J(u_i) <= J(x_i)`` in place; ``best[s]`` = run s's best fitness."""
+def de_select(pop, fit, trial, tfit, best, accepted):
+    """Greedy selection ``x_i <- u_i if J(u_i) <= J(x_i)`` in place; ``best[s]`` = run s's best fitness,
+    ``accepted[s, i]`` = whether trial i replaced its parent."""
     n_runs, n_pop, dim = pop.shape
     for s in range(n_runs):
         b = np.inf
         for i in range(n_pop):
-            if tfit[s, i] <= fit[s, i]:
+            accepted[s, i] = tfit[s, i] <= fit[s, i]
+            if accepted[s, i]:
                 fit[s, i] = tfit[s, i]
                 for j in range(dim):
                     pop[s, i, j] = trial[s, i, j]

@@ -228,6 +228,11 @@ class MethodSpec:
     family: tuple | None = None
 
 
+def _reading2_stage(family_key: tuple) -> bool:
+    """Whether a ``family`` key names reading 2's DE stage (the stop read by ``hybrid_target``)."""
+    return family_key[3:] == ("hybrid",)
+
+
 #: ADE's default rules (:class:`navlib.methods.de.DEParams`): F by generation, CR by value.
 ADE_DEFAULT_RULES = ("generation", "value")
 #: The other readings of ADE's rules in section 1.2, as (f_rule, cr_rule, id suffix, label part).
@@ -425,7 +430,7 @@ def fit_family(methods, x, reference, params: StudyParams = StudyParams(), seeds
     tgt = params.target
     nets = train_de_family(xx, tgt.target(xx, reference), params.n_hidden, d, generators(seeds, base_seed),
                            params.lm, [f[1] for f in fams],
-                           params.hybrid_target if len(fams[0][0]) > 3 else "deg2")
+                           params.hybrid_target if _reading2_stage(fams[0][0]) else "deg2")
     return {m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
             for m, f in zip(mids, fams)}
 
@@ -496,7 +501,7 @@ def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
 def _unit_cost(unit, params: StudyParams) -> float:
     """Estimated CPU seconds per seed of a fitting unit (:data:`RUN_COST_S`)."""
     fams = [METHODS[m].family for m in unit]
-    if len(unit) > 1 and len(fams[0][0]) > 3:                 # reading 2's stage: the costliest member's
+    if len(unit) > 1 and _reading2_stage(fams[0][0]):        # reading 2's stage: the costliest member's
         c = max(RUN_COST_S.get(m, 0.001) for m in unit) + RUN_COST_S["trainlm"] * (len(unit) - 1)
     elif all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
         c = RUN_COST_S["de_stage"] + RUN_COST_S["trainlm"] * sum(f[1] != "pure" for f in fams)
