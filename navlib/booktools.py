@@ -52,9 +52,11 @@ import time
 from html.parser import HTMLParser
 from pathlib import Path
 
+from . import claims as claims_mod
 from . import verdicts
 from .errors import InputError
 from .report import RESULTS_ENV, read_results, reading_label
+from .report import record_label as report_label
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")
@@ -671,8 +673,11 @@ def verdict_box() -> str:
              "(a paired difference over the same seeds where two methods are compared):", ""]
     for label, text in verdicts.VERDICT_DEFINITIONS.items():
         lines.append(f"- **{label}**: {text}.")
-    lines += ["", "The papers' claims and the book's own (tests the papers did not run) are counted apart. "
-              "Where a paper can be read in several ways, each reading is judged on its own.", ":::"]
+    lines += ["", "The papers' claims and the book's own (tests the papers did not run) are counted apart, "
+              "one count per claim of the source's claims register. Where a paper can be read in several "
+              "ways, the chapter names the most plausible reading and why, counts the claim under it, and "
+              "shows the verdict under every other reading (and on other drawn simulators) as sensitivity.",
+              ":::"]
     return "\n".join(lines)
 
 
@@ -712,6 +717,7 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
         lines = ["No chapter has written its results yet."]
     if missing:
         lines += ["", f"Not yet summarised (no results file): {', '.join(missing)}."]
+    lines += sources_markdown(results)
     total = {src: {k: sum(counts[c][src][k] for c in counts) for k in COUNTED} for src in verdicts.SOURCES}
     if counts:
         lines += ["", f"In all, **{total['paper']['reproduced']} of {sum(total['paper'].values())}** of the "
@@ -725,6 +731,41 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
     return "\n".join(lines) + "\n\n" + verdict_box() + "\n"
 
 
+def sources_markdown(results: dict[str, dict]) -> list[str]:
+    """The landing page's rows per source (paper A and document B apart): what the source claims in one
+    line (its headline claim, in its words), the headline's verdict under the primary reading, and the
+    source's claims (register entries, not readings) by verdict under their primary readings, with how
+    many are judged, not yet computed and not checkable, and the contradictions noted."""
+    rows = []
+    for chapter, res in results.items():
+        recs = [c for c in res.get("claims", []) if "sensitivity" in c]
+        for name in claims_mod.registers(chapter):
+            mine = [c for c in recs if c.get("register") == name and c.get("source") == "paper"]
+            if not mine:
+                continue
+            head = next((c for c in mine if c.get("headline")), None)
+            n = {k: sum(c["verdict"] == k for c in mine) for k in COUNTED}
+            st = {k: sum(c.get("status") == k for c in mine) for k in ("judged", "open", "not checkable")}
+            noted = sum(1 for x in res.get("inconsistencies") or [] if x.get("register") == name)
+            verdict = report_label(head) if head else "–"
+            claim = f"{head['claim']}: \u201c{head['quote']}\u201d ({head['where']})" if head else "–"
+            rows += [f"* - {_md_cell(claims_mod.SOURCE_NAMES[name])}<br>({chapter})", f"  - {_md_cell(claim)}",
+                     f"  - **{_md_cell(verdict)}**" + (f"<br>({_md_cell(head['primary_reading'])})"
+                                                       if head and head.get("status") == "judged" else ""),
+                     f"  - {stacked_bar(n)}<br>{_counts_cell(n)} of {len(mine)} claims<br>"
+                     f"{st['judged']} judged, {st['open']} not yet computed, {st['not checkable']} not "
+                     f"checkable" + (f"; {noted} contradiction{'s' if noted != 1 else ''} in the paper"
+                                     if noted else "")]
+    if not rows:
+        return []
+    return ["", "(status-by-source)=", "Each source's headline claim and its claims, one count per claim (a "
+            "claims-register entry) under the reading the chapter finds most plausible; the other readings "
+            "are shown in the chapter as sensitivity.", "",
+            ":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 14 40 20 26", "",
+            "* - source", "  - headline claim, in its words", "  - verdict (primary reading)",
+            "  - claims: reproduced / not / cannot be judged"] + rows + [":::"]
+
+
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
                       sources: dict[str, tuple[str, str]] | None = None) -> str:
     """The landing page's per-reading rows (MyST markdown): one dropdown per chapter, in the order of
@@ -736,10 +777,12 @@ def readings_markdown(results: dict[str, dict], notebooks: list[Path],
     for chapter, doc, title, _ in _chapters(results, notebooks, sources):
         if chapter not in results:
             continue
-        claims = results[chapter].get("claims", [])
+        claims = [c for c in flat_claims(results[chapter]) if c.get("rule") != "no statistic"
+                  or c.get("reason") not in ("not yet computed", "not checkable")]
         readings = list(dict.fromkeys((c.get("source", "paper"), c.get("reading", "as printed"))
                                       for c in claims))
-        parts += [f"::::{{dropdown}} {_md_cell(title)}: {len(claims)} claims, {len(readings)} readings", "",
+        parts += [f"::::{{dropdown}} {_md_cell(title)}: {len(claims)} rows (claims under readings), "
+                  f"{len(readings)} readings", "",
                   f"{{doc}}`The chapter <{doc}>`.", "",
                   "| reading | claims | reproduced | not reproduced | cannot be judged |", "|---|---|---|---|---|"]
         for src in verdicts.SOURCES:
@@ -933,11 +976,15 @@ def claim_problems(c: dict) -> list[str]:
     floor = c.get("floor")
     floor_value = None
     if floor is not None:
+        fi = floor.get("interval") if isinstance(floor, dict) else None
         if not (isinstance(floor, dict) and _is_num(floor.get("value"))
                 and all(isinstance(floor.get(k), str) and floor[k].strip() for k in ("assumption", "needs"))):
-            p.append("floor must be null or {value, assumption, needs}")
+            p.append("floor must be null or {value, interval, assumption, needs}")
+        elif fi is not None and not (isinstance(fi, list) and len(fi) == 2 and all(_is_num(v) for v in fi)
+                                     and fi[0] <= floor["value"] <= fi[1]):
+            p.append(f"floor interval {fi!r}: must be [lo, hi] around the floor's value")
         else:
-            floor_value = floor["value"]
+            floor_value = tuple(fi) if fi is not None else floor["value"]
     if not isinstance(c.get("volatile", False), bool):
         p.append("volatile must be true or false")
     if not isinstance(c.get("by_construction"), bool):
@@ -969,6 +1016,39 @@ def claim_problems(c: dict) -> list[str]:
     return p
 
 
+REGISTER_KEYS = ("id", "quote", "where", "primary_reading")
+
+
+def register_problems(c: dict) -> list[str]:
+    """Problems of a claims-register record (one with ``sensitivity``, :func:`navlib.claims.evaluate`):
+    the register's fields present (a paper's claim needs its words, where they are and the primary
+    reading), a list of sensitivity records, a status the register knows."""
+    if "sensitivity" not in c:
+        return []
+    p = []
+    for k in REGISTER_KEYS:
+        if not (isinstance(c.get(k), str) and c[k].strip()) and not (k == "quote" and c.get("source") == "book"):
+            p.append(f"{k} missing or empty (the claims register)")
+    if not isinstance(c.get("sensitivity"), list):
+        p.append("sensitivity must be a list of claim records")
+    if c.get("status") not in ("judged", "open", "not checkable"):
+        p.append(f"status {c.get('status')!r}: judged, open or not checkable")
+    elif (c["status"] == "judged") == (c.get("rule") == "no statistic" and c.get("reason") in
+                                       ("not yet computed", "not checkable")) or (
+            c.get("reason") == "data absent" and c["status"] != "judged"):
+        p.append(f"status {c['status']!r} disagrees with its reason {c.get('reason')!r}")
+    return p
+
+
+def flat_claims(res: dict) -> list[dict]:
+    """Every judged row of a results file: each claim record and its sensitivity records."""
+    out = []
+    for c in res.get("claims") or []:
+        out.append(c)
+        out.extend(c.get("sensitivity") or [])
+    return out
+
+
 def validate_results(res: dict, name: str) -> list[str]:
     """Schema problems of one results file (see ``navlib.report.write_results``)."""
     p = []
@@ -985,7 +1065,10 @@ def validate_results(res: dict, name: str) -> list[str]:
             p.append(f"{name}: claims[{i}] is not an object")
             continue
         p += [f"{name}: claims[{i}] ({c.get('claim')!r}, {c.get('reading')}): {q}"
-              for q in claim_problems(c)]
+              for q in claim_problems(c) + register_problems(c)]
+        for j, s in enumerate(c.get("sensitivity") or []):
+            p += [f"{name}: claims[{i}].sensitivity[{j}] ({s.get('claim')!r}, {s.get('reading')}): {q}"
+                  for q in (claim_problems(s) if isinstance(s, dict) else ["not an object"])]
     methods = res.get("methods")
     if methods is not None:
         unit = res.get("unit")
@@ -1045,7 +1128,10 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
             if not ok:
                 p.append(f"{name}: methods[{label!r}].{k} = {a}, reference {b} "
                          f"(tolerance {rtol:g} relative + {atol:g})")
-    fc, rc = fresh.get("claims") or [], ref.get("claims") or []
+    fc, rc = flat_claims(fresh), flat_claims(ref)
+    ids = [c.get("id") for c in fresh.get("claims") or []], [c.get("id") for c in ref.get("claims") or []]
+    if ids[0] != ids[1]:
+        p.append(f"{name}: claim ids {ids[0]} differ from the reference's {ids[1]}")
     if len(fc) != len(rc):
         p.append(f"{name}: {len(fc)} claims, reference {len(rc)}")
     for i, (a, b) in enumerate(zip(fc, rc)):
@@ -1074,7 +1160,7 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
                                               for u, v in zip(x, y)))):
             p.append(f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)")
     base = {"chapter", "unit", "methods", "claims", "extra"}
-    for key in sorted((set(fresh) | set(ref)) - base):          # tables of records (write_results tables=)
+    for key in sorted((set(fresh) | set(ref)) - base):  # tables (write_results tables=), inconsistencies          # tables of records (write_results tables=)
         if fresh.get(key) != ref.get(key):
             p.append(f"{name}: table {key!r} differs from the reference's "
                      f"({len(fresh.get(key) or [])} records, reference {len(ref.get(key) or [])})")

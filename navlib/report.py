@@ -42,6 +42,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 import pandas as pd
 
+from . import claims as registry
 from . import verdicts
 from .data.tables import write_new
 from .errors import InputError
@@ -387,9 +388,9 @@ def glue_text(name: str, text: str) -> str:
     return str(text)
 
 
-def glue_table(name: str, tab: "Table | Glance | Showed | pd.DataFrame") -> None:
+def glue_table(name: str, tab: "Table | Glance | Answer | Showed | pd.DataFrame") -> None:
     """Glue a table for a MyST ``{glue:}`` directive (e.g. inside the Results-at-a-glance admonition)."""
-    _glue(name, tab if isinstance(tab, (Table, Glance, Showed)) else Table(tab))
+    _glue(name, tab if isinstance(tab, (Table, Glance, Answer, Showed)) else Table(tab))
 
 
 def glue_figure(name: str, fig) -> None:
@@ -492,8 +493,8 @@ class Claim:
         return "no statistic" if self.estimate is None else self.estimate.rule
 
     def _decision(self) -> tuple[bool | None, str]:
-        return verdicts.decide(self.interval, self.boundary, self.holds_when,
-                               None if self.floor is None else self.floor.value, self.by_construction)
+        return verdicts.decide(self.interval, self.boundary, self.holds_when, self.floor,
+                               self.by_construction)
 
     @property
     def reproduced(self) -> bool | None:
@@ -552,9 +553,13 @@ class Claim:
                     f"{self._bound()}")
         elif basis == "noise floor":
             f = self.floor
-            text = (f"our experiment cannot resolve it: its noise floor {self._num(f.value)} is not "
-                    f"{self.holds_when} the boundary {self._bound()} (set by {f.assumption}); "
-                    f"it would need {f.needs}")
+            flo, fhi = f.interval
+            ftext = self._num(f.value) + ("" if flo == fhi else
+                                          f" [{fmt(flo, self.spec)}, {fmt(fhi, self.spec)}]")
+            lo, hi = self.interval
+            text = (f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
+                    f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
+                    f"(set by {f.assumption}); it would need {f.needs}")
         else:
             text = ""
         return "; ".join(t for t in (text, extra) if t)
@@ -570,6 +575,7 @@ class Claim:
                 "boundary": None if self.boundary is None else plain(self.boundary),
                 "holds_when": self.holds_when,
                 "floor": None if self.floor is None else {"value": plain(self.floor.value),
+                                                          "interval": [plain(v) for v in self.floor.interval],
                                                           "assumption": self.floor.assumption,
                                                           "needs": self.floor.needs},
                 "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
@@ -648,6 +654,140 @@ def _glance_html(claims: list[Claim], caption: str) -> str:
     return "\n".join(parts)
 
 
+def register_records(claims: Iterable["Claim | Mapping[str, Any]"], chapter: str | None,
+                     worlds: list[Mapping[str, Any]] | None = None) -> list[dict] | None:
+    """The chapter's rows folded into one record per claims-register entry (:func:`navlib.claims.evaluate`),
+    or None for a chapter without a register."""
+    if not chapter or not registry.registers(chapter):
+        return None
+    rows = [c.record() if isinstance(c, Claim) else dict(c) for c in claims]
+    return registry.evaluate(chapter, rows, worlds)
+
+
+def record_label(r: Mapping[str, Any]) -> str:
+    """A stored record's verdict as the book shows it (*cannot be judged: within our noise floor*)."""
+    if r.get("reproduced") is not None:
+        return str(r["verdict"])
+    cat = r.get("reason")
+    return f"{r['verdict']}: {verdicts.REASONS[cat][0]}" if cat in verdicts.REASONS else str(r["verdict"])
+
+
+def _rec_tally(records: list[Mapping[str, Any]]) -> str:
+    v = [r["verdict"] for r in records]
+    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
+            f"{v.count('cannot be judged')} cannot be judged")
+
+
+def _rec_ours(r: Mapping[str, Any]) -> str:
+    if r.get("rule") == "no statistic":
+        return "–"
+    b = r.get("boundary")
+    side = "< " if r.get("holds_when") == "below" else "> "
+    unit = f" {r['unit']}" if r.get("unit") else ""
+    return f"{r.get('ours') or '–'} (boundary {side}{fmt(b, '{:.4g}')}{unit})"
+
+
+def headline_sentence(r: Mapping[str, Any]) -> str:
+    """One sentence: a source's headline claim, where it is made and its verdict under the primary
+    reading, with our interval and how the verdict moves across the other readings."""
+    who = registry.SOURCE_NAMES.get(r.get("register", ""), "The source")
+    text = f"{who}'s headline claim, \u201c{r['quote']}\u201d ({r['where']}): **{record_label(r)}**"
+    if r.get("status") == "judged":
+        text += (f" under the primary reading ({r['primary_reading']}): ours {_rec_ours(r)}; "
+                 f"{registry.across_text(r)}.")
+    else:
+        text += f" ({r.get('why')})."
+    return text
+
+
+ANSWER_COLUMNS = ["id", "claim", "the paper", "ours: value [95 % interval]", "verdict (primary reading)",
+                  "across readings"]
+
+
+def _answer_frame(records: list[Mapping[str, Any]]) -> pd.DataFrame:
+    rows = [{"id": r["id"], "claim": r["claim"], "the paper": f"\u201c{r['quote']}\u201d ({r['where']})"
+             if r.get("quote") else r["where"], ANSWER_COLUMNS[3]: _rec_ours(r),
+             ANSWER_COLUMNS[4]: record_label(r) + (f" ({r['primary_reading']})" if r.get("status") == "judged"
+                                                 else ""),
+             "across readings": registry.across_text(r) if r.get("status") == "judged" else "–"}
+            for r in records]
+    return pd.DataFrame(rows, columns=ANSWER_COLUMNS)
+
+
+class Answer:
+    """A chapter's opening for a chapter with a claims register (:mod:`navlib.claims`): each source's
+    headline claim and its verdict under the primary reading, then one row per claim (the paper's words
+    and where, ours with its interval and boundary, the verdict under the primary reading, how it moves
+    across the other readings and drawn worlds), the paper's own contradictions, and the per-reading
+    tables of every row behind a fold.  The tallies count claims (register entries), not readings: the
+    landing page counts the same from the results file."""
+
+    def __init__(self, records: list[dict], rows: list["Claim"], chapter: str):
+        self.records, self.rows, self.chapter = records, rows, chapter
+        self.paper = [r for r in records if r["source"] == "paper"]
+        self.book = [r for r in records if r["source"] == "book"]
+        self.noted = registry.inconsistencies(chapter)
+
+    def _groups(self):
+        for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims")):
+            recs = [r for r in self.records if r["source"] == src]
+            if recs:
+                yield src, title, recs
+
+    def tables(self) -> list[Table]:
+        out = []
+        for src, title, recs in self._groups():
+            for name in registry.registers(self.chapter):
+                mine = [r for r in recs if r["register"] == name]
+                if mine:
+                    out.append(Table(_answer_frame(mine), index=False, readable=False,
+                                     caption=f"{title}: {_rec_tally(recs)}; "
+                                             f"{registry.SOURCE_NAMES[name]}: {_rec_tally(mine)}"))
+        if self.noted:
+            out.append(Table(pd.DataFrame([{"id": n["id"], "the paper says": n["claim"], "where": n["where"],
+                                            "its own numbers": n["numbers"]} for n in self.noted]),
+                             index=False, readable=False, caption="Where the paper contradicts itself"))
+        return out
+
+    def _repr_html_(self) -> str:
+        parts = []
+        for r in registry.headlines(self.records):
+            parts.append(f'<p class="navbook-headline">{_inline_md(headline_sentence(r))}</p>')
+        for src, title, recs in self._groups():
+            parts.append(f'<p class="navbook-glance-note">{html.escape(title)}: {_rec_tally(recs)} '
+                         f'(one row per claim, judged under its primary reading; '
+                         f'<a href="{VERDICTS_HREF}">what the verdicts mean</a>)</p>')
+            for name in registry.registers(self.chapter):
+                mine = [r for r in recs if r["register"] == name]
+                if mine:
+                    if len(registry.registers(self.chapter)) > 1:
+                        parts.append(f"<p><b>{html.escape(registry.SOURCE_NAMES[name])}</b>: "
+                                     f"{_rec_tally(mine)}</p>")
+                    parts.append(Table(_answer_frame(mine), index=False, readable=False)._repr_html_())
+        if self.noted:
+            parts.append(self.tables()[-1]._repr_html_())
+        rows = [c for c in self.rows]
+        if rows:
+            parts.append(f"<details><summary>Every claim under every reading ({len(rows)} rows)</summary>"
+                         + "\n".join(_glance_html([c for c in rows if c.source == s], f"{t} by reading")
+                                     for s, t in (("paper", "The paper's claims"), ("book", "The book's own claims"))
+                                     if any(c.source == s for c in rows))
+                         .replace('class="navbook-glance-note"', 'class="navbook-reading-note"')
+                         + "</details>")
+        return "\n".join(parts)
+
+    def __repr__(self) -> str:
+        out = ["\n".join(textwrap.wrap(headline_sentence(r).replace("**", ""), PLAIN_WIDTH))
+               for r in registry.headlines(self.records)]
+        out += [repr(t) for t in self.tables()]
+        return "\n\n".join(out)
+
+
+def _inline_md(text: str) -> str:
+    """HTML of a sentence with **bold** marks."""
+    return re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", html.escape(text, quote=False))
+
+
 class Glance:
     """The Results-at-a-glance tables: the paper's claims and the book's own claims apart, each row with
     the claim, the reading, the paper's number, ours with its 95 % interval, the boundary and the verdict
@@ -685,9 +825,18 @@ class Glance:
         return "\n\n".join(repr(t) for t in self.tables())
 
 
-def glance(claims: Iterable[Claim]) -> Glance:
-    """The Results-at-a-glance tables (see :class:`Glance`)."""
-    return Glance(claims)
+def glance(claims: Iterable[Claim], chapter: str | None = None,
+           worlds: list[Mapping[str, Any]] | None = None) -> "Glance | Answer":
+    """The Results-at-a-glance box: for a chapter with a claims register (``chapter`` given,
+    :mod:`navlib.claims`) the answer first (:class:`Answer`: one row per claim under its primary
+    reading, ``worlds`` the drawn-world verdicts of the rows), else one row per claim and reading
+    (:class:`Glance`)."""
+    claims = list(claims)
+    records = register_records(claims, chapter, worlds)
+    if records is None:
+        return Glance(claims)
+    _GLANCED.update((c.claim, c.reading) for c in claims)
+    return Answer(records, claims, chapter)
 
 
 @dataclass(frozen=True)
@@ -768,10 +917,16 @@ class Showed:
         return "\n".join(out)
 
 
-def showed(claims: Iterable[Claim]) -> Showed:
+def showed(claims: Iterable[Claim], chapter: str | None = None,
+           worlds: list[Mapping[str, Any]] | None = None) -> Showed:
     """The *What this chapter showed* box (see :class:`Showed`); glue it into a ``:::{admonition} What
-    this chapter showed`` block at the chapter's end."""
-    return Showed(claims)
+    this chapter showed`` block at the chapter's end.  With ``chapter`` (a chapter with a claims
+    register) it counts claims, one per register entry, with the verdict under the primary reading."""
+    claims = list(claims)
+    records = register_records(claims, chapter, worlds)
+    if records is None:
+        return Showed(claims)
+    return Showed([{**r, "reading": "primary"} for r in records])
 
 
 def glue_claims(claims: Iterable[Claim]) -> None:
@@ -803,8 +958,8 @@ def method_stats(rms, min_err=None, max_err=None) -> dict:
 def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = None,
                   methods: Mapping[str, Mapping[str, Any]] | None = None,
                   extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
-                  overwrite: bool = False, tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None
-                  ) -> Path:
+                  overwrite: bool = False, tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None,
+                  register: bool = False) -> Path:
     """Write ``<folder>/<chapter>.json`` (``folder`` defaults to :func:`results_dir`)::
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
@@ -817,7 +972,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     (e.g. ``deg``, ``mg``, ``arcsec``) is appended to each statistic's name.  Values are rounded to 6
     significant digits.  ``tables`` adds top-level lists of records (e.g. ``"robustness"``: one
     ``{"compass", "claim", "reading", "verdict"}`` per simulated compass, claim and reading); their names
-    must not be one of the keys above.  An existing file (an earlier run's) is never replaced unless
+    must not be one of the keys above.  ``register=True`` (a chapter with a claims register,
+    :mod:`navlib.claims`) stores one record per register entry instead of one per claim and reading: the
+    primary row's fields, the register's words and place, the other rows as its ``sensitivity`` list,
+    and the paper's contradictions as ``inconsistencies``.  An existing file (an earlier run's) is never replaced unless
     ``overwrite=True``: the call stops with one line naming it.  Returns the path written; it displays as ``results written:
     <chapter>.json``, the same in every run, so a notebook cell that ends with this call shows no
     run-specific folder."""
@@ -844,7 +1002,11 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if len(set(keys)) != len(keys):
         dup = next(k for k in keys if keys.count(k) > 1)
         raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
-    out["claims"] = [c.record() for c in claims]
+    records = register_records(claims, chapter if register else None,
+                               list((tables or {}).get("robustness") or []) or None)
+    out["claims"] = records if records is not None else [c.record() for c in claims]
+    if records is not None:
+        out["inconsistencies"] = registry.inconsistencies(chapter)
     unseen = [k for k in keys if k not in _GLANCED]
     if _GLANCED and unseen:                 # a chapter that shows a glance box, but not all of its claims
         import warnings
@@ -855,7 +1017,7 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}
     for name, records in (tables or {}).items():
-        if name in ("chapter", "unit", "methods", "claims", "extra") or not str(name).isidentifier():
+        if name in ("chapter", "unit", "methods", "claims", "extra", "inconsistencies") or not str(name).isidentifier():
             raise InputError(f"write_results({chapter!r}): table name {name!r} is reserved or not an identifier")
         out[str(name)] = [{str(k): plain(v) for k, v in dict(r).items()} for r in records]
     d = Path(folder) if folder is not None else results_dir()

@@ -1,24 +1,31 @@
 """One rule for every verdict in the book.
 
-A quantitative claim becomes a **statistic** of our runs with a 95 % **interval**, a **boundary** and the
-side of the boundary on which the claim holds (``holds_when`` = ``"above"`` or ``"below"``):
+A quantitative claim becomes a **statistic** of our runs with a 95 % **interval** :math:`[\\ell, u]`, a
+**boundary** :math:`b` and the side of the boundary on which the claim holds (``holds_when`` = ``"above"``
+or ``"below"``).  Our experiment may also have a **noise floor** :math:`f` (the best value of the statistic
+that our simulator and sensor noise allow, e.g. the RMS of the exact physical model), with its own interval
+:math:`[f_\\ell, f_u]` (a point where it rests on one run).  Write :math:`w` for the worse of boundary and
+floor: :math:`w = f_u` when the whole floor interval lies beyond :math:`b` on the side where the claim
+fails (the floor is *separated* from the boundary), else :math:`w = b`.  Then
 
 .. math::
+   :label: verdict-rule
 
     \\text{verdict} = \\begin{cases}
       \\text{reproduced} & [\\ell, u] \\text{ lies wholly on the claim's side of } b,\\\\
-      \\text{not reproduced} & [\\ell, u] \\text{ lies wholly on the other side},\\\\
-      \\text{cannot be judged} & \\text{otherwise (the interval contains } b\\text{).}
+      \\text{not reproduced} & [\\ell, u] \\text{ lies wholly beyond } w
+        \\text{ (beyond the boundary and beyond anything the noise excuses)},\\\\
+      \\text{cannot be judged} & \\text{otherwise.}
     \\end{cases}
 
-A claim also *cannot be judged* when
-
-* the **noise floor** of our experiment (the best value of the statistic that our simulator and sensor
-  noise allow, e.g. the RMS of the exact physical model) does not lie strictly on the claim's side of the
-  boundary: the experiment cannot resolve the claim, and the reason names the assumption that decides it
-  and the value it would need (:class:`Floor`);
-* the statistic is **true by construction** of our simulator (we set it), or
-* there is **no statistic** (the paper prints nothing we can compare with).
+(:math:`f_\\ell` takes the place of :math:`f_u` for a claim that holds above its boundary.)  *Cannot be
+judged* comes in cases, each with its reason: the interval contains or touches the boundary
+(*straddles*); it lies beyond the boundary but not beyond a separated floor, or it straddles the boundary
+while the floor is separated from it (*noise floor*: the reason names the assumption that sets the floor
+and the value it would need, :class:`Floor`); the statistic is **true by construction** of our simulator
+(we set it); there is **no statistic** (the paper prints nothing we can compare with).  A result on the
+claim's side of the boundary is reproduced even where a floor estimate said the experiment could not show
+it: the data crossed the floor, so the floor was the estimate that erred.
 
 Comparisons ("X beats Y", "k times better") are judged on the interval of the **paired** difference or
 ratio over the same seeds or runs (:func:`paired_difference`, :func:`paired_ratio`); rates on the Wilson
@@ -26,7 +33,7 @@ interval (:func:`wilson`); statistics of a real table on a bootstrap over its ro
 deterministic computation on real data (no randomness anywhere) has a zero-width interval (:func:`exact`).
 
 :func:`decide` is the rule; ``booktools check-results`` calls it again on every stored claim, so a verdict
-that does not follow from its interval, boundary and side fails the test.
+that does not follow from its interval, boundary, side and floor fails the test.
 """
 from __future__ import annotations
 
@@ -208,16 +215,19 @@ def attempt(fn: Callable[..., Estimate], *args) -> tuple[Estimate | None, str]:
 @dataclass(frozen=True)
 class Floor:
     """The best value of a claim's statistic that our experiment can resolve (its noise floor), the
-    assumption that sets it, and what the claim would need.
+    assumption that sets it, what the claim would need, and the floor's own 95 % interval.
 
     ``value``: the floor in the statistic's unit (for ``holds_when="below"`` the smallest value our
     experiment can show, for ``"above"`` the largest); ``assumption``: what decides it ("sensor noise
     3 ug per reading"); ``needs``: the value the assumption would need for the claim to be resolvable
-    ("noise below 2.83 ug")."""
+    ("noise below 2.83 ug"); ``lo``, ``hi``: the floor's interval where it rests on several runs (default:
+    the value itself, a floor measured once)."""
 
     value: float
     assumption: str
     needs: str
+    lo: float | None = None
+    hi: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.value, (int, float)) or not math.isfinite(self.value):
@@ -225,6 +235,19 @@ class Floor:
         for f in ("assumption", "needs"):
             if not str(getattr(self, f)).strip():
                 raise InputError(f"Floor.{f} is empty: say what decides the floor and what it would need")
+        for f in ("lo", "hi"):
+            v = getattr(self, f)
+            if v is not None and (not isinstance(v, (int, float)) or not math.isfinite(v)):
+                raise InputError(f"Floor.{f}={v!r}: must be a finite number or None")
+        if not self.interval[0] <= self.value <= self.interval[1]:
+            raise InputError(f"Floor interval [{self.interval[0]}, {self.interval[1]}] must contain its "
+                             f"value {self.value}")
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        """``(lo, hi)``; the value itself for a floor measured once."""
+        return (float(self.value if self.lo is None else self.lo),
+                float(self.value if self.hi is None else self.hi))
 
 
 def on_side(value: float, boundary: float, holds_when: str) -> bool:
@@ -232,16 +255,49 @@ def on_side(value: float, boundary: float, holds_when: str) -> bool:
     return value < boundary if holds_when == "below" else value > boundary
 
 
-def decide(interval: Sequence[float] | None, boundary: float | None, holds_when: str | None,
-           floor: float | None = None, by_construction: bool = False) -> tuple[bool | None, str]:
-    """The verdict (True = reproduced, False = not reproduced, None = cannot be judged) and its basis
-    (one of :data:`BASES`) from a 95 % interval, the boundary, the claim's side and the noise floor.
+def _floor_interval(floor) -> tuple[float, float] | None:
+    if floor is None:
+        return None
+    if isinstance(floor, Floor):
+        return floor.interval
+    if isinstance(floor, (int, float)):
+        return (float(floor), float(floor))
+    lo, hi = (float(v) for v in floor)
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+        raise InputError(f"floor interval [{lo}, {hi}]: need finite numbers with lo <= hi")
+    return (lo, hi)
 
-    The rule, in order: true by construction of our simulator -> cannot be judged; no statistic ->
-    cannot be judged; a floor not strictly on the claim's side -> cannot be judged (the experiment cannot
-    resolve the claim); the whole interval on the claim's side -> reproduced; the whole interval on the
-    other side -> not reproduced; otherwise (the interval touches or contains the boundary) -> cannot be
-    judged."""
+
+def worse_bound(boundary: float, holds_when: str, floor=None) -> float:
+    """The worse of boundary and floor (:math:`w` of the rule): the floor's far end when its whole
+    interval lies beyond the boundary on the side where the claim fails, else the boundary."""
+    f = _floor_interval(floor)
+    other = "above" if holds_when == "below" else "below"
+    if f is None or not (on_side(f[0], boundary, other) and on_side(f[1], boundary, other)):
+        return float(boundary)
+    return f[1] if holds_when == "below" else f[0]
+
+
+def decide(interval: Sequence[float] | None, boundary: float | None, holds_when: str | None,
+           floor=None, by_construction: bool = False) -> tuple[bool | None, str]:
+    """The verdict (True = reproduced, False = not reproduced, None = cannot be judged) and its basis
+    (one of :data:`BASES`) from a 95 % interval, the boundary, the claim's side and the noise floor
+    (``floor``: a number, an interval ``(lo, hi)`` or a :class:`Floor`).
+
+    The rule, in order (the module's equation): true by construction of our simulator -> cannot be
+    judged; no statistic -> cannot be judged; the whole interval on the claim's side of the boundary ->
+    reproduced; the whole interval beyond the worse of boundary and floor (:func:`worse_bound`) -> not
+    reproduced; beyond the boundary but not beyond a separated floor -> cannot be judged (noise floor);
+    otherwise the interval touches or contains the boundary -> cannot be judged (noise floor where the
+    floor is separated from the boundary, else straddles).
+
+    >>> decide((14.1, 20.8), 0.42, "below", floor=0.487)    # far worse than the noise excuses
+    (False, 'interval')
+    >>> decide((0.45, 0.47), 0.42, "below", floor=0.487)    # beyond the boundary, within the floor
+    (None, 'noise floor')
+    >>> decide((0.40, 0.41), 0.42, "below", floor=0.487)    # the data crossed the floor estimate
+    (True, 'interval')
+    """
     if by_construction:
         return None, "by construction"
     if interval is None or boundary is None or holds_when is None:
@@ -252,14 +308,13 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
     b = float(boundary)
     if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(b)) or lo > hi:
         raise InputError(f"interval [{lo}, {hi}] and boundary {b}: need finite numbers with lo <= hi")
-    if floor is not None and not on_side(float(floor), b, holds_when):
-        return None, "noise floor"
     if on_side(lo, b, holds_when) and on_side(hi, b, holds_when):
         return True, "interval"
+    w = worse_bound(b, holds_when, floor)
     other = "above" if holds_when == "below" else "below"
-    if on_side(lo, b, other) and on_side(hi, b, other):
+    if on_side(lo, w, other) and on_side(hi, w, other):
         return False, "interval"
-    return None, "straddles"
+    return None, "noise floor" if w != b else "straddles"
 
 
 def verdict_name(reproduced: bool | None) -> str:
@@ -274,11 +329,12 @@ REASONS = {
     "straddles": ("our interval contains the boundary",
                   "the 95 % interval of our statistic contains (or touches) the claim's boundary: more runs "
                   "or a less noisy experiment could decide it"),
-    "noise floor": ("below our noise floor",
-                    "the best value our experiment can show (the noise floor: sensor noise, the exact "
-                    "physical model) is not on the claim's side of the boundary, so no method could show "
-                    "the claim in our experiment; the reason names the assumption that sets the floor and "
-                    "the value it would need"),
+    "noise floor": ("within our noise floor",
+                    "our interval lies beyond the claim's boundary (or touches it), but not beyond the noise "
+                    "floor of our experiment (the best value sensor noise and the exact physical model allow), "
+                    "whose whole interval lies beyond the boundary: no method could show the claim in our "
+                    "experiment; the reason names the assumption that sets the floor and the value it would "
+                    "need"),
     "by construction": ("by construction of our simulator",
                         "the statistic is true because we set it in our simulator, so our runs cannot test "
                         "it"),
@@ -286,12 +342,24 @@ REASONS = {
                      "the paper prints nothing we can compare our statistic with"),
     "too few runs": ("too few runs for an interval",
                      "our runs are too few for a 95 % interval of the statistic"),
+    "not yet computed": ("not yet computed",
+                         "the claim is checkable but the book does not compute its statistic yet; the claims "
+                         "register says which statistic and how many runs would decide it"),
+    "not checkable": ("not checkable",
+                      "no experiment of ours can test the claim (the register says why)"),
+    "data absent": ("its measurements are absent",
+                    "the real measurements that decide the claim (../shared/realdata) are not on this "
+                    "machine, so the chapter could not judge it"),
 }
+#: The first words of a register entry's reason for the last two cases (written by :mod:`navlib.claims`).
+REGISTER_REASONS = {"not yet computed": "not yet computed: ", "not checkable": "not checkable: ",
+                    "data absent": "data absent: "}
 #: The verdict labels of the book in order, each with its definition (the three verdicts of
 #: ``VERDICTS``, *cannot be judged* split by :data:`REASONS`).
 VERDICT_DEFINITIONS = {
     "reproduced": "the whole 95 % interval of our statistic lies on the claim's side of its boundary",
-    "not reproduced": "the whole 95 % interval lies on the other side of the boundary",
+    "not reproduced": "the whole 95 % interval lies beyond the boundary and beyond the noise floor of our "
+                      "experiment where that floor lies beyond the boundary",
     **{f"cannot be judged: {label}": text for label, text in REASONS.values()},
 }
 
@@ -307,6 +375,9 @@ def reason_category(basis: str | None, why: str = "") -> str | None:
         raise InputError(f"basis={basis!r}: must be one of {list(BASES)}")
     if basis == "no statistic" and "no 95 % interval" in (why or ""):
         return "too few runs"
+    for cat, lead in REGISTER_REASONS.items():
+        if basis == "no statistic" and (why or "").startswith(lead):
+            return cat
     return basis
 
 

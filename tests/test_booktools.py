@@ -183,10 +183,14 @@ def test_a_hand_edited_verdict_is_rejected(verdict):
 
 
 def test_a_floor_on_the_wrong_side_makes_a_stored_claim_undecidable():
-    res = _results(verdict=True)                        # interval [0.2, 0.5] below the boundary 1
+    res = _results(verdict=False)                       # interval beyond the boundary
     c = res["claims"][0]
+    c.update(estimate=1.1, interval=[1.05, 1.15])       # ... but within the floor 1.2
     c["floor"] = {"value": 1.2, "assumption": "sensor noise 3 ug", "needs": "noise below 2.5 ug"}
     assert any("does not follow" in p for p in validate_results(res, "compass.json"))
+    c["floor"]["interval"] = [1.3, 1.1]
+    assert any("floor interval" in p for p in validate_results(res, "compass.json"))
+    c["floor"]["interval"] = [1.1, 1.3]
     c.update(reproduced=None, verdict="cannot be judged", basis="noise floor", reason="noise floor", why="floor")
     assert validate_results(res, "compass.json") == []
     c["why"] = ""

@@ -14,8 +14,11 @@ from navlib.errors import InputError
 # ------------------------------------------------------------------ helpers
 def _claim(text, reproduced, reading="as printed", source="paper", floor=None, by_construction=False,
            estimate=True):
-    """A claim whose interval gives ``reproduced`` by the rule (boundary 1, holds below)."""
+    """A claim whose interval gives ``reproduced`` by the rule (boundary 1, holds below); with a floor,
+    an interval beyond the boundary but within the floor."""
     interval = {True: [0.2, 0.5], False: [1.5, 2.0], None: [0.5, 1.5]}[reproduced]
+    if floor is not None:
+        interval = [1.05, 1.15]
     est = verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20) if estimate else None
     return report.Claim(text, "0.2 deg", reading=reading, source=source, statistic="rms, deg",
                         estimate=est, boundary=1.0 if estimate else None,
@@ -48,7 +51,7 @@ def _results():
 def test_each_case_of_cannot_be_judged_gets_its_own_label():
     labels = [c.verdict_label for c in CLAIMS]
     assert labels == ["reproduced", "not reproduced", "cannot be judged: our interval contains the boundary",
-                      "cannot be judged: below our noise floor",
+                      "cannot be judged: within our noise floor",
                       "cannot be judged: by construction of our simulator",
                       "cannot be judged: the paper gives no number", "reproduced"]
     assert [c.record()["reason"] for c in CLAIMS] == [None, None, "straddles", "noise floor", "by construction",
@@ -78,7 +81,7 @@ def test_verdict_sentence_follows_the_counts():
     assert bt.verdict_sentence(dict(zip(bt.COUNTED, (5, 0, 2)))).startswith("Mostly reproduced: 5 of the paper's 7")
     recs = [_claim("x", None, floor=verdicts.Floor(1.2, "noise", "less")).record()] * 3
     s = bt.verdict_sentence(dict(zip(bt.COUNTED, (1, 0, 3))), claims=recs)
-    assert s.startswith("Mostly cannot be judged: 3 of the paper's 4") and "(all below our noise floor)" in s
+    assert s.startswith("Mostly cannot be judged: 3 of the paper's 4") and "(all within our noise floor)" in s
 
 
 def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_path):
@@ -103,12 +106,12 @@ def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_pat
     assert rows[0].count("<rect") == 3 and 'aria-label="1 reproduced, 1 not reproduced, 4 cannot be judged"' in rows[0]
     assert "Mostly cannot be judged: 4 of the paper's 6 claims cannot be judged, 1 reproduce" in rows[0]
     assert "In all, **1 of 7** of the papers' claims reproduce" in md
-    assert "(what-the-verdicts-mean)=" in md and "**cannot be judged: below our noise floor**" in md
+    assert "(what-the-verdicts-mean)=" in md and "**cannot be judged: within our noise floor**" in md
     assert "Not yet summarised (no results file): {doc}`INS/celestial </_generated/celestial>`" in md
     by_reading = bt.readings_markdown(_results(), order, sources)
-    assert by_reading.index("::::{dropdown} Electronic compass: 7 claims, 4 readings") < by_reading.index("gyro")
+    assert by_reading.index("::::{dropdown} Electronic compass: 7 rows (claims under readings), 4 readings") < by_reading.index("gyro")
     assert ("| DE + trainlm, validation stop (reading 2) | 2 | 0 | 0 | 2 (1 our interval contains the boundary, "
-            "1 below our noise floor) |" in by_reading)
+            "1 within our noise floor) |" in by_reading)
     assert ("| Document B | 2 | 0 | 0 | 2 (1 by construction of our simulator, 1 the paper gives no number) |"
             in by_reading)
     assert "| Ours (the book's own claims) | 1 | 1 | 0 | 0 |" in by_reading
@@ -167,7 +170,7 @@ def test_the_glance_box_folds_long_lists_by_reading_and_labels_the_case():
     assert h.count("<details>") == 3 and "cannot be judged: our interval contains the boundary" in h
     assert report.VERDICTS_HREF in h
     short = report.glance(CLAIMS)._repr_html_()
-    assert "<details>" not in short and "cannot be judged: below our noise floor" in short
+    assert "<details>" not in short and "cannot be judged: within our noise floor" in short
     # the plain text (what nbval compares) is the tables' text, unchanged
     assert repr(report.glance(CLAIMS)) == "\n\n".join(repr(t) for t in report.glance(CLAIMS).tables())
 

@@ -62,9 +62,12 @@ def test_claim_verdict_follows_from_interval_boundary_and_floor():
     assert _claim((1.5, 2.0)).verdict == "not reproduced"
     c = _claim((0.5, 1.5))
     assert c.verdict == "cannot be judged" and "contains the boundary" in c.reason
-    floored = _claim((0.2, 0.5), floor=verdicts.Floor(1.2, "sensor noise 3 ug", "noise below 2.5 ug"))
-    assert floored.verdict == "cannot be judged"
+    fl = verdicts.Floor(1.2, "sensor noise 3 ug", "noise below 2.5 ug")
+    floored = _claim((1.05, 1.15), floor=fl)              # beyond the boundary 1, within the floor 1.2
+    assert floored.verdict == "cannot be judged" and floored.basis == "noise floor"
     assert "sensor noise 3 ug" in floored.reason and "noise below 2.5 ug" in floored.reason
+    assert _claim((1.5, 2.0), floor=fl).verdict == "not reproduced"   # worse than the noise excuses
+    assert _claim((0.2, 0.5), floor=fl).verdict == "reproduced"       # the data crossed the floor
     built = _claim((0.2, 0.5), by_construction=True, why="the simulator was set to it")
     assert built.verdict == "cannot be judged" and built.basis == "by construction"
     none = report.Claim("c", "p", why="Table 5 prints no drift")

@@ -20,13 +20,56 @@ def test_decide_on_each_side_of_the_boundary(interval, side, expected):
     assert verdicts.decide(interval, 1.0, side) == expected
 
 
-def test_decide_floor_construction_and_missing_statistic():
-    # a floor on the wrong side (or on the boundary) makes even a decisive interval undecidable
-    assert verdicts.decide((0.1, 0.2), 1.0, "below", floor=1.0) == (None, "noise floor")
-    assert verdicts.decide((1.5, 2.0), 1.0, "below", floor=1.2) == (None, "noise floor")
-    assert verdicts.decide((0.1, 0.2), 1.0, "below", floor=0.05) == (True, "interval")
-    assert verdicts.decide((5.0, 6.0), 10.0, "above", floor=12.0) == (False, "interval")
-    assert verdicts.decide((5.0, 6.0), 10.0, "above", floor=8.0) == (None, "noise floor")
+@pytest.mark.parametrize("interval,side,floor,expected", [
+    # a clear failure far beyond both boundary and floor is a failure (ADE-BP's range: [14.1, 20.8] deg
+    # against boundary 0.42 and floor 0.487)
+    ((14.1, 20.8), "below", 0.487, (False, "interval")),
+    # beyond the boundary but not beyond the floor: the noise excuses it
+    ((0.45, 0.47), "below", 0.487, (None, "noise floor")),
+    ((0.45, 0.49), "below", 0.487, (None, "noise floor")),      # reaches past the floor: still excused
+    # the data crossed the floor estimate: a result on the claim's side is reproduced
+    ((0.40, 0.41), "below", 0.487, (True, "interval")),
+    # straddling the boundary with a separated floor: the floor is why it cannot be decided
+    ((0.40, 0.45), "below", 0.487, (None, "noise floor")),
+    # a floor on the claim's side does not change anything
+    ((0.1, 0.2), 1.0, None, None),
+    ((5.0, 6.0), "above", 12.0, (False, "interval")),           # floor on the claim's side of 10
+    ((8.5, 9.0), "above", 8.0, (None, "noise floor")),          # within [8, 10]: excused
+    ((5.0, 6.0), "above", 8.0, (False, "interval")),            # below the floor too: failed
+    # the floor's own interval: it decides only where the whole interval is separated from the boundary
+    ((0.43, 0.44), "below", (0.41, 0.50), (False, "interval")),  # floor straddles 0.42: plain rule
+    ((0.43, 0.44), "below", (0.43, 0.50), (None, "noise floor")),
+    ((0.52, 0.60), "below", (0.43, 0.50), (False, "interval")),  # beyond the floor's far end
+    ((0.49, 0.60), "below", (0.43, 0.50), (None, "noise floor")),  # touches the far end
+])
+def test_decide_with_a_noise_floor(interval, side, floor, expected):
+    if side == 1.0:                                               # the no-op row
+        assert verdicts.decide(interval, 1.0, "below", floor=0.05) == (True, "interval")
+        return
+    b = 10.0 if side == "above" else 0.42
+    assert verdicts.decide(interval, b, side, floor=floor) == expected
+
+
+def test_worse_bound_is_the_floor_only_when_separated():
+    assert verdicts.worse_bound(0.42, "below", 0.487) == 0.487
+    assert verdicts.worse_bound(0.42, "below", 0.30) == 0.42
+    assert verdicts.worse_bound(0.42, "below", (0.40, 0.50)) == 0.42
+    assert verdicts.worse_bound(10.0, "above", (7.0, 9.0)) == 7.0
+    assert verdicts.worse_bound(10.0, "above", None) == 10.0
+    with pytest.raises(InputError, match="lo <= hi"):
+        verdicts.worse_bound(1.0, "below", (2.0, 1.5))
+
+
+def test_floor_interval_must_contain_its_value():
+    f = verdicts.Floor(0.487, "noise 0.04 uT", "noise below 0.03 uT", lo=0.47, hi=0.50)
+    assert f.interval == (0.47, 0.50)
+    assert verdicts.Floor(1.0, "a", "b").interval == (1.0, 1.0)
+    with pytest.raises(InputError, match="must contain its value"):
+        verdicts.Floor(1.0, "a", "b", lo=1.1, hi=1.2)
+    assert verdicts.decide((0.43, 0.44), 0.42, "below", floor=f) == (None, "noise floor")
+
+
+def test_decide_construction_and_missing_statistic():
     assert verdicts.decide((0.1, 0.2), 1.0, "below", by_construction=True) == (None, "by construction")
     assert verdicts.decide(None, None, None) == (None, "no statistic")
     with pytest.raises(InputError, match="holds_when"):

@@ -1,0 +1,295 @@
+"""The claims registers and their one evaluator: every checkable statement of a source, judged once.
+
+A source's register (``data/claims_<source>.csv``, dictionary in ``data/claims.md``) lists each checkable
+statement of the paper once: its words and where they are, the statistic, boundary and side that test it,
+and, where the paper can be read several ways, the **primary reading** (the most plausible one, with a
+sentence on why) and the dimensions along which the verdict is shown to move.  A chapter's study code
+judges each statement under every reading, noise level or split it runs (one results row each, a
+:class:`navlib.report.Claim`); :func:`evaluate` folds those rows into **one record per register entry**:
+the primary row's statistic, interval, boundary, floor and verdict (by the book's one rule,
+:func:`navlib.verdicts.decide`), the other rows as its ``sensitivity`` list, and a summary of how the
+verdict moves across them (and across drawn worlds, e.g. the compass chapter's five drawn compasses).
+Entries without results rows are kept as *not yet computed* (checkable: the register says what would
+decide them) or *not checkable* (it says why); a paper's contradictions of itself are listed apart
+(:func:`inconsistencies`).
+
+Every results row must belong to exactly one entry and every entry's primary row must exist: a chapter
+that writes a row the register does not know, or a register that names a row the chapter did not write,
+stops with one line naming both (:class:`navlib.errors.InputError`).
+"""
+from __future__ import annotations
+
+import csv
+import functools
+import re
+from dataclasses import dataclass
+from typing import Iterable, Mapping
+
+from . import verdicts
+from .errors import InputError
+from .paths import data_path
+
+#: The registers each chapter's rows are judged against (file ``data/claims_<name>.csv``).
+REGISTERS = {"compass": ("paper_a", "patent_b"), "gyro": ("paper_c",), "accelerometer": ("paper_d",),
+             "celestial": ("paper_e",), "workbench": ("workbench",)}
+#: How the book names each register's source.
+SOURCE_NAMES = {"paper_a": "Paper A", "patent_b": "Document B", "paper_c": "Paper C", "paper_d": "Paper D",
+                "paper_e": "Paper E", "workbench": "The workbench"}
+KINDS = ("value", "comparison", "order", "rate", "qualitative", "inconsistency")
+STATUSES = ("judged", "open", "not checkable", "noted")
+COLUMNS = ("id", "origin", "headline", "kind", "status", "claim", "quote", "quote_zh", "where", "statistic",
+           "boundary", "holds_when", "unit", "rows", "primary_claim", "primary_reading", "why_primary",
+           "sensitivity", "needs", "margin", "margin_why")
+_ID = re.compile(r"^[A-Z]\d{2,3}$")
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One register entry (one checkable statement of a source; the columns of ``data/claims.md``)."""
+
+    id: str
+    origin: str
+    headline: bool
+    kind: str
+    status: str
+    claim: str
+    quote: str
+    quote_zh: str
+    where: str
+    statistic: str
+    boundary: float | None
+    holds_when: str | None
+    unit: str
+    rows: tuple[str, ...]
+    primary_claim: str
+    primary_reading: str
+    why_primary: str
+    sensitivity: str
+    needs: str
+    margin: float | None
+    margin_why: str
+    register: str = ""
+
+
+def _number(text: str, where: str) -> float | None:
+    text = text.strip()
+    if not text:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(f"{where}: {text!r} is not a number") from None
+
+
+def parse_register(lines: Iterable[str], name: str) -> tuple[Entry, ...]:
+    """The entries of one register file's text (``name`` names it in messages), validated: one line
+    naming file, row, entry and column for the first problem."""
+    reader = csv.DictReader(lines)
+    cols = tuple(reader.fieldnames or ())
+    if set(cols) != set(COLUMNS):
+        missing, extra = sorted(set(COLUMNS) - set(cols)), sorted(set(cols) - set(COLUMNS))
+        raise InputError(f"{name}: columns differ from data/claims.md (missing {missing}, unknown {extra})")
+    out, seen = [], set()
+    for i, raw in enumerate(reader, start=2):
+        r = {k: (v or "").strip() for k, v in raw.items() if k is not None}
+        at = f"{name}, row {i} ({r.get('id') or 'no id'})"
+
+        def bad(col: str, why: str):
+            raise InputError(f"{at}, column '{col}': {why}")
+
+        if not _ID.match(r["id"]):
+            bad("id", f"{r['id']!r}: a capital letter and 2-3 digits (A01)")
+        if r["id"] in seen:
+            bad("id", f"{r['id']} appears twice")
+        seen.add(r["id"])
+        if r["origin"] not in verdicts.SOURCES:
+            bad("origin", f"{r['origin']!r}: 'paper' or 'book'")
+        if r["headline"] not in ("", "yes"):
+            bad("headline", f"{r['headline']!r}: 'yes' or empty")
+        if r["kind"] not in KINDS:
+            bad("kind", f"{r['kind']!r}: one of {list(KINDS)}")
+        if r["status"] not in STATUSES:
+            bad("status", f"{r['status']!r}: one of {list(STATUSES)}")
+        for col in ("claim", "where"):
+            if not r[col]:
+                bad(col, "empty")
+        if r["origin"] == "paper" and not r["quote"]:
+            bad("quote", "empty: give the paper's words")
+        if r["holds_when"] not in ("",) + verdicts.SIDES:
+            bad("holds_when", f"{r['holds_when']!r}: 'above', 'below' or empty")
+        rows = tuple(t.strip() for t in r["rows"].split(" ; ") if t.strip())
+        if r["status"] == "judged":
+            if not rows:
+                bad("rows", "a judged entry names the results rows that test it")
+            if r["primary_claim"] not in rows:
+                bad("primary_claim", f"{r['primary_claim']!r} is not one of its rows")
+            if not r["primary_reading"]:
+                bad("primary_reading", "empty")
+            if r["origin"] == "paper" and not r["why_primary"]:
+                bad("why_primary", "say why the primary reading is the most plausible")
+        else:
+            if rows:
+                bad("rows", f"a {r['status']!r} entry has no results rows")
+            if not r["needs"]:
+                bad("needs", f"a {r['status']!r} entry says what would decide it or why it cannot be")
+        if (r["kind"] == "inconsistency") != (r["status"] == "noted"):
+            bad("status", "an inconsistency is 'noted', and only an inconsistency is")
+        out.append(Entry(
+            id=r["id"], origin=r["origin"], headline=r["headline"] == "yes", kind=r["kind"], status=r["status"],
+            claim=r["claim"], quote=r["quote"], quote_zh=r["quote_zh"], where=r["where"],
+            statistic=r["statistic"], boundary=_number(r["boundary"], f"{at}, column 'boundary'"),
+            holds_when=r["holds_when"] or None, unit=r["unit"], rows=rows, primary_claim=r["primary_claim"],
+            primary_reading=r["primary_reading"], why_primary=r["why_primary"], sensitivity=r["sensitivity"],
+            needs=r["needs"], margin=_number(r["margin"], f"{at}, column 'margin'"), margin_why=r["margin_why"],
+            register=name.removeprefix("claims_").removesuffix(".csv")))
+    heads = [e.id for e in out if e.headline]
+    if any(e.headline and e.origin != "paper" for e in out):
+        raise InputError(f"{name}: a headline is the source's own claim (origin 'paper')")
+    if any(e.origin == "paper" for e in out) and len(heads) != 1:
+        raise InputError(f"{name}: exactly one headline entry (headline = yes) is needed, found {heads}")
+    return tuple(out)
+
+
+@functools.lru_cache(maxsize=None)
+def load_register(name: str) -> tuple[Entry, ...]:
+    """The entries of ``data/claims_<name>.csv`` (:func:`parse_register`)."""
+    fname = f"claims_{name}.csv"
+    try:
+        with open(data_path(fname), newline="", encoding="utf-8") as fh:
+            return parse_register(fh, fname)
+    except FileNotFoundError:
+        raise InputError(f"{fname}: no such claims register in navlib's data") from None
+
+
+def registers(chapter: str) -> tuple[str, ...]:
+    """The register names a chapter is judged against (empty for a chapter without one)."""
+    return REGISTERS.get(chapter, ())
+
+
+def entries(chapter: str) -> tuple[Entry, ...]:
+    """Every entry of the chapter's registers, in register order."""
+    return tuple(e for name in registers(chapter) for e in load_register(name))
+
+
+def _across(primary: Mapping, others: list[Mapping], worlds: list[Mapping] | None) -> dict:
+    """How the primary verdict moves: across the other rows (readings, noise levels, splits) and across
+    drawn worlds (records ``{"compass"|"world", "claim", "reading", "verdict"}`` of the primary row)."""
+    v = primary["verdict"]
+    out = {"rows": 1 + len(others), "same": 1 + sum(o["verdict"] == v for o in others),
+           "verdicts": {k: sum(o["verdict"] == k for o in [primary, *others]) for k in verdicts.VERDICTS}}
+    if worlds:
+        mine = [w for w in worlds if w.get("claim") == primary["row_claim"]
+                and w.get("reading") == primary["reading"]]
+        if mine:
+            out["worlds"] = len(mine)
+            out["worlds_same"] = sum(w.get("verdict") == v for w in mine)
+    return out
+
+
+def across_text(record: Mapping) -> str:
+    """"same in 4 of 5 readings; flips on 2 of 5 drawn compasses" (or "one reading") from a record's
+    ``across`` summary."""
+    a = record.get("across") or {}
+    n = int(a.get("rows", 1))
+    parts = ["one reading" if n == 1 else
+             (f"same in all {n} readings" if a.get("same") == n else f"same in {a.get('same')} of {n} readings")]
+    if "worlds" in a:
+        flips = a["worlds"] - a["worlds_same"]
+        parts.append(f"same on all {a['worlds']} drawn compasses" if flips == 0 else
+                     f"differs on {flips} of {a['worlds']} drawn compasses")
+    return "; ".join(parts)
+
+
+def _unjudged(e: Entry, cat: str | None = None) -> dict:
+    cat = cat or ("not yet computed" if e.status == "open" else "not checkable")
+    return {"claim": e.claim, "reading": "as printed", "source": e.origin, "paper": e.quote or e.claim,
+            "ours": "–", "statistic": e.statistic or None, "unit": e.unit, "rule": "no statistic",
+            "estimate": None, "interval": None, "n": None, "boundary": None, "holds_when": None,
+            "floor": None, "by_construction": False, "decided_by": [], "reproduced": None,
+            "verdict": "cannot be judged", "basis": "no statistic", "reason": cat,
+            "why": verdicts.REGISTER_REASONS[cat] + e.needs, "key": None, "volatile": False,
+            "row_claim": None, "primary_reading": e.primary_reading if cat == "data absent" else f"none ({cat})"}
+
+
+def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None = None) -> list[dict]:
+    """One record per register entry of ``chapter`` (except inconsistencies): for a judged entry its
+    primary row's fields (``claim`` is the register's wording, ``row_claim`` the row's), the register's
+    ``id``, ``quote``, ``quote_zh``, ``where``, ``kind``, ``status``, ``headline``, ``primary_reading``,
+    ``why_primary``, ``dimensions`` (the register's sensitivity column), ``source`` (the register's
+    origin), the other rows as ``sensitivity`` (each a row record with the same fields) and ``across``
+    (:func:`across_text`); an open or not-checkable entry has no statistic and says why.  ``rows`` are
+    :meth:`navlib.report.Claim.record` dicts; ``worlds`` the drawn-world verdicts of the rows, if any."""
+    rows = [dict(r) for r in rows]
+    es = entries(chapter)
+    if not es:
+        raise InputError(f"chapter {chapter!r} has no claims register (navlib.claims.REGISTERS)")
+    owner: dict[str, Entry] = {}
+    for e in es:
+        for text in e.rows:
+            if text in owner:
+                raise InputError(f"claims_{e.register}.csv, {e.id}: row {text!r} already belongs to "
+                                 f"{owner[text].id}")
+            owner[text] = e
+    files = ", ".join(f"data/claims_{n}.csv" for n in registers(chapter))
+    by_entry: dict[str, list[dict]] = {}
+    for r in rows:
+        e = owner.get(r["claim"])
+        if e is None:
+            raise InputError(f"chapter {chapter!r}: results row {r['claim']!r} ({r['reading']}) belongs to no "
+                             f"entry of {files}: add it to an entry's rows")
+        by_entry.setdefault(e.id, []).append(r)
+    out = []
+    for e in es:
+        if e.status == "noted":
+            continue
+        base = {"id": e.id, "register": e.register, "kind": e.kind, "status": e.status, "headline": e.headline,
+                "quote": e.quote, "quote_zh": e.quote_zh, "where": e.where, "why_primary": e.why_primary,
+                "dimensions": e.sensitivity, "needs": e.needs}
+        if e.status != "judged":
+            out.append({**_unjudged(e), **base, "sensitivity": [],
+                        "across": {"rows": 0, "same": 0, "verdicts": {}}})
+            continue
+        mine = by_entry.get(e.id, [])
+        if not mine:                  # a judged entry whose rows the chapter could not write: no real data
+            rec = _unjudged(e, "data absent")
+            rec["why"] = ("data absent: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): the measurements "
+                           "that decide it are not on this machine")
+            out.append({**rec, **base, "sensitivity": [], "across": {"rows": 0, "same": 0, "verdicts": {}}})
+            continue
+        missing = [t for t in e.rows if not any(r["claim"] == t for r in mine)]
+        if missing:
+            raise InputError(f"claims_{e.register}.csv, {e.id}: the chapter wrote no row {missing[0]!r}")
+        prim = [r for r in mine if r["claim"] == e.primary_claim and r["reading"] == e.primary_reading]
+        if len(prim) != 1:
+            raise InputError(f"claims_{e.register}.csv, {e.id}: no results row {e.primary_claim!r} under the "
+                             f"primary reading {e.primary_reading!r}")
+        p = prim[0]
+        others = [{**r, "source": e.origin} for r in mine if r is not p]
+        rec = {**p, **base, "claim": e.claim, "row_claim": p["claim"], "source": e.origin,
+               "primary_reading": p["reading"], "sensitivity": others}
+        rec["across"] = _across(rec, others, worlds)
+        out.append(rec)
+    return out
+
+
+def inconsistencies(chapter: str) -> list[dict]:
+    """The register's ``noted`` entries of a chapter: where a paper contradicts itself."""
+    return [{"id": e.id, "register": e.register, "claim": e.claim, "quote": e.quote, "where": e.where,
+             "numbers": e.needs} for e in entries(chapter) if e.status == "noted"]
+
+
+def headlines(records: Iterable[Mapping]) -> list[dict]:
+    """The headline record of each register among ``records`` (:func:`evaluate`'s), in order."""
+    return [r for r in records if r.get("headline")]
+
+
+def tally(records: Iterable[Mapping]) -> dict[str, int]:
+    """Counts of register records by status and, for judged ones, by primary verdict."""
+    recs = list(records)
+    out = {k: sum(r["verdict"] == k and r.get("status") == "judged" for r in recs) for k in verdicts.VERDICTS}
+    out.update({s: sum(r.get("status") == s for r in recs) for s in ("judged", "open", "not checkable")})
+    return out
+
+
+__all__ = ["Entry", "REGISTERS", "SOURCE_NAMES", "across_text", "entries", "evaluate", "headlines",
+           "inconsistencies", "load_register", "parse_register", "registers", "tally"]

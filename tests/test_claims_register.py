@@ -1,0 +1,167 @@
+"""navlib.claims: the claims registers (data/claims_*.csv) and their one evaluator.
+
+Every register entry must appear in its chapter: once as a record of the chapter's results file (judged,
+not yet computed, not checkable) or in its list of the paper's contradictions, and by its id in the
+chapter's opening table as the executed notebook stores it."""
+import io
+import json
+from pathlib import Path
+
+import pytest
+
+from navlib import claims, verdicts
+from navlib.booktools import claim_problems, register_problems
+from navlib.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+HEADER = ",".join(claims.COLUMNS)
+
+
+def _row(**kw):
+    base = dict.fromkeys(claims.COLUMNS, "")
+    base.update(id="A01", origin="paper", headline="yes", kind="comparison", status="judged", claim="X beats Y",
+                quote="X is better than Y", where="Sec. 1", statistic="rms Y - rms X, deg", boundary="0",
+                holds_when="above", unit="deg", rows="X beats Y", primary_claim="X beats Y",
+                primary_reading="r1", why_primary="the paper says r1")
+    base.update(kw)
+    out = io.StringIO()
+    import csv
+    w = csv.DictWriter(out, fieldnames=claims.COLUMNS)
+    w.writerow(base)
+    return out.getvalue()
+
+
+def _parse(*rows):
+    return claims.parse_register(io.StringIO(HEADER + "\n" + "".join(rows)), "claims_test.csv")
+
+
+# ------------------------------------------------------------------ the register files
+@pytest.mark.parametrize("name", sorted({n for ns in claims.REGISTERS.values() for n in ns}))
+def test_every_register_parses(name):
+    es = claims.load_register(name)
+    assert es and len({e.id for e in es}) == len(es)
+    if name != "workbench":
+        assert sum(e.headline for e in es) == 1
+
+
+def test_ids_are_unique_over_all_registers():
+    ids = [e.id for ns in claims.REGISTERS.values() for n in ns for e in claims.load_register(n)]
+    assert len(ids) == len(set(ids))
+
+
+@pytest.mark.parametrize("row,match", [
+    (dict(status="guess"), "column 'status'"),
+    (dict(kind="vibe"), "column 'kind'"),
+    (dict(origin="blog"), "column 'origin'"),
+    (dict(primary_claim="Z beats Y"), "column 'primary_claim'"),
+    (dict(rows=""), "column 'rows'"),
+    (dict(why_primary=""), "column 'why_primary'"),
+    (dict(status="open"), "column 'rows'"),
+    (dict(status="open", rows="", needs=""), "column 'needs'"),
+    (dict(kind="inconsistency"), "column 'status'"),
+    (dict(boundary="zero"), "column 'boundary'"),
+    (dict(holds_when="left"), "column 'holds_when'"),
+    (dict(id="a1"), "column 'id'"),
+    (dict(quote=""), "column 'quote'"),
+])
+def test_a_bad_register_row_is_refused_in_one_line_naming_row_and_column(row, match):
+    with pytest.raises(InputError, match=match) as err:
+        _parse(_row(**row))
+    assert "claims_test.csv, row 2 (" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_register_needs_one_headline_and_its_columns():
+    with pytest.raises(InputError, match="exactly one headline"):
+        _parse(_row(), _row(id="A02"))
+    with pytest.raises(InputError, match="exactly one headline"):
+        _parse(_row(headline=""))
+    with pytest.raises(InputError, match="appears twice"):
+        _parse(_row(), _row(headline=""))
+    with pytest.raises(InputError, match="columns differ"):
+        claims.parse_register(io.StringIO("id,claim\nA01,x\n"), "claims_test.csv")
+
+
+# ------------------------------------------------------------------ the evaluator
+def _rec(claim, reading, interval, boundary=0.0, side="above"):
+    rep, basis = verdicts.decide(interval, boundary, side)
+    return {"claim": claim, "reading": reading, "source": "paper", "paper": "p", "ours": "o",
+            "statistic": "s", "unit": "deg", "rule": "paired difference", "estimate": sum(interval) / 2,
+            "interval": list(interval), "n": 20, "boundary": boundary, "holds_when": side, "floor": None,
+            "by_construction": False, "decided_by": [], "reproduced": rep, "verdict": verdicts.verdict_name(rep),
+            "basis": basis, "reason": verdicts.reason_category(basis, ""), "why": "" if rep is not None else "w",
+            "key": None, "volatile": False}
+
+
+@pytest.fixture
+def reg(monkeypatch):
+    es = _parse(_row(rows="X beats Y ; X beats Y [variant]"),
+                _row(id="A02", headline="", status="open", rows="", primary_claim="", needs="20 seeds of Z"),
+                _row(id="A03", headline="", kind="inconsistency", status="noted", rows="", primary_claim="",
+                     needs="8.5x beside 'two orders'"),
+                _row(id="A04", headline="", origin="book", rows="ours", primary_claim="ours",
+                     primary_reading="real"))
+    monkeypatch.setitem(claims.REGISTERS, "testch", ("test",))
+    monkeypatch.setattr(claims, "load_register", lambda name: es)
+    return es
+
+
+def test_evaluate_folds_rows_into_one_record_per_entry(reg):
+    rows = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y", "r2", (-1, 1)),
+            _rec("X beats Y [variant]", "r1", (-3, -2)), _rec("ours", "real", (1, 3))]
+    recs = claims.evaluate("testch", rows, worlds=[
+        {"compass": "C1", "claim": "X beats Y", "reading": "r1", "verdict": "reproduced"},
+        {"compass": "C2", "claim": "X beats Y", "reading": "r1", "verdict": "not reproduced"}])
+    assert [r["id"] for r in recs] == ["A01", "A02", "A04"]
+    a1, a2, a4 = recs
+    assert a1["verdict"] == "reproduced" and a1["primary_reading"] == "r1" and a1["claim"] == "X beats Y"
+    assert [(s["claim"], s["reading"]) for s in a1["sensitivity"]] == [("X beats Y", "r2"),
+                                                                       ("X beats Y [variant]", "r1")]
+    assert claims.across_text(a1) == "same in 1 of 3 readings; differs on 1 of 2 drawn compasses"
+    assert a2["reason"] == "not yet computed" and a2["why"] == "not yet computed: 20 seeds of Z"
+    assert a4["source"] == "book"
+    for r in recs:                                     # what check-results checks, including the nesting
+        assert claim_problems(r) == [] and register_problems(r) == []
+        assert all(claim_problems(s) == [] for s in r["sensitivity"])
+    assert claims.tally(recs)["open"] == 1
+    assert [n["id"] for n in claims.inconsistencies("testch")] == ["A03"]
+
+
+def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(reg):
+    good = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y [variant]", "r1", (1, 2)), _rec("ours", "real", (1, 2))]
+    with pytest.raises(InputError, match="belongs to no entry"):
+        claims.evaluate("testch", good + [_rec("a new claim", "r1", (1, 2))])
+    with pytest.raises(InputError, match="primary reading 'r1'"):
+        claims.evaluate("testch", [_rec("X beats Y", "r2", (1, 2))] + good[1:])
+    with pytest.raises(InputError, match="wrote no row 'X beats Y \\[variant\\]'"):
+        claims.evaluate("testch", [good[0], good[2]])
+    recs = claims.evaluate("testch", good[:2])         # no row of the book's entry: its data are absent
+    a4 = recs[-1]
+    assert a4["reason"] == "data absent" and a4["status"] == "judged" and claim_problems(a4) == []
+    assert register_problems(a4) == []
+
+
+# ------------------------------------------------------------------ every entry is shown by its chapter
+CHAPTERS = sorted(claims.REGISTERS)
+
+
+def _glance_html(chapter):
+    nb = json.loads((ROOT / "notebooks" / f"{chapter}.ipynb").read_text(encoding="utf-8"))
+    for cell in nb["cells"]:
+        for out in cell.get("outputs", []):
+            data = out.get("data", {})
+            if out.get("metadata", {}).get("scrapbook", {}).get("name") == f"{chapter}_glance":
+                return data.get("application/papermill.record/text/html", "")
+    return ""
+
+
+@pytest.mark.parametrize("chapter", CHAPTERS)
+def test_every_register_entry_is_in_the_results_file_and_the_chapters_opening(chapter):
+    res = json.loads((ROOT / "notebooks" / "results" / f"{chapter}.json").read_text(encoding="utf-8"))
+    ids = [c.get("id") for c in res["claims"]]
+    noted = [c["id"] for c in res.get("inconsistencies", [])]
+    html = _glance_html(chapter)
+    for e in claims.entries(chapter):
+        where = noted if e.status == "noted" else ids
+        assert where.count(e.id) == 1, f"{chapter}: register entry {e.id} ({e.claim}) is not in the results file"
+        assert f">{e.id}<" in html, f"{chapter}: register entry {e.id} ({e.claim}) is not in the chapter's opening"
+    assert len(ids) == len(set(ids))
