@@ -390,7 +390,7 @@ def check_chapter_closing(text: str) -> list[str]:
 
 
 _TALLY = re.compile(r"The (paper's|book's own) claims: (\d+) of (\d+) reproduced, (\d+) not reproduced, "
-                    r"(\d+) cannot be judged")
+                    r"(\d+) cannot be judged(?:, (\d+) no difference)?")
 _COUNTS_TAG = re.compile(r'<span class="navbook-counts"([^>]*)>')
 
 
@@ -411,7 +411,7 @@ def _box_counts(fragment: str) -> dict[str, tuple[int, int, int]]:
     out = {}
     for t in _TALLY.finditer(box):
         out.setdefault("paper" if t.group(1) == "paper's" else "book", (int(t.group(2)), int(t.group(4)),
-                                                                         int(t.group(5))))
+                                                                         int(t.group(5)), int(t.group(6) or 0)))
     return out
 
 
@@ -423,7 +423,8 @@ def landing_counts(text: str) -> dict[str, dict]:
         a = dict(re.findall(r'([\w-]+)="([^"]*)"', m.group(1)))
         if "data-page" in a:
             out[a["data-page"]] = {"chapter": a.get("data-chapter", ""),
-                                   **{src: tuple(int(v) for v in a.get(f"data-{src}", "0 0 0").split())
+                                   **{src: (tuple(int(v) for v in a.get(f"data-{src}", "").split())
+                                            + (0, 0, 0, 0))[:4]
                                       for src in verdicts.SOURCES}}
     return out
 
@@ -439,7 +440,7 @@ def count_problems(landing: dict[str, dict], chapter_pages: dict[str, str]) -> l
             continue
         got = glance_counts(text) or {}
         for src in verdicts.SOURCES:
-            shown = got.get(src, (0, 0, 0))
+            shown = got.get(src, (0, 0, 0, 0))
             if tuple(want[src]) != tuple(shown):
                 whose = "the paper's" if src == "paper" else "the book's own"
                 out.append((page, f"counts differ: the glance box shows {whose} claims as {shown[0]} of "
@@ -539,8 +540,9 @@ def _md_cell(text) -> str:
 
 
 #: The three verdicts in the order the book counts them, and the colours of the landing page's bars.
-COUNTED = ("reproduced", "not reproduced", "cannot be judged")
-BAR_COLOURS = {"reproduced": "#2e7d32", "not reproduced": "#c62828", "cannot be judged": "#9e9e9e"}
+COUNTED = ("reproduced", "not reproduced", "cannot be judged", "no difference")
+BAR_COLOURS = {"reproduced": "#2e7d32", "not reproduced": "#c62828", "cannot be judged": "#9e9e9e",
+               "no difference": "#1565c0"}
 def claim_counts(results: dict[str, dict]) -> dict[str, dict[str, dict[str, int]]]:
     """The one source of the book's counts: per chapter and source (``"paper"``, ``"book"``), how many of
     the chapter's claims (every claim of its results file) are reproduced, not reproduced and cannot be
@@ -550,7 +552,7 @@ def claim_counts(results: dict[str, dict]) -> dict[str, dict[str, dict[str, int]
     for chapter, res in results.items():
         counts = {src: dict.fromkeys(COUNTED, 0) for src in verdicts.SOURCES}
         for c in res.get("claims", []):
-            counts[c.get("source", "paper")][verdicts.verdict_name(c.get("reproduced"))] += 1
+            counts[c.get("source", "paper")][verdicts.verdict_name(c.get("reproduced"), c.get("basis"))] += 1
         out[chapter] = counts
     return out
 
@@ -583,8 +585,8 @@ def verdict_sentence(counts: dict[str, int], whose: str = "the paper's", claims:
     claims do not reproduce, 13 do, 7 cannot be judged (mostly our interval contains the boundary)."  The lead is *mostly X* when a verdict holds more than half of the claims, else *mixed*
     (saying which of reproduced and not reproduced is the more frequent); the reason is the most frequent
     case of *cannot be judged* among ``claims`` (the stored records)."""
-    r, nr, cj = (counts[k] for k in COUNTED)
-    n = r + nr + cj
+    r, nr, cj = (counts[k] for k in COUNTED[:3])
+    n = r + nr + cj + counts.get("no difference", 0)
     if n == 0:
         return "No claims judged yet."
     pct = counts
@@ -614,11 +616,11 @@ def verdict_sentence(counts: dict[str, int], whose: str = "the paper's", claims:
 def stacked_bar(counts: dict[str, int], width_px: int = 110, height_px: int = 12) -> str:
     """A small stacked bar (inline SVG, nothing to download): reproduced, not reproduced and cannot be
     judged as shares of the claims, with the counts in its title (shown on hover) and aria label."""
-    n = sum(counts[k] for k in COUNTED)
-    label = ", ".join(f"{counts[k]} {k}" for k in COUNTED)
+    n = sum(counts.get(k, 0) for k in COUNTED)
+    label = ", ".join(f"{counts[k]} {k}" for k in COUNTED if k != "no difference" or counts.get(k))
     parts, x = [], 0.0
     for k in COUNTED:
-        w = width_px * counts[k] / n if n else 0.0
+        w = width_px * counts.get(k, 0) / n if n else 0.0
         if w > 0:
             parts.append(f'<rect x="{x:.1f}" y="0" width="{w:.1f}" height="{height_px}" '
                          f'fill="{BAR_COLOURS[k]}"/>')
@@ -629,7 +631,9 @@ def stacked_bar(counts: dict[str, int], width_px: int = 110, height_px: int = 12
 
 def _counts_cell(counts: dict[str, int]) -> str:
     n = sum(counts.values())
-    return "–" if n == 0 else f"{counts['reproduced']} / {counts['not reproduced']} / {counts['cannot be judged']}"
+    nd = counts.get("no difference", 0)
+    return "–" if n == 0 else (f"{counts['reproduced']} / {counts['not reproduced']} / {counts['cannot be judged']}"
+                               + (f" (+ {nd} no difference)" if nd else ""))
 
 
 def chapter_order(notebooks: list[Path], toc: Path | None = None) -> list[Path]:
@@ -717,7 +721,7 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
         lines = ["No chapter has written its results yet."]
     if missing:
         lines += ["", f"Not yet summarised (no results file): {', '.join(missing)}."]
-    lines += sources_markdown(results)
+    lines = sources_markdown(results) + [""] + lines
     total = {src: {k: sum(counts[c][src][k] for c in counts) for k in COUNTED} for src in verdicts.SOURCES}
     if counts:
         lines += ["", f"In all, **{total['paper']['reproduced']} of {sum(total['paper'].values())}** of the "
@@ -736,34 +740,39 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
     line (its headline claim, in its words), the headline's verdict under the primary reading, and the
     source's claims (register entries, not readings) by verdict under their primary readings, with how
     many are judged, not yet computed and not checkable, and the contradictions noted."""
-    rows = []
-    for chapter, res in results.items():
+    rows, details = [], []
+    order = list(claims_mod.SOURCE_NAMES)
+    pairs = sorted(((name, chapter) for chapter in results for name in claims_mod.registers(chapter)),
+                   key=lambda p: order.index(p[0]))
+    for name, chapter in pairs:
+        res = results[chapter]
         recs = [c for c in res.get("claims", []) if "sensitivity" in c]
-        for name in claims_mod.registers(chapter):
-            mine = [c for c in recs if c.get("register") == name and c.get("source") == "paper"]
-            if not mine:
-                continue
-            head = next((c for c in mine if c.get("headline")), None)
-            n = {k: sum(c["verdict"] == k for c in mine) for k in COUNTED}
-            st = {k: sum(c.get("status") == k for c in mine) for k in ("judged", "open", "not checkable")}
-            noted = sum(1 for x in res.get("inconsistencies") or [] if x.get("register") == name)
-            verdict = report_label(head) if head else "–"
-            claim = f"{head['claim']}: \u201c{head['quote']}\u201d ({head['where']})" if head else "–"
-            rows += [f"* - {_md_cell(claims_mod.SOURCE_NAMES[name])}<br>({chapter})", f"  - {_md_cell(claim)}",
-                     f"  - **{_md_cell(verdict)}**" + (f"<br>({_md_cell(head['primary_reading'])})"
-                                                       if head and head.get("status") == "judged" else ""),
-                     f"  - {stacked_bar(n)}<br>{_counts_cell(n)} of {len(mine)} claims<br>"
-                     f"{st['judged']} judged, {st['open']} not yet computed, {st['not checkable']} not "
-                     f"checkable" + (f"; {noted} contradiction{'s' if noted != 1 else ''} in the paper"
-                                     if noted else "")]
+        mine = [c for c in recs if c.get("register") == name and c.get("source") == "paper"]
+        if not mine:
+            continue
+        head = next((c for c in mine if c.get("headline")), None)
+        n = {k: sum(c["verdict"] == k for c in mine) for k in COUNTED}
+        st = {k: sum(c.get("status") == k for c in mine) for k in ("judged", "open", "not checkable")}
+        noted = sum(1 for x in res.get("inconsistencies") or [] if x.get("register") == name)
+        verdict = report_label(head) if head else "–"
+        claim = head["claim"] if head else "–"
+        rows += [f"* - {_md_cell(claims_mod.SOURCE_NAMES[name])}<br>({chapter})", f"  - {_md_cell(claim)}",
+                 f'  - <span class="navbook-headline"><b>{html.escape(verdict)}</b></span>'
+                 + (f"<br>({_md_cell(head['primary_reading'])})" if head and head.get("status") == "judged"
+                    else ""),
+                 f"  - {stacked_bar(n)} {_counts_cell(n)} of {len(mine)}"]
+        details.append(f"{claims_mod.SOURCE_NAMES[name]} {st['judged']} judged, {st['open']} not yet computed, "
+                       f"{st['not checkable']} not checkable"
+                       + (f", {noted} contradiction{'s' if noted != 1 else ''} noted" if noted else ""))
     if not rows:
         return []
-    return ["", "(status-by-source)=", "Each source's headline claim and its claims, one count per claim (a "
-            "claims-register entry) under the reading the chapter finds most plausible; the other readings "
-            "are shown in the chapter as sensitivity.", "",
-            ":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 14 40 20 26", "",
-            "* - source", "  - headline claim, in its words", "  - verdict (primary reading)",
-            "  - claims: reproduced / not / cannot be judged"] + rows + [":::"]
+    return (["", "(status-by-source)=",
+             ":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 13 37 22 28", "",
+             "* - source", "  - headline claim", "  - verdict (primary reading)",
+             "  - claims: reproduced / not / cannot be judged"]
+            + rows + [":::", "", "Each claim of a source's claims register counts once, under the reading its "
+                      "chapter finds most plausible (the others are shown there as sensitivity): "
+                      + "; ".join(details) + "."])
 
 
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
@@ -996,14 +1005,17 @@ def claim_problems(c: dict) -> list[str]:
         p.append("reproduced must be true, false or null")
     elif not p:
         try:
-            want, basis = verdicts.decide(interval, boundary, side, floor_value, c["by_construction"])
+            margin = c.get("margin")
+            if margin is not None and not _is_num(margin):
+                return p + [f"margin {margin!r}: a number or null"]
+            want, basis = verdicts.decide(interval, boundary, side, floor_value, c["by_construction"], margin)
         except InputError as err:
             return p + [str(err)]
         if c["reproduced"] is not want:
             p.append(f"verdict {c.get('verdict')!r} does not follow from interval {interval}, boundary "
-                     f"{boundary} ({side}), floor {floor_value}: the rule gives "
-                     f"{verdicts.verdict_name(want)!r}")
-        if c.get("verdict") != verdicts.verdict_name(c["reproduced"]):
+                     f"{boundary} ({side}), floor {floor_value}, margin {margin}: the rule gives "
+                     f"{verdicts.verdict_name(want, basis)!r}")
+        if c.get("verdict") != verdicts.verdict_name(c["reproduced"], c.get("basis")):
             p.append(f"verdict {c.get('verdict')!r} disagrees with reproduced={c['reproduced']}")
         if c.get("basis") != basis:
             p.append(f"basis {c.get('basis')!r}, the rule gives {basis!r}")
@@ -1258,6 +1270,14 @@ _FIGURES_JS = r"""(() => {
 })()"""
 
 
+#: The first screen of a page (1400 x 900 px): each source's headline verdict must end within it.
+FIRST_SCREEN_PX = 900
+#: Every headline verdict on a page (``.navbook-headline``): where it ends, from the top of the page.
+_HEADLINES_JS = r"""(() => [...document.querySelectorAll('.navbook-headline')].map(el => ({
+  bottom_px: Math.round(el.getBoundingClientRect().bottom + window.scrollY),
+  text: (el.innerText || '').trim().slice(0, 80)})))()"""
+
+
 def shrunk_figures(figures, min_share: float | None = None) -> list[dict]:
     """The figures displayed below ``min_share`` (default
     :data:`navlib.report_style.MIN_DISPLAY_SHARE`, 75 %) of their natural width, each
@@ -1397,8 +1417,10 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
     """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
     relative names, ``.png``; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
     or tables wider than the content column, by page) and ``shrunk.json`` (figures displayed below 75 % of
-    their natural width, :func:`shrunk_figures`, by page).  Returns 2 if Chromium is missing, 1 if a
-    figure is shown shrunk (every page is still rendered and listed), else 0."""
+    their natural width, :func:`shrunk_figures`, by page) and ``headlines.json`` (headline verdicts,
+    ``.navbook-headline``, that end below the first :data:`FIRST_SCREEN_PX` px).  Returns 2 if Chromium
+    is missing, 1 if a figure is shown shrunk or a headline verdict is not on the first screen (every
+    page is still rendered and listed), else 0."""
     binary = find_chromium(chromium)
     if binary is None:
         print(CHROMIUM_MISSING, file=sys.stderr)
@@ -1410,7 +1432,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
              and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
-    heights, overflow, shrunk = [], {}, {}
+    heights, overflow, shrunk, headlines = [], {}, {}, {}
     try:
         for page in pages:
             rel = page.relative_to(html_dir)
@@ -1440,6 +1462,11 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
             small = shrunk_figures(chrome.send("Runtime.evaluate", {"expression": _FIGURES_JS,
                                                                     "returnByValue": True},
                                                session=session)["result"].get("value") or [])
+            heads = chrome.send("Runtime.evaluate", {"expression": _HEADLINES_JS, "returnByValue": True},
+                                session=session)["result"].get("value") or []
+            late = [hd for hd in heads if hd["bottom_px"] > FIRST_SCREEN_PX]
+            if late:
+                headlines[str(rel)] = late
             png = out_dir / rel.with_suffix(".png")
             png.parent.mkdir(parents=True, exist_ok=True)
             if h <= TILE_PX:
@@ -1484,7 +1511,19 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         for it in items:
             print(f"    {it['src']} shown at {it['shown_px']} of {it['natural_px']} px "
                   f"({100 * it['share']:.0f} %) under '{it['heading']}'", file=sys.stderr)
-    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json, shrunk.json)")
+    (out_dir / "headlines.json").write_text(json.dumps(headlines, indent=1, ensure_ascii=False) + "\n",
+                                            encoding="utf-8")
+    for page, items in headlines.items():
+        for it in items:
+            print(f"  headline verdict below the first screen ({FIRST_SCREEN_PX} px) on {page}: ends at "
+                  f"{it['bottom_px']} px: {it['text'][:60]!r}", file=sys.stderr)
+    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json, shrunk.json, "
+          f"headlines.json)")
+    if headlines:
+        print(f"screenshots: {sum(map(len, headlines.values()))} headline verdict(s) on {len(headlines)} "
+              f"page(s) are not on the first {FIRST_SCREEN_PX} px: shorten what comes before them",
+              file=sys.stderr)
+        return 1
     if shrunk:
         print(f"screenshots: {sum(map(len, shrunk.values()))} figure(s) on {len(shrunk)} page(s) shown below "
               f"75 % of their natural width (draw them at most 7.5 in wide: navlib.report.use_style, "

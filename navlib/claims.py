@@ -132,6 +132,8 @@ def parse_register(lines: Iterable[str], name: str) -> tuple[Entry, ...]:
                 bad("rows", f"a {r['status']!r} entry has no results rows")
             if not r["needs"]:
                 bad("needs", f"a {r['status']!r} entry says what would decide it or why it cannot be")
+        if r["margin"] and not r["margin_why"]:
+            bad("margin_why", "say where the equivalence margin comes from")
         if (r["kind"] == "inconsistency") != (r["status"] == "noted"):
             bad("status", "an inconsistency is 'noted', and only an inconsistency is")
         out.append(Entry(
@@ -200,6 +202,24 @@ def across_text(record: Mapping) -> str:
     return "; ".join(parts)
 
 
+def _with_margin(r: dict, e: Entry) -> dict:
+    """A row record judged again with the entry's equivalence margin (:func:`navlib.verdicts.decide`):
+    only a row whose interval lies within the margin changes, to *no difference*."""
+    if e.margin is None or r.get("interval") is None:
+        return r
+    f = r.get("floor")
+    floor = None if f is None else tuple(f.get("interval") or (f["value"], f["value"]))
+    rep, basis = verdicts.decide(r["interval"], r["boundary"], r["holds_when"], floor, r["by_construction"],
+                                 e.margin)
+    out = {**r, "margin": e.margin}
+    if basis == "equivalent":
+        lo, hi = r["interval"]
+        out.update(reproduced=rep, basis=basis, verdict=verdicts.verdict_name(rep, basis), reason=None,
+                   why=f"the 95 % interval [{lo:.4g}, {hi:.4g}] lies within the equivalence margin "
+                       f"{r['boundary']:.4g} +- {e.margin:g} {e.unit}".rstrip() + f" ({e.margin_why})")
+    return out
+
+
 def _unjudged(e: Entry, cat: str | None = None) -> dict:
     cat = cat or ("not yet computed" if e.status == "open" else "not checkable")
     return {"claim": e.claim, "reading": "as printed", "source": e.origin, "paper": e.quote or e.claim,
@@ -237,7 +257,7 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
         if e is None:
             raise InputError(f"chapter {chapter!r}: results row {r['claim']!r} ({r['reading']}) belongs to no "
                              f"entry of {files}: add it to an entry's rows")
-        by_entry.setdefault(e.id, []).append(r)
+        by_entry.setdefault(e.id, []).append(_with_margin(r, e))
     out = []
     for e in es:
         if e.status == "noted":

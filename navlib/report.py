@@ -193,11 +193,13 @@ class Table:
 
     def __init__(self, frame: pd.DataFrame, formats: Mapping[str, Any] | None = None,
                  caption: str | None = None, index: bool = True, readable: bool | None = None,
-                 fold: bool | str = False):
+                 fold: bool | str | None = None):
         if not isinstance(frame, pd.DataFrame):
             frame = pd.DataFrame(frame)
         if fold is True and not caption:
             raise InputError("report.table: fold=True needs a caption (it is the dropdown's summary)")
+        if fold is None:                    # the chapter's default (fold_tables): evidence behind its caption
+            fold = bool(FOLD_TABLES and caption)
         self.fold = (caption if fold is True else str(fold)) if fold else None
         self.frame = frame
         self.formats = dict(formats or {})
@@ -258,9 +260,22 @@ class Table:
         return "\n".join(head + lines)
 
 
+#: Whether a captioned table folds behind its caption unless it says ``fold=False`` (:func:`fold_tables`).
+FOLD_TABLES = False
+
+
+def fold_tables(on: bool = True) -> None:
+    """Answer first, evidence behind folds: from now on every captioned table of the chapter is shown
+    closed behind its caption (the reader opens what they want to check), unless the table is made with
+    ``fold=False``.  The plain text (what nbval compares) is the same either way."""
+    global FOLD_TABLES
+    FOLD_TABLES = bool(on)
+
+
 def table(frame: pd.DataFrame, formats: Mapping[str, Any] | None = None, caption: str | None = None,
-          index: bool = True, readable: bool | None = None, fold: bool | str = False) -> Table:
-    """Shorthand for :class:`Table`; the last expression of a cell displays it (``fold``: in a dropdown)."""
+          index: bool = True, readable: bool | None = None, fold: bool | str | None = None) -> Table:
+    """Shorthand for :class:`Table`; the last expression of a cell displays it (``fold``: in a dropdown;
+    None: the chapter's default, :func:`fold_tables`)."""
     return Table(frame, formats, caption, index, readable, fold)
 
 
@@ -453,6 +468,7 @@ class Claim:
     key: str = ""
     spec: str = "{:.3g}"
     volatile: bool = False
+    margin: float | None = None
 
     def __post_init__(self):
         for f in ("claim", "paper", "reading"):
@@ -494,7 +510,7 @@ class Claim:
 
     def _decision(self) -> tuple[bool | None, str]:
         return verdicts.decide(self.interval, self.boundary, self.holds_when, self.floor,
-                               self.by_construction)
+                               self.by_construction, self.margin)
 
     @property
     def reproduced(self) -> bool | None:
@@ -506,7 +522,7 @@ class Claim:
 
     @property
     def verdict(self) -> str:
-        return verdicts.verdict_name(self.reproduced)
+        return verdicts.verdict_name(*self._decision())
 
     @property
     def verdict_label(self) -> str:
@@ -560,6 +576,10 @@ class Claim:
             text = (f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
                     f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
                     f"(set by {f.assumption}); it would need {f.needs}")
+        elif basis == "equivalent":
+            lo, hi = self.interval
+            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] lies within the "
+                    f"equivalence margin {self._bound()} +- {fmt(self.margin, '{:.4g}')}")
         else:
             text = ""
         return "; ".join(t for t in (text, extra) if t)
@@ -581,7 +601,8 @@ class Claim:
                 "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
                 "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
                 "reason": verdicts.reason_category(self.basis, self.reason),
-                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile)}
+                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile),
+                "margin": None if self.margin is None else plain(self.margin)}
 
 
 GLANCE_COLUMNS = ["claim", "reading", "paper", "ours: value [95 % interval]", "boundary", "verdict"]
@@ -594,11 +615,17 @@ def _glance_frame(claims: list[Claim]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=GLANCE_COLUMNS)
 
 
-def tally(claims: Iterable[Claim]) -> str:
-    """"k of n reproduced, m not reproduced, j cannot be judged"."""
-    v = [c.verdict for c in claims]
-    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
+def tally_of(v: list[str]) -> str:
+    """"k of n reproduced, m not reproduced, j cannot be judged" (", e no difference" where a claim's
+    equivalence margin decided it) for a list of verdict names."""
+    text = (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
             f"{v.count('cannot be judged')} cannot be judged")
+    return text + (f", {v.count('no difference')} no difference" if v.count("no difference") else "")
+
+
+def tally(claims: Iterable[Claim]) -> str:
+    """"k of n reproduced, m not reproduced, j cannot be judged" (:func:`tally_of`)."""
+    return tally_of([c.verdict for c in claims])
 
 
 #: Abbreviations of the results files' reading labels, spelled out on the landing page and in the glance
@@ -668,14 +695,14 @@ def record_label(r: Mapping[str, Any]) -> str:
     """A stored record's verdict as the book shows it (*cannot be judged: within our noise floor*)."""
     if r.get("reproduced") is not None:
         return str(r["verdict"])
+    if r.get("basis") == "equivalent":
+        return f"no difference at margin {fmt(r.get('margin'), '{:.4g}')}" + (f" {r['unit']}" if r.get("unit") else "")
     cat = r.get("reason")
     return f"{r['verdict']}: {verdicts.REASONS[cat][0]}" if cat in verdicts.REASONS else str(r["verdict"])
 
 
 def _rec_tally(records: list[Mapping[str, Any]]) -> str:
-    v = [r["verdict"] for r in records]
-    return (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
-            f"{v.count('cannot be judged')} cannot be judged")
+    return tally_of([r["verdict"] for r in records])
 
 
 def _rec_ours(r: Mapping[str, Any]) -> str:
@@ -688,30 +715,56 @@ def _rec_ours(r: Mapping[str, Any]) -> str:
 
 
 def headline_sentence(r: Mapping[str, Any]) -> str:
-    """One sentence: a source's headline claim, where it is made and its verdict under the primary
-    reading, with our interval and how the verdict moves across the other readings."""
+    """One sentence: a source's headline claim (the register's words for it, and where the paper makes
+    it) and its verdict under the primary reading, with our interval and how the verdict moves across the
+    other readings."""
     who = registry.SOURCE_NAMES.get(r.get("register", ""), "The source")
-    text = f"{who}'s headline claim, \u201c{r['quote']}\u201d ({r['where']}): **{record_label(r)}**"
-    if r.get("status") == "judged":
+    where = str(r["where"]).split(";")[0].strip()
+    text = f"{who}'s headline claim: {r['claim']} ({where}). **{record_label(r)}**"
+    if r.get("status") == "judged" and r.get("row_claim"):
         text += (f" under the primary reading ({r['primary_reading']}): ours {_rec_ours(r)}; "
                  f"{registry.across_text(r)}.")
     else:
-        text += f" ({r.get('why')})."
+        text += "."
     return text
 
 
-ANSWER_COLUMNS = ["id", "claim", "the paper", "ours: value [95 % interval]", "verdict (primary reading)",
-                  "across readings"]
+ANSWER_COLUMNS = ["id", "claim", "ours: value [95 % interval]", "verdict (primary reading)", "across readings"]
 
 
 def _answer_frame(records: list[Mapping[str, Any]]) -> pd.DataFrame:
-    rows = [{"id": r["id"], "claim": r["claim"], "the paper": f"\u201c{r['quote']}\u201d ({r['where']})"
-             if r.get("quote") else r["where"], ANSWER_COLUMNS[3]: _rec_ours(r),
-             ANSWER_COLUMNS[4]: record_label(r) + (f" ({r['primary_reading']})" if r.get("status") == "judged"
-                                                 else ""),
-             "across readings": registry.across_text(r) if r.get("status") == "judged" else "–"}
+    """One row per claim: the register's short words for it (the paper's own words, where they are and
+    why the primary reading is the most plausible are in the claim's fold below the table)."""
+    rows = [{"id": r["id"], "claim": r["claim"], ANSWER_COLUMNS[2]: _rec_ours(r),
+             ANSWER_COLUMNS[3]: record_label(r) + (f" ({r['primary_reading']})" if r.get("status") == "judged"
+                                                 and r.get("row_claim") else ""),
+             "across readings": registry.across_text(r) if r.get("status") == "judged" and r.get("row_claim")
+             else "–"}
             for r in records]
     return pd.DataFrame(rows, columns=ANSWER_COLUMNS)
+
+
+def _claim_fold(r: Mapping[str, Any]) -> str:
+    """One claim's fold: the paper's words and where, the primary reading and why, the dimensions, and
+    every row (the primary first) with its verdict and reason."""
+    head = (f"<p><b>{html.escape(r['id'])}</b> \u201c{html.escape(r.get('quote') or r['claim'])}\u201d "
+            f"({html.escape(r['where'])})")
+    if r.get("quote_zh"):
+        head += f' <span lang="zh">{html.escape(r["quote_zh"])}</span>'
+    head += "</p>"
+    if r.get("why_primary"):
+        head += (f"<p>Primary reading: {html.escape(r['primary_reading'])}. "
+                 f"{html.escape(r['why_primary'])}</p>")
+    if r.get("dimensions"):
+        head += f"<p>Shown across: {html.escape(r['dimensions'])}.</p>"
+    if r.get("status") != "judged" or not r.get("row_claim"):
+        return head + f"<p>{html.escape(r.get('why') or '')}</p>"
+    rows = [{**r, "claim": r["row_claim"]}] + list(r["sensitivity"])
+    frame = pd.DataFrame([{"claim": x["claim"], "reading": x["reading"] + (" (primary)" if x is rows[0] else ""),
+                           "ours: value [95 % interval]": x.get("ours") or "–",
+                           "verdict": record_label(x) + (f" ({x['why']})" if x.get("why") else "")}
+                          for x in rows])
+    return head + Table(frame, index=False, readable=False)._repr_html_()
 
 
 class Answer:
@@ -722,8 +775,8 @@ class Answer:
     tables of every row behind a fold.  The tallies count claims (register entries), not readings: the
     landing page counts the same from the results file."""
 
-    def __init__(self, records: list[dict], rows: list["Claim"], chapter: str):
-        self.records, self.rows, self.chapter = records, rows, chapter
+    def __init__(self, records: list[dict], chapter: str):
+        self.records, self.chapter = records, chapter
         self.paper = [r for r in records if r["source"] == "paper"]
         self.book = [r for r in records if r["source"] == "book"]
         self.noted = registry.inconsistencies(chapter)
@@ -765,16 +818,21 @@ class Answer:
                                      f"{_rec_tally(mine)}</p>")
                     parts.append(Table(_answer_frame(mine), index=False, readable=False)._repr_html_())
         if self.noted:
-            parts.append(self.tables()[-1]._repr_html_())
-        rows = [c for c in self.rows]
-        if rows:
-            parts.append(f"<details><summary>Every claim under every reading ({len(rows)} rows)</summary>"
-                         + "\n".join(_glance_html([c for c in rows if c.source == s], f"{t} by reading")
-                                     for s, t in (("paper", "The paper's claims"), ("book", "The book's own claims"))
-                                     if any(c.source == s for c in rows))
-                         .replace('class="navbook-glance-note"', 'class="navbook-reading-note"')
+            parts.append(f"<details><summary>Where the paper contradicts itself ({len(self.noted)})</summary>"
+                         + Table(self.tables()[-1].frame, index=False, readable=False)._repr_html_()
                          + "</details>")
+        parts.append(self._readings_html())
         return "\n".join(parts)
+
+    def _readings_html(self) -> str:
+        """Every claim behind one fold, a dropdown per claim: the paper's words and where, the primary
+        reading and why, and every row (each reading, noise level, split; the primary first)."""
+        n = sum(1 + len(r["sensitivity"]) for r in self.records if r.get("row_claim"))
+        inner = [f"<details><summary>{html.escape(r['id'])} {html.escape(r['claim'])}: "
+                 f"{html.escape(registry.across_text(r) if r.get('row_claim') else record_label(r))}</summary>"
+                 + _claim_fold(r) + "</details>" for r in self.records]
+        return (f'<details><summary>The paper\'s words, the primary reading and why, and every claim under '
+                f'every reading ({n} rows)</summary>' + "\n".join(inner) + "</details>")
 
     def __repr__(self) -> str:
         out = ["\n".join(textwrap.wrap(headline_sentence(r).replace("**", ""), PLAIN_WIDTH))
@@ -836,7 +894,7 @@ def glance(claims: Iterable[Claim], chapter: str | None = None,
     if records is None:
         return Glance(claims)
     _GLANCED.update((c.claim, c.reading) for c in claims)
-    return Answer(records, claims, chapter)
+    return Answer(records, chapter)
 
 
 @dataclass(frozen=True)
@@ -885,16 +943,17 @@ class Showed:
     paper's claims, the book's own), the tally with the reasons of the claims that cannot be judged, and
     one line per claim with its verdicts over the readings."""
 
-    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"]):
+    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"], found: Mapping[str, str] | None = None):
         outs = [_outcome(c) for c in claims]
         parts = [(title, [c for c in outs if c.source == src])
                  for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims"))]
         self.parts = [(t, cs) for t, cs in parts if cs]
+        self.found = dict(found or {})
 
-    @staticmethod
-    def _rows(cs: list[_Outcome]) -> pd.DataFrame:
+    def _rows(self, cs: list[_Outcome]) -> pd.DataFrame:
         names = list(dict.fromkeys(c.claim for c in cs))
-        return pd.DataFrame([{"claim": n, "what we found": _claim_outcome([c for c in cs if c.claim == n])}
+        return pd.DataFrame([{"claim": n, "what we found": self.found.get(n) or
+                              _claim_outcome([c for c in cs if c.claim == n])}
                              for n in names], columns=["claim", "what we found"])
 
     @staticmethod
@@ -906,7 +965,8 @@ class Showed:
         out = []
         for title, cs in self.parts:
             out.append(f'<p class="navbook-showed">{html.escape(self._lead(title, cs), quote=False)}</p>')
-            out.append(Table(self._rows(cs), index=False, readable=False)._repr_html_())
+            out.append("<details><summary>Claim by claim</summary>"
+                       + Table(self._rows(cs), index=False, readable=False)._repr_html_() + "</details>")
         return "\n".join(out)
 
     def __repr__(self) -> str:
@@ -926,7 +986,10 @@ def showed(claims: Iterable[Claim], chapter: str | None = None,
     records = register_records(claims, chapter, worlds)
     if records is None:
         return Showed(claims)
-    return Showed([{**r, "reading": "primary"} for r in records])
+    found = {r["claim"]: record_label(r) + (f" (primary reading; {registry.across_text(r)})"
+                                            if r.get("status") == "judged" and r.get("row_claim") else "")
+             for r in records}
+    return Showed([{**r, "reading": "primary"} for r in records], found)
 
 
 def glue_claims(claims: Iterable[Claim]) -> None:
@@ -959,7 +1022,7 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
                   methods: Mapping[str, Mapping[str, Any]] | None = None,
                   extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
                   overwrite: bool = False, tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None,
-                  register: bool = False) -> Path:
+                  register: bool = False, worlds: list[Mapping[str, Any]] | None = None) -> Path:
     """Write ``<folder>/<chapter>.json`` (``folder`` defaults to :func:`results_dir`)::
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
@@ -974,8 +1037,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     ``{"compass", "claim", "reading", "verdict"}`` per simulated compass, claim and reading); their names
     must not be one of the keys above.  ``register=True`` (a chapter with a claims register,
     :mod:`navlib.claims`) stores one record per register entry instead of one per claim and reading: the
-    primary row's fields, the register's words and place, the other rows as its ``sensitivity`` list,
-    and the paper's contradictions as ``inconsistencies``.  An existing file (an earlier run's) is never replaced unless
+    primary row's fields, the register's words and place, the other rows as its ``sensitivity`` list
+    (``worlds``: the rows' verdicts on other drawn simulators, ``{"compass", "claim", "reading",
+    "verdict"}``, summarised in each record's ``across``), and the paper's contradictions as
+    ``inconsistencies``.  An existing file (an earlier run's) is never replaced unless
     ``overwrite=True``: the call stops with one line naming it.  Returns the path written; it displays as ``results written:
     <chapter>.json``, the same in every run, so a notebook cell that ends with this call shows no
     run-specific folder."""
@@ -1002,8 +1067,7 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if len(set(keys)) != len(keys):
         dup = next(k for k in keys if keys.count(k) > 1)
         raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
-    records = register_records(claims, chapter if register else None,
-                               list((tables or {}).get("robustness") or []) or None)
+    records = register_records(claims, chapter if register else None, worlds)
     out["claims"] = records if records is not None else [c.record() for c in claims]
     if records is not None:
         out["inconsistencies"] = registry.inconsistencies(chapter)
@@ -1016,10 +1080,10 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if extra:
         out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
                         for k, v in extra.items()}
-    for name, records in (tables or {}).items():
+    for name, table_rows in (tables or {}).items():
         if name in ("chapter", "unit", "methods", "claims", "extra", "inconsistencies") or not str(name).isidentifier():
             raise InputError(f"write_results({chapter!r}): table name {name!r} is reserved or not an identifier")
-        out[str(name)] = [{str(k): plain(v) for k, v in dict(r).items()} for r in records]
+        out[str(name)] = [{str(k): plain(v) for k, v in dict(r).items()} for r in table_rows]
     d = Path(folder) if folder is not None else results_dir()
     text = json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
     path = d / f"{chapter}.json"

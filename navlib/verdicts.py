@@ -51,9 +51,10 @@ LEVEL = 0.95
 SIDES = ("above", "below")
 Side = Literal["above", "below"]
 SOURCES = ("paper", "book")
-VERDICTS = ("reproduced", "not reproduced", "cannot be judged")
-#: Why a claim cannot be judged (``basis`` of :func:`decide`).
-BASES = ("interval", "straddles", "noise floor", "by construction", "no statistic")
+VERDICTS = ("reproduced", "not reproduced", "cannot be judged", "no difference")
+#: Why a claim cannot be judged (``basis`` of :func:`decide`); ``"equivalent"``: no difference at the
+#: claim's equivalence margin.
+BASES = ("interval", "straddles", "noise floor", "by construction", "no statistic", "equivalent")
 
 #: The rules a claim's interval may come from (the name stored in the results file -> what it means).
 RULES = {
@@ -279,7 +280,7 @@ def worse_bound(boundary: float, holds_when: str, floor=None) -> float:
 
 
 def decide(interval: Sequence[float] | None, boundary: float | None, holds_when: str | None,
-           floor=None, by_construction: bool = False) -> tuple[bool | None, str]:
+           floor=None, by_construction: bool = False, margin: float | None = None) -> tuple[bool | None, str]:
     """The verdict (True = reproduced, False = not reproduced, None = cannot be judged) and its basis
     (one of :data:`BASES`) from a 95 % interval, the boundary, the claim's side and the noise floor
     (``floor``: a number, an interval ``(lo, hi)`` or a :class:`Floor`).
@@ -289,13 +290,20 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
     reproduced; the whole interval beyond the worse of boundary and floor (:func:`worse_bound`) -> not
     reproduced; beyond the boundary but not beyond a separated floor -> cannot be judged (noise floor);
     otherwise the interval touches or contains the boundary -> cannot be judged (noise floor where the
-    floor is separated from the boundary, else straddles).
+    floor is separated from the boundary, else straddles).  A comparison may declare an equivalence
+    ``margin`` :math:`m` (from the paper's printed precision or the sensor's resolution): an interval
+    wholly within :math:`[b - m, b + m]` is the fourth outcome, *no difference at margin m* (``None``,
+    basis ``"equivalent"``), checked first: a difference smaller than anything the paper could have
+    printed neither confirms nor refutes "X beats Y".
 
-    >>> decide((14.1, 20.8), 0.42, "below", floor=0.487)    # far worse than the noise excuses
+    >>> decide((-0.004, 0.003), 0.0, "above", margin=0.01)
+    (None, 'equivalent')
+
+    >>> decide((14.1, 20.8), 0.42, "below", floor=0.487)  # worse than the noise excuses
     (False, 'interval')
-    >>> decide((0.45, 0.47), 0.42, "below", floor=0.487)    # beyond the boundary, within the floor
+    >>> decide((0.45, 0.47), 0.42, "below", floor=0.487)  # within the floor
     (None, 'noise floor')
-    >>> decide((0.40, 0.41), 0.42, "below", floor=0.487)    # the data crossed the floor estimate
+    >>> decide((0.40, 0.41), 0.42, "below", floor=0.487)  # crossed the floor
     (True, 'interval')
     """
     if by_construction:
@@ -308,6 +316,12 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
     b = float(boundary)
     if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(b)) or lo > hi:
         raise InputError(f"interval [{lo}, {hi}] and boundary {b}: need finite numbers with lo <= hi")
+    if margin is not None:
+        m = float(margin)
+        if not math.isfinite(m) or m <= 0:
+            raise InputError(f"margin={margin!r}: an equivalence margin is a positive number")
+        if b - m <= lo and hi <= b + m:
+            return None, "equivalent"
     if on_side(lo, b, holds_when) and on_side(hi, b, holds_when):
         return True, "interval"
     w = worse_bound(b, holds_when, floor)
@@ -317,7 +331,10 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
     return None, "noise floor" if w != b else "straddles"
 
 
-def verdict_name(reproduced: bool | None) -> str:
+def verdict_name(reproduced: bool | None, basis: str | None = None) -> str:
+    """The verdict's name from :func:`decide`'s pair: *no difference* for basis ``"equivalent"``."""
+    if reproduced is None and basis == "equivalent":
+        return "no difference"
     return {True: "reproduced", False: "not reproduced", None: "cannot be judged"}[reproduced]
 
 
@@ -361,6 +378,9 @@ VERDICT_DEFINITIONS = {
     "not reproduced": "the whole 95 % interval lies beyond the boundary and beyond the noise floor of our "
                       "experiment where that floor lies beyond the boundary",
     **{f"cannot be judged: {label}": text for label, text in REASONS.values()},
+    "no difference": "a comparison whose whole 95 % interval lies within its stated equivalence margin of "
+                     "the boundary (from the paper's printed precision or the sensor's resolution): the two "
+                     "do not differ by anything the paper could have shown",
 }
 
 
@@ -369,7 +389,7 @@ def reason_category(basis: str | None, why: str = "") -> str | None:
     ``"interval"``).  A claim without a statistic because :func:`attempt` found too few runs (its reason
     starts with "no 95 % interval") is *too few runs*; any other claim without a statistic is *the paper
     gives no number*."""
-    if basis in (None, "interval"):
+    if basis in (None, "interval", "equivalent"):
         return None
     if basis not in BASES:
         raise InputError(f"basis={basis!r}: must be one of {list(BASES)}")
@@ -384,8 +404,8 @@ def reason_category(basis: str | None, why: str = "") -> str | None:
 def verdict_label(reproduced: bool | None, basis: str | None = None, why: str = "") -> str:
     """The verdict as the book shows it: *reproduced*, *not reproduced*, or *cannot be judged: <reason>*
     (:data:`REASONS`; plain *cannot be judged* when the basis is unknown)."""
-    name = verdict_name(reproduced)
-    if reproduced is not None:
+    name = verdict_name(reproduced, basis)
+    if reproduced is not None or basis == "equivalent":
         return name
     cat = reason_category(basis, why) if basis is not None else None
     return f"{name}: {REASONS[cat][0]}" if cat else name

@@ -151,11 +151,11 @@ def test_landing_and_glance_counts_come_from_one_claim_list():
     assert "No chapter" in md
     marks = bt.landing_counts('<span class="navbook-counts" data-chapter="compass" '
                               'data-page="_generated/compass.html" data-paper="1 1 4" data-book="1 0 0"></span>')
-    assert marks["_generated/compass.html"]["paper"] == (1, 1, 4)
+    assert marks["_generated/compass.html"]["paper"] == (1, 1, 4, 0)
     counts = bt.claim_counts(results)["compass"]
-    assert tuple(counts["paper"].values()) == (1, 1, 4) and tuple(counts["book"].values()) == (1, 0, 0)
+    assert tuple(counts["paper"].values()) == (1, 1, 4, 0) and tuple(counts["book"].values()) == (1, 0, 0, 0)
     full = _chapter_page(report.glance(CLAIMS))
-    assert bt.glance_counts(full) == {"paper": (1, 1, 4), "book": (1, 0, 0)}
+    assert bt.glance_counts(full) == {"paper": (1, 1, 4, 0), "book": (1, 0, 0, 0)}
     assert bt.count_problems(marks, {"_generated/compass.html": full}) == []
     subset = _chapter_page(report.glance(CLAIMS[:3] + CLAIMS[-1:]))    # a glance that leaves claims out
     problems = bt.count_problems(marks, {"_generated/compass.html": subset})

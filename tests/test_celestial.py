@@ -267,6 +267,7 @@ def test_mlp_learns_a_smooth_map():
     ({"smear_levels_arcsec_per_deg_s": (0.0,)}, "smear_levels_arcsec_per_deg_s"),
     ({"smear_levels_arcsec_per_deg_s": [2.0]}, "smear_levels_arcsec_per_deg_s"),
     ({"star_smear_arcsec_per_deg_s": float("inf")}, "star_smear_arcsec_per_deg_s"),
+    ({"quiet_repeats": 0}, "quiet_repeats"), ({"quiet_repeats": 2.5}, "quiet_repeats"),
 ])
 def test_bad_study_parameters_stop_with_one_line(kwargs, name):
     with pytest.raises(InputError) as err:
@@ -302,7 +303,7 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
               bp9_worst=2.0, kf_worst=4.0, t45_over_t6=2.0, named=None, gyro_scale_ppm=100.0, permute=None,
               lm_ratio=12.0, sweep_factor=0.5, sweep_rate_factor=0.5, raw45_factor=0.8, resid_factor=0.95,
               blind_named=None, blind_flagged=None, quiet_flagged=None, blind_left=None, loop_blind=None,
-              loop_smear=None, loop_quiet=None, loop_own=None):
+              loop_smear=None, loop_quiet=None, loop_own=None, turn_factor=1.5):
     """A StudyData with hand-made per-run scores whose claims have known answers.  KF per-run errors vary
     from run to run; BPKF = factor x KF on the same run (``bp_factor`` per case and mode), 6 QR = qr_factor x
     45 raw, 6 QR + rates yaw = rate_factor x 6 QR yaw, augmented KF = aug_factor x 9-input BPKF; the worst
@@ -315,7 +316,8 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
     whether the generalised test flags (``blind_flagged``) and still flags with the scale-factor states
     (``blind_left``, test runs); ``quiet_flagged`` its flags with nothing missing; the decision rule's answers
     per run with the time offset (``loop_blind``), the rate-proportional error (``loop_smear``), nothing
-    missing (``loop_quiet``) and the study's scale factor (``loop_own``)."""
+    missing (``loop_quiet``) and the study's scale factor (``loop_own``); the held-out S-turn error while
+    turning = ``turn_factor`` x the error steady on the same run (KF and 6 QR, every level)."""
     spec = StudySpec(n_repeats=n_repeats, n_test_runs=n_runs, gyro_scale_ppm=gyro_scale_ppm,
                      sweep_repeats=min(2, n_repeats))
     bp_factor = {**{("level_raw45", "held-out"): 1.2, ("level_raw45", "same run"): 0.5,
@@ -406,9 +408,14 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
     diag += [{"level_ppm": float(gyro_scale_ppm), "latency_ms": 0.0, "smear": 0.0, "repeat": 0, "runs": "test",
               "run": i, "named": "gyro scale factor z", "chi2": 1.0, "flagged": True, "flagged_aug": 0.0,
               **loop(dc, "gyro scale factor z")} for i, dc in enumerate(loop_own)]
+    ph = [{"level_ppm": float(level), "repeat": r, "run": i, "method": m, "phase": phase, "axis": ax,
+           "rms_arcsec": float(e[a] * (1 + level / 100) * (0.9 if m == "KF" else 1.0) * f)}
+          for level in set(spec.sweep_ppm) | {float(gyro_scale_ppm)} for (r, i), e in kf.items()
+          for m in ("KF", "BPKF 6 QR") for phase, f in (("turning", turn_factor), ("steady", 1.0))
+          for a, ax in enumerate(paper_e.AXES)]
     empty = pd.DataFrame()
     return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty, {}, lm,
-                             pd.DataFrame(sw), pd.DataFrame(diag))
+                             pd.DataFrame(sw), pd.DataFrame(diag), pd.DataFrame(ph))
 
 
 def by_key(data):
@@ -529,7 +536,8 @@ def test_too_few_runs_cannot_be_judged_with_the_reason():
 def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run():
     spec = StudySpec(duration_s=30.0, n_train_runs=2, n_test_runs=3, n_repeats=2, epochs=5, n_timings=6,
                      timing_epochs=2, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0),
-                     sweep_repeats=1, latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=(10.0,))
+                     sweep_repeats=1, latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=(10.0,),
+                     quiet_repeats=3)
     data = paper_e.simulate(spec)
     n = spec.n_repeats * spec.n_test_runs
     for mode in ("held-out", "same run"):
@@ -545,8 +553,16 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
     assert len(data.lm_timing) == 3 * spec.lm_timings and set(data.lm_timing["n_in"]) == {45, 6, 9}
     d = data.diagnosis
     assert set(zip(d["level_ppm"], d["latency_ms"], d["smear"])) == {(0, 0, 0), (0, 10, 0), (0, 0, 10), (100, 0, 0)}
-    assert len(paper_e.loop_runs(data)) == len(d) == 4 * (spec.n_train_runs + spec.n_test_runs) + (
-        spec.n_repeats - spec.sweep_repeats) * (spec.n_train_runs + spec.n_test_runs)
+    per_rep = spec.n_train_runs + spec.n_test_runs
+    extra_quiet = spec.quiet_repeats - spec.sweep_repeats       # nothing missing: filters and tests only
+    assert len(paper_e.loop_runs(data)) == len(d) == (4 + extra_quiet) * per_rep + (
+        spec.n_repeats - spec.sweep_repeats) * per_rep
+    # the false-alarm rates run over quiet_repeats repeats, each flown once (the sweep's 0 ppm repeat not again)
+    quiet = d[(d["level_ppm"] == 0) & (d["latency_ms"] == 0) & (d["smear"] == 0)]
+    assert sorted(quiet.groupby("repeat").size().items()) == [(r, per_rep) for r in range(spec.quiet_repeats)]
+    assert c["cel_blind_quiet"].estimate.n == c["cel_loop_quiet"].estimate.n == spec.quiet_repeats * per_rep
+    assert not quiet.duplicated(["repeat", "runs", "run"]).any() and quiet["chi2"].nunique() == len(quiet)
+    assert len(paper_e.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs   # no nets
     assert set(d["decision"]) <= {"gyro scale factor z", km.NOT_EXPLAINED, km.NOTHING} | set(km.CANDIDATES)
     assert c["cel_loop_blind"].estimate.n == 2 * (spec.n_train_runs + spec.n_test_runs)
     # the sweep at the study's own level is the study's held-out S-turn scores (same draws, nets, filters)
@@ -588,7 +604,72 @@ def test_sweep_claims_land_on_each_side_at_every_level():
         assert c[f"cel_sw_imp_{level}ppm"].verdict == "not reproduced"
         assert c[f"cel_sw_rates_{level}ppm"].verdict == "not reproduced"
     v = paper_e.sweep_verdicts(fake_data())
-    assert len(v) == 10 and set(v["scale_ppm"]) == {0, 25, 50, 100, 200}
+    assert len(v) == 15 and set(v["scale_ppm"]) == {0, 25, 50, 100, 200}
+    assert (v.groupby("claim").size() == 5).all() and v["claim"].str.contains("without rates").sum() == 5
+
+
+def _scaled(data, case=None, method="BPKF", factor=1.0, level=None, sweep_method="BPKF 6 QR"):
+    """``data`` with one case's held-out BPKF scores (or one sweep level's method) multiplied by ``factor``."""
+    s, sw = data.scores.copy(), data.sweep.copy()
+    if case is not None:
+        sel = (s["case"] == case) & (s["mode"] == "held-out") & (s["method"] == method)
+        s.loc[sel, "rms_arcsec"] *= factor
+    if level is not None:
+        sel = (sw["level_ppm"] == level) & (sw["method"] == sweep_method)
+        sw.loc[sel, "rms_arcsec"] *= factor
+    return paper_e.StudyData(**{**data.__dict__, "scores": s, "sweep": sw})
+
+
+def test_turning_claim_is_the_paired_ratio_of_turning_to_steady_error_and_lands_on_each_side():
+    """E10: per held-out S-turn run the error over the epochs with |yaw rate| at or above the run's median
+    over the error over the rest, paired run by run, boundary 1 (holds above); 6 QR (yaw, three angles), the
+    plain KF, and the 6 QR at each sweep level (the sweep's repeats only)."""
+    keys = ("cel_turn", "cel_turn_all", "cel_turn_kf") + tuple(f"cel_sw_turn_{v}ppm" for v in (0, 25, 50, 100, 200))
+    for factor, verdict in ((1.5, "reproduced"), (0.7, "not reproduced")):
+        c = by_key(fake_data(turn_factor=factor))
+        for k in keys:
+            assert c[k].estimate.value == pytest.approx(factor) and c[k].estimate.rule == "paired ratio"
+            assert c[k].boundary == 1.0 and c[k].holds_when == "above" and c[k].verdict == verdict
+    data = fake_data()
+    assert c["cel_turn"].estimate.n == len(paper_e.phase_per_run(data, "BPKF 6 QR", "turning")) == 8
+    assert len(paper_e.phase_per_run(data, "KF", "steady", level_ppm=50.0, repeats=1)) == 4
+    # the halves of a run: split at its median |yaw rate|, RMS per angle over each half
+    rate = np.zeros((1, 6, 3))
+    rate[0, :, 2] = [0.0, 5.0, -6.0, 1.0, -0.5, 4.0]
+    err = np.arange(18.0).reshape(1, 6, 3)
+    mask = np.array([False, True, True, True, True, True])        # first epoch not scored
+    rows = pd.DataFrame(paper_e._phase_rows(50.0, 0, "KF", err, rate, mask)).set_index(["phase", "axis"])
+    # scored |rate| 5, 6, 1, 0.5, 4: median 4; turning epochs 1, 2, 5, steady 3, 4
+    for phase, e in (("turning", err[0, [1, 2, 5]]), ("steady", err[0, [3, 4]])):
+        for a, ax in enumerate(paper_e.AXES):
+            assert rows.loc[(phase, ax), "rms_arcsec"] == pytest.approx(np.sqrt(np.mean(e[:, a] ** 2)))
+    with pytest.raises(InputError, match="phase"):
+        paper_e.phase_per_run(data, "KF", "turns")
+
+
+def test_without_rates_claim_is_the_paired_improvement_and_holds_below_the_papers_threshold():
+    """E09: the gain-only BPKF (6 QR) 'cannot effectively improve' on the KF in the S-manoeuvres: the median
+    paired improvement over the same held-out runs, below the paper's 30 % (the boundary of E07, the same
+    sentence with the rates), per run over the three angles and for yaw alone, and at every sweep level."""
+    data = fake_data()
+    thr = paper_e.paper_numbers()["value"]["improvement_min_pct"]
+    c = by_key(data)
+    for k in ("cel_norate", "cel_norate_yaw") + tuple(f"cel_sw_norate_{v}ppm" for v in (0, 25, 50, 100, 200)):
+        assert c[k].boundary == thr and c[k].holds_when == "below" and c[k].estimate.rule == "paired ratio"
+        assert c[k].verdict == "reproduced" and c[k].source == "paper"         # fake 6 QR: 10-20 % better
+    for angle, k in (("all", "cel_norate"), ("yaw", "cel_norate_yaw")):
+        bp = paper_e.per_run(data, "sturn_qr6", "held-out", "BPKF", angle).to_numpy()
+        kf = paper_e.per_run(data, "sturn_qr6", "held-out", "KF", angle).to_numpy()
+        assert c[k].estimate.value == pytest.approx(100 * (1 - np.median(bp / kf)))
+        assert c[k].estimate.n == bp.size == 8
+    # the 6 QR BPKF at half the KF's error (50 % better): the claim fails, at the study's runs and at one level
+    c = by_key(_scaled(data, "sturn_qr6", factor=0.55 / 0.85, level=50.0))
+    assert c["cel_norate"].verdict == "not reproduced" and c["cel_norate_yaw"].verdict == "not reproduced"
+    c = by_key(_scaled(data, level=50.0, factor=0.5 / 0.9))
+    assert c["cel_sw_norate_50ppm"].verdict == "not reproduced" and c["cel_sw_norate_50ppm"].estimate.value == pytest.approx(50)
+    assert c["cel_sw_norate_25ppm"].verdict == "reproduced"
+    # the E07 row (rates) is untouched by the 6 QR scores
+    assert c["cel_sw_imp_50ppm"].estimate.value == by_key(data)["cel_sw_imp_50ppm"].estimate.value
 
 
 def test_s_turn_raw45_and_conclusion_3_readings():
@@ -605,8 +686,10 @@ def test_blind_effect_claims_count_runs_and_land_on_each_side():
     c = by_key(fake_data(blind_named=["none"] * 16, blind_flagged=[False] * 16, blind_left=[False] * 16))
     assert c["cel_blind_named"].estimate.value == 0 and c["cel_blind_flag"].verdict == "not reproduced"
     assert c["cel_blind_left"].verdict == "not reproduced"
+    q = by_key(fake_data())["cel_blind_quiet"]                # 0 of 16: says how many runs would decide it
+    assert q.verdict == "cannot be judged" and "needs at least 73 runs" in q.reason
     c = by_key(fake_data(quiet_flagged=[True] * 8 + [False] * 8))
-    assert c["cel_blind_quiet"].verdict == "not reproduced"
+    assert c["cel_blind_quiet"].verdict == "not reproduced" and c["cel_blind_quiet"].why == ""
     assert c["cel_blind_quiet"].holds_when == "below" and c["cel_blind_named"].holds_when == "below"
 
 

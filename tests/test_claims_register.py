@@ -126,6 +126,19 @@ def test_evaluate_folds_rows_into_one_record_per_entry(reg):
     assert [n["id"] for n in claims.inconsistencies("testch")] == ["A03"]
 
 
+def test_a_register_margin_turns_a_tiny_difference_into_no_difference(monkeypatch):
+    es = _parse(_row(margin="0.01", margin_why="the paper prints 0.01 deg"))
+    monkeypatch.setitem(claims.REGISTERS, "testch", ("test",))
+    monkeypatch.setattr(claims, "load_register", lambda name: es)
+    rec, = claims.evaluate("testch", [_rec("X beats Y", "r1", (-0.004, 0.006))])
+    assert rec["verdict"] == "no difference" and rec["basis"] == "equivalent" and rec["margin"] == 0.01
+    assert "the paper prints 0.01 deg" in rec["why"]
+    assert claim_problems(rec) == []
+    assert claim_problems(dict(rec, margin=None))             # without its margin the verdict does not follow
+    with pytest.raises(InputError, match="column 'margin_why'"):
+        _parse(_row(margin="0.01"))
+
+
 def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(reg):
     good = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y [variant]", "r1", (1, 2)), _rec("ours", "real", (1, 2))]
     with pytest.raises(InputError, match="belongs to no entry"):

@@ -115,9 +115,13 @@ def test_claims_and_verdict_table(sw):
         return [c for c in cl if c.claim.startswith(f"LS [{model}] error within") and "default" in c.claim]
 
     # the default noise floor (physical model's band, 0.49 deg wide) is wider than ADE-BP's printed 0.42 deg:
-    # that claim cannot be judged, whatever the method does, and says which noise it would need
+    # a band between the two cannot be judged (the reason says which noise it would need); a band wider
+    # than the floor too has failed, whatever the noise excuses
     for c in ranges("ADE-BP"):
-        assert c.verdict == "cannot be judged" and c.basis == "noise floor"
+        if c.interval[0] > c.floor.value:
+            assert c.verdict == "not reproduced" and c.basis == "interval"
+        else:
+            assert c.verdict == "cannot be judged" and c.basis in ("noise floor", "straddles")
         assert c.floor.value > c.boundary and "uT" in c.floor.needs and "0.04 uT" in c.floor.assumption
         assert c.floor.needs == "noise at most 0.03 uT"       # widths 0.37 deg at 0.03 uT, 0.49 at 0.04
     for c in ls_ranges("Smith 5 terms") + ranges("BP") + ranges("DE-BP"):
@@ -195,10 +199,17 @@ def test_claims_sides_boundaries_and_floor():
     assert by["BP error within the paper's range"].verdict == "reproduced"          # 0.5 < 0.80
     assert by["DE-BP error within the paper's range"].verdict == "not reproduced"   # 0.7 > 0.56
     assert by["ADE-BP error within the paper's range"].verdict == "reproduced"      # 0.2 < 0.42, floor 0.3
-    # the same runs with a physical model wider than ADE-BP's printed width: the floor decides
-    wide = claims(_synthetic_runs(rms, {"ade_bp_pure": 0.2}, phys_width=0.5), paper, default_ut=0.04)
+    # the same runs with a physical model wider than ADE-BP's printed width: a band between the printed
+    # width and the floor is excused by the noise; one inside the printed width crossed the floor estimate
+    wide = claims(_synthetic_runs(rms, {"ade_bp_pure": 0.46}, phys_width=0.5), paper, default_ut=0.04)
     c = next(c for c in wide if c.claim.startswith("ADE-BP error within") and c.reading == READINGS_R1)
     assert c.verdict == "cannot be judged" and c.basis == "noise floor"
+    crossed = claims(_synthetic_runs(rms, {"ade_bp_pure": 0.2}, phys_width=0.5), paper, default_ut=0.04)
+    c = next(c for c in crossed if c.claim.startswith("ADE-BP error within") and c.reading == READINGS_R1)
+    assert c.verdict == "reproduced"
+    worse = claims(_synthetic_runs(rms, {"ade_bp_pure": 0.9}, phys_width=0.5), paper, default_ut=0.04)
+    c = next(c for c in worse if c.claim.startswith("ADE-BP error within") and c.reading == READINGS_R1)
+    assert c.verdict == "not reproduced"
     # too few runs for a 95 % interval of the median: cannot be judged, and the reason says so
     few = claims(_synthetic_runs(rms, {}, seeds=range(4)), paper, default_ut=0.04)
     c = next(c for c in few if c.claim == "ADE-BP beats DE-BP")
@@ -580,11 +591,11 @@ def test_generations_to_reach_and_the_convergence_claims():
     never = generations_to_reach(runs, rms_levels=(0.1,))
     assert not never.reached.any() and set(never.generations) == {201}          # G + 1 when never reached
     cl = convergence_claims(reach, seed=1)
-    faster, stable = cl
+    faster, stable = cl[0], cl[-1]          # between them: the fixed-generation rows (test_compass_claims.py)
     assert faster.estimate.value == 90 and faster.verdict == "reproduced"
     assert stable.boundary == 1.0 and stable.rule == "bootstrap over rows" and stable.verdict == "reproduced"
     swapped = convergence_claims(reach, de="ade_bp_pure", ade="de_bp_pure", seed=1)
-    assert [c.verdict for c in swapped] == ["not reproduced", "not reproduced"]
+    assert [c.verdict for c in (swapped[0], swapped[-1])] == ["not reproduced", "not reproduced"]
     summary = reach_summary(generations_to_reach(runs, rms_levels=(1.0, 0.1)))
     assert len(summary) == 4 and list(summary["share reached"]) == [1.0, 0.0, 1.0, 0.0]
     assert list(summary["generations (median)"]) == [150, 201, 60, 201]

@@ -17,8 +17,9 @@ FAST = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=1))
 #: the fewest draws with which every claim has its interval (6 runs: 3 tests x 2 draws)
 CLAIMS = pc.StudyParams(sim=pc.SimulationSettings(n_tests=3, n_seeds=2),
                         thermal=pc.ColdStudySettings(n_draws=7, batch_size=7, worlds=pc.THERMAL_WORLDS[:2]))
-#: claims before issue 21, those of the readings and stored claims it added, and 3 per thermal world
-N_CLAIMS = 16 + 14 + 3 * 2
+#: claims before issue 21, those of the readings and stored claims it added, 3 per thermal world, and the
+#: register entries judged on the printed tables (C10 2, C11 2, C15 3, C13 3)
+N_CLAIMS = 16 + 14 + 3 * 2 + 10
 
 
 def _t2():
@@ -570,3 +571,122 @@ def test_thermal_settings_reject_bad_input():
         pc.HotNetSettings(width="cauchy")
     with pytest.raises(InputError, match="thermal"):
         pc.StudyParams(thermal=3)
+
+
+# ------------------------------------------------------------------------------ register entries C10, C11, C13, C15
+def _raw(name):
+    return pd.read_csv(data_path(name))
+
+
+def test_implied_drift_error_is_position_over_gain():
+    assert pc.implied_drift_error([0.9, 1.8, 0.0], 1800.0) == pytest.approx([0.0005, 0.001, 0.0])
+    # other error set aside first, never below zero
+    assert pc.implied_drift_error([0.9, 0.2], 1800.0, other_nmi=0.36) == pytest.approx([0.0003, 0.0])
+    with pytest.raises(InputError, match="gain_nmi_per_deg_h"):
+        pc.implied_drift_error([1.0], 0.0)
+    with pytest.raises(InputError, match="other_nmi"):
+        pc.implied_drift_error([1.0], 1800.0, other_nmi=-1.0)
+
+
+def test_table3_other_error_and_before_identification_by_hand():
+    t3 = _raw("gyro_table3_hot_test.csv")
+    other = pc.table3_other_error(1000.0)
+    for i, r in t3.iterrows():
+        assert other[i] == pytest.approx(r["paper_pos_error_after_nmi_72h"] - 1000.0 * abs(r["paper_error_deg_h"]))
+    b = pc.before_identification(2000.0)
+    text = pd.read_csv(data_path("gyro_table3_hot_test.csv"), dtype=str)["paper_pos_error_before_nmi_72h"]
+    for i, r in t3.iterrows():
+        pb, ours = r["paper_pos_error_before_nmi_72h"], 2000.0 * abs(r["true_drift_deg_h"])
+        assert b["drift alone (nmi)"].iloc[i] == pytest.approx(ours)
+        assert b["relative gap"].iloc[i] == pytest.approx(abs(pb - ours) / pb)
+        dec = len(text[i].split(".")[1]) if "." in text[i] else 0          # "1.4": 1 decimal, "8": none
+        assert b["printed rounding (relative)"].iloc[i] == pytest.approx(0.5 * 10.0 ** -dec / pb)
+    with pytest.raises(InputError):
+        pc.before_identification(-1.0)
+
+
+def test_temperature_spans_on_a_small_table():
+    df = pd.DataFrame({"temperature_min_c": [28, 43, 49], "temperature_max_c": [39, 43, 52]})
+    assert list(pc.temperature_spans(df)) == [11, 0, 3]
+
+
+def test_swap_basis_keeps_the_gaussian_and_fits_the_others():
+    x2, y2, x3, _ = pc._hot_xy()
+    net = pc.design_hot_net(x2, y2, P.hot)
+    assert pc.swap_basis(net, x2, y2, "gaussian")(x3) == pytest.approx(net.predict(x3), abs=1e-12)
+    # two training points, one centre + bias: every basis fits them exactly (2 unknowns, 2 equations)
+    one = pc.design_hot_net(x2[:2], y2[:2], pc.HotNetSettings(goal=0.0))
+    one_c = pc.RBFNet(one.centers[:1], one.b, one.weights[:1], one.bias, one.scaler, one.spread, one.center_index[:1])
+    for basis in pc.BASIS_FUNCTIONS:
+        assert pc.swap_basis(one_c, x2[:2], y2[:2], basis)(x2[:2]) == pytest.approx(y2[:2], abs=1e-12), basis
+    # by hand: multiquadric at r = b |s(x) - c|
+    r = one_c.b * np.abs(one_c.scaler.transform(x2[:2])[:, 0] - one_c.centers[0, 0])
+    M = np.column_stack([np.sqrt(1 + r * r), np.ones(2)])
+    w = np.linalg.solve(M, y2[:2])
+    x_new = x3[:1]
+    r_new = one_c.b * abs(one_c.scaler.transform(x_new)[0, 0] - one_c.centers[0, 0])
+    assert pc.swap_basis(one_c, x2[:2], y2[:2], "multiquadric")(x_new)[0] == pytest.approx(
+        w[0] * np.sqrt(1 + r_new ** 2) + w[1])
+    with pytest.raises(InputError, match="basis"):
+        pc.swap_basis(net, x2, y2, "cubic")
+
+
+def test_basis_readings_start_from_the_gaussian_net():
+    br = pc.basis_readings(P).set_index("basis")
+    assert list(br.index) == ["gaussian", *pc.BASIS_FUNCTIONS]
+    assert br.loc["gaussian", "max |output - Gaussian| (deg/h)"] == pytest.approx(0.0, abs=1e-15)
+    loo = pc.hot_leave_one_out(P).rows["err our RBF"].to_numpy()
+    assert br.loc["gaussian", "LOO RMS (deg/h)"] == pytest.approx(np.sqrt(np.mean(loo ** 2)))
+
+
+def test_register_claims_by_hand(claims):
+    k = _by_key(claims)
+    gain = pc._unit_position_gain(CLAIMS)
+    lim = pc.fact("claimed_accuracy")
+    t3, t5, t2 = _raw("gyro_table3_hot_test.csv"), _raw("gyro_table5_cold_test.csv"), _raw("gyro_table2_hot_train.csv")
+    # C10: the largest cold-net position error over the gain, against the claimed accuracy
+    c = k["gyro_cold_accuracy_table5"]
+    assert c.rule == "exact" and c.boundary == lim
+    assert c.estimate.value == pytest.approx(t5["paper_pos_error_cold_net_nmi_72h"].max() / gain)
+    assert any("whole position error" in d for d in c.decided_by)
+    other = max(t3["paper_pos_error_after_nmi_72h"] - gain * t3["paper_error_deg_h"].abs())
+    assert k["gyro_cold_accuracy_table5_less_other"].estimate.value == pytest.approx(
+        (t5["paper_pos_error_cold_net_nmi_72h"].max() - other) / gain)
+    assert c.verdict == "not reproduced"                     # 0.0005 deg/h implied, above 0.0003
+    assert k["gyro_cold_accuracy"].basis == "no statistic"   # the row as printed is unchanged
+    # C11: largest relative gap, boundary from the printed precision, floor from Table 3's other errors
+    c = k["gyro_t3_before"]
+    gap = (t3["paper_pos_error_before_nmi_72h"] - gain * t3["true_drift_deg_h"].abs()).abs() \
+        / t3["paper_pos_error_before_nmi_72h"]
+    assert c.estimate.value == pytest.approx(gap.max()) and c.rule == "exact"
+    assert c.floor.value == pytest.approx(other / t3["paper_pos_error_before_nmi_72h"].min())
+    assert c.verdict == "not reproduced"
+    g2 = pc.fact("position_goal") / pc.fact("required_accuracy")
+    gap2 = (t3["paper_pos_error_before_nmi_72h"] - g2 * t3["true_drift_deg_h"].abs()).abs() \
+        / t3["paper_pos_error_before_nmi_72h"]
+    assert k["gyro_t3_before_paper_gain"].estimate.value == pytest.approx(gap2.max())
+    # C15: the largest printed span against 3 C
+    span = t2["temperature_max_c"] - t2["temperature_min_c"]
+    c = k["gyro_hot_temp_change"]
+    assert c.boundary == pc.fact("hot_state_max_temp_change") and c.estimate.value == span.max()
+    assert c.verdict == "not reproduced"
+    assert k["gyro_hot_temp_change_no_widest"].estimate.value == span.sort_values().iloc[-2]
+    assert k["gyro_hot_temp_change_t3"].estimate.value == (t3["temperature_max_c"] - t3["temperature_min_c"]).max()
+    # C13: against half a unit of Table 3's printed decimal
+    br = pc.basis_readings(CLAIMS).set_index("basis")
+    c = k["gyro_basis_outputs"]
+    assert c.boundary == pytest.approx(0.5 * 10.0 ** -pc.printed_decimals(3, "paper_rbf_drift_deg_h").min())
+    assert c.estimate.value == pytest.approx(br["max |output - Gaussian| (deg/h)"].max())
+    w = pc.width_readings(CLAIMS).set_index("width")
+    cols = [f"T3 #{i} (deg/h)" for i in (1, 2, 3)]
+    assert k["gyro_basis_width"].estimate.value == pytest.approx(
+        np.max(np.abs(w.loc["gaussian", cols].to_numpy(float) - w.loc["matlab", cols].to_numpy(float))))
+
+
+def test_register_claims_fold_into_their_entries(claims):
+    from navlib import claims as reg
+    recs = {r["id"]: r for r in reg.evaluate("gyro", [c.record() for c in claims])}
+    for cid, key in (("C10", "gyro_cold_accuracy_table5"), ("C11", "gyro_t3_before"),
+                     ("C13", "gyro_basis_outputs"), ("C15", "gyro_hot_temp_change")):
+        assert recs[cid]["status"] == "judged" and recs[cid]["key"] == key, cid
+        assert recs[cid]["rule"] == "exact" and recs[cid]["verdict"] == _by_key(claims)[key].verdict

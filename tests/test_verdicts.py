@@ -148,3 +148,17 @@ def test_exact_and_estimate_validation():
         verdicts.Estimate(1.0, 2.0, 0.0, "exact", 1)
     with pytest.raises(InputError, match="Floor.needs"):
         verdicts.Floor(1.0, "noise 3 ug", " ")
+
+
+def test_an_equivalence_margin_gives_the_fourth_outcome():
+    # "A beats B" where the two differ by at most 0.005 deg: within the paper's 0.01 deg precision
+    assert verdicts.decide((-0.004, 0.005), 0.0, "above", margin=0.01) == (None, "equivalent")
+    assert verdicts.verdict_name(None, "equivalent") == "no difference"
+    assert verdicts.verdict_label(None, "equivalent") == "no difference"
+    assert verdicts.decide((0.002, 0.008), 0.0, "above", margin=0.01) == (None, "equivalent")  # checked first
+    assert verdicts.decide((-0.004, 0.015), 0.0, "above", margin=0.01) == (None, "straddles")
+    assert verdicts.decide((0.02, 0.05), 0.0, "above", margin=0.01) == (True, "interval")
+    assert verdicts.decide((-0.05, -0.02), 0.0, "above", margin=0.01) == (False, "interval")
+    with pytest.raises(InputError, match="positive number"):
+        verdicts.decide((0, 1), 0.0, "above", margin=0.0)
+    assert "no difference" in verdicts.VERDICTS and "no difference" in verdicts.VERDICT_DEFINITIONS

@@ -670,6 +670,51 @@ def drift_summary(df: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, s
     return pd.DataFrame(rows, columns=["quantity", "unit", "ours", "paper"])
 
 
+def drift_by_seed(params: PaperDParams, seeds) -> pd.DataFrame:
+    """Figs 2-3 per seed (unit A, measured, against 55 degC): the largest ``|bias drift|`` of the 0/180 deg
+    bias test (:func:`fig3_bias`, noise :func:`sim_seed` ``(seed, "bias_test")``) and the largest
+    ``|N(T, q) - N(55, q)|`` of the tumble (:func:`fig2_output_drift`, unit A's noise ``(seed,
+    "noise_a")``), in mg; one row per seed."""
+    rows = []
+    for s in seeds:
+        s = int(s)
+        df = simulate_tumble(params.coefficients, params.experiment, sim_seed(s, "noise_a"), "A")
+        rows.append({"seed": s,
+                     "max |bias drift| (mg)": float(fig3_bias(params, s)["bias_drift_mg"].abs().max()),
+                     "max |output drift| (mg)": float(fig2_output_drift(df, "A", params.experiment.reference_c)
+                                                      ["drift_mg"].abs().max())})
+    return pd.DataFrame(rows)
+
+
+def drift_claims(params: PaperDParams, paper: pd.DataFrame, seeds) -> list:
+    """The drifts our simulator was set to (sections 2 and 2.1.1, Figs 2-3): per seed the largest output
+    drift and the largest 0/180 deg bias drift of unit A (:func:`drift_by_seed`), median over the seeds
+    against the paper's 5 mg and 1.7 mg ("reached": holds above).  True by construction: the simulator's
+    default coefficients were chosen to approach them, so the verdict checks our simulator, not the paper."""
+    d = drift_by_seed(params, seeds)
+    c = params.coefficients
+    setting = (f"navlib.sensors.accelerometer.AccelCoefficients defaults were chosen to approach the paper's "
+               f"drifts over {params.experiment.t_start_c:g}..{params.experiment.t_stop_c:g} degC: bias "
+               f"b1 = {c.bias_lin_mg_c:g} mg/degC, b2 = {c.bias_quad_mg_c2:g} mg/degC^2, b3 = "
+               f"{c.bias_cub_mg_c3:g} mg/degC^3, step {c.bias_step_mg:g} mg; scale factor k1 = "
+               f"{c.sf_lin_per_c:g} /degC, k2 = {c.sf_quad_per_c2:g} /degC^2")
+    out = []
+    for what, key_p, col, where, key in (
+            ("output drift", "max_output_drift", "max |output drift| (mg)",
+             "largest |N(T, q) - N(55 degC, q)| of unit A over the tumble", "accel_drifts"),
+            ("bias drift", "max_bias_drift", "max |bias drift| (mg)",
+             "largest |bias drift| of unit A's 0/180 deg bias test against 55 degC", "accel_drift_bias")):
+        b = _paper_value(paper, key_p)
+        v = d[col].to_numpy()
+        out.append(report.Claim(
+            f"{what} up to {b:g} mg vs 55 degC", f"{b:g} mg", reading="simulator defaults",
+            statistic=f"{where}, median over seeds, mg", estimate=verdicts.median_ci(v), boundary=b,
+            holds_when="above", unit="mg", by_construction=True, why=setting,
+            decided_by=("our simulated sensor (navlib.sensors.accelerometer defaults)",),
+            ours=f"per seed {v.min():.3f}-{v.max():.3f} mg", spec="{:.3f}", key=key))
+    return out
+
+
 # ------------------------------------------------------------------------------------------- claims
 def per_seed(err: pd.DataFrame, methods, s: str, col: str = "RMSE_mg") -> pd.DataFrame:
     """One row per seed, one column per method: statistic ``col`` on set ``s`` in ug (seeds that lack a
@@ -687,8 +732,10 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
     seeds (held-out = whole temperatures never fitted): the paper's order of the four models (paired
     differences of the held-out RMSE), its 4 ug (median RMSE, training and held-out readings, against our
     noise floors), "1-2 orders of magnitude" better than ANN and FIS (paired ratios, boundary 10), the second
-    unit's 9.3 ug (median largest error), the drifts our simulator was set to, and the book's own
-    polynomial-calibration baseline."""
+    unit's 9.3 ug (median largest error), the drifts our simulator was set to (median over the seeds,
+    :func:`drift_claims`, true by construction), the book's own polynomial-calibration baseline and, last,
+    FIS more accurate than ANN (paired difference of the held-out RMSE; section 5.2 says it only through
+    its printed RMSEs)."""
     n = err["seed"].nunique()
     if n < MIN_SEEDS_FOR_CLAIMS:
         raise InputError(f"parameter seeds: the 95 % intervals of the claims need at least "
@@ -774,15 +821,8 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
             f"{ub['oracle'].median():.0f} ug on unit B",
         ours=f"{ub_before:.2f} mg before", spec="{:.4g}", key="accel_unit_b"))
 
-    # -- drifts our simulator was set to (sections 2.1.1-2.1.2, Figs 2-3)
-    f = drift.set_index("quantity")
-    out.append(report.Claim(
-        "bias drift up to 1.7 mg, output drift up to 5 mg vs 55 degC",
-        f"{_paper_value(paper, 'max_bias_drift'):g} mg, {_paper_value(paper, 'max_output_drift'):g} mg",
-        reading="simulator defaults", by_construction=True,
-        why="our simulator's default coefficients were set to give these drifts",
-        ours=f"{f.loc['max |bias drift|', 'ours']:.2f} mg, {f.loc['max |output drift|, unit A', 'ours']:.2f} mg "
-             "(first seed)", key="accel_drifts"))
+    # -- drifts our simulator was set to (sections 2 and 2.1.1, Figs 2-3): per seed, median over the seeds
+    out += drift_claims(params, paper, sorted(err["seed"].unique()))
 
     # -- the book's own baseline: what a calibration engineer does first
     phys = "physical (poly K0, K1, K2)"
@@ -794,6 +834,17 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
                     f"{params.coefficients.bias_step_mg:g} mg; at 0 the polynomial reaches the noise floor)",
                     f"polynomial degree {params.poly_degree}"),
         ours=f"{test[phys].median():.1f} vs {test[best].median():.1f} ug", key="accel_vs_poly"))
+
+    # -- FIS more accurate than ANN (section 5.2, only through the printed RMSEs): the same paired
+    # difference as the order above (kept last so that the first seven claims stay the order, the 4 ug and
+    # the two "1-2 orders" claims the chapter's split table shows)
+    out.append(report.Claim(
+        "ANN RMSE > FIS RMSE", f"{p_rmse['ANN']:.0f} > {p_rmse['FIS']:.0f} ug", reading="held-out temperatures",
+        statistic="RMSE ANN - RMSE FIS, held-out temperatures, same seeds, ug",
+        estimate=verdicts.paired_difference(test["ANN"], test["FIS"]), boundary=0.0, holds_when="above", unit=ug,
+        decided_by=(sims, f"FIS clustering radius {params.fis_radius:g} (MATLAB's default)",
+                    f"ANN 2-{params.mlp.n_hidden}-1"),
+        ours=f"{test['ANN'].median():.1f} vs {test['FIS'].median():.1f} ug", key="accel_order_ann_fis"))
     return out
 
 
@@ -888,9 +939,10 @@ def two_orders_claims(err: pd.DataFrame, params: PaperDParams, paper: pd.DataFra
 def reading_claims(err: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, reading: str,
                    key_prefix: str = "") -> list:
     """The paper's claims on its test readings under one reading (a split or a noise level): the order of
-    the four models (paired differences), the 4 ug (median RMSE against the reading's floor), "1-2 orders"
-    better than ANN and FIS (boundary 10) and "nearly two orders" better than ANN, FIS and ANFIS
-    (:func:`two_orders_claims`).  ``params`` must be those the errors were run with (noise, split)."""
+    the four models and FIS more accurate than ANN (paired differences), the 4 ug (median RMSE against the
+    reading's floor), "1-2 orders" better than ANN and FIS (boundary 10) and "nearly two orders" better than
+    ANN, FIS and ANFIS (:func:`two_orders_claims`).  ``params`` must be those the errors were run with
+    (noise, split)."""
     n = err["seed"].nunique()
     if n < MIN_SEEDS_FOR_CLAIMS:
         raise InputError(f"parameter seeds: the 95 % intervals of the claims need at least "
@@ -904,7 +956,8 @@ def reading_claims(err: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame,
     decided = (f"sensor noise {sigma:g} ug per reading", "our simulated sensor",
                f"FIS/ANFIS clustering radius {params.fis_radius:g} (MATLAB's default)")
     out = []
-    for hi, lo, k in (("ANN", "ANFIS", "order_ann"), ("FIS", "ANFIS", "order_fis"), ("ANFIS", best, "order_anfis")):
+    for hi, lo, k in (("ANN", "ANFIS", "order_ann"), ("FIS", "ANFIS", "order_fis"), ("ANFIS", best, "order_anfis"),
+                      ("ANN", "FIS", "order_ann_fis")):
         out.append(report.Claim(
             f"{hi} RMSE > {lo} RMSE", f"{p[hi]:.0f} > {p[lo]:.0f} ug", reading=reading,
             statistic=f"RMSE {hi} - RMSE {lo}, test readings, same seeds, ug",
@@ -1149,4 +1202,4 @@ def verdict_grid(claims: list, column: str = "reading") -> pd.DataFrame:
     df = pd.DataFrame([{"claim": parts(c)[0], column: parts(c)[1], "verdict": c.verdict} for c in claims])
     t = df.pivot_table(index="claim", columns=column, values="verdict", aggfunc="first", sort=False)
     t.columns.name = None
-    return t.reset_index()
+    return t.fillna("–").reset_index()          # a claim not judged under that reading among these rows

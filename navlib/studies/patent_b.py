@@ -348,6 +348,9 @@ def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, sm
     """Document B's claims (reading ``'document B'``), each judged by the one rule of
     :mod:`navlib.verdicts` on a paired difference over the same seeds (boundary 0, holds above):
 
+    - the invention's own result, "the back-tuned ELM improves the uncompensated heading" (document B's
+      headline): RMS(uncompensated) - RMS(ELM back-tuned), paired with every seed, boundary 0 (B states no
+      amount);
     - "ELM back-tuned beats X": RMS(X) - RMS(ELM back-tuned) from paper A's seed study ``runs`` (method
       ids; a deterministic X is paired with every seed).  Against the 8-position LS (an explicit model)
       and a randomly started BP net (``bp_rows`` among :data:`RANDOM_START`) the claim is the patent's;
@@ -381,7 +384,16 @@ def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, sm
                      ours=f"{bt.median():.3f} vs {rms[worse_id].median():.3f} deg rms", key=key,
                      why="; ".join(t for t in (short, why) if t))
 
-    out = [beats(f"ELM back-tuned beats 8-position LS [{name}]", "implicit beats explicit models (no numbers)",
+    out = []
+    if "uncompensated" in rms:
+        # The invention's own result (its headline): the back-tuned ELM against no compensation at all.  B
+        # states no amount, so "improves" is any reduction of the test RMS (boundary 0).
+        out.append(beats("the back-tuned ELM improves the uncompensated heading", "compensates the nonlinear "
+                         "error and improves the heading accuracy (no numbers)", "paper", "uncompensated",
+                         "b_bt_uncompensated",
+                         why="boundary 0: document B states no amount of improvement, so any reduction of "
+                             "the test RMS counts"))
+    out += [beats(f"ELM back-tuned beats 8-position LS [{name}]", "implicit beats explicit models (no numbers)",
                  "paper", ls, "b_bt_ls" if ls == "ls8" else f"b_bt_ls_{ls.split('_')[-1]}", (_ls_assumption(ls),))
            for ls, name in LS_MODELS.items() if ls in rms]
     out += [beats("ELM back-tuned beats ADE-BP (pure DE)", "(not in the paper)", "book", "ade_bp_pure",
