@@ -756,21 +756,22 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
         noted = sum(1 for x in res.get("inconsistencies") or [] if x.get("register") == name)
         verdict = report_label(head) if head else "–"
         claim = head["claim"] if head else "–"
-        rows += [f"* - {_md_cell(claims_mod.SOURCE_NAMES[name])}<br>({chapter})", f"  - {_md_cell(claim)}",
+        rows += [f"* - {_md_cell(claims_mod.SOURCE_NAMES[name])} ({chapter})", f"  - {_md_cell(claim)}",
                  f'  - <span class="navbook-headline"><b>{html.escape(verdict)}</b></span>'
                  + (f"<br>({_md_cell(head['primary_reading'])})" if head and head.get("status") == "judged"
                     else ""),
-                 f"  - {stacked_bar(n)} {_counts_cell(n)} of {len(mine)}"]
+                 f"  - {stacked_bar(n, width_px=80)} {_counts_cell(n)} of {len(mine)}"]
         details.append(f"{claims_mod.SOURCE_NAMES[name]} {st['judged']} judged, {st['open']} not yet computed, "
                        f"{st['not checkable']} not checkable"
                        + (f", {noted} contradiction{'s' if noted != 1 else ''} noted" if noted else ""))
     if not rows:
         return []
     return (["", "(status-by-source)=",
-             ":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 13 37 22 28", "",
+             ":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 11 35 30 24", "",
              "* - source", "  - headline claim", "  - verdict (primary reading)",
-             "  - claims: reproduced / not / cannot be judged"]
-            + rows + [":::", "", "Each claim of a source's claims register counts once, under the reading its "
+             "  - claims"]
+            + rows + [":::", "", "Claims: reproduced / not reproduced / cannot be judged, of all the source's "
+                      "claims. Each claim of a source's claims register counts once, under the reading its "
                       "chapter finds most plausible (the others are shown there as sensitivity): "
                       + "; ".join(details) + "."])
 
