@@ -1048,7 +1048,7 @@ def register_problems(c: dict) -> list[str]:
         p.append(f"status {c.get('status')!r}: judged, open or not checkable")
     elif (c["status"] == "judged") == (c.get("rule") == "no statistic" and c.get("reason") in
                                        ("not yet computed", "not checkable")) or (
-            c.get("reason") == "data absent" and c["status"] != "judged"):
+            c.get("reason") == "not run" and c["status"] != "judged"):
         p.append(f"status {c['status']!r} disagrees with its reason {c.get('reason')!r}")
     return p
 
@@ -1499,21 +1499,17 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         w = csv.writer(fh)
         w.writerow(["page", "height_px"])
         w.writerows(heights)
-    (out_dir / "overflow.json").write_text(json.dumps(overflow, indent=1, ensure_ascii=False) + "\n",
-                                           encoding="utf-8")
+    for name, found in (("overflow.json", overflow), ("shrunk.json", shrunk), ("headlines.json", headlines)):
+        (out_dir / name).write_text(json.dumps(found, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     for page, items in overflow.items():
         for it in items:
             print(f"  wider than the column: {page}: {it['what']} by {it['overflow_px']} px under "
                   f"'{it['heading']}': {html.unescape(it['text'])[:50]!r}", file=sys.stderr)
-    (out_dir / "shrunk.json").write_text(json.dumps(shrunk, indent=1, ensure_ascii=False) + "\n",
-                                         encoding="utf-8")
     for page, items in shrunk.items():
         print(f"  figures shrunk on {page}: {len(items)}", file=sys.stderr)
         for it in items:
             print(f"    {it['src']} shown at {it['shown_px']} of {it['natural_px']} px "
                   f"({100 * it['share']:.0f} %) under '{it['heading']}'", file=sys.stderr)
-    (out_dir / "headlines.json").write_text(json.dumps(headlines, indent=1, ensure_ascii=False) + "\n",
-                                            encoding="utf-8")
     for page, items in headlines.items():
         for it in items:
             print(f"  headline verdict below the first screen ({FIRST_SCREEN_PX} px) on {page}: ends at "

@@ -13,9 +13,11 @@ Entries without results rows are kept as *not yet computed* (checkable: the regi
 decide them) or *not checkable* (it says why); a paper's contradictions of itself are listed apart
 (:func:`inconsistencies`).
 
-Every results row must belong to exactly one entry and every entry's primary row must exist: a chapter
-that writes a row the register does not know, or a register that names a row the chapter did not write,
-stops with one line naming both (:class:`navlib.errors.InputError`).
+Every results row must belong to exactly one entry: a chapter that writes a row the register does not
+know stops with one line naming both (:class:`navlib.errors.InputError`).  A rerun with other parameters
+may not run an entry's primary reading (or any of its rows: other parameters, or no real measurements):
+the entry is then kept as *cannot be judged: its primary reading was not run*, with the rows that were
+run as its sensitivity, and the run finishes.
 """
 from __future__ import annotations
 
@@ -228,7 +230,8 @@ def _unjudged(e: Entry, cat: str | None = None) -> dict:
             "floor": None, "by_construction": False, "decided_by": [], "reproduced": None,
             "verdict": "cannot be judged", "basis": "no statistic", "reason": cat,
             "why": verdicts.REGISTER_REASONS[cat] + e.needs, "key": None, "volatile": False,
-            "row_claim": None, "primary_reading": e.primary_reading if cat == "data absent" else f"none ({cat})"}
+            "row_claim": None,
+            "primary_reading": e.primary_reading if cat == "not run" else f"none ({cat})"}
 
 
 def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None = None) -> list[dict]:
@@ -270,19 +273,24 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
                         "across": {"rows": 0, "same": 0, "verdicts": {}}})
             continue
         mine = by_entry.get(e.id, [])
-        if not mine:                  # a judged entry whose rows the chapter could not write: no real data
-            rec = _unjudged(e, "data absent")
-            rec["why"] = ("data absent: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): the measurements "
-                           "that decide it are not on this machine")
+        if not mine:                  # none of its rows run: other parameters, or no real measurements
+            rec = _unjudged(e, "not run")
+            rec["why"] = ("not run: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): with these "
+                          "parameters, or without the real measurements they need (../shared/realdata), they "
+                          "are not computed")
             out.append({**rec, **base, "sensitivity": [], "across": {"rows": 0, "same": 0, "verdicts": {}}})
             continue
-        missing = [t for t in e.rows if not any(r["claim"] == t for r in mine)]
-        if missing:
-            raise InputError(f"claims_{e.register}.csv, {e.id}: the chapter wrote no row {missing[0]!r}")
         prim = [r for r in mine if r["claim"] == e.primary_claim and r["reading"] == e.primary_reading]
-        if len(prim) != 1:
-            raise InputError(f"claims_{e.register}.csv, {e.id}: no results row {e.primary_claim!r} under the "
+        if len(prim) > 1:
+            raise InputError(f"claims_{e.register}.csv, {e.id}: two results rows {e.primary_claim!r} under the "
                              f"primary reading {e.primary_reading!r}")
+        if not prim:                  # a rerun with other parameters: the primary reading was not run
+            rec = _unjudged(e, "not run")
+            rec["why"] = (f"not run: the primary reading {e.primary_reading!r} of {e.primary_claim!r} was not "
+                          f"run with these parameters; the {len(mine)} row(s) that were are its sensitivity")
+            out.append({**rec, **base, "sensitivity": [{**r, "source": e.origin} for r in mine],
+                        "across": {"rows": 0, "same": 0, "verdicts": {}}})
+            continue
         p = prim[0]
         others = [{**r, "source": e.origin} for r in mine if r is not p]
         rec = {**p, **base, "claim": e.claim, "row_claim": p["claim"], "source": e.origin,

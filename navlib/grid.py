@@ -8,7 +8,8 @@ its own results file.  ``DIR`` (new or empty: never written into otherwise) gets
 - ``results/<notebook>_<k>/<chapter>.json``: the results file it wrote (:func:`navlib.report.write_results`);
 - ``grid.csv``: one row per run: ``run``, ``notebook``, ``status`` (``ok`` or the failure in one line), the
   parameters, then every method statistic (``<method>: <statistic>``) and every claim's verdict and
-  estimate (``<claim key>: verdict``, ``<claim key>: estimate``) from the results file.
+  estimate (``<claim id>: verdict``, ``<claim id>: estimate``: the claims-register id, the verdict under
+  the primary reading, or the claim's key where a chapter has no register) from the results file.
 
 Parameters are checked against the notebook's ``parameters`` cell before any run: an unknown name, or a
 value that does not read as the type of the notebook's default (a number for a number, ``True``/``False``
@@ -261,7 +262,9 @@ def _flatten(results: dict[str, str]) -> dict[str, Any]:
             for stat, v in stats.items():
                 out[f"{pre}{method}: {stat}"] = v
         for c in data.get("claims") or []:
-            key = c.get("key") or (f"{c['claim']} [{c['reading']}]" if c.get("reading") else c["claim"])
+            # a claims-register record: its id (the same column in every run, whatever readings ran)
+            key = c.get("id") or c.get("key") or (f"{c['claim']} [{c['reading']}]" if c.get("reading")
+                                                  else c["claim"])
             out[f"{pre}{key}: verdict"] = c.get("verdict")
             out[f"{pre}{key}: estimate"] = c.get("estimate")
     return out

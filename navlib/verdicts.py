@@ -364,13 +364,14 @@ REASONS = {
                          "register says which statistic and how many runs would decide it"),
     "not checkable": ("not checkable",
                       "no experiment of ours can test the claim (the register says why)"),
-    "data absent": ("its measurements are absent",
-                    "the real measurements that decide the claim (../shared/realdata) are not on this "
-                    "machine, so the chapter could not judge it"),
+    "not run": ("its primary reading was not run",
+                "the chapter ran with parameters under which the claim's primary reading does not exist, or "
+                "without the real measurements it needs (../shared/realdata); the readings that were run are "
+                "shown as its sensitivity"),
 }
 #: The first words of a register entry's reason for the last two cases (written by :mod:`navlib.claims`).
 REGISTER_REASONS = {"not yet computed": "not yet computed: ", "not checkable": "not checkable: ",
-                    "data absent": "data absent: "}
+                    "not run": "not run: "}
 #: The verdict labels of the book in order, each with its definition (the three verdicts of
 #: ``VERDICTS``, *cannot be judged* split by :data:`REASONS`).
 VERDICT_DEFINITIONS = {

@@ -143,13 +143,15 @@ def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(
     good = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y [variant]", "r1", (1, 2)), _rec("ours", "real", (1, 2))]
     with pytest.raises(InputError, match="belongs to no entry"):
         claims.evaluate("testch", good + [_rec("a new claim", "r1", (1, 2))])
-    with pytest.raises(InputError, match="primary reading 'r1'"):
-        claims.evaluate("testch", [_rec("X beats Y", "r2", (1, 2))] + good[1:])
-    with pytest.raises(InputError, match="wrote no row 'X beats Y \\[variant\\]'"):
-        claims.evaluate("testch", [good[0], good[2]])
-    recs = claims.evaluate("testch", good[:2])         # no row of the book's entry: its data are absent
+    # a rerun with other parameters: the primary reading was not run; the run finishes and says so
+    a1 = claims.evaluate("testch", [_rec("X beats Y", "r2", (1, 2))] + good[1:])[0]
+    assert a1["reason"] == "not run" and a1["verdict"] == "cannot be judged" and "'r1'" in a1["why"]
+    assert [s["reading"] for s in a1["sensitivity"]] == ["r2", "r1"]
+    assert claim_problems(a1) == [] and register_problems(a1) == []
+    assert claims.evaluate("testch", [good[0], good[2]])[0]["verdict"] == "reproduced"   # a row not run
+    recs = claims.evaluate("testch", good[:2])         # no row of the book's entry: e.g. no real data
     a4 = recs[-1]
-    assert a4["reason"] == "data absent" and a4["status"] == "judged" and claim_problems(a4) == []
+    assert a4["reason"] == "not run" and a4["status"] == "judged" and claim_problems(a4) == []
     assert register_problems(a4) == []
 
 
@@ -173,8 +175,14 @@ def test_every_register_entry_is_in_the_results_file_and_the_chapters_opening(ch
     ids = [c.get("id") for c in res["claims"]]
     noted = [c["id"] for c in res.get("inconsistencies", [])]
     html = _glance_html(chapter)
+    by_id = {c.get("id"): c for c in res["claims"]}
     for e in claims.entries(chapter):
         where = noted if e.status == "noted" else ids
+        if e.status == "judged" and e.id in by_id:      # with the chapter's defaults every primary row is run
+            assert by_id[e.id].get("reason") not in ("not run",), f"{chapter}: {e.id}'s primary reading not run"
+            if by_id[e.id].get("reason") != "not run":
+                written = {by_id[e.id].get("row_claim")} | {s["claim"] for s in by_id[e.id]["sensitivity"]}
+                assert set(e.rows) <= written, f"{chapter}: {e.id} lists rows the chapter did not write"
         assert where.count(e.id) == 1, f"{chapter}: register entry {e.id} ({e.claim}) is not in the results file"
         assert f">{e.id}<" in html, f"{chapter}: register entry {e.id} ({e.claim}) is not in the chapter's opening"
     assert len(ids) == len(set(ids))
