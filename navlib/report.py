@@ -701,10 +701,6 @@ def record_label(r: Mapping[str, Any]) -> str:
     return f"{r['verdict']}: {verdicts.REASONS[cat][0]}" if cat in verdicts.REASONS else str(r["verdict"])
 
 
-def _rec_tally(records: list[Mapping[str, Any]]) -> str:
-    return tally_of([r["verdict"] for r in records])
-
-
 def _rec_ours(r: Mapping[str, Any]) -> str:
     if r.get("rule") == "no statistic":
         return "–"
@@ -727,6 +723,10 @@ def headline_sentence(r: Mapping[str, Any]) -> str:
     else:
         text += "."
     return text
+
+
+def _rec_tally(records: list[Mapping[str, Any]]) -> str:
+    return tally_of([r["verdict"] for r in records])
 
 
 ANSWER_COLUMNS = ["id", "claim", "ours: value [95 % interval]", "verdict (primary reading)", "across readings"]
@@ -777,8 +777,6 @@ class Answer:
 
     def __init__(self, records: list[dict], chapter: str):
         self.records, self.chapter = records, chapter
-        self.paper = [r for r in records if r["source"] == "paper"]
-        self.book = [r for r in records if r["source"] == "book"]
         self.noted = registry.inconsistencies(chapter)
 
     def _groups(self):
