@@ -1273,6 +1273,10 @@ _FIGURES_JS = r"""(() => {
 
 #: The first screen of a page (1400 x 900 px): each source's headline verdict must end within it.
 FIRST_SCREEN_PX = 900
+#: The tallest a chapter may be at 1400 px with its folds closed: 15 screens.
+CHAPTER_MAX_PX = 15 * FIRST_SCREEN_PX
+#: Opens every fold of a page (``<details>``: a section's evidence, captioned tables, code).
+_OPEN_FOLDS_JS = "document.querySelectorAll('details').forEach(d => { d.open = true; }); "
 #: Every headline verdict on a page (``.navbook-headline``): where it ends, from the top of the page.
 _HEADLINES_JS = r"""(() => [...document.querySelectorAll('.navbook-headline')].map(el => ({
   bottom_px: Math.round(el.getBoundingClientRect().bottom + window.scrollY),
@@ -1413,14 +1417,40 @@ def find_chromium(explicit: str | None = None) -> str | None:
 TILE_PX = 16000
 
 
+def _capture(chrome, session, metrics: dict, height: int, png: Path) -> None:
+    """Capture the page in ``session`` at its full ``height`` into ``png``; a page taller than
+    :data:`TILE_PX` as viewport-high tiles ``png``, ``<stem>-2.png``, ... (Chromium refuses one capture taller
+    than its texture limit, "Page is too large")."""
+    if height <= TILE_PX:
+        chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": height}, session=session)
+        # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
+        chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
+                    "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
+        shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
+                           session=session)
+        png.write_bytes(base64.b64decode(shot["data"]))
+        return
+    chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session)
+    for k, top in enumerate(range(0, height, TILE_PX)):
+        chrome.send("Runtime.evaluate", {"expression": f"window.scrollTo(0, {top}); new Promise("
+                    "r => setTimeout(r, 200)).then(() => 1)", "awaitPromise": True}, session=session)
+        shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
+        tile = png if k == 0 else png.with_name(f"{png.stem}-{k + 1}.png")
+        tile.write_bytes(base64.b64decode(shot["data"]))
+
+
 def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str | None = None,
                 settle_s: float = 0.5) -> int:
     """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
-    relative names, ``.png``; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv`` (page, height_px) and ``overflow.json`` (output blocks
+    relative names, ``.png``, folds closed as a reader first sees the page, and ``-open.png`` with every fold
+    open; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv``
+    (page, height with folds closed and open) and ``long.json`` (chapters taller than
+    :data:`CHAPTER_MAX_PX` with their folds closed) and ``overflow.json`` (output blocks
     or tables wider than the content column, by page) and ``shrunk.json`` (figures displayed below 75 % of
     their natural width, :func:`shrunk_figures`, by page) and ``headlines.json`` (headline verdicts,
     ``.navbook-headline``, that end below the first :data:`FIRST_SCREEN_PX` px).  Returns 2 if Chromium
-    is missing, 1 if a figure is shown shrunk or a headline verdict is not on the first screen (every
+    is missing, 1 if a chapter is too tall, a figure is shown shrunk or a headline verdict is not on the
+    first screen (the figures and overflow are checked with every fold open; every
     page is still rendered and listed), else 0."""
     binary = find_chromium(chromium)
     if binary is None:
@@ -1433,7 +1463,9 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
              and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
-    heights, overflow, shrunk, headlines = [], {}, {}, {}
+    heights, overflow, shrunk, headlines, long_pages = [], {}, {}, {}, {}
+    toc = html_dir.parent.parent / "_toc.yml"
+    chapters = set(read_chapter_sources(toc.with_name("chapters.csv"))) if toc.exists() else set()
     try:
         for page in pages:
             rel = page.relative_to(html_dir)
@@ -1451,18 +1483,10 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
             js_height = ("Math.max(document.documentElement.scrollHeight, document.body.scrollHeight, "
                          "...[...document.querySelectorAll('.bd-main, .bd-container, .bd-page-width')]"
                          ".map(e => e.scrollHeight))")
-            h = chrome.send("Runtime.evaluate", {"expression": js_height, "returnByValue": True},
-                            session=session)["result"]["value"]
-            h = int(h)
-            chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": h}, session=session)
-            # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
-            chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
-                        "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
-            found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
-                                session=session)["result"].get("value") or []
-            small = shrunk_figures(chrome.send("Runtime.evaluate", {"expression": _FIGURES_JS,
-                                                                    "returnByValue": True},
-                                               session=session)["result"].get("value") or [])
+            closed_h = int(chrome.send("Runtime.evaluate", {"expression": js_height, "returnByValue": True},
+                                       session=session)["result"]["value"])
+            if rel.parts[0] == "_generated" and rel.stem in chapters and closed_h > CHAPTER_MAX_PX:
+                long_pages[str(rel)] = closed_h
             heads = chrome.send("Runtime.evaluate", {"expression": _HEADLINES_JS, "returnByValue": True},
                                 session=session)["result"].get("value") or []
             late = [hd for hd in heads if hd["bottom_px"] > FIRST_SCREEN_PX]
@@ -1470,22 +1494,25 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
                 headlines[str(rel)] = late
             png = out_dir / rel.with_suffix(".png")
             png.parent.mkdir(parents=True, exist_ok=True)
-            if h <= TILE_PX:
-                shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
-                                   session=session)
-                png.write_bytes(base64.b64decode(shot["data"]))
-            else:
-                # Chromium refuses one capture taller than its texture limit ("Page is too large"): a long
-                # page (the API reference) is written as viewport-high tiles page.png, page-2.png, ...
-                chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session)
-                for k, top in enumerate(range(0, h, TILE_PX)):
-                    chrome.send("Runtime.evaluate", {"expression": f"window.scrollTo(0, {top}); new Promise("
-                                "r => setTimeout(r, 200)).then(() => 1)", "awaitPromise": True}, session=session)
-                    shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
-                    tile = png if k == 0 else png.with_name(f"{png.stem}-{k + 1}.png")
-                    tile.write_bytes(base64.b64decode(shot["data"]))
+            # the page as a reader first sees it (folds closed), then with every fold open: the figures and
+            # tables inside the folds are checked and captured too (page-open.png)
+            _capture(chrome, session, metrics, closed_h, png)
+            folds = chrome.send("Runtime.evaluate", {"expression": "document.querySelectorAll('details').length",
+                                                     "returnByValue": True}, session=session)["result"]["value"]
+            h = closed_h
+            if folds:
+                h = int(chrome.send("Runtime.evaluate", {"expression": _OPEN_FOLDS_JS + js_height,
+                                                         "returnByValue": True}, session=session)["result"]["value"])
+                _capture(chrome, session, metrics, h, png.with_name(png.stem + "-open.png"))
+            chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": min(h, TILE_PX)},
+                        session=session)
+            found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
+                                session=session)["result"].get("value") or []
+            small = shrunk_figures(chrome.send("Runtime.evaluate", {"expression": _FIGURES_JS,
+                                                                    "returnByValue": True},
+                                               session=session)["result"].get("value") or [])
             chrome.send("Target.closeTarget", {"targetId": target})
-            heights.append((str(rel), h))
+            heights.append((str(rel), closed_h, h))
             if found:
                 overflow[str(rel)] = found
             if small:
@@ -1497,7 +1524,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         chrome.close()
     with open(out_dir / "heights.csv", "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
-        w.writerow(["page", "height_px"])
+        w.writerow(["page", "height_px", "height_open_px"])
         w.writerows(heights)
     for name, found in (("overflow.json", overflow), ("shrunk.json", shrunk), ("headlines.json", headlines)):
         (out_dir / name).write_text(json.dumps(found, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
@@ -1514,8 +1541,15 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         for it in items:
             print(f"  headline verdict below the first screen ({FIRST_SCREEN_PX} px) on {page}: ends at "
                   f"{it['bottom_px']} px: {it['text'][:60]!r}", file=sys.stderr)
-    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, overflow.json, shrunk.json, "
+    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, long.json, overflow.json, shrunk.json, "
           f"headlines.json)")
+    for page, h in long_pages.items():
+        print(f"  chapter taller than {CHAPTER_MAX_PX // FIRST_SCREEN_PX} screens with its folds closed: {page}: "
+              f"{h} px (limit {CHAPTER_MAX_PX} px): put a section's evidence behind its fold ({{evidence}})",
+              file=sys.stderr)
+    (out_dir / "long.json").write_text(json.dumps(long_pages, indent=1) + "\n", encoding="utf-8")
+    if long_pages:
+        return 1
     if headlines:
         print(f"screenshots: {sum(map(len, headlines.values()))} headline verdict(s) on {len(headlines)} "
               f"page(s) are not on the first {FIRST_SCREEN_PX} px: shorten what comes before them",
