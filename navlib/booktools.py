@@ -858,7 +858,7 @@ API_LAYERS = (
     ("workbench", "Workbench: find the missing physical effect", ("navlib.workbench",)),
     ("studies", "Studies: one module per source", ("navlib.studies",)),
     ("data", "Data: loaders with validation", ("navlib.data", "navlib.paths")),
-    ("cli", "Command line", ("navlib.cli",)),
+    ("cli", "Command line", ("navlib.cli", "navlib.commands")),
     ("foundations", "Shared tools: verdicts, results, engine, seeds",
      ("navlib.verdicts", "navlib.report", "navlib.engine", "navlib.seeding", "navlib.grid", "navlib.angles",
       "navlib.errors", "navlib._optional")),

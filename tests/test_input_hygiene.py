@@ -450,7 +450,7 @@ def test_a_closed_pipe_ends_quietly(compass):
     assert err == "" and p.returncode == cli.BROKEN_PIPE
     shell = subprocess.run(f"{sys.executable} -m navlib loop compass {compass[1]} --model misalignment | head -1",
                            shell=True, capture_output=True, text=True, env=ENV)
-    assert shell.stderr == "" and shell.stdout.split() == ["model", "rms", "(deg)", "held-out", "rms", "(deg)", "named"]
+    assert shell.stderr == "" and shell.stdout.split() == ["step", "model", "rms", "(deg)", "held-out", "rms", "(deg)", "named"]
 
 
 def test_the_report_folder_is_refused_before_the_fit(tmp_path, compass):

@@ -212,6 +212,18 @@ def test_the_command_line_runs_from_another_directory_without_torch_or_book_tool
     assert all(c in help_ for c in commands)
 
 
+def test_the_shipped_examples_run_from_a_plain_install(installed):
+    """``navlib examples`` in the plain install lists files in site-packages, and each listed command runs
+    from another folder (README's "Use navlib without the book")."""
+    python, bindir, elsewhere = installed
+    listed = check(run([bindir / "navlib", "examples"], cwd=elsewhere)).stdout
+    commands = [ln.strip() for ln in listed.splitlines() if ln.startswith("    navlib ")]
+    assert len(commands) >= 3 and "site-packages" in listed
+    for command in commands:
+        check(run([bindir / "navlib", *command.split()[1:]], cwd=elsewhere))
+    assert not list(elsewhere.iterdir())
+
+
 def test_data_files_are_read_from_site_packages(installed):
     python, _, elsewhere = installed
     code = ("import navlib, navlib.paths as p, navlib.data.gyro_tables as g, navlib.data.tumble as t; "

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from navlib import commands
 from navlib.cli import main
 from navlib.errors import InputError
 from navlib.sensors.earth_field import Site, igrf_field
@@ -154,8 +155,7 @@ def test_the_cli_loop_has_no_per_system_branch(monkeypatch, sim, tmp_path, capsy
     """The end-of-loop field report is the system's ``final_check`` hook; a system without one refuses
     --site in one line."""
     import inspect
-    import navlib.cli as cli
-    assert "magnetometer_free" not in inspect.getsource(cli._loop)
+    assert "magnetometer_free" not in inspect.getsource(commands._loop)
     assert get_system("magnetometer_free").final_check is MF.loop_field_check
     assert get_system("compass").final_check is None
     assert main(["loop", "compass", "whatever.csv", "--site", "50,10"]) == 2

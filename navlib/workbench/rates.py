@@ -59,7 +59,7 @@ class Rates:
     def to_dict(self) -> dict:
         """Plain JSON-ready dictionary (the CLI's ``--json``)."""
         def records(df):
-            return None if df is None else [{k: (v.item() if isinstance(v, np.generic) else v)
+            return None if df is None else [{str(k).replace(" ", "_"): (v.item() if isinstance(v, np.generic) else v)
                                              for k, v in r.items()} for r in df.to_dict("records")]
         return {"system": self.system, "unit": self.unit, "noise": list(self.noises), "ratios": list(self.ratios),
                 "trials_per_case": self.trials, "null_trials_per_noise": self.null_trials,
