@@ -72,6 +72,11 @@ def test_hybrid_reaches_floor_and_pure_does_not(sw):
     assert (hyb.epochs > 0).all()
 
 
+def rule_reading_table_of(records):
+    from navlib.studies.paper_a import rule_reading_table
+    return rule_reading_table(records, READINGS_R1)
+
+
 def test_claims_and_verdict_table(sw):
     p = StudyParams(de=DEParams(max_generations=100), lm=replace(StudyParams().lm, epochs=50))
     ids = sorted({i for r in READINGS.values() for i in r} | {"physical"} | set(LS_MODELS))
@@ -90,6 +95,12 @@ def test_claims_and_verdict_table(sw):
     with tempfile.TemporaryDirectory() as tmp:
         written = read_result(write_results("compass", claims=cl, folder=tmp))["claims"]
     pd.testing.assert_frame_equal(verdict_table(written), vt)
+    # ... and from the register's records (one per claim, the other readings in 'sensitivity'): same table
+    with tempfile.TemporaryDirectory() as tmp:
+        per_claim = read_result(write_results("compass", claims=cl, folder=tmp, register=True))["claims"]
+    assert len(per_claim) < len(cl)
+    pd.testing.assert_frame_equal(verdict_table(per_claim).loc[vt.index, vt.columns], vt)
+    assert len(rule_reading_table_of(per_claim)) == len(rule_reading_table_of(written))
     pd.testing.assert_frame_equal(verdict_table(written, list(RULE_READINGS)), verdict_table(cl, list(RULE_READINGS)))
     from navlib.studies.paper_a import R4, rule_reading_table
     rt = rule_reading_table(written, READINGS_R1)

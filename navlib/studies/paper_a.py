@@ -1064,14 +1064,20 @@ def verdict_table(claim_list, readings=None) -> pd.DataFrame:
     :class:`navlib.report.Claim` objects (:func:`claims`) or the claim records of a results file
     (``read_results()["compass"]["claims"]``, the chapter's way); ``readings`` selects and orders the
     columns (default: every reading found).  "-": the claim is not judged in that reading (a reading of
-    ADE's rules judges only the claims that involve ADE-BP)."""
-    recs = [c if isinstance(c, Mapping) else {"claim": c.claim, "reading": c.reading, "verdict": c.verdict}
-            for c in claim_list]
+    ADE's rules judges only the claims that involve ADE-BP).  A results file's record carries its other
+    readings in ``sensitivity`` (:func:`navlib.claims.evaluate`): they are rows of the table too."""
+    recs = []
+    for c in claim_list:
+        if isinstance(c, Mapping):
+            recs += [c, *c.get("sensitivity", ())]
+        else:
+            recs.append({"claim": c.claim, "reading": c.reading, "verdict": c.verdict})
     missing = [k for k in ("claim", "reading", "verdict") if recs and k not in recs[0]]
     if missing:
         raise InputError(f"verdict_table: a claim record has no {missing[0]!r}")
-    rows = [{"claim": c["claim"], "reading": c["reading"], "verdict": c["verdict"]} for c in recs
-            if readings is None or c["reading"] in readings]
+    # a register record names its claim as the register does and keeps the row's own words in 'row_claim'
+    rows = [{"claim": c.get("row_claim") or c["claim"], "reading": c["reading"], "verdict": c["verdict"]}
+            for c in recs if readings is None or c["reading"] in readings]
     if not rows:
         raise InputError("verdict_table: no claim under the readings asked for")
     df = pd.DataFrame(rows)

@@ -1202,4 +1202,16 @@ def verdict_grid(claims: list, column: str = "reading") -> pd.DataFrame:
     df = pd.DataFrame([{"claim": parts(c)[0], column: parts(c)[1], "verdict": c.verdict} for c in claims])
     t = df.pivot_table(index="claim", columns=column, values="verdict", aggfunc="first", sort=False)
     t.columns.name = None
+    # words every reading starts with ("batch spread 0.001", "batch spread 0.002", ...) are said once, in the
+    # first column's header, so that the grid fits the page
+    names = [str(c) for c in t.columns]
+    words = names[0].split(" ")
+    k = 0
+    while len(names) > 1 and k < len(words) - 1 and all(n.split(" ")[:k + 1] == words[:k + 1] for n in names):
+        k += 1
+    if k:
+        prefix = " ".join(words[:k])
+        t.columns = [n[len(prefix) + 1:] for n in names]
+        t = t.rename_axis(columns=None)
+        return t.fillna("–").reset_index().rename(columns={"claim": f"claim (by {prefix})"})
     return t.fillna("–").reset_index()          # a claim not judged under that reading among these rows
