@@ -215,6 +215,6 @@ def _grid(args) -> int:
     return 1 if failed else 0
 
 
-#: Command name -> function (the names of :func:`navlib.cli.build_parser`).
+#: Command name -> function (the commands ``navlib.cli.build_parser`` offers).
 COMMANDS = {"examples": _examples, "simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
             "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field}

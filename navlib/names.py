@@ -4,20 +4,20 @@ example files shipped with navlib.  Each list equals the library's own registry 
 keeps them equal)."""
 from __future__ import annotations
 
-#: The systems of the workbench (:data:`navlib.workbench.SYSTEMS`; a test keeps the two equal).
+#: The systems of the workbench (``navlib.workbench.SYSTEMS``; a test keeps the two equal).
 SYSTEM_NAMES = ("accelerometer", "compass", "drift", "magnetometer", "magnetometer_free")
 #: The systems ``rates`` simulates (:data:`navlib.workbench.rates.RATE_SYSTEMS`).
 RATE_SYSTEM_NAMES = ("accelerometer", "compass", "drift", "magnetometer", "magnetometer_free")
-#: ``calibrate``'s default model (:data:`navlib.workbench.calibration.DEFAULT_MODEL`).
+#: ``calibrate``'s default model (``navlib.workbench.calibration.DEFAULT_MODEL``).
 CALIBRATION_MODEL = ("hard_iron", "scale", "soft_iron")
 #: ``rates``' default effect sizes (:data:`navlib.workbench.rates.DEFAULT_RATIOS`).
 RATE_RATIOS = (3.0, 10.0)
 #: ``rates``' default noise per system, in the system's unit (:data:`navlib.workbench.rates.DEFAULT_NOISE`).
 RATE_NOISE = {"compass": 0.1, "drift": 1e-4, "magnetometer": 0.3, "accelerometer": 0.003, "magnetometer_free": 0.3}
-#: The unit of each system's noise in ``rates`` (:attr:`navlib.workbench.System.unit`).
+#: The unit of each system's noise in ``rates`` (``navlib.workbench.System.unit``).
 RATE_UNITS = {"compass": "deg", "drift": "deg/h", "magnetometer": "uT", "accelerometer": "mg",
               "magnetometer_free": "uT"}
-#: The date of the field when none is given (:attr:`navlib.sensors.earth_field.Site.date`).
+#: The date of the field when none is given (``navlib.sensors.earth_field.Site.date``).
 FIELD_DATE = "2025-01-01"
 #: The example files shipped with navlib (``navlib examples``; ``--example NAME`` instead of FILE): name ->
 #: (system, file among navlib's data files, one command that runs on it).
