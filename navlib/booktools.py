@@ -1426,8 +1426,9 @@ def _capture(chrome, session, metrics: dict, height: int, png: Path) -> None:
         # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
         chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
                     "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
-        shot = chrome.send("Page.captureScreenshot", {"format": "png", "captureBeyondViewport": True},
-                           session=session)
+        # the viewport is the whole page: no captureBeyondViewport, which lays a long chapter out again
+        # without its left sidebar and shifted left (seen on every chapter page)
+        shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
         png.write_bytes(base64.b64decode(shot["data"]))
         return
     chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session)

@@ -129,6 +129,12 @@ def test_noise_claims_give_one_verdict_per_level_and_the_permitted_noise():
     grid = D.verdict_grid(cl, "noise")
     # the words every reading starts with are said once, in the first header
     assert list(grid.columns) == ["claim (by held-out temperatures, noise)", "1 ug", "10 ug"]
+    # or one row per reading
+    flip = D.verdict_grid(cl, "noise", rows="readings")
+    assert list(flip["noise"]) == ["held-out temperatures, noise 1 ug", "held-out temperatures, noise 10 ug"]
+    assert len(flip.columns) == 1 + len(grid) and not flip.isna().any().any()
+    with pytest.raises(InputError, match="rows="):
+        D.verdict_grid(cl, "noise", rows="both")
 
 
 # ------------------------------------------------------------------------------------------- unit B

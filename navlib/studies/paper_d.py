@@ -1193,13 +1193,21 @@ def unit_b_spread_claims(ub: pd.DataFrame, params: PaperDParams, paper: pd.DataF
     return out
 
 
-def verdict_grid(claims: list, column: str = "reading") -> pd.DataFrame:
+def verdict_grid(claims: list, column: str = "reading", rows: str = "claims") -> pd.DataFrame:
     """Claims as a grid: one row per claim, one column per reading (its text before a ``;``; what follows,
-    e.g. the boundary of "nearly two orders", goes with the claim), the verdict in each cell."""
+    e.g. the boundary of "nearly two orders", goes with the claim), the verdict in each cell.  ``rows=
+    "readings"``: one row per reading and one column per claim instead (many readings of few claims fit
+    the page that way)."""
+    if rows not in ("claims", "readings"):
+        raise InputError(f"verdict_grid: rows={rows!r}: 'claims' or 'readings'")
     def parts(c):
         head, _, tail = c.reading.partition(";")
         return (c.claim + (f" ({tail.strip()})" if tail.strip() else ""), head.strip())
     df = pd.DataFrame([{"claim": parts(c)[0], column: parts(c)[1], "verdict": c.verdict} for c in claims])
+    if rows == "readings":
+        t = df.pivot_table(index=column, columns="claim", values="verdict", aggfunc="first", sort=False)
+        t.columns.name = None
+        return t.fillna("–").reset_index()
     t = df.pivot_table(index="claim", columns=column, values="verdict", aggfunc="first", sort=False)
     t.columns.name = None
     # words every reading starts with ("batch spread 0.001", "batch spread 0.002", ...) are said once, in the
