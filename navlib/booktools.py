@@ -474,6 +474,40 @@ def is_chapter_page(rel: Path) -> bool:
     return rel.parts[0] == "_generated" and not rel.name.startswith("api_")
 
 
+#: Typographic characters a command copied from a page must not contain (an en or em dash for ``--``,
+#: curly quotes for straight ones).
+_TYPOGRAPHIC = re.compile("[\u2013\u2014\u2018\u2019\u201c\u201d]")
+
+
+def check_api_page(text: str, cli_page: bool = False) -> list[str]:
+    """Problems of one API page: a ``Type:`` field (napoleon split a constant's description at a colon:
+    ``book/_ext/navbook_attrdoc.py``); on the command line's page (``cli_page``), an option written with a
+    typographic dash or quote, or an option of a command line that the command's parser does not have
+    (each line of the page that starts with a command name)."""
+    out = []
+    n = text.count('Type<span class="colon">:</span>')
+    if n:
+        out.append(f"{n} description(s) split into a 'Type:' field")
+    if not cli_page:
+        return out
+    from .cli import build_parser
+    sub = next(a for a in build_parser()._actions if a.dest == "command").choices
+    body = html.unescape(re.sub(r"<[^>]+>", "", re.sub(r"</(?:p|dt|dd|li|pre|div)>|<br\s*/?>", "\n", text)))
+    for line in body.splitlines():
+        words = line.split()
+        if not words or words[0] not in sub:
+            continue
+        if _TYPOGRAPHIC.search(line):
+            out.append(f"a command with a typographic dash or quote: {line.strip()[:70]!r}")
+            continue
+        known = {s for a in sub[words[0]]._actions for s in a.option_strings}
+        for w in words[1:]:
+            opt = w.strip("[]").split("=")[0]
+            if opt.startswith("--") and opt not in known:
+                out.append(f"'{words[0]}' has no option {opt}: {line.strip()[:70]!r}")
+    return out
+
+
 def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) -> int:
     """Run :func:`check_page` on every built page; print each problem as ``page: problem``; 1 if any."""
     found: list[tuple[str, str]] = []
@@ -483,6 +517,8 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
         text = page.read_text(encoding="utf-8", errors="replace")
         rel = page.relative_to(html_dir)
         found += [(rel.as_posix(), p) for p in check_page(text, content=rel.parts[0] != "_modules")]
+        if rel.name.startswith("api_"):
+            found += [(rel.as_posix(), p) for p in check_api_page(text, cli_page=rel.name == "api_cli.html")]
         if is_chapter_page(rel):                       # the chapters (executed notebooks)
             found += [(rel.as_posix(), p) for p in check_chapter_opening(text) + check_chapter_closing(text)]
             chapter_pages[rel.as_posix()] = text

@@ -101,3 +101,25 @@ def test_other_builders_show_the_page_unfolded(tmp_path):
     txt = (out / "index.txt").read_text()
     assert "How it was found." in txt and "More evidence." in txt and "Tuning detail." in txt
     assert "The evidence" not in txt and "How the filter was tuned" not in txt
+
+
+# ------------------------------------------------------------------ book/_ext/navbook_attrdoc.py
+def test_a_constant_description_split_by_napoleon_is_made_whole():
+    sys.path.insert(0, str(EXT))
+    try:
+        from navbook_attrdoc import rejoin
+    finally:
+        sys.path.remove(str(EXT))
+    napoleon = pytest.importorskip("sphinx.ext.napoleon")
+    text = ["The output must change by 1000 mg per g within this factor (paper D's units: 1001.7 and",
+            "1002.2 mg/g); outside it the output is in another unit."]
+    lines = napoleon.NumpyDocstring(list(text), napoleon.Config(), what="data", name="X").lines()
+    assert any(ln.startswith(":type: ") for ln in lines)                  # napoleon splits it
+    rejoin(lines)
+    assert not any(ln.startswith(":type: ") for ln in lines)
+    assert " ".join(" ".join(lines).split()) == " ".join(" ".join(text).split())
+    plain = ["No colon on this line", "but one: on the next."]
+    lines = napoleon.NumpyDocstring(list(plain), napoleon.Config(), what="data", name="X").lines()
+    before = list(lines)
+    rejoin(lines)
+    assert lines == before

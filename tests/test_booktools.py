@@ -337,3 +337,19 @@ def test_compare_results_compares_tables_of_records_exactly(tmp_path):
     assert compare_results(json.loads(path.read_text()), res, "demo") == []
     with pytest.raises(Exception, match="reserved"):
         report.write_results("demo2", claims=[claim], folder=tmp_path, tables={"claims": rows})
+
+
+def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run():
+    from navlib.booktools import check_api_page
+    ok = ("<dl><dt>loop SYSTEM FILE.csv --model START [--json] [--report DIR]</dt>"
+          "<dd><p>the whole loop</p></dd><dt>field --site LAT,LON [--date YYYY-MM-DD] [--json]</dt></dl>")
+    assert check_api_page(ok, cli_page=True) == []
+    dash = ok.replace("[--json] [--report", "[\u2013json] [--report")
+    assert any("typographic" in p for p in check_api_page(dash, cli_page=True))
+    quote = ok.replace("--model START", "--model \u201cSTART\u201d")
+    assert any("typographic" in p for p in check_api_page(quote, cli_page=True))
+    unknown = ok.replace("[--report DIR]", "[--reprot DIR]")
+    assert any("no option --reprot" in p for p in check_api_page(unknown, cli_page=True))
+    split = '<dt class="field-odd">Type<span class="colon">:</span></dt><dd>The output must</dd>'
+    assert check_api_page(split) == ["1 description(s) split into a 'Type:' field"]
+    assert check_api_page(ok) == []                       # commands are checked on the CLI page only
