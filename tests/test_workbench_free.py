@@ -231,7 +231,10 @@ def test_bad_input_one_line_exit_2(sim, tmp_path, capsys):
     flat = raw.copy()
     t = np.linspace(0, 2 * np.pi, len(flat))
     flat["mag_x_ut"], flat["mag_y_ut"], flat["mag_z_ut"] = 40 * np.cos(t), 40 * np.sin(t), 5 + 0.01 * t
-    assert "distinct orientations" in run(flat)
+    # a circle of directions: enough 30-deg cells, no spread out of its plane; only what failed is named
+    assert MF.orientation_cells(flat) >= MF.MIN_ORIENTATIONS
+    said = run(flat)
+    assert "smallest spread of the field's directions" in said and "distinct orientations" not in said
     assert "unknown magnetometer_free effect" in run(raw, "--model", "hard_iron,wobble")
     few = raw.iloc[::12]                                # 25 rows: too few for the loader
     assert "rows" in run(few)
@@ -244,8 +247,9 @@ def test_bad_input_one_line_exit_2(sim, tmp_path, capsys):
     assert "a calibration of the system 'compass'" in capsys.readouterr().err
     # too few distinct orientations for a model with more parameters than cells
     part = sim.iloc[:40]
-    with pytest.raises(InputError, match="distinct orientations"):
+    with pytest.raises(InputError, match="distinct orientations") as err:
         MF.check_orientations(part, "part", needed=MF.orientation_cells(part) + 1)
+    assert (MF.orientation_spread(part) >= MF.MIN_SPREAD) == ("spread" not in str(err.value))
 
 
 # IGRF: published values of the NOAA/NCEI geomagnetic calculator (model IGRF2020, calculator 0.5.1.11) at

@@ -288,11 +288,16 @@ def check_orientations(frame: pd.DataFrame, name: str = "data") -> None:
     north = C[:, :, 0]
     cells = {tuple(v) for v in np.round(np.column_stack([down, north]) * 2).astype(int)}
     tilt = np.degrees(np.arccos(np.clip(down[:, 2], -1, 1)))
-    if len(cells) < MIN_ORIENTATIONS or np.max(np.abs(tilt - np.median(tilt))) < MIN_TILT_DEG:
-        raise InputError(f"{name}: columns q_w..q_z, rows 1..{len(frame)}: only {len(cells)} distinct "
-                         f"orientations (30-deg cells) and a tilt range of {np.ptp(tilt):.1f} deg; at least "
-                         f"{MIN_ORIENTATIONS} and a tilt of {MIN_TILT_DEG:g} deg are needed to separate hard "
-                         f"iron from the local field")
+    failed = []
+    if len(cells) < MIN_ORIENTATIONS:
+        failed.append(f"only {len(cells)} distinct orientations (30-deg cells; at least {MIN_ORIENTATIONS} "
+                      f"are needed)")
+    if np.max(np.abs(tilt - np.median(tilt))) < MIN_TILT_DEG:
+        failed.append(f"a tilt of at most {np.max(np.abs(tilt - np.median(tilt))):.1f} deg from the median "
+                      f"(at least {MIN_TILT_DEG:g} deg is needed)")
+    if failed:
+        raise InputError(f"{name}: columns q_w..q_z, rows 1..{len(frame)}: {' and '.join(failed)}, to separate "
+                         f"hard iron from the local field")
 
 
 def _rotation(theta_deg) -> np.ndarray:

@@ -234,12 +234,20 @@ def orientation_spread(frame: pd.DataFrame) -> float:
 
 
 def check_orientations(frame: pd.DataFrame, name: str, needed: int = MIN_ORIENTATIONS) -> None:
+    """Refuse data whose field directions cannot separate the model's parameters, naming each limit that
+    failed with its value: at least ``needed`` distinct 30-deg cells of the field's direction, and a
+    smallest spread (:func:`orientation_spread`) of at least :data:`MIN_SPREAD`."""
     cells, spread = orientation_cells(frame), orientation_spread(frame)
-    if cells < needed or spread < MIN_SPREAD:
-        raise InputError(f"{name}: columns mag_x_ut..mag_z_ut: only {cells} distinct orientations (30-deg cells "
-                         f"of the field's direction; smallest spread {spread:.3f}); the model needs at least "
-                         f"{needed} and a spread of {MIN_SPREAD:g} (turn the sensor through all directions, "
-                         f"not about one axis)")
+    failed = []
+    if cells < needed:
+        failed.append(f"only {cells} distinct orientations (30-deg cells of the field's direction; the model "
+                      f"needs at least {needed})")
+    if spread < MIN_SPREAD:
+        failed.append(f"a smallest spread of the field's directions of {spread:.3f} (the model needs at least "
+                      f"{MIN_SPREAD:g}: the directions lie near a plane or a line)")
+    if failed:
+        raise InputError(f"{name}: columns mag_x_ut..mag_z_ut: {' and '.join(failed)}; turn the sensor through "
+                         f"all directions, not about one axis")
 
 
 def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
