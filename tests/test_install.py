@@ -30,7 +30,7 @@ from packaging.version import Version
 
 ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ("pyproject.toml", "README.md", "navlib", "data")     # what the wheel is built from
-CORE = {"numpy", "scipy", "pandas", "matplotlib", "numba", "ppigrf"}
+CORE = {"numpy", "scipy", "pandas", "matplotlib", "numba", "ppigrf", "threadpoolctl"}
 EXTRA_ONLY = {"torch", "dask", "distributed", "papermill", "nbformat", "nbval", "jupyter-book", "myst-nb",
               "ipykernel", "sphinx-mathjax-offline", "sphinxcontrib-bibtex", "pytest"}
 #: modules the command line must not import (optional extras and the book's build tooling)

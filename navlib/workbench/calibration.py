@@ -37,12 +37,14 @@ from .fit import fit_model
 from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, check_units, correction_matrix,
                                 field_summary, free_columns, full_params, has_acc, load_free, site_of)
 from .screen import screen
+from ..threads import one_blas_thread
 
 FORMAT = "navlib calibration"
 VERSION = 1
 DEFAULT_MODEL = ("hard_iron", "scale", "soft_iron")
 
 
+@one_blas_thread
 def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=None, date=None) -> dict:
     """The calibration of ``data`` (a frame of :func:`navlib.workbench.magnetometer_free.load_free`) with
     the effects ``model``, as a JSON-ready dict (module docstring); where the site is known (``site`` =

@@ -72,6 +72,7 @@ from .effects import testable
 from .fit import Fit, drift_design, orth_basis
 from .screen import Screening, screen as screen_data
 from .serial import NoiseModel
+from ..threads import one_blas_thread
 
 SMALL_SAMPLE = 12
 # Family-wise false-alarm level. Bonferroni keeps the false-alarm rate at or below alpha; the users' target
@@ -481,6 +482,7 @@ def _f_p(drop: np.ndarray, rss1: np.ndarray, q: int, df2: int) -> np.ndarray:
     return np.where(rss1 > 0, fdtrc(q, df2, f), np.where(drop > 0, 0.0, 1.0))
 
 
+@one_blas_thread
 def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:
     """Rank the effects not yet in ``fit`` by the evidence that adding each explains the residuals; name the
     one to add, or say the residuals are consistent with noise, or name the structure no effect explains.

@@ -27,6 +27,7 @@ from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
 from .effects import (COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, call_contribution, get_system,
                       register_system, resolve)
 from .serial import ar1_noise
+from ..threads import one_blas_thread
 
 RAD = 180.0 / np.pi
 
@@ -135,6 +136,7 @@ class Fit:
                 f"max ({self.unit})": float(self.residuals.max()), f"held-out rms ({self.unit})": self.loo_rms}
 
 
+@one_blas_thread
 def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
               user_effects: tuple[Effect, ...] = ()) -> Fit:
     """Fit the named effects of ``system`` (a name or a :class:`.System`) to ``data`` (a validated frame,

@@ -20,6 +20,7 @@ from .diagnose import Diagnosis, diagnose
 from .effects import Effect
 from .fit import Fit, fit_model
 from .screen import Screening, screen
+from ..threads import one_blas_thread
 
 
 @dataclass
@@ -99,6 +100,7 @@ class LoopResult:
         return out
 
 
+@one_blas_thread
 def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effect, ...] = (),
          alpha: float | None = None, max_steps: int = 8) -> LoopResult:
     """Run the workbench loop on ``data``.
