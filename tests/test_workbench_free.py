@@ -77,16 +77,18 @@ def test_noise_model_on_the_sensor_axes_not_on_the_invariants(seed):
     """AR(1) noise of 0.9 on the axes, seen through the turning field direction: an AR model of the
     invariants' residuals runs to its bound (0.995) on these seeds -- the cause of the false alarms --
     while the projected model (the system's noise_directions hook) recovers the axes' correlation."""
-    from dataclasses import replace
     from navlib.workbench.screen import screen
-    from navlib.workbench.serial import KAPPA_MAX, select
+    from navlib.workbench.serial import KAPPA_MAX, select, series_of
     d = MF.simulate_free({"hard_x_ut": 5.0}, duration_s=20.0, noise_ut=NOISE, noise_correlation=0.9,
                          seed=np.random.SeedSequence(seed))
     sc = screen(fit_model("magnetometer_free", d, ["hard_iron"]))
     ser = sc.noise.series
     assert ser.projection is not None and sc.noise.order == 1
     assert 0.85 < sc.noise.lag1 < 0.96
-    ar = select(sc.rich.residuals, *sc.regressors, replace(ser, projection=None))
+    # the AR model of each invariant in time (the series axis-major, as without a projection; the projected
+    # series is time-major), on the same observations
+    axis_major = series_of(sc.rich.data, sc.rich.n, sc.rich.system).without(~np.isin(np.arange(sc.rich.n), ser.order))
+    ar = select(sc.rich.residuals, *sc.regressors, axis_major)
     assert ar.lag1 > KAPPA_MAX - 1e-3
 
 
@@ -96,8 +98,8 @@ def test_projected_whitening_is_the_inverse_of_colouring():
     n = 40
     d = rng.standard_normal((2 * n, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    order = np.r_[np.arange(0, 2 * n, 2), np.arange(1, 2 * n, 2)]
-    ser = Series(order, np.tile(np.arange(n), 2), "time_s", Projection(d, np.repeat(np.arange(n, dtype=float), 2)))
+    order = np.arange(2 * n)                     # a projected series is time-major (serial.with_projection)
+    ser = Series(order, order, "time_s", Projection(d, np.repeat(np.arange(n, dtype=float), 2)))
     u = rng.standard_normal((2 * n, 5))
     x = colour(u, (0.8,), ser, 2 * n)
     assert np.allclose(whiten(x, (0.8,), ser), u)

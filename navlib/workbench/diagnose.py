@@ -224,9 +224,10 @@ def _f_test(rss0: float, rss1: float, q: int, df2: int) -> tuple[float, float]:
 def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n_random: int = 5000) -> float:
     """Permutation test of a drift covariate: shuffle the candidate's column across rows (every
     permutation when n! <= 5040, else ``n_random`` random ones) and count how often the shuffled column
-    removes at least as much RSS as the real one.  Vectorised: with ``M0`` the residual maker of the
-    current design, a column ``x`` removes ``(x' M0 y)^2 / (x' M0 x)``.  Bias (a constant) cannot be
-    permuted: returns None and the F test is used."""
+    removes at least as much RSS as the real one.  Vectorised: with ``M0 = I - Q Q'`` the residual maker
+    of the current design (``Q`` an orthonormal basis of it; ``M0`` is never formed), a column ``x``
+    removes ``(x' M0 y)^2 / (x' M0 x)``.  Bias (a constant) cannot be permuted: returns None and the F test
+    is used."""
     col = {"earth_rate": "latitude_error_deg", "temperature": "temperature_c",
            "temperature_change": "temperature_change_c"}.get(effect)
     if col is None:
@@ -237,7 +238,7 @@ def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n
     x1, _ = drift_design(data, (effect,))
     x1 = x1[:, 0]
     n = len(y)
-    M0 = np.eye(n) - (X0 @ np.linalg.pinv(X0) if X0.shape[1] else 0.0)
+    Q = orth_basis(X0) if X0.shape[1] else np.zeros((n, 0))
     if math.factorial(n) <= 5040:
         perms = np.array(list(permutations(range(n))))
         exact = True
@@ -246,8 +247,9 @@ def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n
         perms = np.array([rng.permutation(n) for _ in range(n_random)])
         exact = False
     Xp = x1[perms]                                    # (P, n) permuted columns (centring is invariant)
-    a = Xp @ (M0 @ y)
-    b = np.einsum("pn,pn->p", Xp @ M0, Xp)
+    Mx = Xp - (Xp @ Q) @ Q.T                           # M0 x of each permuted column (M0 symmetric, idempotent)
+    a = Mx @ y
+    b = np.einsum("pn,pn->p", Mx, Mx)
     drops = np.where(b > 1e-300, a ** 2 / np.where(b > 1e-300, b, 1.0), 0.0)
     hits = np.sum(drops >= observed_drop * (1 - 1e-9))
     return float(hits / len(perms)) if exact else float((1 + hits) / (1 + len(perms)))
@@ -406,7 +408,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
     minima = np.empty(0)
     # a projected noise model (:class:`navlib.workbench.serial.Projection`) re-estimates every replicate on
-    # one grid of Cholesky factors: all replicates in one batch
+    # one grid of filters (each a pass over the series): all replicates in one batch
     batch = B if ser.projection is not None else _BATCH
     for start in range(0, B, batch):
         E = colour(U[:, start:start + batch], noise.kappa, ser, fit.n)

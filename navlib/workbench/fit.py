@@ -175,7 +175,7 @@ def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
     """An orthonormal basis of the column space of ``X``: columns are scaled to unit norm and a column is
     dropped when less than ``rtol`` of it is left after removing the previous ones."""
     n, k = X.shape
-    Q = np.zeros((n, k))
+    Q = np.zeros((n, k), order="F")                  # columns contiguous: Q[:, :r] is one block
     r = 0
     for j in range(k):
         v = X[:, j].astype(float)
@@ -190,7 +190,7 @@ def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
         if left > rtol:
             Q[:, r] = v / left
             r += 1
-    return Q[:, :r]
+    return np.ascontiguousarray(Q[:, :r])
 
 
 def lstsq(X: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -39,9 +39,19 @@ through the directions::
     Cov(x_i, x_j) = s^2 kappa^|t_i - t_j| (d_i . d_j)
                                      (positive definite: a Schur product)
 
-Whitening and colouring use the Cholesky factor of this matrix (exact GLS for the invariants), and its REML
-likelihood is computed from the same factor; the order is 0 or 1 (AIC), the rest of the machinery --
-tests, bootstrap, intervals -- unchanged.
+Whitening and colouring are those of the Cholesky factor of this matrix (exact GLS for the invariants), and
+its REML likelihood uses ``log det R`` of the same factor; the order is 0 or 1 (AIC), the rest of the
+machinery -- tests, bootstrap, intervals -- unchanged.  The matrix is never formed: the model is a state-space
+model (the 3-axis noise is the state, each residual a scalar observation of it), and a Kalman filter over
+the observations in time order gives the innovations, whose standardised values are exactly ``L^-1 x`` for
+the Cholesky factor ``L`` in that order, with ``log det R = sum log S_i`` (:mod:`navlib.workbench.innovations`;
+O(n) time and memory instead of O(n^3) and O(n^2)).  A filter needs time order, so a projected series is
+ordered *time-major* (:func:`with_projection`): the observations of each row together, rows in time order
+(row 0's axes, row 1's axes, ...), where any other series is axis-major (each axis in time order, one
+after the other).  Whitened vectors (``W x``), the bootstrap's unit draws (:func:`colour`) and ``pos`` are
+in that order; no consumer depends on it (the tests use sums of squares and projections of whitened
+vectors, and colour returns observation order), and the GLS quantities (``RSS_W``, the likelihood, the F
+tests) do not depend on the order at all.
 
 **The estimate.**  The kappas maximise the *restricted* (REML) log likelihood of the residual ``r`` given
 the regressors ``X`` (the columns a least-squares fit has already taken out of it: the model's Jacobian
@@ -65,9 +75,10 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 from scipy import stats
-from scipy.linalg import solve_triangular
 from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
+
+from . import innovations
 
 #: A time step more than this many times the median step starts a new segment.
 GAP_FACTOR = 2.5
@@ -101,9 +112,11 @@ class Projection:
 @dataclass(frozen=True)
 class Series:
     """Where the observations of a residual vector sit in time: ``order`` lists observation indices axis by
-    axis, each axis in time order; ``pos`` is each ordered observation's place in its segment (0 starts a
-    segment); ``source`` says what ordered them (``"time_s"`` or ``"file order"``); ``projection``: the
-    residuals are a turning projection of axis-wise noise (:class:`Projection`), or None."""
+    axis, each axis in time order -- or, with a ``projection``, time-major: rows in time order, each row's
+    observations together (:func:`with_projection`); ``pos`` is each ordered observation's place in its
+    segment (0 starts a segment); ``source`` says what ordered them (``"time_s"`` or ``"file order"``);
+    ``projection``: the residuals are a turning projection of axis-wise noise (:class:`Projection`), or
+    None."""
 
     order: np.ndarray
     pos: np.ndarray
@@ -160,7 +173,9 @@ def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
 def with_projection(series: Series | None, data: pd.DataFrame, directions: np.ndarray) -> Series | None:
     """``series`` with the :class:`Projection` of residuals that see axis-wise noise along ``directions``
     ((n_obs, 3), observation order, rows flattened as the systems do): each observation's clock is its
-    row's ``time_s`` over the median time step (a series in file order: the row number)."""
+    row's ``time_s`` over the median time step (a series in file order: the row number).  The series is
+    reordered time-major (rows in time order, each row's observations together: the order of the filter,
+    module docstring); a segment starts where one of ``series``'s started."""
     if series is None:
         return None
     d = np.asarray(directions, float)
@@ -173,12 +188,26 @@ def with_projection(series: Series | None, data: pd.DataFrame, directions: np.nd
         t = (t - t.min()) / (float(np.median(steps)) if steps.size else 1.0)
     else:
         t = np.arange(n, dtype=float)
-    return replace(series, projection=Projection(d, np.repeat(t, axes)))
+    clock = np.repeat(t, axes)
+    old = series.order
+    starts = np.zeros(n * axes, bool)
+    starts[old[series.pos == 0]] = True               # observations that started a segment
+    row = old // axes
+    first = np.full(n, len(old))                      # each row's place in time: its first in ``old``
+    np.minimum.at(first, row, np.arange(len(old)))
+    order = old[np.lexsort((old % axes, first[row]))]
+    row = order // axes
+    start = starts[order] & np.r_[True, row[1:] != row[:-1]]
+    start[0] = True
+    seg = np.cumsum(start) - 1
+    pos = np.arange(len(order)) - np.flatnonzero(start)[seg]
+    return Series(order, pos, series.source, Projection(d, clock))
 
 
-#: Cholesky factors of projected correlation matrices kept (:func:`_projected_factor`).
-_KEEP_FACTORS = 6
-_FACTORS: dict = {}
+#: Filters of projected series kept (:func:`_projected_gains`).
+_KEEP_GAINS = 6
+_GAINS: dict = {}
+_INPUTS: dict = {}
 
 
 def regular_clock(series: Series) -> bool:
@@ -188,38 +217,30 @@ def regular_clock(series: Series) -> bool:
     return bool(np.allclose(c, np.round(c), atol=1e-6))
 
 
-def _projected_factor(kappa, series: Series) -> np.ndarray:
-    """Lower Cholesky factor of the projected model's correlation matrix (module docstring) over the
-    observations of ``series``, in series order (AR(1): ``kappa[0]``); the last few are kept."""
+def _projected_gains(kappa, series: Series) -> innovations.Gains:
+    """The Kalman filter of the projected model (module docstring; :mod:`navlib.workbench.innovations`)
+    over the observations of ``series``, in series order (time-major), AR(1): ``kappa[0]``; the last few
+    are kept (a likelihood's optimiser and a bootstrap come back to the same ones)."""
     k = float(kappa[0])
     key = (id(series), k)
-    hit = _FACTORS.get(key)
+    hit = _GAINS.get(key)
     if hit is not None and hit[0] is series:
         return hit[1]
-    pr = series.projection
-    d = pr.directions[series.order]
-    t = pr.clock[series.order]
-    lag = np.abs(t[:, None] - t[None, :])
-    rho = np.abs(k) ** lag
-    if k < 0:
-        if not regular_clock(series):
-            raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
-        rho = rho * np.where(np.round(lag) % 2 == 1, -1.0, 1.0)
-    K = rho * (d @ d.T)
-    jitter = 1e-10 * np.mean(np.diag(K))                            # round-off only
-    for _ in range(4):
-        K[np.diag_indices_from(K)] += jitter
-        try:
-            L = np.linalg.cholesky(K)
-            break
-        except np.linalg.LinAlgError:                               # near the bound: numerically singular
-            jitter *= 100.0
-    else:
-        raise np.linalg.LinAlgError("projected noise covariance is not positive definite")
-    if len(_FACTORS) >= _KEEP_FACTORS:
-        _FACTORS.pop(next(iter(_FACTORS)))
-    _FACTORS[key] = (series, L)
-    return L
+    inputs = _INPUTS.get(id(series))
+    if inputs is None or inputs[0] is not series:       # the clock and directions in series order, once
+        pr = series.projection
+        inputs = (series, pr.clock[series.order], np.ascontiguousarray(pr.directions[series.order], float),
+                  regular_clock(series))
+        _INPUTS.clear()
+        _INPUTS[id(series)] = inputs
+    _, clock, d, regular = inputs
+    if k < 0 and not regular:
+        raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
+    g = innovations.gains(k, clock, d)
+    if len(_GAINS) >= _KEEP_GAINS:
+        _GAINS.pop(next(iter(_GAINS)))
+    _GAINS[key] = (series, g)
+    return g
 
 
 def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) -> np.ndarray:
@@ -261,7 +282,7 @@ def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
     if p == 0:
         return xo
     if series.projection is not None:
-        return solve_triangular(_projected_factor(kappa, series), xo, lower=True, check_finite=False)
+        return innovations.whiten_columns(_projected_gains(kappa, series), xo)
     phi, v = levinson(kappa)
     m = len(xo)
     out = xo.copy()
@@ -295,7 +316,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
         out[series.order] = u
         return out
     if series.projection is not None:
-        out[series.order] = _projected_factor(kappa, series) @ u
+        out[series.order] = innovations.colour_columns(_projected_gains(kappa, series), u)
         return out
     phi, v = levinson(kappa)
     x = np.empty_like(u)
@@ -486,13 +507,13 @@ class _Restricted:
 
 class _ProjectedLik:
     """:class:`_Restricted` for a series with a :class:`Projection`: the same REML and plain likelihoods,
-    from the Cholesky factor of the projected correlation matrix (AR order 0 or 1)."""
+    from the Kalman filter of the projected model (AR order 0 or 1): ``[Q, r]`` whitened, ``log det R`` the
+    sum of the log innovation variances."""
 
     def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series):
-        self.r = np.asarray(r, float)[series.order]
-        self.Q = np.asarray(Q, float)[series.order]
+        self.Z = np.column_stack([np.asarray(Q, float), np.asarray(r, float)])[series.order]   # [Q, r]
         self.series = series
-        self.n, self.k = len(self.r), self.Q.shape[1]
+        self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -506,11 +527,11 @@ class _ProjectedLik:
         if len(kappa) > 1:
             raise ValueError("the projected noise model is of order 0 or 1")
         if len(kappa):
-            L = _projected_factor(kappa, self.series)
-            w = solve_triangular(L, np.column_stack([self.Q, self.r]), lower=True, check_finite=False)
-            logdet_r = 2.0 * float(np.sum(np.log(np.diag(L))))
+            g = _projected_gains(kappa, self.series)
+            w = innovations.whiten_columns(g, self.Z)
+            logdet_r = g.logdet
         else:
-            w, logdet_r = np.column_stack([self.Q, self.r]), 0.0
+            w, logdet_r = self.Z, 0.0
         rss, logdet_g = _rss_g(w.T @ w, self.k)
         return rss, logdet_r, logdet_g
 
@@ -773,26 +794,26 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
 
 #: The grid of lag-1 correlations of the projected model's bootstrap re-estimates (:func:`projected_grid`):
 #: every fourth point of :data:`AR1_GRID` (spacing 0.1 in ``atanh(kappa)``, 0.02 in ``kappa`` near 0.9),
-#: since each point costs a Cholesky factor of the whole series.
+#: since each point costs a pass of the filter over every replicate.
 PROJECTED_GRID = AR1_GRID[::4]
 
 
 def projected_grid(E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID) -> list:
     """:func:`ar1_grid` for a series with a :class:`Projection`: for each regressor basis of ``bases``,
-    ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one Cholesky factor per grid point, shared."""
+    ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one filter per grid point, shared."""
     Ze = np.asarray(E, float)[series.order]
     Qs = [np.asarray(Q, float)[series.order] for Q in bases]
     n, B = Ze.shape
     out = [(np.empty((len(grid), B)), np.empty((len(grid), B))) for _ in Qs]
     for g, phi in enumerate(grid):
-        L = _projected_factor((float(phi),), series)
-        logdet_r = 2.0 * float(np.sum(np.log(np.diag(L))))
-        we = solve_triangular(L, Ze, lower=True, check_finite=False)
+        gains = _projected_gains((float(phi),), series)
+        logdet_r = gains.logdet
+        we = innovations.whiten_columns(gains, Ze)
         ee = np.einsum("ij,ij->j", we, we)
         for (reml, ml), Q in zip(out, Qs):
             k = Q.shape[1]
             if k:
-                wq = solve_triangular(L, Q, lower=True, check_finite=False)
+                wq = innovations.whiten_columns(gains, Q)
                 ev, U = np.linalg.eigh(wq.T @ wq)
                 ev = np.maximum(ev, 1e-300)
                 z = (U.T @ (wq.T @ we)) / np.sqrt(ev)[:, None]
