@@ -169,6 +169,8 @@ def _calibrate(args) -> int:
         from .workbench.calibration import field_lines
         print("\n".join(field_lines(cal["field"])))
     print(f"wrote {path}")
+    for w in cal.get("warnings", ()):
+        print(f"navlib calibrate: warning: {w}", file=sys.stderr)
     return 0
 
 

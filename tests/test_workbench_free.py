@@ -308,3 +308,22 @@ def test_conventions_example_and_the_heading_claim():
     assert wb.free_vs_reference_claim(heads(-0.1 - 0.01 * np.arange(8))).verdict == "reproduced"
     assert wb.free_vs_reference_claim(heads(0.1 + 0.01 * np.arange(8))).verdict == "not reproduced"
     assert wb.free_vs_reference_claim(heads(0.1 * np.tile([-1.0, 1.0], 4))).verdict == "cannot be judged"
+
+
+def test_an_accelerated_sensor_is_warned_about(sim, tmp_path, capsys):
+    """The dip constraint takes a/|a| for the vertical: a recording whose accelerometer saw more than gravity
+    (fast hand motion) gets a warning in the calibration and on stderr; a still or slowly turned one none."""
+    assert MF.accelerometer_motion(sim) is None
+    moved = sim.copy()
+    rng = np.random.default_rng(3)
+    jolt = rng.random(len(moved)) < 0.3
+    moved.loc[jolt, list(MF.ACC)] += rng.normal(0, 4.0, (int(jolt.sum()), 3))
+    said = MF.accelerometer_motion(moved)
+    assert said is not None and "accelerated" in said and "acc_x_ms2" in said
+    src = tmp_path / "moved.csv"
+    moved.drop(columns=list(MF.DERIVED)).to_csv(src, index=False)
+    capsys.readouterr()
+    assert main(["calibrate", "magnetometer", str(src), "--out", str(tmp_path / "cal.json")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("navlib calibrate: warning: columns acc_x_ms2")
+    assert json.loads((tmp_path / "cal.json").read_text())["warnings"] == [said]

@@ -34,8 +34,9 @@ from scipy.spatial.transform import Rotation
 from ..data.tables import read_table, write_new, write_new_csv
 from ..errors import InputError
 from .fit import fit_model
-from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, check_units, correction_matrix,
-                                field_summary, free_columns, full_params, has_acc, load_free, site_of)
+from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, accelerometer_motion, check_units,
+                                correction_matrix, field_summary, free_columns, full_params, has_acc, load_free,
+                                site_of)
 from .screen import screen
 from ..threads import one_blas_thread
 
@@ -118,6 +119,8 @@ def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=No
     }
     if "dip (deg)" in summary:
         out["dip_deg"] = summary["dip (deg)"]
+    moved = accelerometer_motion(data)
+    out["warnings"] = [moved] if moved else []
     where = site_of(data, site, date, source or "data")
     if where is not None:
         out["field"] = field_check(fit, where, noise)

@@ -205,6 +205,31 @@ def has_acc(frame: pd.DataFrame) -> bool:
     return all(c in frame for c in ACC)
 
 
+#: The dip invariant takes the accelerometer's direction for gravity's.  Where the 95th percentile of
+#: ``| |a| - median |a| |`` exceeds this (m/s^2) the sensor was accelerated, not still or slowly turned: 1.5
+#: m/s^2 of non-gravitational acceleration tilts the apparent vertical by up to 9 deg, far more than the dip
+#: constraint tolerates (a free choice, stated; BROAD's slow hand-held trials stay below 1, its fast and
+#: magnet trials reach 2-15).
+ACC_STILL_TOL_MS2 = 1.5
+
+
+def accelerometer_motion(frame: pd.DataFrame) -> str | None:
+    """One sentence when the accelerometer of ``frame`` measured more than gravity (:data:`ACC_STILL_TOL_MS2`),
+    else None (no accelerometer, or a still or slowly turned one)."""
+    if not has_acc(frame):
+        return None
+    g = np.linalg.norm(frame[list(ACC)].to_numpy(float), axis=1)
+    dev = np.abs(g - np.median(g))
+    p95 = float(np.percentile(dev, 95))
+    if p95 <= ACC_STILL_TOL_MS2:
+        return None
+    share = float(np.mean(dev > ACC_STILL_TOL_MS2))
+    return (f"columns {', '.join(ACC)}: |a| departs from gravity by more than {ACC_STILL_TOL_MS2:g} m/s^2 on "
+            f"{100 * share:.0f} % of the rows (95th percentile {p95:.2g} m/s^2): the sensor was accelerated, "
+            f"so the dip constraint, which takes a/|a| for the vertical, is biased; calibrate without the "
+            f"acceleration columns, or on the still or slowly turned part of the recording")
+
+
 def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
     """``frame`` with the derived columns ``field_norm_ut`` (``|m|``) and, with an accelerometer,
     ``field_gravity_ut`` (``a/|a| . m``), the raw values of the two invariants."""
