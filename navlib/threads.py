@@ -4,10 +4,10 @@ The workbench's linear algebra is tall and skinny (QR factors of 100k x 10, 100k
 solves): there a second BLAS thread costs more than it gives, and on a shared 2-core machine OpenBLAS's
 threads stall for 50-400 ms on small solves (issue 34 measured ``calibrate()`` in a Python session at 8-20 s
 with the default threads against 0.6-0.9 s with one).  The command line sets the thread variables before
-numpy loads (:mod:`navlib.__main__`); a library call cannot, because numpy is already loaded.  So the entry
+numpy loads (``navlib.__main__``); a library call cannot, because numpy is already loaded.  So the entry
 points (:func:`navlib.workbench.fit.fit_model`, :func:`~navlib.workbench.diagnose.diagnose`,
 :func:`~navlib.workbench.loop.loop`, :func:`~navlib.workbench.calibration.calibrate`) run under
-:func:`threadpoolctl.threadpool_limits` with one BLAS thread (:func:`one_blas_thread`).
+``threadpoolctl.threadpool_limits`` with one BLAS thread (:func:`one_blas_thread`).
 
 A caller who set a thread count in the environment (``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS``,
 ``MKL_NUM_THREADS``) keeps it: the limit applies only where none is set.  Calls nested inside one entry point

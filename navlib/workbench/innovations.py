@@ -18,7 +18,8 @@ round-off, kept so the numbers are those of the dense code).  So
 state's prediction ``a_i`` (3-vector) and its covariance ``P_i`` (3 x 3) start at ``a = 0``, ``P = I``
 (the stationary law), and for each observation::
 
-    a_i = phi_i a,   P_i = phi_i^2 P + (1 - phi_i^2) I            (phi_i = kappa^(t_i - t_(i-1)); 1 at equal times)
+    a_i = phi_i a,   P_i = phi_i^2 P + (1 - phi_i^2) I
+                     (phi_i = kappa^(t_i - t_(i-1)); 1 at equal times)
     e_i = x_i - d_i . a_i,   S_i = d_i' P_i d_i + delta,   K_i = P_i d_i / S_i
     a = a_i + K_i e_i,       P = P_i - S_i K_i K_i'
 
