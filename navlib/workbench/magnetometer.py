@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation
 from ..angles import wrap_deg
 from ..data.tables import Column, read_table, require_variation, where
 from ..errors import InputError
+from ..methods.ellipsoid import algebraic_ellipsoid
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, lstsq, user_columns, user_design
 from .serial import ar1_noise
@@ -515,19 +516,12 @@ def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
 
     Returns
     -------
-    (W, c) : the 3x3 matrix and the centre (uT)."""
+    (W, c) : the 3x3 matrix and the centre (uT).  (:func:`navlib.methods.ellipsoid.algebraic_ellipsoid`,
+    scaled to the mean radius.)"""
     m = frame[list(MAG)].to_numpy(float)
-    x, y, z = m.T
-    D = np.column_stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z, 2 * x, 2 * y, 2 * z])
-    v = np.linalg.lstsq(D, np.ones(len(m)), rcond=None)[0]
-    M = np.array([[v[0], v[3], v[4]], [v[3], v[1], v[5]], [v[4], v[5], v[2]]])
-    c = -np.linalg.solve(M, v[6:9])
-    M = M / (1.0 + c @ M @ c)
-    w, U = np.linalg.eigh(M)
-    if np.any(w <= 0):
-        raise InputError("the ellipsoid fit is not an ellipsoid (too few orientations)")
+    c, S = algebraic_ellipsoid(m)
     radius = float(np.mean(np.linalg.norm(m - c, axis=1)))
-    return radius * (U @ np.diag(np.sqrt(w)) @ U.T), c
+    return radius * S, c
 
 
 MEASURED["magnetometer"] = (MAG, False)
