@@ -112,3 +112,45 @@ def test_own_data_sections_show_the_schema_sample_rows_and_a_command_that_fits(t
         wb.own_data_report(tmp_path / "rep")
     text = wb.wrap_report("| a | b |\n" + "word " * 40)
     assert max(map(len, text.splitlines())) <= 88 and text.startswith("| a | b |")
+
+
+# ------------------------------------------------------------------- the largest table (issue 34)
+def test_a_table_over_the_row_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    """Every workbench step is linear in the rows, but 2,000,000 rows would still take hours and tens of GB:
+    a file over MAX_ROWS is refused by name, its line count and the limit, before any parsing."""
+    import navlib.data.tables as T
+    from navlib.errors import InputError
+    cols = [T.Column("x", "-", "a number")]
+    ok, big = tmp_path / "ok.csv", tmp_path / "big.csv"
+    ok.write_text("x\n" + "1\n" * 50)
+    big.write_text("x\n" + "1\n" * 51)
+    monkeypatch.setattr(T, "_parse", lambda *a: (_ for _ in ()).throw(AssertionError("parsed")))
+    with pytest.raises(InputError, match=r"big.csv: 51 lines after the header; navlib reads at most 50 rows"):
+        T.read_table(big, cols, max_rows=50)
+    monkeypatch.undo()
+    assert len(T.read_table(ok, cols, max_rows=50)) == 50
+    assert len(T.read_table(big, cols, max_rows=None)) == 51
+    no_newline = tmp_path / "last.csv"
+    no_newline.write_text("x\n" + "1\n" * 49 + "1")            # 50 rows, no final newline
+    assert len(T.read_table(no_newline, cols, max_rows=50)) == 50
+    utf16 = tmp_path / "u16.csv"
+    utf16.write_bytes(("x\n" + "1\n" * 51).encode("utf-16"))
+    with pytest.raises(InputError, match="51 lines"):
+        T.read_table(utf16, cols, max_rows=50)
+    assert T.MAX_ROWS >= 100_000                                 # the 100k-row compass benchmark still loads
+
+
+def test_the_cli_refuses_a_two_million_row_file_in_one_line(tmp_path):
+    import subprocess
+    import sys
+    from navlib.paths import ROOT
+    p = tmp_path / "huge.csv"
+    with open(p, "w") as fh:
+        fh.write("mag_x_ut,mag_y_ut,mag_z_ut\n")
+        fh.write("20.0,1.0,40.0\n" * 2_000_000)
+    r = subprocess.run([sys.executable, "-m", "navlib", "calibrate", "magnetometer", str(p), "--out",
+                        str(tmp_path / "cal.json")], capture_output=True, text=True, timeout=120,
+                       env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin", "OPENBLAS_NUM_THREADS": "1"})
+    assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert "huge.csv: 2,000,000 lines after the header; navlib reads at most" in r.stderr
+    assert not (tmp_path / "cal.json").exists()

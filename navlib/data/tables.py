@@ -88,9 +88,16 @@ def show(text: str) -> str:
     return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
 
 
-def _decode(p: Path, kind: str) -> str:
-    """The file's text.  Compressed, archived or binary files are refused by name; UTF-16 with a byte-order
-    mark is decoded; otherwise UTF-8 (BOM skipped) with undecodable bytes kept as surrogates."""
+#: The most data rows a table may have: every workbench step is linear in the rows (issue 34: a calibration
+#: of 30,000 rows takes about 6 s and 140 MB, a diagnosis of 30,000 rows about 25 s and 0.8 GB on 2 cores),
+#: so 200,000 rows cost minutes and several GB; a larger file is refused before it is parsed.
+MAX_ROWS = 200_000
+
+
+def _decode(p: Path, kind: str, max_rows: int | None = MAX_ROWS) -> str:
+    """The file's text.  Compressed, archived or binary files are refused by name; a file of more than
+    ``max_rows`` lines after its header is refused before it is parsed; UTF-16 with a byte-order mark is
+    decoded; otherwise UTF-8 (BOM skipped) with undecodable bytes kept as surrogates."""
     try:
         data = p.read_bytes()
     except OSError as err:
@@ -101,13 +108,24 @@ def _decode(p: Path, kind: str) -> str:
         raise InputError(f"{p.name}: is a zip archive (an Excel workbook?); save or extract it as a CSV {kind}")
     if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
         try:
-            return data.decode("utf-16")
+            text = data.decode("utf-16")
         except UnicodeDecodeError as err:
             raise InputError(f"{p.name}: starts as UTF-16 text but byte {err.start} is not UTF-16") from None
+        _check_size(p, text.count("\n") + (not text.endswith("\n")) - 1, max_rows)
+        return text
     nul = data.find(b"\x00")
     if nul >= 0:
         raise InputError(f"{p.name}: is a binary file (a NUL byte at byte {nul}), not a CSV {kind}")
+    _check_size(p, data.count(b"\n") + (not data.endswith(b"\n")) - 1, max_rows)
     return data.decode("utf-8-sig", errors="surrogateescape")
+
+
+def _check_size(p: Path, lines: int, max_rows: int | None) -> None:
+    """Refuse a file of more than ``max_rows`` lines after its header (None: no limit)."""
+    if max_rows is not None and lines > max_rows:
+        raise InputError(f"{p.name}: {lines:,} lines after the header; navlib reads at most {max_rows:,} rows (the "
+                         f"cost of every step grows with the rows: minutes and gigabytes at that size): keep "
+                         f"every k-th row or split the file")
 
 
 def _parse(p: Path, text: str, kind: str) -> tuple[list[str], list[list[str]], list[int]]:
@@ -180,7 +198,7 @@ _SEPARATORS = {";": "';'", "\t": "a tab", "|": "'|'"}
 
 
 def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int = 1,
-               kind: str = "table") -> pd.DataFrame:
+               kind: str = "table", max_rows: int | None = MAX_ROWS) -> pd.DataFrame:
     """Read and validate a CSV table.
 
     Checks, in order: the file exists, is a regular file and text (not compressed, archived or binary) and parses as CSV; no
@@ -188,7 +206,8 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     separator other than the comma, is pointed out); every value in a described (checked) column is a
     finite number (no text, empty cell, NaN, infinity or a literal that overflows a float), whole if the
     column is ``integer``, and within the column's range (``-LIMIT..LIMIT``, 1e12, where the column gives
-    none); there are at least ``min_rows`` rows.  Optional columns that are absent are simply not in the
+    none); there are at least ``min_rows`` rows and, counted before parsing, at most ``max_rows`` (default
+    :data:`MAX_ROWS`; None: no limit).  Optional columns that are absent are simply not in the
     result; informational columns (``checked=False``) and columns the list does not describe are not
     checked (described informational ones become floats with NaN where a cell is not a number, others stay
     text, with any byte that is not UTF-8 replaced by U+FFFD).  Where blank lines or quoted line breaks move
@@ -201,7 +220,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
         raise InputError(f"{p}: is a folder, expected a CSV {kind}")
     if not p.is_file():                               # a device or a pipe (/dev/zero would never end)
         raise InputError(f"{p}: is not a regular file, expected a CSV {kind}")
-    header, rows, lines = _parse(p, _decode(p, kind), kind)
+    header, rows, lines = _parse(p, _decode(p, kind, max_rows), kind)
     names = _names(p, header)
     for col in columns:
         if col.required and col.name not in names:
