@@ -1,9 +1,12 @@
 """Command line: ``python -m navlib COMMAND ...`` (also installed as ``navlib``).
 
 Commands:
+  examples
+      list the example files shipped with navlib, each with one command that runs on it; diagnose and loop
+      take --example NAME instead of FILE.csv, from any folder.
   simulate-compass OUT.csv [--seed N] [--noise-ut X] [--overwrite]
       write paper A's two simulated turntable sweeps (train = sweep 1, test = sweep 2).
-  diagnose SYSTEM FILE.csv [--model EFFECT,EFFECT] [--effects FILE.py] [--json] [--alpha A]
+  diagnose SYSTEM FILE.csv [--example NAME] [--model EFFECT,EFFECT] [--effects FILE.py] [--json] [--alpha A]
       fit the model, then name the effect it lacks (or say the residuals are noise, or name the structure
       no effect explains).
   loop SYSTEM FILE.csv --model START [--effects FILE.py] [--json] [--report DIR] [--alpha A]
