@@ -94,7 +94,8 @@ def _measurement_file(args) -> str:
 
 
 def _prepare(args):
-    """Validate names before reading the data; load user effects and the file; fit the start model."""
+    """Validate names before reading the data; load user effects and the file (FILE or --example).
+    Returns ``(system, users, names, data, file)``."""
     system = get_system(args.system)
     file = _measurement_file(args)
     users = load_effects(args.effects, system.name, system.catalogue) if args.effects else ()
@@ -104,11 +105,11 @@ def _prepare(args):
     if unit is not None and system.name != "accelerometer":
         raise InputError(f"parameter --unit={unit!r}: only the accelerometer system has units")
     data = system.load(file) if unit is None else system.load(file, unit=unit)
-    return system, users, names, data
+    return system, users, names, data, file
 
 
 def _diagnose(args) -> int:
-    system, users, names, data = _prepare(args)
+    system, users, names, data, _ = _prepare(args)
     d = diagnose(fit_model(system, data, names, user_effects=users), alpha=args.alpha)
     if args.json:
         out = d.to_dict()
@@ -130,12 +131,12 @@ def _loop(args) -> int:
     if (site is not None or date is not None) and system.final_check is None:
         raise InputError(f"parameter {'--site' if site is not None else '--date'}: the system {system.name} makes no "
                          f"field check ({', '.join(n for n, s in SYSTEMS.items() if s.final_check is not None)} do)")
-    system, users, names, data = _prepare(args)
+    system, users, names, data, file = _prepare(args)
     result = loop(system, data, names, user_effects=users, alpha=args.alpha)
     # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
     check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
     if args.report:
-        png, md = write_report(result, args.report, source=_measurement_file(args))
+        png, md = write_report(result, args.report, source=file)
     if args.json:
         out = result.to_dict()
         if check is not None:
