@@ -225,16 +225,17 @@ def user_design(effects, data: pd.DataFrame, shape) -> np.ndarray:
     return np.column_stack(cols) if cols else np.zeros((int(np.prod(shape)), 0))
 
 
-def best_least_squares(model_minus_obs, starts, lo, hi, jac="2-point"):
+def best_least_squares(model_minus_obs, starts, lo, hi, jac="2-point", tr_solver=None):
     """``scipy.optimize.least_squares`` (trust-region reflective) from each start; the lowest cost wins.
-    ``jac``: a function returning d(model)/d(x), or scipy's finite differences."""
+    ``jac``: a function returning d(model)/d(x), or scipy's finite differences; ``tr_solver``: scipy's
+    (default: ``"exact"`` up to 6 parameters, ``"lsmr"`` above)."""
     best = None
     finite = np.isfinite(lo) & np.isfinite(hi)
     margin = np.where(finite, 1e-9 * (np.abs(np.where(finite, hi - lo, 0.0)) + 1), 0.0)
     for x0 in starts:
         x0 = np.clip(np.asarray(x0, float), lo + margin, hi - margin)
         sol = least_squares(model_minus_obs, x0, jac=jac, bounds=(lo, hi), x_scale="jac", method="trf",
-                            tr_solver="lsmr" if len(x0) > 6 else "exact")
+                            tr_solver=tr_solver or ("lsmr" if len(x0) > 6 else "exact"))
         if best is None or sol.cost < best.cost:
             best = sol
     return best

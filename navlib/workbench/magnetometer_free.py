@@ -71,6 +71,7 @@ from ..errors import InputError, check_param
 from ..methods.preprocess import field_gravity_dot
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
+from .free_kernel import FreeKernel
 from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
 from .serial import ar1_noise
 
@@ -351,16 +352,15 @@ def corrected(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray
 def invariant_residuals(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
     """(n, 1) or (n, 2): ``e = |u| - F`` and, with an accelerometer, ``(g - c e) / sqrt(1 - c^2)`` (uT;
     module docstring)."""
-    p = full_params(params)
-    u = corrected(params, frame, t_c)
-    cols = [np.linalg.norm(u, axis=1) - p.get("field_ut", 0.0)]
-    if has_acc(frame):
-        a = frame[list(ACC)].to_numpy(float)
-        R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
-        g = np.einsum("ij,ij->i", a / np.linalg.norm(a, axis=1, keepdims=True), u @ R.T) - p.get("field_down_ut", 0.0)
-        c = float(np.clip(p.get("field_down_ut", 0.0) / max(p.get("field_ut", 0.0), 1e-9), -0.99, 0.99))
-        cols.append((g - c * cols[0]) / np.sqrt(1.0 - c * c))
-    return np.column_stack(cols)
+    names = list(params)
+    return kernel_of(frame, names, t_c).residuals(np.array([params[q] for q in names], float))
+
+
+def kernel_of(frame: pd.DataFrame, names, t_c: float = 0.0) -> FreeKernel:
+    """The frame's arrays in a :class:`navlib.workbench.free_kernel.FreeKernel` for the parameters ``names``."""
+    a = frame[list(ACC)].to_numpy(float) if has_acc(frame) else None
+    dt = frame["temperature_c"].to_numpy(float) - t_c if "temperature_c" in frame else None
+    return FreeKernel(names, frame[list(MAG)].to_numpy(float), a, dt)
 
 
 def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
@@ -383,9 +383,11 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     shape = (len(data), k)
     obs = data[list(DERIVED[:k])].to_numpy(float)
 
+    kern = kernel_of(data, names, t_c)
+
     def resid(x):
-        p = dict(zip(names, x))
-        return invariant_residuals(p, data, t_c).ravel() - user_columns(users, p, data, shape)
+        r = kern.residuals(x).ravel()
+        return r - user_columns(users, dict(zip(names, x)), data, shape) if users else r
 
     # start 2 (linearised): a sphere fit |m|^2 = 2 m.b + c for the centre (if hard iron is in the model)
     m = data[list(MAG)].to_numpy(float)
@@ -406,7 +408,8 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     x2v = np.array([x2[n] for n in names])
     x1v = np.array([(start or {}).get(n, x2[n]) for n in names])
     inf = np.full(len(names), np.inf)
-    sol = best_least_squares(resid, [x1v, x2v], -inf, inf)
+    sol = best_least_squares(resid, [x1v, x2v], -inf, inf, jac="2-point" if users else kern.jacobian,
+                             tr_solver=None if users else "exact")
     params = dict(zip(names, map(float, sol.x)))
 
     def predict(frame):

@@ -1,0 +1,144 @@
+"""The reference-free magnetometer invariants on plain arrays, with their analytic Jacobian (the inner loop
+of :mod:`navlib.workbench.magnetometer_free`'s fit; issue 34: the fit once spent 90 % of its time in
+pandas column lookups and finite differences).
+
+With the offset ``o = b + k (T - T_c)``, ``v = m - o``, the correction ``M = I + K`` (symmetric, ``K``
+trace-free: ``diag(s_x, s_y, -s_x - s_y)`` and the soft-iron terms) and ``u = M v``::
+
+    e_0 = |u| - F
+    g   = (R^T a/|a|) . u - D                     (R: the misalignment rotation)
+    c   = clip(D / F, -0.99, 0.99),  s = sqrt(1 - c^2)
+    e_1 = (g - c e_0) / s
+
+and, for any parameter ``q`` that moves ``u``: ``de_0/dq = (u/|u|) . du/dq``, ``dg/dq = (R^T a/|a|) . du/dq``,
+with ``du/db_j = -M e_j``, ``du/dk_j = -(T - T_c) M e_j`` and ``du/dK = dK v``.  The field parameters move
+``e_1`` through ``c`` too: ``de_1/dc = -e_0/s + (g - c e_0) c / s^3``, ``dc/dF = -D/F^2``, ``dc/dD = 1/F``
+(zero where ``c`` is clipped).  The misalignment angles' columns differentiate the rotation matrix by central differences
+(step 1e-4 deg).
+Rows are interleaved as the fit's residual vector is: ``[e_0, e_1]`` of row 0, then of row 1, and so on.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+CLIP = 0.99
+# d K / d parameter, the trace-free symmetric part of the correction
+_DK = {
+    "scale_x": np.diag([1.0, 0.0, -1.0]),
+    "scale_y": np.diag([0.0, 1.0, -1.0]),
+    "soft_xy": np.array([[0.0, 1, 0], [1, 0, 0], [0, 0, 0]]),
+    "soft_xz": np.array([[0.0, 0, 1], [0, 0, 0], [1, 0, 0]]),
+    "soft_yz": np.array([[0.0, 0, 0], [0, 0, 1], [0, 1, 0]]),
+}
+_HARD = ("hard_x_ut", "hard_y_ut", "hard_z_ut")
+_TEMP = ("temp_x_ut_c", "temp_y_ut_c", "temp_z_ut_c")
+_MIS = ("mis_x_deg", "mis_y_deg", "mis_z_deg")
+MIS_STEP_DEG = 1e-4
+
+
+def rotation_deg(rotvec_deg) -> np.ndarray:
+    """The rotation matrix of a rotation vector in degrees (Rodrigues' formula; scipy's
+    ``Rotation.from_rotvec(np.radians(v)).as_matrix()`` without its per-call overhead)."""
+    v = np.radians(np.asarray(rotvec_deg, float))
+    th = float(np.sqrt(v @ v))
+    if th == 0.0:
+        return np.eye(3)
+    K = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]) / th
+    return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
+
+
+class FreeKernel:
+    """The invariants of one data set for the parameter vector ``x`` named ``names``.
+
+    ``m``: (n, 3) field, uT; ``a``: (n, 3) acceleration or None; ``dt``: (n,) ``T - T_c`` or None."""
+
+    def __init__(self, names, m: np.ndarray, a: np.ndarray | None = None, dt: np.ndarray | None = None):
+        self.names = list(names)
+        self.index = {q: i for i, q in enumerate(self.names)}
+        self.m = np.asarray(m, float)
+        self.ahat = None if a is None else a / np.linalg.norm(a, axis=1, keepdims=True)
+        self.dt = None if dt is None else np.asarray(dt, float)
+        self.k = 1 if a is None else 2
+
+    def _get(self, x, q: str) -> float:
+        i = self.index.get(q)
+        return 0.0 if i is None else float(x[i])
+
+    def _parts(self, x):
+        M = np.eye(3)
+        for q, dk in _DK.items():
+            M = M + self._get(x, q) * dk
+        o = np.array([self._get(x, q) for q in _HARD])
+        v = self.m - o
+        kt = np.array([self._get(x, q) for q in _TEMP])
+        if self.dt is not None and np.any(kt):
+            v = v - self.dt[:, None] * kt
+        u = v @ M          # M symmetric: rows of (M v)
+        return M, v, u
+
+    def _rotation(self, x) -> np.ndarray:
+        return rotation_deg([self._get(x, q) for q in _MIS])
+
+    def residuals(self, x) -> np.ndarray:
+        """(n, k): the invariants' misfit (module docstring)."""
+        _, _, u = self._parts(x)
+        r = np.sqrt(np.einsum("ij,ij->i", u, u))
+        e0 = r - self._get(x, "field_ut")
+        if self.ahat is None:
+            return e0[:, None]
+        F, D = self._get(x, "field_ut"), self._get(x, "field_down_ut")
+        g = np.einsum("ij,ij->i", self.ahat @ self._rotation(x), u) - D
+        c = float(np.clip(D / max(F, 1e-9), -CLIP, CLIP))
+        return np.column_stack([e0, (g - c * e0) / np.sqrt(1.0 - c * c)])
+
+    def jacobian(self, x) -> np.ndarray:
+        """(n k, p): d(residuals().ravel())/dx (module docstring)."""
+        M, v, u = self._parts(x)
+        n, p = len(u), len(self.names)
+        r = np.sqrt(np.einsum("ij,ij->i", u, u))
+        uh = u / r[:, None]
+        J0 = np.zeros((n, p))
+        acc = self.ahat is not None
+        if acc:
+            at = self.ahat @ self._rotation(x)
+            Jg = np.zeros((n, p))
+        for q, i in self.index.items():
+            if q in _DK:
+                du = v @ _DK[q]
+            elif q in _HARD:
+                du = np.broadcast_to(-M[_HARD.index(q)], u.shape)
+            elif q in _TEMP:
+                du = -np.outer(self.dt if self.dt is not None else np.zeros(n), M[_TEMP.index(q)])
+            else:
+                continue
+            J0[:, i] = np.einsum("ij,ij->i", uh, du)
+            if acc:
+                Jg[:, i] = np.einsum("ij,ij->i", at, du)
+        if "field_ut" in self.index:
+            J0[:, self.index["field_ut"]] = -1.0
+        if not acc:
+            return J0
+        F, D = self._get(x, "field_ut"), self._get(x, "field_down_ut")
+        e0 = r - F
+        g = np.einsum("ij,ij->i", at, u) - D
+        raw = D / max(F, 1e-9)
+        c = float(np.clip(raw, -CLIP, CLIP))
+        s = np.sqrt(1.0 - c * c)
+        J1 = (Jg - c * J0) / s
+        de1_dc = -e0 / s + (g - c * e0) * c / s ** 3
+        free = abs(raw) < CLIP and F > 1e-9
+        if "field_ut" in self.index:
+            J1[:, self.index["field_ut"]] = c / s + (de1_dc * (-D / F ** 2) if free else 0.0)
+        if "field_down_ut" in self.index:
+            J1[:, self.index["field_down_ut"]] = -1.0 / s + (de1_dc / F if free else 0.0)
+        mis = [self._get(x, q) for q in _MIS]
+        for j, q in enumerate(_MIS):
+            if q in self.index:
+                up, dn = list(mis), list(mis)
+                up[j] += MIS_STEP_DEG
+                dn[j] -= MIS_STEP_DEG
+                dR = (rotation_deg(up) - rotation_deg(dn)) / (2 * MIS_STEP_DEG)
+                J1[:, self.index[q]] = np.einsum("ij,ij->i", self.ahat @ dR, u) / s
+        J = np.empty((2 * n, p))
+        J[0::2], J[1::2] = J0, J1
+        return J
