@@ -150,6 +150,9 @@ def _loop(args) -> int:
             print(f"not tested: {u['effect']} ({u['why']})")
         if lines:
             print("\n".join(lines))
+        rem = result.remaining()
+        if rem is not None and not result.consistent_with_noise:
+            print(f"what remains: {rem[1]}")
         if args.report:
             print(f"report: {md} and {png}")
     return 0

@@ -150,6 +150,11 @@ class System:
         the Earth-field model at the site, ``site`` = ``(lat, lon[, height_m])`` and ``date`` from the
         command line or None); the CLI prints the lines and puts the dict under ``"field"`` in ``--json``.
         None: nothing more (and ``--site``/``--date`` are refused).
+    remaining : callable or None
+        ``remaining(fit) -> (DataFrame, str)``: what the residuals of a final model still hold, broken down
+        by the factors the system knows (the reference-free magnetometer: time, turn rate, orientation,
+        acceleration; :mod:`navlib.workbench.free_breakdown`), and one sentence reading it.  None: no
+        breakdown.
     columns : tuple of Column
         The file schema ``load`` reads (:class:`navlib.data.tables.Column`: name, unit, required, limits,
         meaning); :func:`columns_table` derives the system's data dictionary from it.
@@ -165,6 +170,7 @@ class System:
     noise_directions: Callable | None = None
     final_check: Callable | None = None
     columns: tuple = ()
+    remaining: Callable | None = None
 
 
 #: Every system, by name (filled by the system modules as they are imported; the package imports them all).

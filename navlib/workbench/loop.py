@@ -17,7 +17,7 @@ import pandas as pd
 from ..angles import wrap_deg
 from ..errors import InputError, check_param
 from .diagnose import Diagnosis, diagnose
-from .effects import Effect
+from .effects import Effect, get_system
 from .fit import Fit, fit_model
 from .screen import Screening, screen
 from ..threads import one_blas_thread
@@ -74,6 +74,12 @@ class LoopResult:
                               f"held-out rms ({unit})": f.loo_rms, "named": d.missing or "-"}
                              for i, (f, d) in enumerate(zip(self.fits, self.diagnoses))]).set_index("step")
 
+    def remaining(self) -> tuple[pd.DataFrame, str] | None:
+        """What the final residuals still hold, by the factors the system knows (its ``remaining`` hook,
+        e.g. :func:`navlib.workbench.magnetometer_free.remaining_structure`), or None."""
+        hook = get_system(self.final.system).remaining
+        return None if hook is None else hook(self.final)
+
     def outcome(self) -> str:
         if self.consistent_with_noise:
             return "consistent with noise"
@@ -93,6 +99,9 @@ class LoopResult:
                          "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
                          "message": self.final_diagnosis.message},
                "untested": self.untested, "outliers": self.outliers}
+        rem = self.remaining()
+        if rem is not None:
+            out["remaining"] = {"by_factor": rem[0].to_dict(orient="records"), "reading": rem[1]}
         if self.screening is not None:
             extra = self.screening.to_dict()
             extra.pop("outliers")
@@ -438,7 +447,15 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
         lines += ["", f"**Outliers:** {sc.outlier_line(unit)}."]
     if sc is not None and sc.noise.series is not None:
         lines += ["", f"**Noise:** {sc.noise.describe()}."]
-    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.split("\n")[-1],
-              "", f"![the loop]({png.name})", ""]
+    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.split("\n")[-1]]
+    rem = result.remaining()
+    if rem is not None and not rem[0].empty:
+        lines += ["", "**What remains** (a description, not a test; the factors overlap: a pause is a cell of time, "
+                  f"turn rate and acceleration at once): {rem[1]}.", "",
+                  f"| invariant | factor | cells | share of variance | rms of cell means ({unit}) | largest cell | "
+                  f"its mean ({unit}) |", "|---|---|---|---|---|---|---|"]
+        lines += [f"| {r.invariant} | {r.factor} | {r.cells} | {100 * r.share:.0f} % | {r.amplitude_ut:.3g} | "
+                  f"{r.largest_cell} | {r.largest_mean_ut:+.3g} |" for r in rem[0].itertuples()]
+    lines += ["", f"![the loop]({png.name})", ""]
     md.write_text("\n".join(lines))
     return png, md

@@ -71,6 +71,7 @@ from ..errors import InputError, check_param
 from ..methods.preprocess import field_gravity_dot
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
+from . import free_breakdown
 from .free_kernel import FreeKernel
 from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
 from .serial import ar1_noise
@@ -489,12 +490,26 @@ def loop_field_check(result, site=None, date: str | None = None) -> tuple[dict, 
     return check, field_lines(check)
 
 
+def remaining_structure(fit: Fit) -> tuple[pd.DataFrame, str]:
+    """The system's ``remaining`` hook: the final residuals by time, turn rate, orientation and acceleration
+    (:func:`navlib.workbench.free_breakdown.breakdown`) and the sentence reading them."""
+    d = fit.data
+    k = fit.n // len(d)
+    u = corrected(full_params(fit.params), d, fit.model.get("temperature_centre_c", 0.0))
+    gyr = d[list(GYR)].to_numpy(float) if all(c in d for c in GYR) else None
+    rate = np.linalg.norm(gyr, axis=1) if gyr is not None and np.all(np.isfinite(gyr)) else None
+    cells = free_breakdown.factors(d["time_s"].to_numpy(float) if "time_s" in d else None, rate, u,
+                                   d[list(ACC)].to_numpy(float) if has_acc(d) else None)
+    table = free_breakdown.breakdown(fit.residuals.reshape(len(d), k), ["magnitude", "dip"][:k], cells)
+    return table, free_breakdown.reading(table)
+
+
 MEASURED["magnetometer_free"] = (DERIVED, False)
 SYSTEM = register_system(System(
     "magnetometer_free", "uT", FREE_EFFECTS, load_free, _fit_free, free_structure,
     "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
     "and (with an accelerometer) its component along gravity - D, uT", noise_directions=noise_directions,
-    final_check=loop_field_check, columns=FREE_COLUMNS))
+    final_check=loop_field_check, columns=FREE_COLUMNS, remaining=remaining_structure))
 
 
 def field_summary(fit: Fit) -> dict:
