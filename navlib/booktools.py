@@ -483,7 +483,8 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
     """Problems of one API page: a ``Type:`` field (napoleon split a constant's description at a colon:
     ``book/_ext/navbook_attrdoc.py``); on the command line's page (``cli_page``), an option written with a
     typographic dash or quote, or an option of a command line that the command's parser does not have
-    (each line of the page that starts with a command name)."""
+    (each line of the page that starts with a command name), or whose ``--help``, run for real, fails or
+    does not show it (:func:`_help_problems`)."""
     out = []
     n = text.count('Type<span class="colon">:</span>')
     if n:
@@ -493,6 +494,7 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
     from .cli import build_parser
     sub = next(a for a in build_parser()._actions if a.dest == "command").choices
     body = html.unescape(re.sub(r"<[^>]+>", "", re.sub(r"</(?:p|dt|dd|li|pre|div)>|<br\s*/?>", "\n", text)))
+    shown: dict[str, set] = {}
     for line in body.splitlines():
         words = line.split()
         if not words or words[0] not in sub:
@@ -505,6 +507,24 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
             opt = w.strip("[]").split("=")[0]
             if opt.startswith("--") and opt not in known:
                 out.append(f"'{words[0]}' has no option {opt}: {line.strip()[:70]!r}")
+            elif opt.startswith("--"):
+                shown.setdefault(words[0], set()).add(opt)
+    return out + _help_problems(shown)
+
+
+def _help_problems(shown: dict) -> list[str]:
+    """Each command as a user copies it from the page: ``python -m navlib COMMAND --help`` run for real (a
+    new process); a problem when it fails or its help does not show an option the page shows."""
+    out = []
+    for command, options in sorted(shown.items()):
+        run = subprocess.run([sys.executable, "-m", "navlib", command, "--help"], capture_output=True,
+                             text=True, timeout=60)
+        if run.returncode != 0:
+            out.append(f"'navlib {command} --help' failed (exit {run.returncode}): {run.stderr.strip()[-120:]}")
+            continue
+        missing = sorted(o for o in options if not re.search(re.escape(o) + r"(?![\w-])", run.stdout))
+        if missing:
+            out.append(f"'navlib {command} --help' does not show {', '.join(missing)}, which the page shows")
     return out
 
 

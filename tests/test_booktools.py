@@ -353,3 +353,14 @@ def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run
     split = '<dt class="field-odd">Type<span class="colon">:</span></dt><dd>The output must</dd>'
     assert check_api_page(split) == ["1 description(s) split into a 'Type:' field"]
     assert check_api_page(ok) == []                       # commands are checked on the CLI page only
+
+
+def test_commands_on_the_cli_page_are_run_with_help():
+    """Each command the page shows runs ``python -m navlib COMMAND --help`` in a new process: a command
+    that fails, or whose help lacks an option the page shows, is a problem."""
+    from navlib.booktools import _help_problems
+    assert _help_problems({"loop": {"--json", "--report"}, "field": {"--site"}}) == []
+    assert _help_problems({"loop": {"--json", "--jsonl"}}) == [
+        "'navlib loop --help' does not show --jsonl, which the page shows"]
+    bad = _help_problems({"no-such-command": {"--json"}})
+    assert len(bad) == 1 and "failed (exit 2)" in bad[0]
