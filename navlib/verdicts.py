@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from typing import Callable, Literal, Sequence
 
 import numpy as np
-from scipy import stats
+from scipy import special
 
 from .errors import InputError
 
@@ -110,7 +110,7 @@ def _order_ranks(n: int, q: float, level: float) -> tuple[int, int] | None:
     """0-based ranks ``(i, j)`` of the order statistics that bracket the ``q`` quantile with coverage of at
     least ``level`` (equal tails, :math:`B \\sim \\mathrm{Bin}(n, q)`), or None when ``n`` is too small."""
     a = (1 - level) / 2
-    cdf = stats.binom.cdf(np.arange(n + 1), n, q)
+    cdf = special.bdtr(np.arange(n + 1), n, q)     # the binomial cdf (scipy.stats.binom.cdf)
     low = np.flatnonzero(cdf <= a)           # P(x_(r) > quantile) = P(B <= r - 1) <= a
     high = np.flatnonzero(cdf >= 1 - a)      # P(x_(s) < quantile) = 1 - P(B <= s - 1) <= a
     if low.size == 0 or high.size == 0 or high[0] + 1 > n:
@@ -143,7 +143,7 @@ def mean_ci(x, level: float = LEVEL) -> Estimate:
     """The mean over runs with its Student-t interval :math:`\\bar x \\pm t_{n-1} s / \\sqrt n`."""
     a = _sample(x, "mean_ci")
     m = float(a.mean())
-    half = float(stats.t.ppf(0.5 + level / 2, a.size - 1) * a.std(ddof=1) / math.sqrt(a.size))
+    half = float(special.stdtrit(a.size - 1, 0.5 + level / 2) * a.std(ddof=1) / math.sqrt(a.size))
     return Estimate(m, m - half, m + half, "mean over runs", int(a.size))
 
 
@@ -173,6 +173,8 @@ def wilson(k: int, n: int, level: float = LEVEL) -> Estimate:
     """A rate ``k / n`` over independent trials with its Wilson score interval."""
     if not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer))) or n < 1 or not 0 <= k <= n:
         raise InputError(f"wilson: k={k!r}, n={n!r}: need whole numbers with 0 <= k <= n and n >= 1")
+    from scipy import stats     # here: importing scipy.stats costs every command-line start 0.3 s
+
     ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
     return Estimate(k / n, float(ci.low), float(ci.high), "wilson rate", int(n))
 
@@ -188,6 +190,8 @@ def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequ
     if not cols or any(c.shape[0] != cols[0].shape[0] for c in cols) or cols[0].shape[0] < 2:
         raise InputError("bootstrap: give at least one column, all of the same length >= 2")
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    from scipy import stats     # here: as in wilson
+
     res = stats.bootstrap(tuple(cols), statistic, n_resamples=n_resamples, confidence_level=level,
                           method="percentile", paired=paired, vectorized=False,
                           rng=np.random.default_rng(ss))

@@ -60,7 +60,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
-from scipy import stats
+from scipy import special
 
 from ..errors import InputError
 from .effects import testable
@@ -174,7 +174,7 @@ def cutoff(n_obs: int, dof: int) -> float:
     """The robust ``|z|`` above which one of ``n_obs`` observations with ``dof`` residual degrees of freedom
     is an outlier (module docstring)."""
     nu = max(MAD_EFFICIENCY * dof, 1.0)
-    return float(max(Z_MIN, stats.t.isf(OUTLIER_ALPHA / (2 * max(n_obs, 1)), nu)))
+    return float(max(Z_MIN, -special.stdtrit(nu, OUTLIER_ALPHA / (2 * max(n_obs, 1)))))
 
 
 def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:

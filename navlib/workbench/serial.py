@@ -74,7 +74,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy import stats
+from scipy import special
 from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
@@ -650,7 +650,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
     kappa, ll = best
     bounds = ()
     if kappa and interval:
-        drop = stats.chi2.ppf(KAPPA_LEVEL, 1) / 2
+        drop = special.gammaincinv(0.5, KAPPA_LEVEL)     # chi2.ppf(KAPPA_LEVEL, 1) / 2
         lim = np.arctanh(KAPPA_MAX)
         a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
 
