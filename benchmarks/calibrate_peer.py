@@ -11,10 +11,13 @@ copied here) or the files given.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/calibrate_peer.py [FILE ...]
 
-Measured (2 cores, quiet, 17 BROAD recordings of 1,500-2,100 rows): navlib 0.4-4 s per fit (median about
-1 s), the peer about 5 ms: navlib about 140-180 x slower.  Held-out direction: navlib made it worse than the
-raw field on 12 of 17 recordings and warned on all 12 (fast rotation, magnets: the accelerometer saw more
-than gravity); the peer made it worse on 11 and failed on 2.
+Measured (2 cores, quiet, 17 BROAD recordings of 1,500-2,100 rows), 2026-12-03: navlib 0.14-1.05 s per fit
+(median 0.26 s; before the analytic Jacobian of :mod:`navlib.workbench.free_kernel` 0.4-4 s, median about
+1 s), the peer 0.5-6.6 ms (median 3.9 ms): navlib about 65 x slower (was 140-180 x).  What the rest costs:
+the screen's outlier rounds (up to 13 refits on the magnet trials) and the noise model.  The issue measured
+magcc's LM fit at 13-29 ms per file: against that navlib is 5-20 x.  Held-out direction: navlib made it
+worse than the raw field on 12 of 17 recordings and warned on all 12 (fast rotation, magnets: the
+accelerometer saw more than gravity); the peer made it worse on 11 and failed on 2.
 """
 from __future__ import annotations
 
