@@ -70,6 +70,7 @@ from ..errors import InputError
 from ..seeding import child
 from .effects import testable
 from .fit import Fit, drift_design, orth_basis
+from .noise_size import NoiseSize, noise_size
 from .screen import Screening, screen as screen_data
 from .serial import NoiseModel
 from ..threads import one_blas_thread
@@ -133,6 +134,7 @@ class Diagnosis:
     message: str
     screening: Screening | None = field(default=None, repr=False, compare=False)
     calibration: "Calibration | None" = field(default=None, repr=False, compare=False)
+    noise_size: NoiseSize | None = field(default=None, repr=False, compare=False)
 
     @property
     def outliers(self) -> list[dict]:
@@ -149,6 +151,9 @@ class Diagnosis:
         d["structure"] = [asdict(s) for s in self.structure]
         for s in d["structure"]:
             s.pop("log_p")
+            if not np.isfinite(s["p_value"]):
+                s["p_value"] = None                     # the size check's finding has no p-value
+        d["noise_size"] = self.noise_size.to_dict() if self.noise_size is not None else None
         d.update({"untestable": dict(self.untestable), "alpha": self.alpha, "tests": self.tests,
                   "message": self.message, "outliers": self.outliers})
         if self.calibration is not None:
@@ -200,7 +205,8 @@ class Diagnosis:
         if found:
             lines.append("")
             lines.append("structure no catalogued effect explains:")
-            lines.extend(f"  {s.what}: amplitude {_fmt(s.amplitude)} {self.unit}, p = {s.p_value:.2g}" for s in found)
+            lines.extend(f"  {s.what}: amplitude {_fmt(s.amplitude)} {self.unit}, "
+                         + (f"p = {s.p_value:.2g}" if np.isfinite(s.p_value) else "by the size check") for s in found)
         lines.append("")
         lines.append(self.message)
         return "\n".join(lines)
@@ -592,6 +598,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
         c.significant = bool(c.p_value < level and c.loo_rms < fit.loo_rms)
     cands.sort(key=lambda c: (not c.significant, c.log_p, -c.variance_explained))
     missing, blocked = None, []
+    size = None
     for c in cands:
         if not c.significant:
             break
@@ -610,7 +617,26 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
             found = remaining
             break
         blocked.append(c.effect)
-    if missing:
+    if missing is None and not found:
+        # "consistent with noise" needs the residual small against the noise the data show at short lags,
+        # and no candidate taking out much more than that (module noise_size)
+        size = noise_size(fit, fits, unit)
+        big = None if size is None or size.biggest is None else next(c for c in cands if c.effect == size.biggest)
+        if size is not None and size.problem and size.problem.startswith("'") and big.loo_rms < fit.loo_rms:
+            missing = big.effect                       # too large to be noise, and it predicts better
+        elif size is not None and size.problem:
+            amp = float(np.sqrt(max(size.rms ** 2 - size.short ** 2, 0.0)))
+            if size.problem.startswith("'"):
+                amp = size.explained
+            found = [Finding(size.problem, amp, float("nan"), significant=True)]
+            structure = structure + found
+    if missing and size is not None and missing == size.biggest and size.problem:
+        c = next(c for c in cands if c.effect == missing)
+        msg = (f"add '{missing}': it takes out {_fmt(size.explained)} {unit} rms, "
+               f"{size.explained / size.short:.1f} times the sample-to-sample noise ({_fmt(size.short)} {unit}: "
+               f"too large for noise), and lowers the held-out rms from {_fmt(fit.loo_rms)} to {_fmt(c.loo_rms)} "
+               f"{unit}; the correlated-noise test alone leaves it undecided (p = {c.p_value:.2g})")
+    elif missing:
         c = next(c for c in cands if c.effect == missing)
         msg = (f"add '{missing}': it removes {100 * c.variance_explained:.1f} % of the residual variance "
                f"(p = {c.p_value:.2g}, {c.test} test) and lowers the held-out rms from {_fmt(fit.loo_rms)} to "
@@ -638,7 +664,8 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
         msg += (f" [serially correlated noise, AR({noise.order}) with lag-1 correlation {noise.lag1:.2f}: "
                 f"tests on whitened residuals]")
     return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
-                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc, cal))
+                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc, cal,
+                             size))
 
 
 def _finish(d: Diagnosis) -> Diagnosis:

@@ -49,7 +49,8 @@ class LoopResult:
     @property
     def unexplained(self) -> list[dict]:
         """Significant structure left at the end that no effect explains."""
-        return [{"structure": s.what, "amplitude": float(s.amplitude), "p_value": float(s.p_value)}
+        return [{"structure": s.what, "amplitude": float(s.amplitude),
+                 "p_value": float(s.p_value) if np.isfinite(s.p_value) else None}
                 for s in self.final_diagnosis.structure if s.significant]
 
     @property
