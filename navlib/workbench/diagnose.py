@@ -53,7 +53,11 @@ the residual once the remaining structure is allowed for in both models.  A cand
 little of an unexplained structure (a temperature term and a three-cycle error; a one-cycle term and the
 heading-correlated part of a drift in time) fails that test and is not named; the report then says which
 structure remains and that no catalogued effect explains it.  If no candidate is named and no structure is
-found, the residuals are consistent with noise.
+found, the residuals are consistent with noise -- provided they are also small enough to be noise
+(:mod:`navlib.workbench.noise_size`): a correlated-noise model can absorb a large slow error (a reference
+attitude bad in segments), so residuals more than ``RATIO_MAX`` times the noise consecutive samples show
+are reported as slow structure, and a candidate that takes out more than ``EXPLAINED_MAX`` times that
+noise and lowers the held-out RMS is named although the whitened test leaves it undecided.
 """
 from __future__ import annotations
 
