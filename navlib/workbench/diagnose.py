@@ -624,7 +624,7 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
     if missing is None and not found:
         # "consistent with noise" needs the residual small against the noise the data show at short lags,
         # and no candidate taking out much more than that (module noise_size)
-        size = noise_size(fit, fits, unit)
+        size = noise_size(fit, fits, unit, noise.effective_samples if noise.correlated else None)
         big = None if size is None or size.biggest is None else next(c for c in cands if c.effect == size.biggest)
         if size is not None and size.problem and size.problem.startswith("'") and big.loo_rms < fit.loo_rms:
             missing = big.effect                       # too large to be noise, and it predicts better

@@ -14,8 +14,13 @@ residual column::
 For AR(1) noise of lag-1 correlation ``phi``, ``var(d) = 2 sigma^2 (1 - phi)`` and the ratio is
 ``1 / sqrt(1 - phi)``: 1 for independent noise, 3.2 at ``phi = 0.9``, 5 at 0.96, 7.1 at 0.98.  Residuals are called noise only when
 
-1. ``ratio <= RATIO_MAX`` (slow variation larger than that is not called noise: at that size noise and a
-   slow error cannot be told apart, and calling it noise would be confident and wrong), and
+1. the ratio's lower 95 % bound is at most ``RATIO_MAX`` (slow variation larger than that is not called
+   noise: at that size noise and a slow error cannot be told apart, and calling it noise would be confident
+   and wrong).  The bound allows for the few independent samples correlated noise leaves:
+   ``rms_lo = rms sqrt(nu / chi2_0.975(nu))`` with ``nu`` the effective samples of the noise model (those
+   a slowly varying shape sees, ``NoiseModel.effective_samples``; all of them for independent noise), so
+   AR(1) noise of lag-1 0.9 on a 242-reading compass sweep pair (``nu`` about 13, ratio 2.8 typical, 5.2
+   seen once in 100 trials) is not flagged by chance; and
 2. no candidate effect explains more than ``EXPLAINED_MAX`` times ``s_short`` (rms of the fitted
    change), however undecided the correlated-noise test leaves it: noise does not make an effect's shape
    that large.
@@ -28,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from scipy import special
 
 #: Largest rms / sample-to-sample noise of residuals still called noise (AR(1) noise of lag-1 0.96).
 RATIO_MAX = 5.0
@@ -37,6 +43,8 @@ RATIO_MAX = 5.0
 EXPLAINED_MAX = 4.0
 #: Fewer rows than this: not checked.
 MIN_ROWS = 30
+#: One-sided tail of the ratio's lower bound.
+TAIL = 0.025
 MAD_SD = 1.482602218505602
 
 
@@ -49,12 +57,14 @@ class NoiseSize:
     short: float
     rms: float
     ratio: float
+    ratio_low: float
     biggest: str | None
     explained: float
     problem: str
 
     def to_dict(self) -> dict:
         return {"sample_to_sample_noise": self.short, "rms": self.rms, "ratio": self.ratio,
+                "ratio_low": self.ratio_low,
                 "largest_candidate": self.biggest, "largest_explained_rms": self.explained,
                 "problem": self.problem}
 
@@ -71,10 +81,11 @@ def short_lag_noise(residuals: np.ndarray, data: pd.DataFrame) -> float:
     return float(np.sqrt(np.mean(s ** 2)))
 
 
-def noise_size(fit, candidates: dict, unit: str) -> NoiseSize | None:
+def noise_size(fit, candidates: dict, unit: str, effective: float | None = None) -> NoiseSize | None:
     """The check of the module docstring on the residuals of ``fit`` (a :class:`navlib.workbench.fit.Fit`),
-    ``candidates``: ``{effect: fit with it added}``; None for a table under :data:`MIN_ROWS` rows or
-    residuals whose short-lag spread is zero."""
+    ``candidates``: ``{effect: fit with it added}``, ``effective``: the noise model's effective samples
+    (default: every observation); None for a table under :data:`MIN_ROWS` rows or residuals whose
+    short-lag spread is zero."""
     if len(fit.data) < MIN_ROWS:
         return None
     short = short_lag_noise(fit.residuals, fit.data)
@@ -82,6 +93,8 @@ def noise_size(fit, candidates: dict, unit: str) -> NoiseSize | None:
         return None
     rms = float(np.sqrt(np.mean(np.asarray(fit.residuals, float) ** 2)))
     ratio = rms / short
+    nu = float(fit.n if effective is None else max(min(effective, fit.n), 1.0))
+    ratio_low = ratio * float(np.sqrt(nu / (2.0 * special.gammaincinv(nu / 2.0, 1.0 - TAIL))))
     biggest, explained = None, 0.0
     for name, f1 in candidates.items():
         e = float(np.sqrt(max(fit.rss - f1.rss, 0.0) / fit.n))
@@ -92,7 +105,8 @@ def noise_size(fit, candidates: dict, unit: str) -> NoiseSize | None:
         problem = (f"'{biggest}' would take out {explained:.3g} {unit} rms, {explained / short:.1f} times the "
                    f"sample-to-sample noise ({short:.3g} {unit}), though the correlated-noise test leaves it "
                    f"undecided")
-    elif ratio > RATIO_MAX:
+    elif ratio_low > RATIO_MAX:
         problem = (f"slow variation of {rms:.3g} {unit} rms, {ratio:.1f} times the sample-to-sample noise "
-                   f"({short:.3g} {unit}; noise is called noise up to {RATIO_MAX:g} times)")
-    return NoiseSize(short, rms, ratio, biggest, explained, problem)
+                   f"({short:.3g} {unit}; at least {ratio_low:.1f} times at 95 %, where noise is called noise up "
+                   f"to {RATIO_MAX:g} times)")
+    return NoiseSize(short, rms, ratio, ratio_low, biggest, explained, problem)
