@@ -20,12 +20,11 @@ Commands:
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
       compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
       --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
-  compare SYSTEM FILE.csv [--methods ID,ID] [--split sweep|heading|random] [--seed S] [--seeds N] [--json]
-          [--report DIR] [--workers N] [--scheduler ADDR]
+  compare SYSTEM FILE.csv [--methods ID,ID] [--split RULE] [--seeds N] [--json] [--report DIR] [--workers N]
       which of the papers' compensation methods works best on your file: each fitted on part of it and
       scored on the rest (every row held out once), over seeds, with 95 % intervals, the paired differences
-      to the best method and the book's verdict.  --report DIR writes compare.md and compare.png (error
-      against heading per method).  SYSTEM: compass.
+      to the best method and the book's verdict.  RULE: sweep, heading or random (--seed S).  --report DIR
+      writes compare.md and compare.png (error against heading per method).  SYSTEM: compass.
   field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
       the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
       loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop

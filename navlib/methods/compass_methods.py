@@ -271,6 +271,8 @@ def _rule_reading(base: str, label: str) -> str:
     return f"{base}, ADE {label}"
 
 
+#: Every method by stable id: display label, factory, whether it is stochastic, the paper's row it answers,
+#: its reading and its DE family (:class:`MethodSpec`).
 METHODS: dict[str, MethodSpec] = {
     "uncompensated": MethodSpec("uncompensated", lambda p: Uncompensated(), False, "uncompensated"),
     "ls8": MethodSpec("LS 8-position (Smith, 5 terms)", _eight("smith"), False,

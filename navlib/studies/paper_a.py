@@ -118,8 +118,9 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
 
 def _method_runs(sw: Sweeps, params: StudyParams, mids, seeds: list, base_seed: int,
                  keep_errors: bool) -> list[dict]:
-    """The rows of :func:`seed_study` for one method (or one family sharing a DE stage, :func:`fit_family`)
-    and the given seeds (one batch).  A family's ``train_time_s`` is the family's time per seed."""
+    """The rows of :func:`seed_study` for one method (or one family sharing a DE stage,
+    :func:`~navlib.methods.compass_methods.fit_family`) and the given seeds (one batch).  A family's
+    ``train_time_s`` is the family's time per seed."""
     mids = (mids,) if isinstance(mids, str) else tuple(mids)
     t0 = time.perf_counter()
     if len(mids) > 1:
@@ -155,8 +156,8 @@ MAX_TASK_S = 2.0
 
 def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
     """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one (or
-    of a family sharing a DE stage, :func:`_units`; fewer seeds when a batch would cost more than
-    :data:`MAX_TASK_S`), with its estimated cost (CPU seconds)."""
+    of a family sharing a DE stage, :func:`~navlib.methods.compass_methods.fitting_units`; fewer seeds when
+    a batch would cost more than :data:`MAX_TASK_S`), with its estimated cost (CPU seconds)."""
     tasks, cost = [], []
     for unit in _units(params, methods):
         stochastic = METHODS[unit[0]].stochastic
@@ -470,10 +471,11 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
       ``implied_ut``); where it is not below the paper's width the claim cannot be judged, and the
       reason names the noise it would need (from :func:`floor_curve` ``floor``).
 
-    Every claim that involves the 8-position LS is judged once per LS model of :data:`LS_MODELS` found in
-    ``runs`` (the paper does not print its model); the readings of ADE's rules (:data:`RULE_READINGS`)
-    change only ADE-BP, so only the claims involving ADE-BP are judged there.  A reading whose methods are
-    not all in ``runs`` is skipped.  The intervals cover training randomness on one fixed sweep pair
+    Every claim that involves the 8-position LS is judged once per LS model of
+    :data:`~navlib.methods.compass_methods.LS_MODELS` found in ``runs`` (the paper does not print its model);
+    the readings of ADE's rules (:data:`~navlib.methods.compass_methods.RULE_READINGS`) change only ADE-BP,
+    so only the claims involving ADE-BP are judged there.  A reading whose methods are not all in ``runs``
+    is skipped.  The intervals cover training randomness on one fixed sweep pair
     (:data:`TRAINING_ONLY`)."""
     pr = paper.set_index("method")
     out = []
@@ -552,7 +554,8 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
 
 
 def _ls_text(text: str, ls: str | None) -> str:
-    """A claim's text with the LS model it is judged against (``ls`` an id of :data:`LS_MODELS`)."""
+    """A claim's text with the LS model it is judged against (``ls`` an id of
+    :data:`~navlib.methods.compass_methods.LS_MODELS`)."""
     if ls is None:
         return text
     tag = f"[{LS_MODELS[ls]}]"
@@ -604,9 +607,9 @@ LS_REF_POSITIONS = 24
 
 
 def ls_positions_rms(sw: Sweeps, counts=LS_POSITIONS, models=tuple(LS_MODELS)) -> pd.DataFrame:
-    """Test-sweep RMS (deg) of each 8-position LS model of :data:`LS_MODELS` (the chapter's fit,
-    ``_Eight``) fitted on ``n`` equally spaced positions of sweep 1 (0, 360/n, ... deg true heading) for
-    every ``n`` of ``counts``, scored on sweep 2: one row per (``model`` id, ``name``, ``n_positions``,
+    """Test-sweep RMS (deg) of each 8-position LS model of :data:`~navlib.methods.compass_methods.LS_MODELS`
+    (the chapter's fit, :class:`~navlib.methods.compass_methods.EightPosition`) fitted on ``n`` equally
+    spaced positions of sweep 1 (0, 360/n, ... deg true heading) for every ``n`` of ``counts``, scored on sweep 2: one row per (``model`` id, ``name``, ``n_positions``,
     ``test_rms_deg``).  A count that cannot determine the model (fewer readings than it needs) or whose
     headings are not on the sweep is left out.  Deterministic (no random draw)."""
     rows = []
@@ -614,7 +617,7 @@ def ls_positions_rms(sw: Sweeps, counts=LS_POSITIONS, models=tuple(LS_MODELS)) -
         for n in counts:
             check_param("positions", n, lo=2, integer=True)
             try:
-                comp = _Eight(METHODS[mid].factory(StudyParams()).model, 360.0 / n).fit(sw.x_train, sw.t_train)
+                comp = EightPosition(METHODS[mid].factory(StudyParams()).model, 360.0 / n).fit(sw.x_train, sw.t_train)
             except InputError:
                 continue
             rows.append({"model": mid, "name": LS_MODELS[mid], "n_positions": int(n),
@@ -730,7 +733,8 @@ def verdict_table(claim_list, readings=None) -> pd.DataFrame:
 def rule_reading_table(claim_list, base: str) -> pd.DataFrame:
     """:func:`verdict_table` of the claims under ADE's rule readings built on reading ``base`` (``R1`` or
     ``R4``), the default rules (``base`` itself) first; columns named by the rules only (``'F by
-    generation, CR by value'`` for the default, then each label of :data:`ADE_RULE_READINGS`)."""
+    generation, CR by value'`` for the default, then each label of
+    :data:`~navlib.methods.compass_methods.ADE_RULE_READINGS`)."""
     cols = [base] + [r for r in RULE_READINGS if r.startswith(base + ", ")]
     if len(cols) == 1:
         raise InputError(f"rule_reading_table: {base!r} has no readings of ADE's rules")

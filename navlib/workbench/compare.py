@@ -286,6 +286,8 @@ def compass_errors(mid: str, settings: CompassSettings, train: dict, test: dict,
 COMPASS_DEFAULT = ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "physical", "bp_matlab") + \
     cm.READINGS[cm.R4][2:] + cm.ELM_METHODS
 
+#: The compass's comparison: paper A's and document B's methods (:mod:`navlib.methods.compass_methods`) on a
+#: compass sweep file (:func:`navlib.data.compass_sweeps.load_sweeps`).
 COMPASS = register_comparison(Comparison(
     system="compass", unit="deg", load=load_sweeps,
     methods={mid: spec.label for mid, spec in cm.METHODS.items()}, default=COMPASS_DEFAULT,
