@@ -309,7 +309,9 @@ def _task(system: str, mid: str, settings, train: dict, test: dict, fold: int, s
 @dataclass
 class CompareResult:
     """The outcome of :func:`compare`: per method its pooled test-row errors per run (``errors[id]``, an
-    array ``(runs, rows)`` in row order), the folds, and what was not run and why."""
+    array ``(runs, rows)`` in the file's row order, each row's error from the fold that held it out), the
+    folds, and the default methods that were not run and why (``not_run``).  :meth:`table`, :meth:`text`,
+    :meth:`to_dict` present it; :func:`write_report` writes it."""
 
     system: str
     unit: str
@@ -328,7 +330,7 @@ class CompareResult:
     margin: float | None = None
     x_column: str = ""
     x_label: str = ""
-    _table: pd.DataFrame | None = None
+    _table: pd.DataFrame | None = field(default=None, repr=False)
 
     # ------------------------------------------------------------------ statistics
     def rms(self, mid: str) -> np.ndarray:
@@ -496,6 +498,8 @@ def compare(system: str, source, methods: str | Sequence[str] | None = None, spl
         Equivalence margin (the system's unit) of the verdict against the best method.
     workers, scheduler
         Where the runs go (:func:`navlib.engine.run`).
+    frame : pandas.DataFrame, optional
+        The data, already loaded and checked by the caller (``source`` then only names it in messages).
     options
         The system's settings (compass: ``ls_tolerance_deg`` = 5, ``bin_deg`` = 15).
 
