@@ -20,6 +20,11 @@ Commands:
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
       compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
       --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
+  compare SYSTEM FILE.csv [--methods ID,ID] [--split RULE] [--seeds N] [--json] [--report DIR] [--workers N]
+      which of the papers' compensation methods works best on your file: each fitted on part of it and
+      scored on the rest (every row held out once), over seeds, with 95 % intervals, the paired differences
+      to the best method and the book's verdict.  RULE: sweep, heading or random (--seed S).  --report DIR
+      writes compare.md and compare.png (error against heading per method).  SYSTEM: compass.
   field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
       the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
       loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
@@ -36,7 +41,7 @@ Commands:
       file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
       statistics, claim verdicts).  Needs papermill.
 
-rates and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
+rates, compare and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
 variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.
 
@@ -72,8 +77,9 @@ import os
 import sys
 
 from .errors import InputError, UserCodeError
-from .names import (CALIBRATION_MODEL, EXAMPLES, FIELD_DATE, RATE_NOISE, RATE_RATIOS, RATE_SYSTEM_NAMES,
-                    RATE_UNITS, SYSTEM_NAMES, WORKERS_HELP)
+from .names import (CALIBRATION_MODEL, COMPARE_BIN_DEG, COMPARE_DEFAULT_METHODS, COMPARE_LS_TOLERANCE_DEG,
+                    COMPARE_SEEDS, COMPARE_SPLITS, COMPARE_SYSTEM_NAMES, EXAMPLES, FIELD_DATE, RATE_NOISE,
+                    RATE_RATIOS, RATE_SYSTEM_NAMES, RATE_UNITS, SYSTEM_NAMES, WORKERS_HELP)
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):                       # one line, exit 2, like every other bad input
@@ -148,6 +154,47 @@ def build_parser() -> argparse.ArgumentParser:
                        + ",".join(f"{r:g}" for r in RATE_RATIOS) + ")")
     rates.add_argument("--null-trials", type=int, default=None,
                        help="nothing-hidden trials per noise level (default twice --trials)")
+    # ---- compare: the papers' methods on the user's file (navlib.workbench.compare)
+    cmp_ = sub.add_parser("compare", help="which of the papers' compensation methods works best on your file",
+                          description="fit the papers' compensation methods on part of your file and score them "
+                                      "on the rest (every row held out once), over seeds: held-out rms with "
+                                      "95 % intervals, the paired differences to the best method and the book's "
+                                      "verdict on each")
+    cmp_.add_argument("system", choices=COMPARE_SYSTEM_NAMES)
+    cmp_.add_argument("file", nargs="?", default=None, help="measurement CSV (or --example NAME)")
+    cmp_.add_argument("--example", default=None, choices=sorted(n for n, e in EXAMPLES.items()
+                                                                  if e[0] in COMPARE_SYSTEM_NAMES),
+                      help="a file shipped with navlib instead of FILE")
+    cmp_.add_argument("--methods", default=None, metavar="ID,ID",
+                      help="comma-separated method ids (default, compass: "
+                           + ",".join(COMPARE_DEFAULT_METHODS["compass"]) + "; DE-BP and ADE-BP in paper A's "
+                           "primary reading, the full DE stage then trainlm); a default method that cannot be "
+                           "fitted on the split is left out with a 'not run' line, a named one is refused")
+    cmp_.add_argument("--split", default=None, choices=COMPARE_SPLITS,
+                      help="sweep: train on the other sweeps, test on each (column 'sweep'); heading: alternate "
+                           "heading bins of --bin-deg, both ways; random: two random halves of the rows (--seed), "
+                           "both ways (default: sweep when the file has 2 sweeps or more, else heading)")
+    cmp_.add_argument("--seed", type=int, default=0,
+                      help="entropy of every random draw: the random split and every run (default 0)")
+    cmp_.add_argument("--seeds", type=int, default=COMPARE_SEEDS,
+                      help=f"runs of every stochastic method, the same seeds for all; 6 or more give a 95 %% "
+                           f"interval (default {COMPARE_SEEDS})")
+    cmp_.add_argument("--bin-deg", type=float, default=COMPARE_BIN_DEG,
+                      help=f"--split heading: width of the heading bins, deg; 360 must hold an even number of "
+                           f"them (default {COMPARE_BIN_DEG:g})")
+    cmp_.add_argument("--ls-tolerance", type=float, default=COMPARE_LS_TOLERANCE_DEG, metavar="DEG",
+                      help=f"8-position LS: it uses the training reading nearest to each of 0, 45, ..., 315 deg "
+                           f"true heading, which must lie within DEG of it, at most 22.5 "
+                           f"(default {COMPARE_LS_TOLERANCE_DEG:g})")
+    cmp_.add_argument("--margin", type=float, default=None,
+                      help="equivalence margin of the verdicts, in the system's unit: a difference to the best "
+                           "whose interval lies within +-margin is 'no difference' (default: none)")
+    cmp_.add_argument("--json", action="store_true", help="print one JSON object")
+    cmp_.add_argument("--report", default=None,
+                      help="folder for compare.md and compare.png (claimed before the work, never overwritten)")
+    cmp_.add_argument("--workers", type=int, default=None, help=WORKERS_HELP)
+    cmp_.add_argument("--scheduler", default=None,
+                      help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
     grid = sub.add_parser("grid", help="run a chapter notebook over a grid of its parameters",
                           description="one papermill run of NOTEBOOK per point of the grid, each with its own "
                                       "results file; DIR gets the executed notebooks and grid.csv")

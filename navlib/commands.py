@@ -211,6 +211,29 @@ def _rates(args) -> int:
     return 0
 
 
+def _compare(args) -> int:
+    """``navlib compare``: the papers' methods fitted and scored on the user's file (the workbench's
+    :mod:`navlib.workbench.compare`, imported here: it loads the networks, and with them torch)."""
+    from contextlib import nullcontext
+    from .workbench.compare import claimed_report, compare, write_report
+    file = _measurement_file(args)
+    with (claimed_report(args.report) if args.report else nullcontext()) as paths:
+        result = compare(args.system, file, methods=args.methods, split=args.split, seeds=args.seeds, seed=args.seed,
+                         margin=args.margin, workers=_workers(args), scheduler=args.scheduler,
+                         ls_tolerance_deg=args.ls_tolerance, bin_deg=args.bin_deg)
+        out = result.to_dict()
+        if paths:
+            md, png = write_report(result, paths)
+            out["report"] = {"markdown": str(md), "figure": str(png)}
+    if args.json:
+        print(json.dumps(out, allow_nan=False))
+    else:
+        print(result.text())
+        if paths:
+            print(f"report: {md} and {png}")
+    return 0
+
+
 def _grid(args) -> int:
     from .grid import run_grid                      # papermill and the notebook machinery: only here
     rows = run_grid(args.notebook, args.param, args.out, workers=_workers(args), scheduler=args.scheduler)
@@ -223,4 +246,4 @@ def _grid(args) -> int:
 
 #: Command name -> function (the commands ``navlib.cli.build_parser`` offers).
 COMMANDS = {"examples": _examples, "simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
-            "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field}
+            "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field, "compare": _compare}

@@ -28,6 +28,15 @@ EXAMPLES = {
                                 "navlib diagnose drift --example gyro_drift_measurements --model earth_rate"),
     "accel_tumble": ("accelerometer", "accel_tumble.csv", "navlib loop accelerometer --example accel_tumble --unit A"),
 }
+#: The systems ``compare`` knows (:data:`navlib.workbench.compare.COMPARISONS`), its split rules and, per
+#: system, the default methods (``navlib.workbench.compare.COMPASS_DEFAULT``) and settings.
+COMPARE_SYSTEM_NAMES = ("compass",)
+COMPARE_SPLITS = ("sweep", "heading", "random")
+COMPARE_DEFAULT_METHODS = {"compass": ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "physical", "bp_matlab",
+                                       "de_bp_full_trainlm", "ade_bp_full_trainlm", "elm", "elm_backtuned")}
+COMPARE_SEEDS = 10
+COMPARE_BIN_DEG = 15.0
+COMPARE_LS_TOLERANCE_DEG = 5.0
 #: What ``--workers`` does when not given.
 WORKERS_HELP = ("local worker processes (default: the cores this process may use, or 1 when dask.distributed "
                 "is not installed; 1 = in this process)")

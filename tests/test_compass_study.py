@@ -40,18 +40,6 @@ def sw(frames):
     return Sweeps(*frames)
 
 
-def test_registry_ids_labels_and_readings():
-    assert METHODS["elm"].stochastic and not METHODS["ls8"].stochastic
-    labels = [m.label for m in METHODS.values()]
-    assert len(set(labels)) == len(labels)                       # one label per reading and trainer
-    for ids in READINGS.values():
-        assert all(i in METHODS for i in ids)
-    for old, new in LEGACY_NAMES.items():
-        assert method_id(old) == new
-    with pytest.raises(InputError, match="unknown method"):
-        method_id("BP (magic)")
-
-
 def test_ordering_probability_exact():
     # ls 10 > bp > de > ade: bp {5, 20}: only 5 is below ls; de {3, 6}; ade {1, 4}
     p = ordering_probability(10.0, [5.0, 20.0], [3.0, 6.0], [1.0, 4.0])
@@ -512,71 +500,6 @@ def test_parallel_studies_give_the_same_numbers(sw):
     n2 = noise_study([0.01, 0.05], p, seeds=range(2), methods=("physical", "ade_bp_pure"), workers=2)
     pd.testing.assert_frame_equal(n1[cols + ["noise_ut"]], n2[cols + ["noise_ut"]])
     assert set(n1.noise_ut) == {0.01, 0.05} and len(n1) == 2 * (1 + 2)
-
-
-def test_new_readings_are_registered_with_their_labels():
-    labels = {m.label for m in METHODS.values()}
-    for lab in ("ADE-BP full DE + trainlm", "ADE-BP full DE + trainlm, val. stop", "DE-BP full DE + trainlm",
-                "ADE-BP F per individual", "ADE-BP F combined", "ADE-BP CR by rank",
-                "LS 8-position (Smith, 5 terms)", "LS 8-position (planar, 5 par.)",
-                "LS 8-position (harmonic, 3rd order)"):
-        assert lab in labels
-    for reading, ade in RULE_READINGS.items():
-        assert READINGS[reading][3] == ade and METHODS[ade].family[0][0] is True
-        assert METHODS[ade].family[0][1:] != ("generation", "value")      # not the default rules
-
-
-def test_third_order_ls_on_eight_readings_reproduces_a_third_order_error_exactly(sw):
-    """A compass whose deviation is a known harmonic series to 3rd order in the measured heading: the
-    3rd-order 8-position LS recovers it exactly (every test heading corrected to 1e-9 deg), Smith's 5 terms
-    cannot (the 3rd harmonic aliases at 8 positions)."""
-    coef = np.array([0.7, 3.0, -2.0, 1.1, 0.4, 1.2, -0.8])               # A, B1, C1, B2, C2, B3, C3 (deg)
-
-    def deviation(m):
-        return design(m, 3) @ coef
-
-    true = np.arange(0.0, 363.0, 3.0)
-    m = true.copy()
-    for _ in range(200):                                                 # measured: m - delta(m) = true
-        m = true + deviation(m)
-    assert np.max(np.abs(m - deviation(m) - true)) < 1e-10
-    model = fit_smith(np.mod(m[eight_position_indices(true)], 360.0), true[eight_position_indices(true)], 3)
-    np.testing.assert_allclose(model.coef, coef, atol=1e-9)
-    h3 = fit_method("ls8_h3", m, true)[0]
-    smith = fit_method("ls8", m, true)[0]
-    assert np.max(np.abs(wrap_deg(h3.correct(m) - true))) < 1e-9
-    assert np.max(np.abs(wrap_deg(smith.correct(m) - true))) > 0.5
-    with pytest.raises(InputError, match="7 coefficients"):
-        fit_smith(m[:6], true[:6], 3)
-
-
-def _family_equals_alone(sw, mids, p, seeds):
-    """fit_family(mids) gives each method's networks (and trainer info) as fit_method alone; the family."""
-    fam = fit_family(mids, sw.x_train, sw.t_train, p, seeds=seeds)
-    for mid in mids:
-        for a, b in zip(fam[mid], fit_method(mid, sw.x_train, sw.t_train, p, seeds=seeds)):
-            np.testing.assert_array_equal(a.net.theta, b.net.theta)
-            for key in ("de_generations", "epochs", "stop"):
-                assert a.info.get(key) == b.info.get(key)
-    return fam
-
-
-def test_family_of_one_de_stage_equals_each_method_alone(sw):
-    """Pure DE and full DE + trainlm (with and without the validation stop) fitted from one shared DE stage
-    give the same networks as each method fitted alone with the same seeds; so do reading 2's DE +
-    trainlm with and without the validation stop from their own (shorter) stage."""
-    p = StudyParams(de=DEParams(max_generations=30), lm=replace(StudyParams().lm, epochs=15))
-    _family_equals_alone(sw, ("ade_bp_pure_f_ind", "ade_bp_full_trainlm_f_ind"), p, [3, 4])
-    _family_equals_alone(sw, ("ade_bp_pure", "ade_bp_full_trainlm", "ade_bp_full_trainlm_val"), p, [1])
-    with pytest.raises(InputError, match="share one DE stage"):
-        fit_family(("ade_bp_pure", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
-    with pytest.raises(InputError, match="share one DE stage"):
-        fit_family(("de_bp_hybrid_trainlm", "de_bp_full_trainlm"), sw.x_train, sw.t_train, p)
-    for hybrid_target, gens in (("normalised", 3000), ("deg2", 30)):
-        ph = replace(p, hybrid_target=hybrid_target, de=DEParams(max_generations=gens))
-        fam = _family_equals_alone(sw, ("de_bp_hybrid_trainlm", "de_bp_hybrid_trainlm_val"), ph, [0, 2])
-        if hybrid_target == "normalised":                           # the stage stopped at the target
-            assert all(0 < f.info["de_generations"] < 3000 for f in fam["de_bp_hybrid_trainlm"])
 
 
 def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):

@@ -12,8 +12,9 @@ choice of network target, the true heading or the heading error (:class:`Heading
 heading handed to ``fit`` and ``correct`` may be unwrapped along the sweep (networks need a continuous
 input); models of periodic form (Smith, the planar model) do not mind.
 
-Registries of concrete methods, keyed by stable ids with display labels, live with the studies that use
-them (``navlib.studies.paper_a.METHODS``).
+The registry of the compass's concrete methods, keyed by stable ids with display labels, is
+:mod:`navlib.methods.compass_methods` (``METHODS``); the compass chapter's studies and the workbench's
+``navlib compare`` both fit them from there.
 """
 from __future__ import annotations
 

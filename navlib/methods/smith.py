@@ -83,15 +83,49 @@ def fit_smith(measured_deg, true_deg, order: int = 2) -> SmithModel:
     return SmithModel(coef)
 
 
-def eight_position_indices(true_deg, step_deg: float = 45.0) -> np.ndarray:
-    """Indices of the readings at 0, 45, ..., 315 deg true heading (paper A's 8 positions)."""
+def nearest_positions(true_deg, step_deg: float = 45.0, tol_deg: float = 1e-6) -> np.ndarray:
+    """For each position ``0, step, 2 step, ...`` deg of true heading (paper A's 8 positions for 45 deg), the
+    index of the reading nearest to it, or -1 where no reading lies within ``tol_deg`` of it.
+
+    The distance is the wrapped angle ``|wrap(t - position)|``; a tie goes to the first reading.  A
+    turntable sweep has a reading at each position (the default ``tol_deg`` asks for that); a hand-turned
+    recording or a file binned by heading has the nearest within a few degrees.
+
+    Parameters
+    ----------
+    true_deg : array_like
+        True (reference) headings of the readings, deg.
+    step_deg : float
+        Spacing of the positions, deg (45: the 8 positions).
+    tol_deg : float
+        How far the nearest reading may lie from its position, deg (>= 0).
+
+    Returns
+    -------
+    numpy.ndarray
+        One index per position (int), -1 where the position has no reading within ``tol_deg``.
+    """
+    if not np.isfinite(tol_deg) or tol_deg < 0:
+        raise InputError(f"parameter tol_deg: must be a number >= 0, got {tol_deg!r}")
     t = np.mod(np.asarray(true_deg, dtype=float), 360.0)
-    want = np.arange(0.0, 360.0, step_deg)
-    idx = []
-    for w in want:
+    out = []
+    for w in np.arange(0.0, 360.0, step_deg):
+        if t.size == 0:
+            out.append(-1)
+            continue
         d = np.abs(((t - w) + 180.0) % 360.0 - 180.0)
         j = int(np.argmin(d))
-        if d[j] > 1e-6:
-            raise InputError(f"no reading at true heading {w:g} deg for the 8-position fit")
-        idx.append(j)
-    return np.array(idx)
+        out.append(j if d[j] <= tol_deg else -1)
+    return np.array(out, dtype=int)
+
+
+def eight_position_indices(true_deg, step_deg: float = 45.0, tol_deg: float = 1e-6) -> np.ndarray:
+    """Indices of the readings at 0, 45, ..., 315 deg true heading (paper A's 8 positions): the nearest
+    reading to each position (:func:`nearest_positions`), which must lie within ``tol_deg`` of it (default:
+    a reading at the position itself, as on paper A's turntable)."""
+    idx = nearest_positions(true_deg, step_deg, tol_deg)
+    missing = np.arange(0.0, 360.0, step_deg)[idx < 0]
+    if missing.size:
+        within = "at" if tol_deg <= 1e-6 else f"within {tol_deg:g} deg of"
+        raise InputError(f"no reading {within} true heading {missing[0]:g} deg for the 8-position fit")
+    return idx

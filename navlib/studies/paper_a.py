@@ -1,20 +1,10 @@
 """Paper A's comparison under every plausible reading of its training, as one reusable study: every
 compensation method trained on sweep 1 and scored on sweep 2, repeated over seeds for the stochastic ones.
 
-Methods are registered in ``METHODS`` under stable ids (labels are for display only):
-
-- ``uncompensated``; ``ls8`` (Smith's A..E fitted at 0, 45, ..., 315 deg, :mod:`navlib.methods.smith`);
-  ``physical`` (the exact planar model fitted to all of sweep 1, our noise floor);
-- reading 1, pure DE training: ``de_bp_pure``, ``ade_bp_pure`` (:func:`navlib.methods.bpnet.train_de_many`;
-  the paper's target 0.2 read in deg^2, where it never fires);
-- reading 2, DE-initialised BP: ``de_bp_hybrid_trainlm``, ``ade_bp_hybrid_trainlm`` and the ``_val``
-  variants with MATLAB's dividerand split and validation stop
-  (:func:`navlib.methods.bpnet.train_hybrid_many`; the target 0.2 read as a sum of squares of the
-  normalised errors, which ends the DE stage early);
-- reading 3, the paper's "BP" as MATLAB creates it: ``bp_matlab``, ``bp_matlab_val``
-  (:func:`navlib.methods.bpnet.train_matlab_bp_many`);
-- extras: ``bp_adam`` (Adam from U(-1, 1)), ``bp_scipy_lm`` (MINPACK LM from U(-1, 1));
-- document B: ``elm``, ``elm_backtuned`` (:mod:`navlib.methods.elm`).
+The methods, their ids, labels, readings and settings are registered in
+:mod:`navlib.methods.compass_methods` (``METHODS``, ``MethodParams``; re-exported here under their former
+names, ``StudyParams`` for ``MethodParams``); this module runs them on sweeps, over seeds, and judges paper
+A's claims.
 
 Error = compensated - true heading, wrapped to (-180, 180], on the test sweep.
 """
@@ -22,84 +12,32 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import Callable, Iterable, Literal, Mapping
+from typing import Iterable, Mapping
 
 import numpy as np
 import pandas as pd
 
 from ..angles import wrap_deg
 from ..data.compass_sweeps import unwrap_measured
-from ..errors import InputError, check_choice, check_param
-from ..methods.bpnet import (AdamParams, train_adam_many, train_de_family, train_de_many, train_hybrid_many,
-                             train_least_squares, train_matlab_bp_many)
-from ..methods.compensator import (HeadingTarget, MethodBase, ModelCompensator, NetworkCompensator,
-                                   ScaledRegressor)
-from ..methods.de import DEParams
-from ..methods.elm import ELMParams, IncrementalELMParams, fit_elm, fit_incremental_elm
-from ..methods.lm import LMParams
-from ..methods.seeding import generators, sequence
-from ..methods.smith import eight_position_indices, fit_smith
+from ..errors import InputError, check_param
+from ..methods.compass_methods import (ADE_DEFAULT_RULES, ADE_RULE_READINGS, ELM_METHODS, LEGACY_NAMES,  # noqa: F401
+                                       LS_MODELS, METHODS, R1, R2, R2V, R3, R3V, R4, R4V, RA, READINGS,
+                                       RULE_READINGS, RUN_COST_S, EightPosition, MethodParams, MethodSpec,
+                                       NetworkMethod, PlanarFit, Uncompensated, elm_trainer, fit_family,
+                                       fit_method, fitting_units, label, method_id, unit_cost, _rule_reading)
+from ..methods.seeding import sequence
 from .. import verdicts
 from ..report import Claim, method_stats
 from ..sensors.compass import PAPER_A_EARTH, CompassErrors, simulate_sweep, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
-from ..sensors.planar import fit_planar_model
 from .. import engine
 
-
-@dataclass(frozen=True)
-class StudyParams:
-    """Everything a reader may change in the compass chapter. Defaults are paper A's settings (DE, ADE)
-    and MATLAB's defaults (``trainlm``).
-
-    ``de``: the DE settings of both DE-BP and ADE-BP (``adaptive`` is set per method);
-    ``pure_target``/``hybrid_target``: how the paper's stopping value ``de.target_fitness`` is read in
-    readings 1 and 2 (``'deg2'`` or ``'normalised'``, see :func:`navlib.methods.bpnet.train_hybrid_many`);
-    ``lm``: ``trainlm`` settings; ``adam``: the Adam extra row; ``network_target``: what the networks learn
-    (:class:`navlib.methods.compensator.HeadingTarget`).  The ``elm_*`` fields are our a-priori choices for
-    document B (the patent gives no numbers)."""
-
-    n_hidden: int = 6
-    de: DEParams = DEParams()
-    pure_target: Literal["deg2", "normalised"] = "deg2"
-    hybrid_target: Literal["deg2", "normalised"] = "normalised"
-    lm: LMParams = LMParams()
-    adam: AdamParams = AdamParams()
-    network_target: Literal["heading", "error"] = "heading"
-    elm_nodes: int = 19          # plain ELM: 19 trained output weights = the 19 weights of the 1-6-1 net
-    elm_range: float = 5.0       # input weights and biases ~ U(-elm_range, elm_range) (Huang 2006: 1)
-    elm_max_nodes: int = 30      # incremental ELM: cap on the hidden-node count
-    elm_goal_deg: float = 0.1    # incremental ELM: stop when the training RMS error (deg) is <= this
-    elm_max_iter: int = 200      # incremental ELM: the patent's k (ELM and tuning stages together)
-
-    def __post_init__(self):
-        check_param("n_hidden", self.n_hidden, lo=1, integer=True)
-        for name, cls in (("de", DEParams), ("lm", LMParams), ("adam", AdamParams)):
-            if not isinstance(getattr(self, name), cls):
-                raise InputError(f"parameter {name}: must be a {cls.__name__}")
-        check_choice("pure_target", self.pure_target, ("deg2", "normalised"))
-        check_choice("hybrid_target", self.hybrid_target, ("deg2", "normalised"))
-        check_choice("network_target", self.network_target, ("heading", "error"))
-        check_param("elm_nodes", self.elm_nodes, lo=1, integer=True)
-        check_param("elm_range", self.elm_range, lo=0, lo_open=True)
-        check_param("elm_max_nodes", self.elm_max_nodes, lo=1, integer=True)
-        check_param("elm_goal_deg", self.elm_goal_deg, lo=0)
-        check_param("elm_max_iter", self.elm_max_iter, lo=1, integer=True)
-
-    @property
-    def target(self) -> HeadingTarget:
-        return HeadingTarget(self.network_target)
-
-    def elm_params(self) -> ELMParams:
-        return ELMParams(n_hidden=self.elm_nodes, weight_range=self.elm_range, bias_range=self.elm_range)
-
-    def incremental_params(self, target_span_deg: float) -> IncrementalELMParams:
-        """The incremental ELM's settings; the goal in degrees becomes a normalised MSE through the span of
-        the training target (360 deg for the heading, about 47 deg for the error of the default compass)."""
-        return IncrementalELMParams(max_nodes=self.elm_max_nodes,
-                                    loss_goal=(self.elm_goal_deg / float(target_span_deg)) ** 2,
-                                    max_iter=self.elm_max_iter, weight_range=self.elm_range,
-                                    bias_range=self.elm_range)
+#: The chapter's name for the methods' settings (:class:`navlib.methods.compass_methods.MethodParams`).
+StudyParams = MethodParams
+# former private names of the methods (now public in navlib.methods.compass_methods)
+_Uncompensated, _Eight, _Smith8, _Planar, _Network = (Uncompensated, EightPosition, EightPosition, PlanarFit,
+                                                      NetworkMethod)
+_elm_train, _units, _unit_cost = elm_trainer, fitting_units, unit_cost
 
 
 def error_stats(err) -> dict:
@@ -147,201 +85,6 @@ def test_errors(corrected, sw: Sweeps) -> np.ndarray:
 test_errors.__test__ = False     # not a pytest test
 
 
-# ----------------------------------------------------------------------------------------------- methods
-class _Uncompensated(MethodBase):
-    def fit(self, measured_deg, reference_deg, rng=None):
-        return ModelCompensator(None)
-
-
-@dataclass
-class _Eight(MethodBase):
-    """Paper A's 8-position least squares (readings at 0, 45, ..., 315 deg true heading) under one model:
-    ``'smith'`` (Smith's A..E, 5 terms), ``'harmonic3'`` (the harmonic series to 3rd order, 7 terms) or
-    ``'planar'`` (the exact 5-parameter hard/soft-iron model of :mod:`navlib.sensors.planar`).  ``step_deg``:
-    the spacing of the positions (45 deg: paper A's 8; :func:`ls_positions_rms` varies it)."""
-
-    model: str = "smith"
-    step_deg: float = 45.0
-
-    def fit(self, measured_deg, reference_deg, rng=None):
-        m, t = np.asarray(measured_deg, float), np.asarray(reference_deg, float)
-        idx = eight_position_indices(t, self.step_deg)
-        if self.model == "planar":
-            return ModelCompensator(fit_planar_model(t[idx], np.mod(m[idx], 360.0)))
-        return ModelCompensator(fit_smith(np.mod(m[idx], 360.0), t[idx], 3 if self.model == "harmonic3" else 2))
-
-
-_Smith8 = _Eight
-
-
-class _Planar(MethodBase):
-    def fit(self, measured_deg, reference_deg, rng=None):
-        return ModelCompensator(fit_planar_model(reference_deg, np.mod(measured_deg, 360.0)))
-
-
-@dataclass
-class _Network(MethodBase):
-    """A network method: ``train(x, target, rngs) -> list of nets`` on the target chosen by ``target``."""
-
-    train: Callable
-    target: HeadingTarget
-
-    def fit_many(self, measured_deg, reference_deg, rngs):
-        x = np.asarray(measured_deg, dtype=float)
-        nets = self.train(x, self.target.target(x, reference_deg), list(rngs))
-        return [NetworkCompensator(n, self.target, dict(getattr(n, "info", {}))) for n in nets]
-
-
-def _elm_train(params: StudyParams, back_tuned: bool):
-    """Plain ELM or the patent's back-tuned incremental ELM on min-max normalised data; ``info`` has
-    ``n_nodes`` and, for the back-tuned ELM, the stage ``history`` of :func:`fit_incremental_elm`."""
-    def train(x, t, rngs):
-        out = []
-        for g in rngs:
-            info = {}
-            if back_tuned:
-                goal = params.incremental_params(float(np.ptp(t)))
-
-                def fit(xn, tn):
-                    model, info["history"] = fit_incremental_elm(xn, tn, goal, rng=g)
-                    return model
-            else:
-                def fit(xn, tn):
-                    return fit_elm(xn, tn, params.elm_params(), rng=g)
-            reg = ScaledRegressor.fit(x, t, fit)
-            reg.info = dict(info, n_nodes=reg.n_hidden)
-            out.append(reg)
-        return out
-    return train
-
-
-@dataclass(frozen=True)
-class MethodSpec:
-    """A registered method: display ``label``, ``factory(params) -> method``, whether it is stochastic,
-    the row of ``data/paper_a_error_ranges.csv`` it answers (or None), and its ``reading``."""
-
-    label: str
-    factory: Callable[[StudyParams], MethodBase]
-    stochastic: bool
-    paper_row: str | None = None
-    reading: str = ""
-    #: runs sharing one DE stage: ``((adaptive, f_rule, cr_rule), variant)`` for the full stage,
-    #: ``((adaptive, f_rule, cr_rule, "hybrid"), variant)`` for reading 2's stage (``hybrid_target``)
-    family: tuple | None = None
-
-
-def _reading2_stage(family_key: tuple) -> bool:
-    """Whether a ``family`` key names reading 2's DE stage (the stop read by ``hybrid_target``)."""
-    return family_key[3:] == ("hybrid",)
-
-
-#: ADE's default rules (:class:`navlib.methods.de.DEParams`): F by generation, CR by value.
-ADE_DEFAULT_RULES = ("generation", "value")
-#: The other readings of ADE's rules in section 1.2, as (f_rule, cr_rule, id suffix, label part).
-ADE_RULE_READINGS = (("individual", "value", "f_ind", "F per individual"),
-                     ("combined", "value", "f_comb", "F combined"),
-                     ("generation", "rank", "cr_rank", "CR by rank"),
-                     ("individual", "rank", "f_ind_cr_rank", "F per individual, CR by rank"))
-
-
-def _de(p: StudyParams, adaptive: bool, rules=ADE_DEFAULT_RULES) -> DEParams:
-    return replace(p.de, adaptive=adaptive, f_rule=rules[0], cr_rule=rules[1])
-
-
-def _pure(adaptive, rules=ADE_DEFAULT_RULES):
-    def make(p):
-        d = _de(p, adaptive, rules)
-        if p.pure_target == "normalised":
-            return _Network(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g,
-                                                              replace(p.lm, epochs=0)), p.target)
-        return _Network(lambda x, t, g: train_de_many(x, t, p.n_hidden, d, g)[0], p.target)
-    return make
-
-
-def _hybrid(adaptive, validation):
-    def make(p):
-        d = _de(p, adaptive)
-        return _Network(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation,
-                                                          p.hybrid_target), p.target)
-    return make
-
-
-def _full(adaptive, validation, rules=ADE_DEFAULT_RULES):
-    """The full DE stage (the paper's target read in deg^2, so all ``max_generations``), then trainlm."""
-    def make(p):
-        d = _de(p, adaptive, rules)
-        return _Network(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation, "deg2"),
-                        p.target)
-    return make
-
-
-def _matlab(validation):
-    return lambda p: _Network(lambda x, t, g: train_matlab_bp_many(x, t, p.n_hidden, g, p.lm, validation),
-                              p.target)
-
-
-R1, R2, R2V = "1: pure DE", "2: DE + trainlm", "2: DE + trainlm, val. stop"
-R4, R4V = "4: full DE + trainlm", "4: full DE + trainlm, val. stop"
-R3, R3V, RA = "3: MATLAB BP", "3: MATLAB BP, val. stop", "extra: Adam"
-_DE0, _ADE0 = (False,) + ADE_DEFAULT_RULES, (True,) + ADE_DEFAULT_RULES
-
-
-def _rule_reading(base: str, label: str) -> str:
-    return f"{base}, ADE {label}"
-
-
-METHODS: dict[str, MethodSpec] = {
-    "uncompensated": MethodSpec("uncompensated", lambda p: _Uncompensated(), False, "uncompensated"),
-    "ls8": MethodSpec("LS 8-position (Smith, 5 terms)", lambda p: _Eight("smith"), False,
-                      "8-position least squares"),
-    "ls8_planar": MethodSpec("LS 8-position (planar, 5 par.)", lambda p: _Eight("planar"), False,
-                             "8-position least squares"),
-    "ls8_h3": MethodSpec("LS 8-position (harmonic, 3rd order)", lambda p: _Eight("harmonic3"), False,
-                         "8-position least squares"),
-    "physical": MethodSpec("physical model", lambda p: _Planar(), False),
-    "bp_matlab": MethodSpec("BP MATLAB (trainlm)", _matlab(False), True, "BP network", R3),
-    "bp_matlab_val": MethodSpec("BP MATLAB (trainlm, val. stop)", _matlab(True), True, "BP network", R3V),
-    "bp_adam": MethodSpec("BP (Adam)", lambda p: _Network(
-        lambda x, t, g: train_adam_many(x, t, p.n_hidden, p.adam, g), p.target), True, "BP network", RA),
-    "bp_scipy_lm": MethodSpec("BP (scipy LM)", lambda p: _Network(
-        lambda x, t, g: [train_least_squares(x, t, p.n_hidden, r) for r in g], p.target), True),
-    "de_bp_pure": MethodSpec("DE-BP pure", _pure(False), True, "DE-BP", R1, (_DE0, "pure")),
-    "ade_bp_pure": MethodSpec("ADE-BP pure", _pure(True), True, "ADE-BP", R1, (_ADE0, "pure")),
-    "de_bp_hybrid_trainlm": MethodSpec("DE-BP hybrid (trainlm)", _hybrid(False, False), True, "DE-BP", R2,
-                                       (_DE0 + ("hybrid",), "trainlm")),
-    "ade_bp_hybrid_trainlm": MethodSpec("ADE-BP hybrid (trainlm)", _hybrid(True, False), True, "ADE-BP", R2,
-                                        (_ADE0 + ("hybrid",), "trainlm")),
-    "de_bp_hybrid_trainlm_val": MethodSpec("DE-BP hybrid (trainlm, val. stop)", _hybrid(False, True), True,
-                                           "DE-BP", R2V, (_DE0 + ("hybrid",), "trainlm_val")),
-    "ade_bp_hybrid_trainlm_val": MethodSpec("ADE-BP hybrid (trainlm, val. stop)", _hybrid(True, True), True,
-                                            "ADE-BP", R2V, (_ADE0 + ("hybrid",), "trainlm_val")),
-    "de_bp_full_trainlm": MethodSpec("DE-BP full DE + trainlm", _full(False, False), True, "DE-BP", R4,
-                                     (_DE0, "trainlm")),
-    "ade_bp_full_trainlm": MethodSpec("ADE-BP full DE + trainlm", _full(True, False), True, "ADE-BP", R4,
-                                      (_ADE0, "trainlm")),
-    "de_bp_full_trainlm_val": MethodSpec("DE-BP full DE + trainlm, val. stop", _full(False, True), True, "DE-BP",
-                                         R4V, (_DE0, "trainlm_val")),
-    "ade_bp_full_trainlm_val": MethodSpec("ADE-BP full DE + trainlm, val. stop", _full(True, True), True,
-                                          "ADE-BP", R4V, (_ADE0, "trainlm_val")),
-    "elm": MethodSpec("ELM", lambda p: _Network(_elm_train(p, False), p.target), True, None, "document B"),
-    "elm_backtuned": MethodSpec("ELM back-tuned", lambda p: _Network(_elm_train(p, True), p.target), True,
-                                None, "document B"),
-}
-#: Each reading of ADE's rules (:data:`ADE_RULE_READINGS`), in pure DE and in full DE + trainlm: the ADE-BP
-#: of that reading (DE-BP is unchanged).
-RULE_READINGS: dict[str, str] = {}
-for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
-    _key = (True, _f, _c)
-    METHODS[f"ade_bp_pure_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}", _pure(True, (_f, _c)), True, "ADE-BP",
-                                                _rule_reading(R1, _lab), (_key, "pure"))
-    METHODS[f"ade_bp_full_trainlm_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}, full DE + trainlm",
-                                                        _full(True, False, (_f, _c)), True, "ADE-BP",
-                                                        _rule_reading(R4, _lab), (_key, "trainlm"))
-    RULE_READINGS[_rule_reading(R1, _lab)] = f"ade_bp_pure_{_sfx}"
-    RULE_READINGS[_rule_reading(R4, _lab)] = f"ade_bp_full_trainlm_{_sfx}"
-
-#: The 8-position least squares under each model (paper A does not print its model): id -> short name.
-LS_MODELS = {"ls8": "Smith 5 terms", "ls8_planar": "planar 5 par.", "ls8_h3": "harmonic 3rd order"}
 #: Glue-key part of each LS model (Smith's keeps the former keys).
 _LS_KEYS = {"ls8": "ls", "ls8_planar": "lsplanar", "ls8_h3": "lsh3"}
 
@@ -352,51 +95,9 @@ MAIN_METHODS = ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "bp_matlab", "bp
                 "ade_bp_full_trainlm", "de_bp_full_trainlm_val", "ade_bp_full_trainlm_val") + tuple(
     f"ade_bp_{v}_{sfx}" for _, _, sfx, _ in ADE_RULE_READINGS for v in ("pure", "full_trainlm")) + (
     "elm", "elm_backtuned", "physical")
-ELM_METHODS = ("elm", "elm_backtuned")
-
-#: Each reading of paper A's four methods: (LS, BP, DE-BP, ADE-BP) ids (LS: Smith's; every LS claim is
-#: judged once per model of :data:`LS_MODELS`).  The readings of ADE's rules change only ADE-BP: their
-#: claims are those that involve ADE-BP (:data:`RULE_READINGS`).
-READINGS: dict[str, tuple[str, str, str, str]] = {
-    R1: ("ls8", "bp_matlab", "de_bp_pure", "ade_bp_pure"),
-    R2: ("ls8", "bp_matlab", "de_bp_hybrid_trainlm", "ade_bp_hybrid_trainlm"),
-    R2V: ("ls8", "bp_matlab_val", "de_bp_hybrid_trainlm_val", "ade_bp_hybrid_trainlm_val"),
-    R4: ("ls8", "bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm"),
-    R4V: ("ls8", "bp_matlab_val", "de_bp_full_trainlm_val", "ade_bp_full_trainlm_val"),
-}
-for _r, _ade in RULE_READINGS.items():
-    _base = READINGS[R1 if _r.startswith(R1) else R4]
-    READINGS[_r] = _base[:3] + (_ade,)
 #: The same with the Adam extra as the "BP" (for the ordering probabilities).
 BP_VARIANTS = ("bp_matlab", "bp_matlab_val", "bp_adam")
 
-#: The chapter's former display names, accepted by :func:`method_id` (the workbench notebook used them).
-LEGACY_NAMES = {"ADE-BP": "ade_bp_pure", "DE-BP": "de_bp_pure", "BP (Adam)": "bp_adam",
-                "BP (LM)": "bp_scipy_lm", "LS 8-position": "ls8", "physical model": "physical",
-                "ELM": "elm", "ELM back-tuned": "elm_backtuned"}
-
-
-def method_id(name: str) -> str:
-    """The registry id of ``name`` (an id, or one of :data:`LEGACY_NAMES`)."""
-    if name in METHODS:
-        return name
-    if name in LEGACY_NAMES:
-        return LEGACY_NAMES[name]
-    raise InputError(f"unknown method {name!r}; known: {', '.join(METHODS)}")
-
-
-def label(mid: str) -> str:
-    """Display label of a method id."""
-    return METHODS[method_id(mid)].label
-
-
-def fit_method(method: str, x, reference, params: StudyParams = StudyParams(), seeds=(0,), base_seed: int = 0):
-    """Fit ``method`` (an id of ``METHODS``) on measured headings ``x`` (unwrapped) and true headings,
-    one run per seed (run ``k`` uses generator ``k`` of :func:`navlib.seeding.generators`).
-    Returns the fitted compensators (one for a deterministic method)."""
-    spec = METHODS[method_id(method)]
-    rngs = generators(seeds if spec.stochastic else [0], base_seed)
-    return spec.factory(params).fit_many(x, reference, rngs)
 
 
 def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), seed: int = 0):
@@ -413,43 +114,13 @@ def compensate(method: str, sw: Sweeps, params: StudyParams = StudyParams(), see
     return fitted.correct(sw.x_test), info
 
 
-def fit_family(methods, x, reference, params: StudyParams = StudyParams(), seeds=(0,),
-               base_seed: int = 0) -> dict[str, list]:
-    """Fit methods that share one DE stage (the same ``family`` key of :class:`MethodSpec`: pure DE and
-    full DE + trainlm, with and without the validation stop, of one DE / ADE rule; or reading 2's DE +
-    trainlm with and without the validation stop) from one stage per seed
-    (:func:`navlib.methods.bpnet.train_de_family`): the same fitted compensators as
-    :func:`fit_method` gives for each method alone, at the cost of one stage.  ``{method id: fitted}``."""
-    mids = [method_id(m) for m in methods]
-    fams = [METHODS[m].family for m in mids]
-    if any(f is None for f in fams) or len({f[0] for f in fams}) != 1:
-        raise InputError(f"fit_family: {', '.join(mids)} do not share one DE stage")
-    if params.pure_target != "deg2" and any(f[1] == "pure" for f in fams):
-        raise InputError("fit_family: pure DE shares the full stage only with pure_target='deg2'")
-    adaptive, f_rule, cr_rule = fams[0][0][:3]
-    d = replace(params.de, adaptive=adaptive, f_rule=f_rule, cr_rule=cr_rule)
-    xx = np.asarray(x, dtype=float)
-    tgt = params.target
-    nets = train_de_family(xx, tgt.target(xx, reference), params.n_hidden, d, generators(seeds, base_seed),
-                           params.lm, [f[1] for f in fams],
-                           params.hybrid_target if _reading2_stage(fams[0][0]) else "deg2")
-    return {m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
-            for m, f in zip(mids, fams)}
-
-
-#: CPU seconds per run of each method at the chapter's defaults (measured; for ordering parallel tasks,
-#: most expensive first).  Methods not listed count as cheap; a family of methods sharing one DE stage
-#: costs the stage (``"de_stage"``) plus ``"trainlm"`` per trainlm variant.
-RUN_COST_S = {"de_bp_pure": 0.3, "ade_bp_pure": 0.3, "de_bp_hybrid_trainlm": 0.14,
-              "ade_bp_hybrid_trainlm": 0.07, "de_bp_hybrid_trainlm_val": 0.1, "ade_bp_hybrid_trainlm_val": 0.03,
-              "bp_adam": 0.05, "bp_matlab": 0.06, "bp_matlab_val": 0.02, "elm_backtuned": 0.1,
-              "de_stage": 0.3, "trainlm": 0.04}
 
 
 def _method_runs(sw: Sweeps, params: StudyParams, mids, seeds: list, base_seed: int,
                  keep_errors: bool) -> list[dict]:
-    """The rows of :func:`seed_study` for one method (or one family sharing a DE stage, :func:`fit_family`)
-    and the given seeds (one batch).  A family's ``train_time_s`` is the family's time per seed."""
+    """The rows of :func:`seed_study` for one method (or one family sharing a DE stage,
+    :func:`~navlib.methods.compass_methods.fit_family`) and the given seeds (one batch).  A family's
+    ``train_time_s`` is the family's time per seed."""
     mids = (mids,) if isinstance(mids, str) else tuple(mids)
     t0 = time.perf_counter()
     if len(mids) > 1:
@@ -483,39 +154,10 @@ SEED_BATCH = 4
 MAX_TASK_S = 2.0
 
 
-def _units(params: StudyParams, methods) -> list[tuple[str, ...]]:
-    """The methods grouped into fitting units: the methods sharing one DE stage (``family``: the full
-    stage, pure DE only with ``pure_target='deg2'``; or reading 2's stage) form one unit, every other
-    method its own."""
-    units, at = [], {}
-    for m in methods:
-        mid = method_id(m)
-        fam = METHODS[mid].family
-        if fam is not None and (fam[1] != "pure" or params.pure_target == "deg2"):
-            if fam[0] in at:
-                units[at[fam[0]]].append(mid)
-                continue
-            at[fam[0]] = len(units)
-        units.append([mid])
-    return [tuple(u) for u in units]
-
-
-def _unit_cost(unit, params: StudyParams) -> float:
-    """Estimated CPU seconds per seed of a fitting unit (:data:`RUN_COST_S`)."""
-    fams = [METHODS[m].family for m in unit]
-    if len(unit) > 1 and _reading2_stage(fams[0][0]):        # reading 2's stage: the costliest member's
-        c = max(RUN_COST_S.get(m, 0.001) for m in unit) + RUN_COST_S["trainlm"] * (len(unit) - 1)
-    elif all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
-        c = RUN_COST_S["de_stage"] + RUN_COST_S["trainlm"] * sum(f[1] != "pure" for f in fams)
-    else:
-        c = RUN_COST_S.get(unit[0], 0.001)
-    return c * params.de.max_generations / 3000
-
-
 def _tasks(sw, params, seeds, methods, base_seed, keep_errors):
     """One task per deterministic method and per batch of :data:`SEED_BATCH` seeds of a stochastic one (or
-    of a family sharing a DE stage, :func:`_units`; fewer seeds when a batch would cost more than
-    :data:`MAX_TASK_S`), with its estimated cost (CPU seconds)."""
+    of a family sharing a DE stage, :func:`~navlib.methods.compass_methods.fitting_units`; fewer seeds when
+    a batch would cost more than :data:`MAX_TASK_S`), with its estimated cost (CPU seconds)."""
     tasks, cost = [], []
     for unit in _units(params, methods):
         stochastic = METHODS[unit[0]].stochastic
@@ -829,10 +471,11 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
       ``implied_ut``); where it is not below the paper's width the claim cannot be judged, and the
       reason names the noise it would need (from :func:`floor_curve` ``floor``).
 
-    Every claim that involves the 8-position LS is judged once per LS model of :data:`LS_MODELS` found in
-    ``runs`` (the paper does not print its model); the readings of ADE's rules (:data:`RULE_READINGS`)
-    change only ADE-BP, so only the claims involving ADE-BP are judged there.  A reading whose methods are
-    not all in ``runs`` is skipped.  The intervals cover training randomness on one fixed sweep pair
+    Every claim that involves the 8-position LS is judged once per LS model of
+    :data:`~navlib.methods.compass_methods.LS_MODELS` found in ``runs`` (the paper does not print its model);
+    the readings of ADE's rules (:data:`~navlib.methods.compass_methods.RULE_READINGS`) change only ADE-BP,
+    so only the claims involving ADE-BP are judged there.  A reading whose methods are not all in ``runs``
+    is skipped.  The intervals cover training randomness on one fixed sweep pair
     (:data:`TRAINING_ONLY`)."""
     pr = paper.set_index("method")
     out = []
@@ -911,7 +554,8 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
 
 
 def _ls_text(text: str, ls: str | None) -> str:
-    """A claim's text with the LS model it is judged against (``ls`` an id of :data:`LS_MODELS`)."""
+    """A claim's text with the LS model it is judged against (``ls`` an id of
+    :data:`~navlib.methods.compass_methods.LS_MODELS`)."""
     if ls is None:
         return text
     tag = f"[{LS_MODELS[ls]}]"
@@ -963,9 +607,9 @@ LS_REF_POSITIONS = 24
 
 
 def ls_positions_rms(sw: Sweeps, counts=LS_POSITIONS, models=tuple(LS_MODELS)) -> pd.DataFrame:
-    """Test-sweep RMS (deg) of each 8-position LS model of :data:`LS_MODELS` (the chapter's fit,
-    ``_Eight``) fitted on ``n`` equally spaced positions of sweep 1 (0, 360/n, ... deg true heading) for
-    every ``n`` of ``counts``, scored on sweep 2: one row per (``model`` id, ``name``, ``n_positions``,
+    """Test-sweep RMS (deg) of each 8-position LS model of :data:`~navlib.methods.compass_methods.LS_MODELS`
+    (the chapter's fit, :class:`~navlib.methods.compass_methods.EightPosition`) fitted on ``n`` equally
+    spaced positions of sweep 1 (0, 360/n, ... deg true heading) for every ``n`` of ``counts``, scored on sweep 2: one row per (``model`` id, ``name``, ``n_positions``,
     ``test_rms_deg``).  A count that cannot determine the model (fewer readings than it needs) or whose
     headings are not on the sweep is left out.  Deterministic (no random draw)."""
     rows = []
@@ -973,7 +617,7 @@ def ls_positions_rms(sw: Sweeps, counts=LS_POSITIONS, models=tuple(LS_MODELS)) -
         for n in counts:
             check_param("positions", n, lo=2, integer=True)
             try:
-                comp = _Eight(METHODS[mid].factory(StudyParams()).model, 360.0 / n).fit(sw.x_train, sw.t_train)
+                comp = EightPosition(METHODS[mid].factory(StudyParams()).model, 360.0 / n).fit(sw.x_train, sw.t_train)
             except InputError:
                 continue
             rows.append({"model": mid, "name": LS_MODELS[mid], "n_positions": int(n),
@@ -1089,7 +733,8 @@ def verdict_table(claim_list, readings=None) -> pd.DataFrame:
 def rule_reading_table(claim_list, base: str) -> pd.DataFrame:
     """:func:`verdict_table` of the claims under ADE's rule readings built on reading ``base`` (``R1`` or
     ``R4``), the default rules (``base`` itself) first; columns named by the rules only (``'F by
-    generation, CR by value'`` for the default, then each label of :data:`ADE_RULE_READINGS`)."""
+    generation, CR by value'`` for the default, then each label of
+    :data:`~navlib.methods.compass_methods.ADE_RULE_READINGS`)."""
     cols = [base] + [r for r in RULE_READINGS if r.startswith(base + ", ")]
     if len(cols) == 1:
         raise InputError(f"rule_reading_table: {base!r} has no readings of ADE's rules")
