@@ -30,7 +30,10 @@ Commands:
       convention, m_corrected = (m - b) A, with the expected field strength and every parameter's
       uncertainty (navlib.workbench.calibration).
   apply CAL.json FILE.csv --out CORRECTED.csv
-      correct the field columns of FILE with a calibration (never over an existing file).
+      correct the field columns of FILE with a calibration (never over an existing file).  The calibration
+      is checked key by key first (A 3x3, b_ut 3 finite numbers, A's condition number at most 10, ...), and
+      the corrected field's median strength against expected_field_strength_ut: beyond 25 % refused (nothing
+      written), beyond 10 % a warning line (navlib.workbench.calibration: COND_LIMIT, FIELD_*_REL).
   grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
       one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
       file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method

@@ -179,8 +179,10 @@ def _calibrate(args) -> int:
 
 
 def _apply(args) -> int:
-    path, n = apply_file(args.calibration, args.file, args.out)
+    path, n, warnings = apply_file(args.calibration, args.file, args.out)
     print(f"wrote {n} corrected rows to {path}")
+    for w in warnings:
+        print(f"navlib apply: warning: {w}", file=sys.stderr)
     return 0
 
 
