@@ -41,7 +41,9 @@ Commands:
 
 rates and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
-variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.
+variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.  An address that
+does not connect within 5 s, or then does not send dask's handshake within 5 s more (a silent port, another
+protocol, random bytes), stops the command with one line (navlib.engine.probe_scheduler).
 
 SYSTEM is compass, drift, magnetometer, magnetometer_free or accelerometer:
   compass columns: true_heading_deg, measured_heading_deg; optional temperature_c, time_s, sweep.
