@@ -14,7 +14,8 @@ Commands:
       or nothing more can be named.  --json prints {"steps": [...], "final": {...}}; --report DIR writes
       loop.png (the loop as a staircase: one step per effect added, log error axis, held-out rms, the
       noise floor as a band; below it the measurement against the models and the residuals; 750 px wide)
-      and loop.md (never over existing files).
+      and loop.md (never over existing files).  The folder is claimed before the work (a marker file
+      loop.incomplete, created atomically): a second loop writing into it stops with one line.
   rates SYSTEM [--trials N] [--noise X,X] [--ratio R,R] [--workers N] [--scheduler ADDR] [--json]
       how far to trust the loop on your set-up: the share of simulated trials in which a hidden effect of
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
@@ -37,7 +38,9 @@ Commands:
   grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
       one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
       file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
-      statistics, claim verdicts).  Needs papermill.
+      statistics, claim verdicts).  DIR is claimed before the first run (a marker file grid.incomplete,
+      created atomically, removed after grid.csv): a second grid on DIR stops with one line, and a grid stopped
+      by an error or Ctrl-C leaves the marker saying DIR is incomplete.  Needs papermill.
 
 rates and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
@@ -204,21 +207,27 @@ def main(argv: list[str] | None = None) -> int:
     return status
 
 
+def _notes(err: BaseException) -> str:
+    """The exception's notes (e.g. an output folder left incomplete) as the end of its one line."""
+    notes = [" ".join(str(n).split()) for n in getattr(err, "__notes__", ())]
+    return "".join(f"; {n}" for n in notes if n)
+
+
 def _run(args) -> int:
     try:
         return _command(args.command)(args)
     except BrokenPipeError:
         raise
     except (InputError, UserCodeError) as err:
-        print(f"navlib {args.command}: error: {err}", file=sys.stderr)
+        print(f"navlib {args.command}: error: {err}{_notes(err)}", file=sys.stderr)
         return 2
     except OSError as err:
         where = f"{err.filename}: " if err.filename else ""
-        print(f"navlib {args.command}: error: {where}{err.strerror or err}", file=sys.stderr)
+        print(f"navlib {args.command}: error: {where}{err.strerror or err}{_notes(err)}", file=sys.stderr)
         return 2
     except Exception as err:                        # a bug, not bad input: one line; --debug shows the traceback
         print(f"navlib {args.command}: internal error: {type(err).__name__}: {err}".splitlines()[0]
-              + " (run with --debug for the traceback)", file=sys.stderr)
+              + " (run with --debug for the traceback)" + _notes(err), file=sys.stderr)
         return 1
 
 

@@ -3,13 +3,14 @@ arguments): each reads the user's files, runs the workbench or a simulator and p
 Bad input raises :class:`navlib.errors.InputError` (the CLI prints one line and exits 2)."""
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
 from dataclasses import replace
 
 from . import engine
-from .data.tables import write_new_csv
+from .data.tables import claim_folder, write_new_csv
 from .errors import InputError
 from .names import EXAMPLES
 from .paths import data_path
@@ -123,6 +124,12 @@ def _diagnose(args) -> int:
     return 0
 
 
+#: The marker file ``loop --report DIR`` keeps in DIR while it works (:func:`navlib.data.tables.claim_folder`):
+#: a second loop writing its report into the same folder stops before any work; a loop stopped between the
+#: report's two files leaves it, saying the report is incomplete.
+REPORT_MARKER = "loop.incomplete"
+
+
 def _loop(args) -> int:
     if args.report:
         check_report_folder(args.report)            # refuse before the work, not after it
@@ -131,12 +138,17 @@ def _loop(args) -> int:
     if (site is not None or date is not None) and system.final_check is None:
         raise InputError(f"parameter {'--site' if site is not None else '--date'}: the system {system.name} makes no "
                          f"field check ({', '.join(n for n, s in SYSTEMS.items() if s.final_check is not None)} do)")
-    system, users, names, data, file = _prepare(args)
-    result = loop(system, data, names, user_effects=users, alpha=args.alpha)
-    # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
-    check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
-    if args.report:
-        png, md = write_report(result, args.report, source=file)
+    claim = (claim_folder(args.report, REPORT_MARKER, what="navlib loop --report", label="--report", empty=False)
+             if args.report else contextlib.nullcontext())
+    with claim:                                     # one report per folder: claimed before the work
+        if args.report:
+            check_report_folder(args.report)        # again, under the claim: a report finished meanwhile
+        system, users, names, data, file = _prepare(args)
+        result = loop(system, data, names, user_effects=users, alpha=args.alpha)
+        # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
+        check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
+        if args.report:
+            png, md = write_report(result, args.report, source=file)
     if args.json:
         out = result.to_dict()
         if check is not None:

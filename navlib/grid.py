@@ -11,6 +11,13 @@ its own results file.  ``DIR`` (new or empty: never written into otherwise) gets
   estimate (``<claim id>: verdict``, ``<claim id>: estimate``: the claims-register id, the verdict under
   the primary reading, or the claim's key where a chapter has no register) from the results file.
 
+The folder is claimed before the first run (:func:`claim_out_dir`): it is created, or must be empty, and the
+marker file ``grid.incomplete`` is created in it atomically, so a second grid on the same folder stops with
+one line before writing anything.  ``grid.csv`` is written last and the marker then removed: a folder with
+``grid.csv`` and no marker is complete.  A grid stopped by an error or Ctrl-C keeps the runs it finished
+(their notebooks and results) and the marker, which then says the folder is incomplete and why; when no
+run had finished, the folder is removed again (or left empty, as it was found).
+
 Parameters are checked against the notebook's ``parameters`` cell before any run: an unknown name, or a
 value that does not read as the type of the notebook's default (a number for a number, ``True``/``False``
 for a flag, a Python list for a list ...), stops with one line naming the parameter.  A value that
@@ -43,6 +50,7 @@ from typing import Any
 
 from . import engine
 from ._optional import require
+from .data.tables import claim_folder, write_new
 from .errors import InputError
 from .report import RESULTS_ENV
 
@@ -176,19 +184,16 @@ def points(grid: dict[str, list]) -> list[dict[str, Any]]:
     return [dict(zip(names, combo)) for combo in itertools.product(*(grid[n] for n in names))]
 
 
-def check_out_dir(out: str | os.PathLike) -> Path:
-    """The output folder: created if missing; refused if it is a file or holds anything."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"grid --out {out}: is a file, not a folder")
-    if out.is_dir() and any(out.iterdir()):
-        raise InputError(f"grid --out {out}: the folder is not empty (the grid writes only into a new or empty "
-                         f"folder, never over earlier outputs)")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise InputError(f"grid --out {out}: cannot create the folder ({err.strerror or err})") from None
-    return out
+#: The marker file :func:`run_grid` keeps in its output folder while it writes (``navlib.data.tables.
+#: claim_folder``): a second grid on the same folder stops before writing anything; a grid stopped by an
+#: error or Ctrl-C after some runs leaves it, saying the folder is incomplete (no ``grid.csv``).
+MARKER = "grid.incomplete"
+
+
+def claim_out_dir(out: str | os.PathLike):
+    """Claim the output folder for this grid (:func:`navlib.data.tables.claim_folder`): created if missing,
+    refused if it is a file, holds anything, or another grid is writing there (one line, before any work)."""
+    return claim_folder(out, MARKER, what="navlib grid", label="grid --out", empty=True)
 
 
 def _papermill():
@@ -274,11 +279,10 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
              scheduler: str | None = None, progress: bool | None = None) -> list[dict]:
     """Run ``notebook`` at every point of the grid ``specs`` (``["NAME=V1,V2", ...]``) and write ``out``
     (see the module docstring).  Returns grid.csv's rows."""
-    nb_path = Path(notebook)
+    nb_path, out = Path(notebook), Path(out)
     params = notebook_parameters(nb_path)
     grid = parse_grid(list(specs), params, nb_path.name)
     engine.scheduler_address(scheduler)                      # a bad address stops here, before any run
-    out = check_out_dir(out)
     _papermill()
     text = nb_path.read_text(encoding="utf-8")
     stem = nb_path.stem
@@ -303,14 +307,17 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
         rows[i] = {"run": i + 1, "notebook": f"{names[i]}.ipynb" if r["notebook"] is not None else "",
                    "status": status, "seconds": round(r["seconds"], 1), **pts[i], **_flatten(r["results"])}
 
-    engine.run(run_point, tasks, workers=workers, scheduler=scheduler, label=f"grid {stem}", progress=progress,
-               on_result=write)
-    columns: list[str] = []
-    for r in rows:
-        columns += [k for k in r if k not in columns]
-    with open(out / "grid.csv", "w", newline="", encoding="utf-8") as f:
+    def table(f) -> None:
+        columns: list[str] = []
+        for r in rows:
+            columns += [k for k in r if k not in columns]
         w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
         for r in rows:
             w.writerow({k: (json.dumps(v) if isinstance(v, (list, tuple, dict)) else v) for k, v in r.items()})
+
+    with claim_out_dir(out):                                  # one grid per folder, claimed before any run
+        engine.run(run_point, tasks, workers=workers, scheduler=scheduler, label=f"grid {stem}", progress=progress,
+                   on_result=write)
+        write_new(out / "grid.csv", table, newline="")         # last: a folder with grid.csv is complete
     return rows
