@@ -22,6 +22,8 @@ import difflib
 import io
 import os
 import re
+import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, TextIO
@@ -496,3 +498,70 @@ def claim_folder(folder: str | os.PathLike, marker: str, *, what: str, label: st
         fh.write(f"{what} is writing this folder (process {os.getpid()}, started "
                  f"{pd.Timestamp.now().isoformat(timespec='seconds')}); it is complete once this file is gone.\n")
     return claim
+
+
+def staging_folder(target: str | os.PathLike) -> Path:
+    """A new, empty, hidden folder beside ``target`` (in its parent when ``target`` does not exist, else
+    inside it: on the same file system either way) to write outputs into before :func:`publish` moves them
+    into ``target`` at once.  The caller removes it when done (``shutil.rmtree``)."""
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise InputError(f"{target}: is a file, not a folder")
+    where = target if target.is_dir() else target.parent
+    where.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-", dir=where))
+
+
+def _place(src: Path, dst: Path) -> None:
+    """``src`` at ``dst``, never over an existing file: a hard link, or a copy where links are not allowed."""
+    try:
+        os.link(src, dst)
+    except FileExistsError:
+        raise
+    except OSError:                                   # no hard links here (some network file systems)
+        with open(src, "rb") as fin, open(dst, "xb") as fout:
+            shutil.copyfileobj(fin, fout)
+
+
+def publish(staging: str | os.PathLike, target: str | os.PathLike) -> dict[Path, Path]:
+    """Move the finished outputs in ``staging`` (:func:`staging_folder`) into ``target``, all or none, never
+    over an existing file.  A missing ``target`` is the staging folder renamed (one atomic step); into an
+    existing one each file is linked in place (an existing file there stops it: the files placed so far and
+    the folders made for them are removed again, and a one-line InputError names the file).  Returns
+    ``{staging file: its path in target}``."""
+    staging, target = Path(staging), Path(target)
+    files = sorted(p for p in staging.rglob("*") if p.is_file())
+    where = {p: target / p.relative_to(staging) for p in files}
+    if not target.exists():
+        try:
+            os.rename(staging, target)
+            return where
+        except OSError:                               # it appeared meanwhile: placed file by file below
+            pass
+    placed: list[Path] = []
+    made: list[Path] = []
+    try:
+        for src, dst in where.items():
+            missing = []
+            d = dst.parent
+            while not d.exists():
+                missing.append(d)
+                d = d.parent
+            for m in reversed(missing):
+                m.mkdir()
+                made.append(m)
+            _place(src, dst)
+            placed.append(dst)
+    except BaseException as err:
+        for p in placed:
+            p.unlink(missing_ok=True)
+        for m in reversed(made):
+            try:
+                m.rmdir()
+            except OSError:
+                pass
+        if isinstance(err, FileExistsError):
+            raise InputError(f"{dst}: already exists; not overwritten (choose another folder); "
+                             f"nothing written") from None
+        raise
+    return where
