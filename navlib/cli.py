@@ -70,7 +70,10 @@ folder that exists with a report in it or cannot be written (checked before the 
 cannot test are listed ("not tested: ..." lines; "untested" in --json).  ``python -m navlib --debug ...``
 shows the full traceback of any error (for bug reports).  The parser needs nothing but the standard
 library: ``--help`` answers before the workbench is loaded (:mod:`navlib.commands` holds the commands).  Output into a closed pipe (``| head -1``) ends
-quietly, with status 141 like a process stopped by SIGPIPE.
+quietly, with status 141 like a process stopped by SIGPIPE.  Ctrl-C prints one line ("interrupted") and
+exits with status 130, like a process stopped by SIGINT; an output folder it stopped half-written keeps its
+marker file (grid.incomplete, loop.incomplete) saying it is incomplete, and the line names it (a folder
+nothing was written into yet is removed again: it never looks complete).
 """
 from __future__ import annotations
 
@@ -182,6 +185,8 @@ def _site_options(cmd, required: bool, site_help: str = "", date_help: str = "")
 
 #: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.
 BROKEN_PIPE = 141
+#: Exit status after Ctrl-C (SIGINT): what a shell reports for a process stopped by SIGINT.
+INTERRUPTED = 130
 
 
 def _command(name: str):
@@ -204,6 +209,17 @@ def main(argv: list[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return BROKEN_PIPE
+    except KeyboardInterrupt as err:
+        if args.debug:                              # the traceback shows where it was
+            raise
+        # Ctrl-C: one line (and the output folder it left incomplete, if any: navlib.data.tables.FolderClaim)
+        print(f"navlib {args.command}: interrupted{_notes(err)}", file=sys.stderr)
+        # CPython remembers a KeyboardInterrupt that passed through an exec() of a string (fastjsonschema
+        # compiles nbformat's schema that way) and, under ``python -m``, ends the process by SIGINT after
+        # main returned, as if nobody had handled it; an exec of a string that completes resets that memory
+        # (run_eval_code_obj in CPython's pythonrun.c).  It was handled here: the status is 130.
+        exec("pass", {})
+        return INTERRUPTED
     return status
 
 

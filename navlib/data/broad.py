@@ -346,7 +346,7 @@ def convert(in_dir, out_dir, trials=None, level: bool = True) -> list[Path]:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m navlib.data.broad --in DIR --out DIR [--trials 05,32] [--no-level]``; bad input: one
-    line on stderr, exit status 2."""
+    line on stderr, exit status 2; Ctrl-C: one line, exit status 130, nothing written."""
     ap = argparse.ArgumentParser(prog="python -m navlib.data.broad",
                                  description="Convert BROAD's data_mat/*.mat into the workbench's CSV files.")
     ap.add_argument("--in", dest="in_dir", required=True, help="folder holding BROAD's NN_name.mat files")
@@ -366,6 +366,9 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:                       # Ctrl-C: nothing was written (convert is all or nothing)
+        print("interrupted; nothing written", file=sys.stderr)
+        return 130
     return 0
 
 
