@@ -22,7 +22,9 @@ Commands:
       compass, an error outside the catalogue names no catalogued effect; 95 % Wilson intervals.
       --noise in the system's unit (compass deg, drift deg/h, magnetometer uT, accelerometer mg).
   field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
-      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
+      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination
+      (a southern or western site as --site -33.9,18.4 or --site=-33.9,18.4; at a geographic pole north, east
+      and the declination are undefined: null in --json, with a note).
       loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
       estimates with it and flags a local anomaly when they differ beyond the uncertainty; without
       --site the file's columns lat_deg, lon_deg (height_m, date) say where and when, if it has them.
@@ -80,6 +82,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 
 from .errors import InputError, UserCodeError
@@ -195,8 +198,30 @@ def _command(name: str):
     return importlib.import_module(".commands", __package__).COMMANDS[name]
 
 
+_NEGATIVE = re.compile(r"^-\.?\d")
+
+
+def site_argument(argv: list[str]) -> list[str]:
+    """``--site -33.9,18.4`` (a southern or western site, the documented form) as ``--site=-33.9,18.4``:
+    argparse takes a value that starts with '-' and is not a plain negative number for an option and
+    would refuse it.  Nothing after a ``--`` is touched."""
+    out = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a == "--":
+            return out + list(argv[i:])
+        if a == "--site" and i + 1 < len(argv) and _NEGATIVE.match(str(argv[i + 1])):
+            out.append(f"--site={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    args = build_parser().parse_args(site_argument(list(sys.argv[1:] if argv is None else argv)))
     try:
         if args.debug:                              # let every error through with its traceback
             status = _command(args.command)(args)

@@ -43,16 +43,20 @@ def _site(args):
 
 
 def _field(args) -> int:
-    from .sensors.earth_field import igrf_field
+    from .workbench.calibration import model_field
     site = _site(args)
-    f = igrf_field(site).to_dict()
+    f = model_field(site)                           # at a pole: no north, east or declination, and a note
     if args.json:
         print(json.dumps({"model": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
-                          "height_m": site.height_m, "date": site.date, **f}))
+                          "height_m": site.height_m, "date": site.date, **f}, allow_nan=False))
     else:
-        print(f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
-              f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
-              f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
+        where = f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
+        if f["declination_deg"] is None:
+            print(where + f"horizontal {f['horizontal_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+                  f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg; declination undefined ({f['note']})")
+        else:
+            print(where + f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+                  f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
     return 0
 
 

@@ -367,6 +367,29 @@ CRUST_TOL_UT = 0.3
 SCALE_TOL = 0.01
 
 
+#: How far from a geographic pole (deg of latitude, about 1 cm) :func:`model_field` evaluates the field it
+#: reports at the pole: the limit of horizontal, down, intensity and dip (they change by about 1e-9 of their
+#: value over that distance; at the pole itself ppigrf divides by sin(colatitude) = 0 and returns NaN).
+POLE_STEP_DEG = 1e-7
+#: What :func:`model_field` says at a geographic pole instead of a declination.
+POLE_NOTE = ("at a geographic pole the directions north and east are undefined, and so is the declination; "
+             "horizontal, down, intensity and dip are the field's limits at the pole")
+
+
+def model_field(site) -> dict:
+    """The IGRF-14 field at ``site`` (:class:`navlib.sensors.earth_field.Site`) as a JSON-ready dict
+    (:meth:`navlib.sensors.earth_field.EarthField.to_dict`), finite everywhere: at a geographic pole
+    (``|lat_deg| = 90``) ``north_ut``, ``east_ut`` and ``declination_deg`` are None, ``note`` says why
+    (:data:`POLE_NOTE`), and the other values are the limits at the pole (:data:`POLE_STEP_DEG`)."""
+    from ..sensors.earth_field import Site, igrf_field
+    if abs(site.lat_deg) < 90.0:
+        return igrf_field(site).to_dict()
+    near = Site(float(np.copysign(90.0 - POLE_STEP_DEG, site.lat_deg)), site.lon_deg, site.height_m, site.date)
+    out = igrf_field(near).to_dict()
+    out.update(north_ut=None, east_ut=None, declination_deg=None, note=POLE_NOTE)
+    return out
+
+
 def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dict:
     """The local field the reference-free fit estimates beside the IGRF-14 model at ``site``
     (:class:`navlib.sensors.earth_field.Site`), and whether they differ beyond the uncertainty.
@@ -376,7 +399,6 @@ def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dic
     the sensor's scale): anomaly when ``|dip - dip_model| > 1.96 sigma + deg(CRUST_TOL_UT / F_model)``.
     Without a site only the estimate is returned."""
     from ..errors import check_param
-    from ..sensors.earth_field import igrf_field
     check_param("scale_tol", scale_tol, lo=0, hi=0.5)
     names, cov = parameter_covariance(fit, noise)
     iF = names.index("field_ut")
@@ -393,23 +415,25 @@ def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dic
         out["dip_std_deg"] = float(np.degrees(np.sqrt(g @ cov @ g)))
     if site is None:
         return out
-    model = igrf_field(site)
+    model = model_field(site)
+    model_f, model_dip = model["intensity_ut"], model["dip_deg"]
     out["model"] = {"name": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
-                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model.intensity_ut,
-                    "dip_deg": model.dip_deg, "declination_deg": model.declination_deg}
-    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model.intensity_ut
-    out["intensity_difference_ut"] = F - model.intensity_ut
+                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model_f,
+                    "dip_deg": model_dip, "declination_deg": model["declination_deg"],
+                    **({"note": model["note"]} if "note" in model else {})}
+    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model_f
+    out["intensity_difference_ut"] = F - model_f
     out["intensity_tolerance_ut"] = tol_f
     anomalies = []
-    if abs(F - model.intensity_ut) > tol_f:
-        anomalies.append(f"intensity {F:.2f} uT against the model's {model.intensity_ut:.2f} uT "
+    if abs(F - model_f) > tol_f:
+        anomalies.append(f"intensity {F:.2f} uT against the model's {model_f:.2f} uT "
                          f"(beyond +-{tol_f:.2f} uT)")
     if "dip_deg" in out:
-        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model.intensity_ut))
-        out["dip_difference_deg"] = out["dip_deg"] - model.dip_deg
+        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model_f))
+        out["dip_difference_deg"] = out["dip_deg"] - model_dip
         out["dip_tolerance_deg"] = tol_d
         if abs(out["dip_difference_deg"]) > tol_d:
-            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model.dip_deg:.2f} deg "
+            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model_dip:.2f} deg "
                              f"(beyond +-{tol_d:.2f} deg)")
     out["local_anomaly"] = bool(anomalies)
     out["message"] = ("local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "

@@ -150,13 +150,23 @@ def free_columns() -> list[Column]:
     return list(FREE_COLUMNS)
 
 
-def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str) -> float:
+def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str, circle: bool = False) -> float:
+    """The column's one value (its median), refused when it spreads by more than ``tol``.  ``circle``: a
+    longitude, compared on the circle (179.99 and -179.99 deg are 0.02 deg apart, and so are 359.99 and
+    0.01): the spread and the median of the differences from the first value, wrapped into [-180, 180)."""
     v = frame[col].to_numpy(float)
-    spread = float(np.ptp(v)) if len(v) else 0.0
+    if circle and len(v):
+        d = np.mod(v - v[0] + 180.0, 360.0) - 180.0
+        spread = float(np.ptp(d))
+        value = float(v[0] + np.median(d))
+        value = value + 360.0 if value < -180.0 else value - 360.0 if value > 360.0 else value
+    else:
+        spread = float(np.ptp(v)) if len(v) else 0.0
+        value = float(np.median(v)) if len(v) else float("nan")
     if spread > tol:
         raise InputError(f"{name}: column '{col}' varies by {spread:.4g} {unit} within the file (more than "
                          f"{tol:g} {unit}): one site per file")
-    return float(np.median(v))
+    return value
 
 
 def _date_of(frame: pd.DataFrame, name: str) -> str:
@@ -189,7 +199,7 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
                              f"'{({'lat_deg', 'lon_deg'} - set(have)).pop()}': give both, or --site")
         if have:
             site = (_one_value(frame, "lat_deg", SITE_TOL_DEG, "deg", name),
-                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name))
+                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name, circle=True))
             if "height_m" in frame:
                 site += (_one_value(frame, "height_m", HEIGHT_TOL_M, "m", name),)
     if date is None and "date" in frame:
