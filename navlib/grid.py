@@ -20,7 +20,9 @@ run had finished, the folder is removed again (or left empty, as it was found).
 
 Parameters are checked against the notebook's ``parameters`` cell before any run: an unknown name, or a
 value that does not read as the type of the notebook's default (a number for a number, ``True``/``False``
-for a flag, a Python list for a list ...), stops with one line naming the parameter.  A value that
+for a flag, a Python list for a list ...), stops with one line naming the parameter.  A default cast in
+the cell (``n = int(2)``, ``x = float("1e-3")``) or annotated (``n: int = some_call()``) has the type of
+the cast or annotation, so ``--param n=4`` reaches the notebook as the number 4, never the text "4".  A value that
 contains a comma goes in double quotes (``--param 'start_model="misalignment,hard_iron",misalignment'`` is
 two values); a list parameter takes one list per ``--param`` (``--param 'noise_levels_ut=[0.01, 0.02]'``),
 and a name given twice adds its values.  Range checks are the notebook's own (its
@@ -93,24 +95,59 @@ def notebook_parameters(path: str | os.PathLike) -> dict[str, Any]:
                           else list(getattr(node.value, "elts", [None] * len(names))))
                 for n, v in zip(names, values):
                     if isinstance(n, ast.Name):
-                        try:
-                            out[n.id] = ast.literal_eval(v) if v is not None else None
-                        except ValueError:
-                            out[n.id] = ast.get_source_segment(src, v)
+                        out[n.id] = _default(v, src) if v is not None else None
         elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is not None:
-            try:
-                out[node.target.id] = ast.literal_eval(node.value)
-            except ValueError:
-                out[node.target.id] = ast.get_source_segment(src, node.value)
+            out[node.target.id] = _default(node.value, src, node.annotation)
     return out
+
+
+#: The types a parameter's default may be cast to in the parameters cell (``n = int(2)``) or annotated
+#: with (``n: int = ...``): its values are read as that type.
+CASTS = {"int": int, "float": float, "bool": bool, "str": str}
+
+
+class Expression(str):
+    """A default that is not a literal (``scale = np.sqrt(2)``): its source text; ``kind`` is the type its
+    annotation names (``scale: float = np.sqrt(2)``: float), or None when nothing says."""
+
+    kind: type | None = None
+
+
+def _default(value: ast.expr, src: str, annotation: ast.expr | None = None) -> Any:
+    """A parameter's default in the parameters cell: a literal's value; a cast of a literal to one of
+    :data:`CASTS` (``int(2)``, ``float("1e-3")``) evaluated; an int where the annotation says float as a
+    float; anything else an :class:`Expression` (its text, and the annotation's type if it names one)."""
+    kind = CASTS.get(annotation.id) if isinstance(annotation, ast.Name) else None
+    try:
+        v = ast.literal_eval(value)
+    except ValueError:
+        v = Expression(ast.get_source_segment(src, value) or "")
+        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Name) and value.func.id in CASTS
+                and len(value.args) == 1 and not value.keywords):
+            try:
+                v = CASTS[value.func.id](ast.literal_eval(value.args[0]))
+            except (ValueError, TypeError, SyntaxError):
+                pass
+    if isinstance(v, Expression):
+        v.kind = kind
+    elif kind is float and isinstance(v, int) and not isinstance(v, bool):
+        v = float(v)
+    return v
 
 
 _TRUE, _FALSE = ("true", "yes", "1"), ("false", "no", "0")
 
 
 def convert(name: str, raw: str, default: Any) -> Any:
-    """Read the text ``raw`` as a value of parameter ``name`` of the type of its ``default``."""
+    """Read the text ``raw`` as a value of parameter ``name`` of the type of its ``default`` (int, float,
+    bool, str, list or tuple; for an :class:`Expression`, the type its annotation names, else a literal or
+    the text).  A value that does not convert: one-line InputError naming the parameter."""
     text = raw.strip()
+    shown = str(default) if isinstance(default, Expression) else repr(default)
+    if isinstance(default, Expression) and default.kind is not None:
+        default = {int: 0, float: 0.0, bool: False, str: ""}[default.kind]
+    elif isinstance(default, Expression):
+        default = None
     try:
         if isinstance(default, bool):
             if text.lower() in _TRUE:
@@ -145,7 +182,7 @@ def convert(name: str, raw: str, default: Any) -> Any:
         kind = {bool: "True or False", int: "a whole number", float: "a number",
                 list: "a Python list", tuple: "a Python tuple"}.get(type(default), "a Python literal")
         raise InputError(f"grid: parameter {name}={raw!r}: expected {kind} (the notebook's default is "
-                         f"{default!r})") from None
+                         f"{shown})") from None
 
 
 def parse_grid(specs: list[str], parameters: dict[str, Any], notebook: str = "the notebook") -> dict[str, list]:
