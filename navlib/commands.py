@@ -26,12 +26,27 @@ from .workbench.rates import DEFAULT_RATIOS, rates
 
 
 def _site_values(args):
-    """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None."""
+    """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None; each
+    checked here, before any work, against the limits of :class:`navlib.sensors.earth_field.Site` (one line
+    naming the option)."""
+    from .sensors.earth_field import Site
     site = None
     if args.site is not None:
         site = _numbers("--site", args.site, None)
         if len(site) not in (2, 3):
             raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
+        for i, what in enumerate(("latitude", "longitude", "height")[:len(site)]):
+            one = [0.0, 0.0, 0.0]
+            one[i] = site[i]
+            try:
+                Site(*one)
+            except InputError as err:
+                raise InputError(f"parameter --site={args.site!r}: the {what} {str(err).split(': ', 1)[-1]}") from None
+    if args.date is not None:
+        try:
+            Site(0.0, 0.0, 0.0, args.date)
+        except InputError as err:
+            raise InputError(f"parameter --date={args.date!r}: {str(err).split(': ', 1)[-1]}") from None
     return site, args.date
 
 

@@ -105,3 +105,64 @@ def test_two_sites_across_the_date_line_are_still_two(sim):
     frame["lon_deg"] = np.resize((179.9, -179.9), len(frame))                 # 0.2 deg apart
     with pytest.raises(InputError, match=r"f.csv: column 'lon_deg' varies by 0.2 deg"):
         MF.site_of(frame, name="f.csv")
+
+
+# ------------------------------------------------------------------------- item 8: who is blamed
+def _file(tmp_path, sim, name="rec.csv", **cols):
+    frame = sim.copy()
+    for k, v in cols.items():
+        frame[k] = v
+    p = tmp_path / name
+    frame.to_csv(p, index=False)
+    return p
+
+
+def test_a_date_column_without_a_site_names_the_file_and_column(sim, tmp_path, capsys):
+    p = _file(tmp_path, sim, date="2021-01-01")
+    for args in (["calibrate", "magnetometer", str(p), "--out", str(tmp_path / "c.json")],
+                 ["loop", "magnetometer_free", str(p), "--model", "hard_iron"]):
+        rc, _, err = _run(capsys, *args)
+        assert rc == 2 and len(err.splitlines()) == 1, err
+        assert "rec.csv: column 'date' without a site" in err and "--date" not in err, err
+    assert not (tmp_path / "c.json").exists()
+    # the same file with --site is fine; --date without any site blames --date, which the user gave
+    rc, _, err = _run(capsys, "calibrate", "magnetometer", str(p), "--site", "50,10", "--out", str(tmp_path / "ok.json"))
+    assert rc == 0, err
+    rc, _, err = _run(capsys, "calibrate", "magnetometer", str(_file(tmp_path, sim, "plain.csv")), "--date", "2020-01-01",
+                      "--out", str(tmp_path / "c.json"))
+    assert rc == 2 and err.endswith("error: parameter --date: a date without a site: give --site LAT,LON[,HEIGHT_M] "
+                                    "or the columns lat_deg, lon_deg"), err
+
+
+def test_a_date_column_outside_igrf_names_the_file_column_and_row(sim, tmp_path, capsys):
+    dates = np.full(len(sim), "2021-01-01", dtype=object)
+    dates[4] = "2031-06-01"
+    p = _file(tmp_path, sim, lat_deg=50.0, lon_deg=10.0, date=dates)
+    rc, _, err = _run(capsys, "calibrate", "magnetometer", str(p), "--out", str(tmp_path / "c.json"))
+    assert rc == 2 and len(err.splitlines()) == 1, err
+    assert "rec.csv: column 'date', row 5: '2031-06-01' is outside the model's years (IGRF-14 covers" in err, err
+    assert "parameter" not in err
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--site", "95,0"], "parameter --site='95,0': the latitude must be <= 90"),
+    (["--site", "nan,0"], "parameter --site='nan,0': the latitude must be finite"),
+    (["--site", "10,400"], "parameter --site='10,400': the longitude must be <= 360"),
+    (["--site", "10,20,-2e4"], "parameter --site='10,20,-2e4': the height must be >= -10000"),
+    (["--site", "10,20", "--date", "2040-01-01"], "parameter --date='2040-01-01': IGRF-14 covers"),
+    (["--site", "10,20", "--date", "soon"], "parameter --date='soon': not a date"),
+])
+def test_site_and_date_options_are_named_as_given_and_checked_before_the_work(sim, tmp_path, capsys, args, says):
+    p = _file(tmp_path, sim)
+    for command in (["field"], ["calibrate", "magnetometer", str(p), "--out", str(tmp_path / "c.json")]):
+        rc, _, err = _run(capsys, *command, *args)
+        assert rc == 2 and len(err.splitlines()) == 1 and says in err, err
+        assert "lat_deg" not in err and "parameter date=" not in err
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_a_frame_read_from_a_file_is_named_by_it(sim, tmp_path):
+    from navlib.workbench.magnetometer_free import load_free
+    frame = load_free(_file(tmp_path, sim, "named.csv", date="2021-01-01"))
+    with pytest.raises(InputError, match="^named.csv: column 'date' without a site"):
+        MF.site_of(frame)

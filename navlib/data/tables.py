@@ -257,6 +257,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     frame = pd.DataFrame(out, index=pd.RangeIndex(len(rows)))
     if jumps:
         frame.attrs["line_jumps"] = jumps
+    frame.attrs["source"] = p.name                  # later messages about the data name the file
     if len(frame) < min_rows:
         raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
                          f"a {kind} needs at least {min_rows}")
