@@ -221,9 +221,10 @@ def points(grid: dict[str, list]) -> list[dict[str, Any]]:
     return [dict(zip(names, combo)) for combo in itertools.product(*(grid[n] for n in names))]
 
 
-#: The marker file :func:`run_grid` keeps in its output folder while it writes (``navlib.data.tables.
-#: claim_folder``): a second grid on the same folder stops before writing anything; a grid stopped by an
-#: error or Ctrl-C after some runs leaves it, saying the folder is incomplete (no ``grid.csv``).
+#: The marker file :func:`run_grid` keeps in its output folder while it writes
+#: (:func:`navlib.data.tables.claim_folder`): a second grid on the same folder stops before writing
+#: anything; a grid stopped by an error or Ctrl-C after some runs leaves it, saying the folder is incomplete
+#: (no ``grid.csv``).
 MARKER = "grid.incomplete"
 
 
