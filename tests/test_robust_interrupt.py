@@ -96,3 +96,21 @@ def test_the_broad_converter_interrupted_is_one_line(tmp_path, monkeypatch, caps
     monkeypatch.setattr(broad, "convert", interrupted)
     assert broad.main(["--in", str(tmp_path), "--out", str(tmp_path / "out")]) == 130
     assert capsys.readouterr().err == "interrupted; nothing written\n"
+
+
+@pytest.mark.parametrize("stop", [KeyboardInterrupt, OSError])
+def test_a_file_interrupted_while_written_is_removed(tmp_path, stop):
+    """tables.write_new (every CSV and JSON output of navlib): a write stopped half-way leaves no file."""
+    from navlib.data.tables import write_new
+
+    def half(fh):
+        fh.write("time_s,mag_x_ut\n1,2\n")
+        raise stop
+
+    with pytest.raises(stop):
+        write_new(tmp_path / "out.csv", half)
+    assert not (tmp_path / "out.csv").exists()
+    (tmp_path / "mine.csv").write_text("mine")                       # an existing file is still refused, kept
+    with pytest.raises(Exception, match="already exists"):
+        write_new(tmp_path / "mine.csv", half)
+    assert (tmp_path / "mine.csv").read_text() == "mine"

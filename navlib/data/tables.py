@@ -331,7 +331,8 @@ def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, ove
     """The one overwrite rule of navlib: create ``path`` (and its folder) and let ``write(fh)`` fill it,
     never replacing an existing file unless ``overwrite`` is set; user data and earlier outputs are not
     overwritten by accident.  The check and the creation are one step (``open(path, "x")``), so no file
-    that appears in between is replaced, nor one a symbolic link points to.
+    that appears in between is replaced, nor one a symbolic link points to.  A ``write`` that raises (an
+    error, Ctrl-C) removes the half-written file: nothing is left that looks like a complete output.
 
     Parameters
     ----------
@@ -354,10 +355,15 @@ def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, ove
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with open(p, "w" if overwrite else "x", encoding="utf-8", newline=newline) as fh:
-            write(fh)
+        fh = open(p, "w" if overwrite else "x", encoding="utf-8", newline=newline)
     except FileExistsError:
         raise InputError(f"{p}: {exists}") from None
+    try:
+        with fh:
+            write(fh)
+    except BaseException:                           # an error or Ctrl-C half-way: no file that looks complete
+        p.unlink(missing_ok=True)
+        raise
     return p
 
 
