@@ -14,7 +14,8 @@ Commands:
       or nothing more can be named.  --json prints {"steps": [...], "final": {...}}; --report DIR writes
       loop.png (the loop as a staircase: one step per effect added, log error axis, held-out rms, the
       noise floor as a band; below it the measurement against the models and the residuals; 750 px wide)
-      and loop.md (never over existing files).
+      and loop.md (never over existing files).  The folder is claimed before the work (a marker file
+      loop.incomplete, created atomically): a second loop writing into it stops with one line.
   rates SYSTEM [--trials N] [--noise X,X] [--ratio R,R] [--workers N] [--scheduler ADDR] [--json]
       how far to trust the loop on your set-up: the share of simulated trials in which a hidden effect of
       each size is named (detection), nothing-hidden data are called noise (false alarms) and, for the
@@ -26,7 +27,9 @@ Commands:
       to the best method and the book's verdict.  RULE: sweep, heading or random (--seed S).  --report DIR
       writes compare.md and compare.png (error against heading per method).  SYSTEM: compass.
   field --site LAT,LON[,HEIGHT_M] [--date YYYY-MM-DD] [--json]
-      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination.
+      the Earth's main field from IGRF-14 (ppigrf, offline): north, east, down, intensity, dip, declination
+      (a southern or western site as --site -33.9,18.4 or --site=-33.9,18.4; at a geographic pole north, east
+      and the declination are undefined: null in --json, with a note).
       loop magnetometer_free ... --site LAT,LON[,HEIGHT_M] --date D compares the local field the loop
       estimates with it and flags a local anomaly when they differ beyond the uncertainty; without
       --site the file's columns lat_deg, lon_deg (height_m, date) say where and when, if it has them.
@@ -35,15 +38,22 @@ Commands:
       convention, m_corrected = (m - b) A, with the expected field strength and every parameter's
       uncertainty (navlib.workbench.calibration).
   apply CAL.json FILE.csv --out CORRECTED.csv
-      correct the field columns of FILE with a calibration (never over an existing file).
+      correct the field columns of FILE with a calibration (never over an existing file).  The calibration
+      is checked key by key first (A 3x3, b_ut 3 finite numbers, A's condition number at most 10, ...), and
+      the corrected field's median strength against expected_field_strength_ut: beyond 25 % refused (nothing
+      written), beyond 10 % a warning line (navlib.workbench.calibration: COND_LIMIT, FIELD_*_REL).
   grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
       one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
       file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
-      statistics, claim verdicts).  Needs papermill.
+      statistics, claim verdicts).  DIR is claimed before the first run (a marker file grid.incomplete,
+      created atomically, removed after grid.csv): a second grid on DIR stops with one line, and a grid stopped
+      by an error or Ctrl-C leaves the marker saying DIR is incomplete.  Needs papermill.
 
 rates, compare and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
-variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.
+variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.  An address that
+does not connect within 5 s, or then does not send dask's handshake within 5 s more (a silent port, another
+protocol, random bytes), stops the command with one line (navlib.engine.probe_scheduler).
 
 SYSTEM is compass, drift, magnetometer, magnetometer_free or accelerometer:
   compass columns: true_heading_deg, measured_heading_deg; optional temperature_c, time_s, sweep.
@@ -67,13 +77,17 @@ folder that exists with a report in it or cannot be written (checked before the 
 cannot test are listed ("not tested: ..." lines; "untested" in --json).  ``python -m navlib --debug ...``
 shows the full traceback of any error (for bug reports).  The parser needs nothing but the standard
 library: ``--help`` answers before the workbench is loaded (:mod:`navlib.commands` holds the commands).  Output into a closed pipe (``| head -1``) ends
-quietly, with status 141 like a process stopped by SIGPIPE.
+quietly, with status 141 like a process stopped by SIGPIPE.  Ctrl-C prints one line ("interrupted") and
+exits with status 130, like a process stopped by SIGINT; an output folder it stopped half-written keeps its
+marker file (grid.incomplete, loop.incomplete) saying it is incomplete, and the line names it (a folder
+nothing was written into yet is removed again: it never looks complete).
 """
 from __future__ import annotations
 
 import argparse
 import importlib
 import os
+import re
 import sys
 
 from .errors import InputError, UserCodeError
@@ -221,6 +235,8 @@ def _site_options(cmd, required: bool, site_help: str = "", date_help: str = "")
 
 #: Exit status after output into a closed pipe: what a shell reports for a process stopped by SIGPIPE.
 BROKEN_PIPE = 141
+#: Exit status after Ctrl-C (SIGINT): what a shell reports for a process stopped by SIGINT.
+INTERRUPTED = 130
 
 
 def _command(name: str):
@@ -229,8 +245,30 @@ def _command(name: str):
     return importlib.import_module(".commands", __package__).COMMANDS[name]
 
 
+_NEGATIVE = re.compile(r"^-\.?\d")
+
+
+def site_argument(argv: list[str]) -> list[str]:
+    """``--site -33.9,18.4`` (a southern or western site, the documented form) as ``--site=-33.9,18.4``:
+    argparse takes a value that starts with '-' and is not a plain negative number for an option and
+    would refuse it.  Nothing after a ``--`` is touched."""
+    out = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a == "--":
+            return out + list(argv[i:])
+        if a == "--site" and i + 1 < len(argv) and _NEGATIVE.match(str(argv[i + 1])):
+            out.append(f"--site={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    args = build_parser().parse_args(site_argument(list(sys.argv[1:] if argv is None else argv)))
     try:
         if args.debug:                              # let every error through with its traceback
             status = _command(args.command)(args)
@@ -243,7 +281,24 @@ def main(argv: list[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return BROKEN_PIPE
+    except KeyboardInterrupt as err:
+        if args.debug:                              # the traceback shows where it was
+            raise
+        # Ctrl-C: one line (and the output folder it left incomplete, if any: navlib.data.tables.FolderClaim)
+        print(f"navlib {args.command}: interrupted{_notes(err)}", file=sys.stderr)
+        # CPython remembers a KeyboardInterrupt that passed through an exec() of a string (fastjsonschema
+        # compiles nbformat's schema that way) and, under ``python -m``, ends the process by SIGINT after
+        # main returned, as if nobody had handled it; an exec of a string that completes resets that memory
+        # (run_eval_code_obj in CPython's pythonrun.c).  It was handled here: the status is 130.
+        exec("pass", {})
+        return INTERRUPTED
     return status
+
+
+def _notes(err: BaseException) -> str:
+    """The exception's notes (e.g. an output folder left incomplete) as the end of its one line."""
+    notes = [" ".join(str(n).split()) for n in getattr(err, "__notes__", ())]
+    return "".join(f"; {n}" for n in notes if n)
 
 
 def _run(args) -> int:
@@ -252,15 +307,15 @@ def _run(args) -> int:
     except BrokenPipeError:
         raise
     except (InputError, UserCodeError) as err:
-        print(f"navlib {args.command}: error: {err}", file=sys.stderr)
+        print(f"navlib {args.command}: error: {err}{_notes(err)}", file=sys.stderr)
         return 2
     except OSError as err:
         where = f"{err.filename}: " if err.filename else ""
-        print(f"navlib {args.command}: error: {where}{err.strerror or err}", file=sys.stderr)
+        print(f"navlib {args.command}: error: {where}{err.strerror or err}{_notes(err)}", file=sys.stderr)
         return 2
     except Exception as err:                        # a bug, not bad input: one line; --debug shows the traceback
         print(f"navlib {args.command}: internal error: {type(err).__name__}: {err}".splitlines()[0]
-              + " (run with --debug for the traceback)", file=sys.stderr)
+              + " (run with --debug for the traceback)" + _notes(err), file=sys.stderr)
         return 1
 
 

@@ -3,13 +3,14 @@ arguments): each reads the user's files, runs the workbench or a simulator and p
 Bad input raises :class:`navlib.errors.InputError` (the CLI prints one line and exits 2)."""
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
 from dataclasses import replace
 
 from . import engine
-from .data.tables import write_new_csv
+from .data.tables import claim_folder, write_new_csv
 from .errors import InputError
 from .names import EXAMPLES
 from .paths import data_path
@@ -25,12 +26,27 @@ from .workbench.rates import DEFAULT_RATIOS, rates
 
 
 def _site_values(args):
-    """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None."""
+    """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None; each
+    checked here, before any work, against the limits of :class:`navlib.sensors.earth_field.Site` (one line
+    naming the option)."""
+    from .sensors.earth_field import Site
     site = None
     if args.site is not None:
         site = _numbers("--site", args.site, None)
         if len(site) not in (2, 3):
             raise InputError(f"parameter --site={args.site!r}: give LAT,LON or LAT,LON,HEIGHT_M")
+        for i, what in enumerate(("latitude", "longitude", "height")[:len(site)]):
+            one = [0.0, 0.0, 0.0]
+            one[i] = site[i]
+            try:
+                Site(*one)
+            except InputError as err:
+                raise InputError(f"parameter --site={args.site!r}: the {what} {str(err).split(': ', 1)[-1]}") from None
+    if args.date is not None:
+        try:
+            Site(0.0, 0.0, 0.0, args.date)
+        except InputError as err:
+            raise InputError(f"parameter --date={args.date!r}: {str(err).split(': ', 1)[-1]}") from None
     return site, args.date
 
 
@@ -42,16 +58,20 @@ def _site(args):
 
 
 def _field(args) -> int:
-    from .sensors.earth_field import igrf_field
+    from .workbench.calibration import model_field
     site = _site(args)
-    f = igrf_field(site).to_dict()
+    f = model_field(site)                           # at a pole: no north, east or declination, and a note
     if args.json:
         print(json.dumps({"model": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
-                          "height_m": site.height_m, "date": site.date, **f}))
+                          "height_m": site.height_m, "date": site.date, **f}, allow_nan=False))
     else:
-        print(f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
-              f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
-              f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
+        where = f"IGRF-14 at {site.lat_deg:g}, {site.lon_deg:g}, {site.height_m:g} m on {site.date}: "
+        if f["declination_deg"] is None:
+            print(where + f"horizontal {f['horizontal_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+                  f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg; declination undefined ({f['note']})")
+        else:
+            print(where + f"north {f['north_ut']:.3f}, east {f['east_ut']:.3f}, down {f['down_ut']:.3f}, intensity "
+                  f"{f['intensity_ut']:.3f} uT; dip {f['dip_deg']:.3f} deg, declination {f['declination_deg']:.3f} deg")
     return 0
 
 
@@ -123,6 +143,12 @@ def _diagnose(args) -> int:
     return 0
 
 
+#: The marker file ``loop --report DIR`` keeps in DIR while it works (:func:`navlib.data.tables.claim_folder`):
+#: a second loop writing its report into the same folder stops before any work; a loop stopped between the
+#: report's two files leaves it, saying the report is incomplete.
+REPORT_MARKER = "loop.incomplete"
+
+
 def _loop(args) -> int:
     if args.report:
         check_report_folder(args.report)            # refuse before the work, not after it
@@ -131,12 +157,17 @@ def _loop(args) -> int:
     if (site is not None or date is not None) and system.final_check is None:
         raise InputError(f"parameter {'--site' if site is not None else '--date'}: the system {system.name} makes no "
                          f"field check ({', '.join(n for n, s in SYSTEMS.items() if s.final_check is not None)} do)")
-    system, users, names, data, file = _prepare(args)
-    result = loop(system, data, names, user_effects=users, alpha=args.alpha)
-    # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
-    check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
-    if args.report:
-        png, md = write_report(result, args.report, source=file)
+    claim = (claim_folder(args.report, REPORT_MARKER, what="navlib loop --report", label="--report", empty=False)
+             if args.report else contextlib.nullcontext())
+    with claim:                                     # one report per folder: claimed before the work
+        if args.report:
+            check_report_folder(args.report)        # again, under the claim: a report finished meanwhile
+        system, users, names, data, file = _prepare(args)
+        result = loop(system, data, names, user_effects=users, alpha=args.alpha)
+        # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
+        check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])
+        if args.report:
+            png, md = write_report(result, args.report, source=file)
     if args.json:
         out = result.to_dict()
         if check is not None:
@@ -179,8 +210,10 @@ def _calibrate(args) -> int:
 
 
 def _apply(args) -> int:
-    path, n = apply_file(args.calibration, args.file, args.out)
+    path, n, warnings = apply_file(args.calibration, args.file, args.out)
     print(f"wrote {n} corrected rows to {path}")
+    for w in warnings:
+        print(f"navlib apply: warning: {w}", file=sys.stderr)
     return 0
 
 

@@ -35,11 +35,15 @@ from __future__ import annotations
 
 import atexit
 import importlib
+import itertools
 import logging
 import os
 import re
+import socket
+import struct
 import sys
 import threading
+import time
 import uuid
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, Iterable, Sequence
@@ -75,6 +79,18 @@ LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
                 "distributed.nanny.pre-spawn-environ": dict(WORKER_ENV)}
 #: Seconds to wait for a scheduler at an address before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: Seconds an address has to accept a TCP connection, and then again to send the first message of dask's
+#: handshake, before a command stops with one line (:func:`probe_scheduler`): dask itself waits for that
+#: message without a limit, so a port that accepts and never answers would hang the command.  A scheduler
+#: sends it at once (on the same machine within milliseconds); 5 s covers a slow network, and the two
+#: waits together stay within 10 s.
+PROBE_TIMEOUT_S = 5.0
+#: Largest first message (bytes) the probe accepts: a scheduler's handshake is under a hundred bytes (its
+#: compression, Python version and pickle protocol); the first 8 bytes of anything else read as a length of
+#: up to 2^64, which dask would try to allocate.
+PROBE_MAX_BYTES = 1 << 16
+#: Most frames the probe accepts in that first message (dask's handshake has one or two).
+PROBE_MAX_FRAMES = 64
 
 _ADDRESS = re.compile(r"^(tcp|tls|ws|wss|inproc|ucx)://\S+$")
 _CLIENTS: dict[tuple, Any] = {}          # ("local", n) or ("remote", address) -> Client
@@ -102,6 +118,66 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     if not _ADDRESS.match(addr) or (addr.startswith("tcp://") and not re.search(r":\d+$", addr)):
         raise InputError(f"scheduler {given!r}: give an address such as tcp://127.0.0.1:8786 (host and port)")
     return addr
+
+
+def _recv(sock, n: int, deadline: float, addr: str, timeout: float) -> bytes:
+    """Exactly ``n`` bytes from ``sock`` before ``deadline`` (``time.monotonic``); one-line InputError when the
+    peer is silent or hangs up."""
+    buf = b""
+    while len(buf) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise InputError(f"scheduler {addr}: accepts connections but sent no dask handshake within {timeout:g} s "
+                             f"(not a dask scheduler, or a stuck one)")
+        sock.settimeout(left)
+        try:
+            chunk = sock.recv(n - len(buf))
+        except socket.timeout:
+            continue                                    # the deadline check above says it
+        if not chunk:
+            raise InputError(f"scheduler {addr}: closed the connection without a dask handshake (not a dask "
+                             f"scheduler?)")
+        buf += chunk
+    return buf
+
+
+def probe_scheduler(addr: str, timeout: float | None = None) -> None:
+    """Check that ``addr`` answers like a dask scheduler before dask connects to it, in at most twice
+    ``timeout`` seconds (default :data:`PROBE_TIMEOUT_S`): a TCP connection within ``timeout``, then,
+    within ``timeout`` again, the first message of dask's handshake, which a scheduler sends as soon as it
+    accepts a connection.  The message is read as dask's TCP comm frames it
+    (``distributed.comm.tcp.TCP.read``): an 8-byte length (native byte order), then the number of frames
+    and their lengths (8 bytes each), then the frames; the length must be at most :data:`PROBE_MAX_BYTES`,
+    the frames between 1 and :data:`PROBE_MAX_FRAMES` and their lengths must add up to it.  Anything else
+    (silence, a closed connection, another protocol, random bytes) is a one-line InputError, before dask
+    would wait for ever or allocate what the garbage announces.  The connection is then closed (the
+    scheduler logs a handshake cut short).  Only ``tcp://`` addresses are probed (TLS, websockets and UCX
+    speak their own protocol first: dask's ``timeout`` is their only guard)."""
+    if not addr.startswith("tcp://"):
+        return
+    timeout = PROBE_TIMEOUT_S if timeout is None else float(timeout)
+    host, _, port = addr[len("tcp://"):].rpartition(":")
+    host = host.strip("[]")                             # an IPv6 address in brackets
+    try:
+        sock = socket.create_connection((host, int(port)), timeout=timeout)
+    except socket.timeout:
+        raise InputError(f"scheduler {addr}: no connection within {timeout:g} s") from None
+    except OSError as err:
+        raise InputError(f"scheduler {addr}: cannot connect ({err.strerror or type(err).__name__})") from None
+    with sock:
+        deadline = time.monotonic() + timeout
+        (total,) = struct.unpack("Q", _recv(sock, 8, deadline, addr, timeout))
+        if not 16 <= total <= PROBE_MAX_BYTES:
+            raise InputError(f"scheduler {addr}: answered something that is not dask's handshake (a first message "
+                             f"of {total} bytes; a scheduler's is at most {PROBE_MAX_BYTES}): not a dask scheduler")
+        body = _recv(sock, total, deadline, addr, timeout)
+        (n,) = struct.unpack_from("Q", body)
+        head = 8 * (1 + n) if 1 <= n <= PROBE_MAX_FRAMES else None
+        ends = [] if head is None or head > total else \
+            list(itertools.accumulate(struct.unpack_from(f"{n}Q", body, 8), initial=head))
+        if total not in ends:
+            raise InputError(f"scheduler {addr}: answered something that is not dask's handshake (its frames do not "
+                             f"add up): not a dask scheduler")
 
 
 def dask_available() -> bool:
@@ -176,6 +252,7 @@ def _new_client(key, addr, workers):
     from distributed import Client, LocalCluster
 
     if addr:
+        probe_scheduler(addr)                     # a silent or foreign peer: one line, not a hang
         try:
             c = Client(addr, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
         except (OSError, TimeoutError) as err:

@@ -11,9 +11,18 @@ its own results file.  ``DIR`` (new or empty: never written into otherwise) gets
   estimate (``<claim id>: verdict``, ``<claim id>: estimate``: the claims-register id, the verdict under
   the primary reading, or the claim's key where a chapter has no register) from the results file.
 
+The folder is claimed before the first run (:func:`claim_out_dir`): it is created, or must be empty, and the
+marker file ``grid.incomplete`` is created in it atomically, so a second grid on the same folder stops with
+one line before writing anything.  ``grid.csv`` is written last and the marker then removed: a folder with
+``grid.csv`` and no marker is complete.  A grid stopped by an error or Ctrl-C keeps the runs it finished
+(their notebooks and results) and the marker, which then says the folder is incomplete and why; when no
+run had finished, the folder is removed again (or left empty, as it was found).
+
 Parameters are checked against the notebook's ``parameters`` cell before any run: an unknown name, or a
 value that does not read as the type of the notebook's default (a number for a number, ``True``/``False``
-for a flag, a Python list for a list ...), stops with one line naming the parameter.  A value that
+for a flag, a Python list for a list ...), stops with one line naming the parameter.  A default cast in
+the cell (``n = int(2)``, ``x = float("1e-3")``) or annotated (``n: int = some_call()``) has the type of
+the cast or annotation, so ``--param n=4`` reaches the notebook as the number 4, never the text "4".  A value that
 contains a comma goes in double quotes (``--param 'start_model="misalignment,hard_iron",misalignment'`` is
 two values); a list parameter takes one list per ``--param`` (``--param 'noise_levels_ut=[0.01, 0.02]'``),
 and a name given twice adds its values.  Range checks are the notebook's own (its
@@ -43,6 +52,7 @@ from typing import Any
 
 from . import engine
 from ._optional import require
+from .data.tables import claim_folder, write_new
 from .errors import InputError
 from .report import RESULTS_ENV
 
@@ -85,24 +95,59 @@ def notebook_parameters(path: str | os.PathLike) -> dict[str, Any]:
                           else list(getattr(node.value, "elts", [None] * len(names))))
                 for n, v in zip(names, values):
                     if isinstance(n, ast.Name):
-                        try:
-                            out[n.id] = ast.literal_eval(v) if v is not None else None
-                        except ValueError:
-                            out[n.id] = ast.get_source_segment(src, v)
+                        out[n.id] = _default(v, src) if v is not None else None
         elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is not None:
-            try:
-                out[node.target.id] = ast.literal_eval(node.value)
-            except ValueError:
-                out[node.target.id] = ast.get_source_segment(src, node.value)
+            out[node.target.id] = _default(node.value, src, node.annotation)
     return out
+
+
+#: The types a parameter's default may be cast to in the parameters cell (``n = int(2)``) or annotated
+#: with (``n: int = ...``): its values are read as that type.
+CASTS = {"int": int, "float": float, "bool": bool, "str": str}
+
+
+class Expression(str):
+    """A default that is not a literal (``scale = np.sqrt(2)``): its source text; ``kind`` is the type its
+    annotation names (``scale: float = np.sqrt(2)``: float), or None when nothing says."""
+
+    kind: type | None = None
+
+
+def _default(value: ast.expr, src: str, annotation: ast.expr | None = None) -> Any:
+    """A parameter's default in the parameters cell: a literal's value; a cast of a literal to one of
+    :data:`CASTS` (``int(2)``, ``float("1e-3")``) evaluated; an int where the annotation says float as a
+    float; anything else an :class:`Expression` (its text, and the annotation's type if it names one)."""
+    kind = CASTS.get(annotation.id) if isinstance(annotation, ast.Name) else None
+    try:
+        v = ast.literal_eval(value)
+    except ValueError:
+        v = Expression(ast.get_source_segment(src, value) or "")
+        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Name) and value.func.id in CASTS
+                and len(value.args) == 1 and not value.keywords):
+            try:
+                v = CASTS[value.func.id](ast.literal_eval(value.args[0]))
+            except (ValueError, TypeError, SyntaxError):
+                pass
+    if isinstance(v, Expression):
+        v.kind = kind
+    elif kind is float and isinstance(v, int) and not isinstance(v, bool):
+        v = float(v)
+    return v
 
 
 _TRUE, _FALSE = ("true", "yes", "1"), ("false", "no", "0")
 
 
 def convert(name: str, raw: str, default: Any) -> Any:
-    """Read the text ``raw`` as a value of parameter ``name`` of the type of its ``default``."""
+    """Read the text ``raw`` as a value of parameter ``name`` of the type of its ``default`` (int, float,
+    bool, str, list or tuple; for an :class:`Expression`, the type its annotation names, else a literal or
+    the text).  A value that does not convert: one-line InputError naming the parameter."""
     text = raw.strip()
+    shown = str(default) if isinstance(default, Expression) else repr(default)
+    if isinstance(default, Expression) and default.kind is not None:
+        default = {int: 0, float: 0.0, bool: False, str: ""}[default.kind]
+    elif isinstance(default, Expression):
+        default = None
     try:
         if isinstance(default, bool):
             if text.lower() in _TRUE:
@@ -137,7 +182,7 @@ def convert(name: str, raw: str, default: Any) -> Any:
         kind = {bool: "True or False", int: "a whole number", float: "a number",
                 list: "a Python list", tuple: "a Python tuple"}.get(type(default), "a Python literal")
         raise InputError(f"grid: parameter {name}={raw!r}: expected {kind} (the notebook's default is "
-                         f"{default!r})") from None
+                         f"{shown})") from None
 
 
 def parse_grid(specs: list[str], parameters: dict[str, Any], notebook: str = "the notebook") -> dict[str, list]:
@@ -176,19 +221,17 @@ def points(grid: dict[str, list]) -> list[dict[str, Any]]:
     return [dict(zip(names, combo)) for combo in itertools.product(*(grid[n] for n in names))]
 
 
-def check_out_dir(out: str | os.PathLike) -> Path:
-    """The output folder: created if missing; refused if it is a file or holds anything."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"grid --out {out}: is a file, not a folder")
-    if out.is_dir() and any(out.iterdir()):
-        raise InputError(f"grid --out {out}: the folder is not empty (the grid writes only into a new or empty "
-                         f"folder, never over earlier outputs)")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise InputError(f"grid --out {out}: cannot create the folder ({err.strerror or err})") from None
-    return out
+#: The marker file :func:`run_grid` keeps in its output folder while it writes
+#: (:func:`navlib.data.tables.claim_folder`): a second grid on the same folder stops before writing
+#: anything; a grid stopped by an error or Ctrl-C after some runs leaves it, saying the folder is incomplete
+#: (no ``grid.csv``).
+MARKER = "grid.incomplete"
+
+
+def claim_out_dir(out: str | os.PathLike):
+    """Claim the output folder for this grid (:func:`navlib.data.tables.claim_folder`): created if missing,
+    refused if it is a file, holds anything, or another grid is writing there (one line, before any work)."""
+    return claim_folder(out, MARKER, what="navlib grid", label="grid --out", empty=True)
 
 
 def _papermill():
@@ -274,11 +317,10 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
              scheduler: str | None = None, progress: bool | None = None) -> list[dict]:
     """Run ``notebook`` at every point of the grid ``specs`` (``["NAME=V1,V2", ...]``) and write ``out``
     (see the module docstring).  Returns grid.csv's rows."""
-    nb_path = Path(notebook)
+    nb_path, out = Path(notebook), Path(out)
     params = notebook_parameters(nb_path)
     grid = parse_grid(list(specs), params, nb_path.name)
     engine.scheduler_address(scheduler)                      # a bad address stops here, before any run
-    out = check_out_dir(out)
     _papermill()
     text = nb_path.read_text(encoding="utf-8")
     stem = nb_path.stem
@@ -303,14 +345,17 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
         rows[i] = {"run": i + 1, "notebook": f"{names[i]}.ipynb" if r["notebook"] is not None else "",
                    "status": status, "seconds": round(r["seconds"], 1), **pts[i], **_flatten(r["results"])}
 
-    engine.run(run_point, tasks, workers=workers, scheduler=scheduler, label=f"grid {stem}", progress=progress,
-               on_result=write)
-    columns: list[str] = []
-    for r in rows:
-        columns += [k for k in r if k not in columns]
-    with open(out / "grid.csv", "w", newline="", encoding="utf-8") as f:
+    def table(f) -> None:
+        columns: list[str] = []
+        for r in rows:
+            columns += [k for k in r if k not in columns]
         w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
         for r in rows:
             w.writerow({k: (json.dumps(v) if isinstance(v, (list, tuple, dict)) else v) for k, v in r.items()})
+
+    with claim_out_dir(out):                                  # one grid per folder, claimed before any run
+        engine.run(run_point, tasks, workers=workers, scheduler=scheduler, label=f"grid {stem}", progress=progress,
+                   on_result=write)
+        write_new(out / "grid.csv", table, newline="")         # last: a folder with grid.csv is complete
     return rows

@@ -9,7 +9,9 @@ and run::
 
 which writes ``my_broad/3d/broad_<NN>_<name>.csv`` for every trial file found (``--trials 05,32`` for a
 few) and, for the trials with level headings, ``my_broad/level/broad_trial<NN>_level.csv``.  Existing
-files are never overwritten (the run stops with one line naming the file).  The files written are derived
+files are never overwritten (the run stops with one line naming the file), and a run that stops (a
+truncated trial file, Ctrl-C) writes nothing: the files go into a staging folder first and are moved into
+place only when every trial is converted.  The files written are derived
 and modified data under the same licence: cite BROAD wherever they are used.
 
 What a trial file holds (its own ``info`` text says so): ``imu_gyr`` (rad/s), ``imu_acc`` (m/s^2),
@@ -52,6 +54,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import shutil
 import sys
 from pathlib import Path
 
@@ -61,7 +64,7 @@ from scipy.spatial.transform import Rotation
 
 from ..angles import wrap_deg
 from ..errors import InputError
-from .tables import write_new_csv
+from .tables import publish, staging_folder, write_new_csv
 
 #: The variables a BROAD trial file must hold, with their number of columns.
 VARIABLES = {"imu_gyr": 3, "imu_acc": 3, "imu_mag": 3, "opt_quat": 4, "opt_pos": 3, "movement": 1}
@@ -300,8 +303,11 @@ def level_sweep(trial: dict, number: int | None = None, split_s: float = LEVEL_S
 def convert(in_dir, out_dir, trials=None, level: bool = True) -> list[Path]:
     """Convert every ``NN_name.mat`` in ``in_dir`` (or the trial numbers in ``trials``) into
     ``out_dir/3d/broad_NN_name.csv`` and, where a trial has level headings, ``out_dir/level/
-    broad_trialNN_level.csv``.  Never overwrites a file: an existing output stops the run before any file
-    is written (one-line InputError naming it).  Returns the paths written."""
+    broad_trialNN_level.csv``.  All or nothing: every file is written into a staging folder beside the
+    target first (:func:`navlib.data.tables.staging_folder`) and moved into ``out_dir`` only when every trial
+    has been converted (:func:`navlib.data.tables.publish`), so a bad or truncated trial file, an error or
+    Ctrl-C leaves ``out_dir`` as it was.  Never overwrites a file: an existing output stops the run before any
+    file is written (one-line InputError naming it).  Returns the paths written."""
     src = Path(in_dir)
     if not src.is_dir():
         raise InputError(f"{src}: no such folder (give --in the folder data_mat of BROAD)")
@@ -321,20 +327,26 @@ def convert(in_dir, out_dir, trials=None, level: bool = True) -> list[Path]:
         for f in ((f3, fl) if level else (f3,)):
             if f.exists():
                 raise InputError(f"{f}: already exists; not overwritten (choose another --out)")
-    written = []
-    for p, f3, fl in targets:
-        trial = read_trial(p)
-        written.append(write_new_csv(rounded(trial_blocks(trial, trial_number(p))), f3))
-        if level:
-            sweep = level_sweep(trial, trial_number(p))
-            if len(sweep):
-                written.append(write_new_csv(sweep, fl))
-    return written
+    staging = staging_folder(out)                   # all or nothing: written here, then moved into out
+    try:
+        written = []
+        for p, f3, fl in targets:
+            trial = read_trial(p)
+            written.append(write_new_csv(rounded(trial_blocks(trial, trial_number(p))),
+                                         staging / f3.relative_to(out)))
+            if level:
+                sweep = level_sweep(trial, trial_number(p))
+                if len(sweep):
+                    written.append(write_new_csv(sweep, staging / fl.relative_to(out)))
+        where = publish(staging, out)
+        return [where[w] for w in written]
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m navlib.data.broad --in DIR --out DIR [--trials 05,32] [--no-level]``; bad input: one
-    line on stderr, exit status 2."""
+    line on stderr, exit status 2; Ctrl-C: one line, exit status 130, nothing written."""
     ap = argparse.ArgumentParser(prog="python -m navlib.data.broad",
                                  description="Convert BROAD's data_mat/*.mat into the workbench's CSV files.")
     ap.add_argument("--in", dest="in_dir", required=True, help="folder holding BROAD's NN_name.mat files")
@@ -354,6 +366,9 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:                       # Ctrl-C: nothing was written (convert is all or nothing)
+        print("interrupted; nothing written", file=sys.stderr)
+        return 130
     return 0
 
 

@@ -22,6 +22,8 @@ import difflib
 import io
 import os
 import re
+import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, TextIO
@@ -255,6 +257,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     frame = pd.DataFrame(out, index=pd.RangeIndex(len(rows)))
     if jumps:
         frame.attrs["line_jumps"] = jumps
+    frame.attrs["source"] = p.name                  # later messages about the data name the file
     if len(frame) < min_rows:
         raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
                          f"a {kind} needs at least {min_rows}")
@@ -328,7 +331,8 @@ def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, ove
     """The one overwrite rule of navlib: create ``path`` (and its folder) and let ``write(fh)`` fill it,
     never replacing an existing file unless ``overwrite`` is set; user data and earlier outputs are not
     overwritten by accident.  The check and the creation are one step (``open(path, "x")``), so no file
-    that appears in between is replaced, nor one a symbolic link points to.
+    that appears in between is replaced, nor one a symbolic link points to.  A ``write`` that raises (an
+    error, Ctrl-C) removes the half-written file: nothing is left that looks like a complete output.
 
     Parameters
     ----------
@@ -351,10 +355,15 @@ def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, ove
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with open(p, "w" if overwrite else "x", encoding="utf-8", newline=newline) as fh:
-            write(fh)
+        fh = open(p, "w" if overwrite else "x", encoding="utf-8", newline=newline)
     except FileExistsError:
         raise InputError(f"{p}: {exists}") from None
+    try:
+        with fh:
+            write(fh)
+    except BaseException:                           # an error or Ctrl-C half-way: no file that looks complete
+        p.unlink(missing_ok=True)
+        raise
     return p
 
 
@@ -365,3 +374,201 @@ def write_new_csv(frame: pd.DataFrame, path: str | os.PathLike, *, overwrite: bo
     return write_new(path, lambda fh: frame.to_csv(fh, index=False, float_format=float_format),
                      overwrite=overwrite, newline="",
                      exists="already exists; not overwritten (choose another name or pass overwrite)")
+
+
+class FolderClaim:
+    """An output folder claimed by one writer (:func:`claim_folder`).  As a context manager: when the block
+    ends normally the marker file is removed (the folder is complete); when it ends with an exception (an
+    error, Ctrl-C) and nothing but the marker is in the folder, the marker and the folders the claim created
+    are removed (the folder is as it was found); when something was written, the marker stays and says the
+    folder is incomplete (its text: why and when), and the exception gets a note naming it, which the
+    command line adds to its one line."""
+
+    def __init__(self, folder: Path, marker: Path, created: list[Path], what: str):
+        self.folder, self.marker, self.created, self.what = folder, marker, created, what
+        self.before: set[str] = set()            # what the folder held when it was claimed (not ours)
+
+    def __enter__(self) -> "FolderClaim":
+        return self
+
+    def __exit__(self, etype, err, tb) -> bool:
+        if etype is None:
+            self.release()
+        else:
+            self.abandon(err)
+        return False
+
+    def release(self) -> None:
+        """The work is complete: remove the marker."""
+        self.marker.unlink(missing_ok=True)
+
+    def _remove_created(self) -> None:
+        for d in reversed(self.created):
+            try:
+                d.rmdir()
+            except OSError:                             # not empty (someone else's files) or already gone
+                break
+
+    def abandon(self, err: BaseException | None = None) -> None:
+        """The work stopped: leave the folder as found if nothing was written into it since the claim, else
+        mark it incomplete."""
+        try:
+            written = [p for p in self.folder.iterdir() if p != self.marker and p.name not in self.before]
+        except OSError:
+            return
+        if not written:
+            self.marker.unlink(missing_ok=True)
+            self._remove_created()
+            return
+        why = ("interrupted (Ctrl-C)" if isinstance(err, KeyboardInterrupt)
+               else f"stopped by an error ({type(err).__name__}: {' '.join(str(err).split())[:200]})" if err is not None
+               else "stopped")
+        when = pd.Timestamp.now().isoformat(timespec="seconds")
+        try:
+            self.marker.write_text(f"{self.what}: {why} at {when}.  This folder is INCOMPLETE: what is here was "
+                                   f"written before it stopped, and what marks a complete run is missing.\n",
+                                   encoding="utf-8")
+        except OSError:
+            return
+        if err is not None:
+            err.add_note(f"{self.folder} is incomplete ({self.marker.name} says so)")
+
+
+def claim_folder(folder: str | os.PathLike, marker: str, *, what: str, label: str, empty: bool) -> FolderClaim:
+    """Claim the output folder ``folder`` for one writer before any work is done (the rule of
+    :func:`write_new` for a folder of outputs).
+
+    The folder is created where missing (its missing parents too); an existing one must be a folder and,
+    with ``empty``, hold nothing.  Then the marker file ``folder/marker`` is created with ``O_CREAT |
+    O_EXCL``: of two writers that reach this point together only one succeeds; the other gets a one-line
+    :class:`~navlib.errors.InputError` (``label`` and the folder: another run is writing there) before it has
+    written anything.  The marker holds ``what``, the process id and the start time while the work runs
+    (:class:`FolderClaim` removes it at the end, or leaves it saying the folder is incomplete).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder.
+    marker : str
+        The marker's file name inside ``folder`` (e.g. ``"grid.incomplete"``).
+    what : str
+        Who writes (``"navlib grid"``), for the marker's text.
+    label : str
+        What the user gave (``"grid --out"``), the start of every message.
+    empty : bool
+        Require an existing folder to be empty.
+
+    Returns
+    -------
+    FolderClaim
+        Use it as a context manager around the work.
+    """
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{label} {folder}: is a file, not a folder")
+    missing = []
+    p = folder
+    while not p.exists() and p != p.parent:
+        missing.append(p)
+        p = p.parent
+    created: list[Path] = []
+    claim = FolderClaim(folder, folder / marker, created, what)
+    for d in reversed(missing):
+        try:
+            d.mkdir()
+            created.append(d)
+        except FileExistsError:                     # another writer made it in between: the marker decides
+            pass
+        except OSError as err:
+            claim._remove_created()
+            raise InputError(f"{label} {folder}: cannot create the folder ({err.strerror or err})") from None
+    if not folder.is_dir():
+        claim._remove_created()
+        raise InputError(f"{label} {folder}: is a file, not a folder")
+    if claim.marker.exists():
+        raise InputError(f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
+                         f"folder is incomplete: choose another)")
+    if empty and any(folder.iterdir()):
+        claim._remove_created()
+        raise InputError(f"{label} {folder}: the folder is not empty (outputs go only into a new or empty folder, "
+                         f"never over earlier outputs)")
+    try:
+        fd = os.open(claim.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+    except FileExistsError:
+        raise InputError(f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
+                         f"folder is incomplete: choose another)") from None
+    except OSError as err:
+        claim._remove_created()
+        raise InputError(f"{label} {folder}: cannot write there ({err.strerror or err})") from None
+    claim.before = {p.name for p in folder.iterdir()} - {marker}
+    with os.fdopen(fd, "w", encoding="utf-8") as fh:
+        fh.write(f"{what} is writing this folder (process {os.getpid()}, started "
+                 f"{pd.Timestamp.now().isoformat(timespec='seconds')}); it is complete once this file is gone.\n")
+    return claim
+
+
+def staging_folder(target: str | os.PathLike) -> Path:
+    """A new, empty, hidden folder beside ``target`` (in its parent when ``target`` does not exist, else
+    inside it: on the same file system either way) to write outputs into before :func:`publish` moves them
+    into ``target`` at once.  The caller removes it when done (``shutil.rmtree``)."""
+    target = Path(target)
+    if target.exists() and not target.is_dir():
+        raise InputError(f"{target}: is a file, not a folder")
+    where = target if target.is_dir() else target.parent
+    where.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=f".{target.name}.partial-", dir=where))
+
+
+def _place(src: Path, dst: Path) -> None:
+    """``src`` at ``dst``, never over an existing file: a hard link, or a copy where links are not allowed."""
+    try:
+        os.link(src, dst)
+    except FileExistsError:
+        raise
+    except OSError:                                   # no hard links here (some network file systems)
+        with open(src, "rb") as fin, open(dst, "xb") as fout:
+            shutil.copyfileobj(fin, fout)
+
+
+def publish(staging: str | os.PathLike, target: str | os.PathLike) -> dict[Path, Path]:
+    """Move the finished outputs in ``staging`` (:func:`staging_folder`) into ``target``, all or none, never
+    over an existing file.  A missing ``target`` is the staging folder renamed (one atomic step); into an
+    existing one each file is linked in place (an existing file there stops it: the files placed so far and
+    the folders made for them are removed again, and a one-line InputError names the file).  Returns
+    ``{staging file: its path in target}``."""
+    staging, target = Path(staging), Path(target)
+    files = sorted(p for p in staging.rglob("*") if p.is_file())
+    where = {p: target / p.relative_to(staging) for p in files}
+    if not target.exists():
+        try:
+            os.rename(staging, target)
+            return where
+        except OSError:                               # it appeared meanwhile: placed file by file below
+            pass
+    placed: list[Path] = []
+    made: list[Path] = []
+    try:
+        for src, dst in where.items():
+            missing = []
+            d = dst.parent
+            while not d.exists():
+                missing.append(d)
+                d = d.parent
+            for m in reversed(missing):
+                m.mkdir()
+                made.append(m)
+            _place(src, dst)
+            placed.append(dst)
+    except BaseException as err:
+        for p in placed:
+            p.unlink(missing_ok=True)
+        for m in reversed(made):
+            try:
+                m.rmdir()
+            except OSError:
+                pass
+        if isinstance(err, FileExistsError):
+            raise InputError(f"{dst}: already exists; not overwritten (choose another folder); "
+                             f"nothing written") from None
+        raise
+    return where

@@ -132,51 +132,196 @@ def write_calibration(cal: dict, path) -> Path:
     return write_new(path, lambda fh: json.dump(cal, fh, indent=2, allow_nan=False))
 
 
-def read_calibration(path) -> dict:
-    """A calibration file written by :func:`write_calibration`; one-line InputError for anything else (not
-    JSON, not a navlib calibration, a calibration of another system, a newer version)."""
-    name = Path(path).name
-    try:
-        cal = json.loads(Path(path).read_text())
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise InputError(f"{name}: not a calibration file (not JSON: {str(err).splitlines()[0]})") from None
+#: Largest condition number (2-norm, ``cond(A) = s_max / s_min``) of a calibration's ``A`` that ``apply``
+#: accepts.  A working magnetometer's scale and soft-iron errors give a correction near the identity: the
+#: BROAD recordings' calibrations have 1.08 (trial 01, slow rotation) and 1.22 (trial 06, fast rotation); a
+#: magnet glued 1 cm from the sensor (trial 32) 8.4.  Beyond 10 the correction stretches one direction ten
+#: times more than another, which no scale or soft iron of a working sensor does: a failed fit, a hand edit, or
+#: a (nearly) singular matrix that turns the data's noise into most of the corrected field.
+COND_LIMIT = 10.0
+#: How far the corrected field strength (median ``|m_corrected|`` over the file) may differ, relatively, from
+#: the calibration's ``expected_field_strength_ut`` before ``apply`` warns (one line on stderr; the file is
+#: written).  The same sensor in the same lab on other recordings shows up to 4.6 % (BROAD: trial 01's
+#: calibration applied to each of the 17 recordings, magnets included: -1.2 % .. +4.6 %); 10 % leaves room
+#: for a steel-framed building or a site some hundred km away (the main field changes by a few % per
+#: 1000 km), and beyond it the user should know.
+FIELD_WARN_REL = 0.10
+#: Beyond this relative difference ``apply`` refuses (exit 2, nothing written): the corrected data are not
+#: the Earth's field near the calibration's site seen by the calibrated sensor -- another sensor, another
+#: unit, a calibration of another system, or a broken one (e.g. 58 uT against the expected 43.5: +33 %).
+#: The whole Earth spans 22-67 uT, so a sensor taken to another continent needs a new calibration anyway.
+FIELD_REFUSE_REL = 0.25
+
+
+def _key_text(path: tuple) -> str:
+    out = ""
+    for k in path:
+        out += f"[{k}]" if isinstance(k, int) else (f".{k}" if out else str(k))
+    return out
+
+
+def _short(v) -> str:
+    text = json.dumps(v, allow_nan=True) if isinstance(v, (dict, list, str, int, float, bool, type(None))) else repr(v)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _get(cal: dict, path: tuple, name: str, required: bool = True):
+    """The value at ``path`` (a tuple of keys) of the calibration ``cal``; InputError naming the key when it
+    is missing (``required``) or a container on the way is not a JSON object."""
+    node = cal
+    for i, k in enumerate(path):
+        if not isinstance(node, dict):
+            raise InputError(f"{name}: key '{_key_text(path[:i])}' must be a JSON object, got {_short(node)}")
+        if k not in node:
+            if not required:
+                return None
+            raise InputError(f"{name}: key '{_key_text(path[:i + 1])}' is missing (a calibration written by "
+                             f"`navlib calibrate` has it)")
+        node = node[k]
+    return node
+
+
+def _number(value, path: tuple, name: str) -> float:
+    """``value`` as a finite float; InputError naming the key for text, booleans, null, NaN or infinity."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{name}: key '{_key_text(path)}' = {_short(value)} is not a number")
+    v = float(value)
+    if not np.isfinite(v):
+        raise InputError(f"{name}: key '{_key_text(path)}' = {_short(value)} is not a finite number")
+    return v
+
+
+def _array(value, path: tuple, shape: tuple, name: str) -> np.ndarray:
+    """``value`` as a float array of ``shape`` (nested JSON lists), every entry checked by :func:`_number`."""
+    what = (f"{shape[0]} numbers" if len(shape) == 1 else
+            f"a {shape[0]}x{shape[1]} array ({shape[0]} rows of {shape[1]} numbers)")
+
+    def walk(v, p, dims):
+        if not dims:
+            return _number(v, p, name)
+        if not isinstance(v, list) or len(v) != dims[0]:
+            raise InputError(f"{name}: key '{_key_text(path)}' must be {what}, got {_short(value)}")
+        return [walk(x, p + (i,), dims[1:]) for i, x in enumerate(v)]
+
+    return np.array(walk(value, path, shape), dtype=float)
+
+
+def check_calibration(cal, name: str) -> dict:
+    """Validate every key ``apply`` reads, by name: ``format``, ``system``, ``version`` as written by
+    :func:`calibrate`; ``magcal.A`` a 3x3 array and ``magcal.b_ut`` 3 finite numbers, ``A`` with a condition
+    number at most :data:`COND_LIMIT`; ``magcal.expected_field_strength_ut`` a positive number (and the
+    top-level ``expected_field_strength_ut.value``, where present, the same); ``temperature`` null or
+    ``centre_c`` and 3 ``coef_ut_per_c``; ``to_accelerometer_axes`` null or a rotation matrix;
+    ``columns.field``, where present, the columns apply corrects.  One-line InputError naming ``name`` (the
+    file), the key, its value and the limit.  Returns the values: ``{"A", "b", "field_ut", "temperature":
+    (centre, coef) or None, "rotation": R or None}``."""
     if not isinstance(cal, dict) or cal.get("format") != FORMAT:
         raise InputError(f"{name}: not a navlib calibration file (no \"format\": \"{FORMAT}\")")
     if cal.get("system") != SYSTEM.name:
         raise InputError(f"{name}: a calibration of the system {cal.get('system')!r}; apply corrects "
                          f"'{SYSTEM.name}' calibrations (python -m navlib calibrate magnetometer)")
-    if cal.get("version") != VERSION:
-        raise InputError(f"{name}: calibration format version {cal.get('version')!r}; this navlib reads {VERSION}")
+    version = cal.get("version")
+    if isinstance(version, bool) or version != VERSION:
+        raise InputError(f"{name}: calibration format version {version!r}; this navlib reads {VERSION}")
+    A = _array(_get(cal, ("magcal", "A"), name), ("magcal", "A"), (3, 3), name)
+    b = _array(_get(cal, ("magcal", "b_ut"), name), ("magcal", "b_ut"), (3,), name)
+    key = ("magcal", "expected_field_strength_ut")
+    field = _number(_get(cal, key, name), key, name)
+    if field <= 0:
+        raise InputError(f"{name}: key '{_key_text(key)}' = {field:g} must be a positive field strength (uT)")
+    top = _get(cal, ("expected_field_strength_ut",), name, required=False)
+    if top is not None:
+        value = _number(_get(cal, ("expected_field_strength_ut", "value"), name),
+                        ("expected_field_strength_ut", "value"), name)
+        if abs(value - field) > 1e-9 * field:
+            raise InputError(f"{name}: key 'expected_field_strength_ut.value' = {value:g} differs from "
+                             f"'magcal.expected_field_strength_ut' = {field:g} (a hand edit of one of them?)")
+    with np.errstate(all="ignore"):
+        cond = float(np.linalg.cond(A))
+    if not cond <= COND_LIMIT:                        # also NaN / inf: singular
+        said = "infinite: A is singular" if not np.isfinite(cond) or cond > 1e12 else f"{cond:.3g}"
+        raise InputError(f"{name}: key 'magcal.A': condition number {said} (the limit is {COND_LIMIT:g}): "
+                         f"not the correction of a working magnetometer")
+    temperature = _get(cal, ("temperature",), name, required=False)
+    temp = None
+    if temperature is not None:
+        centre = _number(_get(cal, ("temperature", "centre_c"), name), ("temperature", "centre_c"), name)
+        coef = _array(_get(cal, ("temperature", "coef_ut_per_c"), name), ("temperature", "coef_ut_per_c"), (3,),
+                      name)
+        temp = (centre, coef)
+    axes = _get(cal, ("to_accelerometer_axes",), name, required=False)
+    R = None
+    if axes is not None:
+        R = _array(axes, ("to_accelerometer_axes",), (3, 3), name)
+        if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0):
+            raise InputError(f"{name}: key 'to_accelerometer_axes' is not a rotation matrix (R R^T = I, det R = 1 "
+                             f"to 1e-6)")
+    columns = _get(cal, ("columns", "field"), name, required=False) if cal.get("columns") is not None else None
+    if columns is not None and columns != list(MAG):
+        raise InputError(f"{name}: key 'columns.field' = {_short(columns)}: apply corrects the columns "
+                         f"{', '.join(MAG)}")
+    return {"A": A, "b": b, "field_ut": field, "temperature": temp, "rotation": R}
+
+
+def read_calibration(path) -> dict:
+    """A calibration file written by :func:`write_calibration`; one-line InputError for anything else (not
+    JSON, not a navlib calibration, a calibration of another system, a newer version, any key apply reads
+    missing, of the wrong type or shape, not finite, or ``A`` ill conditioned: :func:`check_calibration`)."""
+    name = Path(path).name
     try:
-        A = np.asarray(cal["magcal"]["A"], float)
-        b = np.asarray(cal["magcal"]["b_ut"], float)
-    except (KeyError, TypeError, ValueError):
-        raise InputError(f"{name}: the calibration has no valid magcal A and b_ut") from None
-    if A.shape != (3, 3) or b.shape != (3,) or not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        raise InputError(f"{name}: magcal A must be 3x3 and b_ut 3 finite numbers")
+        cal = json.loads(Path(path).read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputError(f"{name}: not a calibration file (not JSON: {str(err).splitlines()[0]})") from None
+    check_calibration(cal, name)
     return cal
 
 
 def apply_calibration(cal: dict, frame: pd.DataFrame) -> pd.DataFrame:
     """``frame`` with its field columns corrected: ``(m - b(T)) A`` (and turned into the accelerometer's
-    axes when the calibration has a misalignment)."""
-    A = np.asarray(cal["magcal"]["A"], float)
-    b = np.asarray(cal["magcal"]["b_ut"], float)
-    m = frame[list(MAG)].to_numpy(float) - b
-    if cal.get("temperature"):
-        t = cal["temperature"]
-        m = m - (frame["temperature_c"].to_numpy(float) - t["centre_c"])[:, None] * np.asarray(t["coef_ut_per_c"])
-    u = m @ A
-    if cal.get("to_accelerometer_axes") is not None:
-        u = u @ np.asarray(cal["to_accelerometer_axes"], float).T
+    axes when the calibration has a misalignment).  ``cal`` is checked first (:func:`check_calibration`)."""
+    c = check_calibration(cal, "calibration")
+    m = frame[list(MAG)].to_numpy(float) - c["b"]
+    if c["temperature"] is not None:
+        centre, coef = c["temperature"]
+        m = m - (frame["temperature_c"].to_numpy(float) - centre)[:, None] * coef
+    with np.errstate(over="ignore", invalid="ignore"):
+        u = m @ c["A"]
+        if c["rotation"] is not None:
+            u = u @ c["rotation"].T
     out = frame.drop(columns=[c for c in DERIVED if c in frame]).copy()
     out[list(MAG)] = u
     return out
 
 
-def apply_file(cal_path, data_path, out_path) -> tuple[Path, int]:
-    """Read a calibration and a measurement file, check they match, write the corrected file (never over
-    an existing one: checked before the work)."""
+def check_corrected(cal: dict, corrected: pd.DataFrame, cal_name: str, data_name: str) -> list[str]:
+    """Check the corrected field before it is written: every value finite, and the field strength it shows
+    (median ``|m_corrected|``) within :data:`FIELD_REFUSE_REL` of the calibration's expected field strength
+    (InputError otherwise, naming both files); beyond :data:`FIELD_WARN_REL` the returned list holds one
+    warning line."""
+    u = corrected[list(MAG)].to_numpy(float)
+    bad = np.flatnonzero(~np.all(np.isfinite(u), axis=1))
+    if bad.size:
+        raise InputError(f"{data_name}: row {bad[0] + 1} (and {bad.size - 1} more): the field corrected with "
+                         f"{cal_name} is not finite; nothing written")
+    expected = float(cal["magcal"]["expected_field_strength_ut"])
+    big = np.max(np.abs(u), axis=1)                 # |u| without overflow: scaled by the largest component
+    size = big * np.linalg.norm(u / np.where(big > 0, big, 1.0)[:, None], axis=1)
+    seen = float(np.median(size))
+    rel = seen / expected - 1.0
+    said = (f"the corrected field strength (median |m_corrected|) is {seen:.4g} uT, {100 * rel:+.3g} % from "
+            f"{cal_name}'s expected_field_strength_ut {expected:.4g} uT")
+    if not abs(rel) <= FIELD_REFUSE_REL:
+        raise InputError(f"{data_name}: {said} (more than {100 * FIELD_REFUSE_REL:g} %: a calibration of another "
+                         f"sensor, unit or site?); nothing written")
+    if abs(rel) > FIELD_WARN_REL:
+        return [f"{data_name}: {said} (more than {100 * FIELD_WARN_REL:g} %: another site, or steel nearby?)"]
+    return []
+
+
+def apply_file(cal_path, data_path, out_path) -> tuple[Path, int, list[str]]:
+    """Read a calibration and a measurement file, check they match, correct, check the corrected field
+    (:func:`check_corrected`), write the corrected file (never over an existing one: checked before the
+    work).  Returns the path, the rows written and the warnings (lines for stderr)."""
     out_path = Path(out_path)
     if out_path.exists() or out_path.is_symlink():
         raise InputError(f"{out_path}: already exists; not overwritten (choose another --out)")
@@ -187,7 +332,9 @@ def apply_file(cal_path, data_path, out_path) -> tuple[Path, int]:
     if cal.get("temperature") and "temperature_c" not in frame:
         raise InputError(f"{name}: the calibration corrects a temperature-dependent offset: the file needs a "
                          f"'temperature_c' column")
-    return write_new_csv(apply_calibration(cal, frame), out_path), len(frame)
+    corrected = apply_calibration(cal, frame)
+    warnings = check_corrected(cal, corrected, Path(cal_path).name, name)
+    return write_new_csv(corrected, out_path), len(frame), warnings
 
 
 def calibrate_file(data_path, model, out_path, site=None, date=None) -> tuple[Path, dict]:
@@ -220,6 +367,29 @@ CRUST_TOL_UT = 0.3
 SCALE_TOL = 0.01
 
 
+#: How far from a geographic pole (deg of latitude, about 1 cm) :func:`model_field` evaluates the field it
+#: reports at the pole: the limit of horizontal, down, intensity and dip (they change by about 1e-9 of their
+#: value over that distance; at the pole itself ppigrf divides by sin(colatitude) = 0 and returns NaN).
+POLE_STEP_DEG = 1e-7
+#: What :func:`model_field` says at a geographic pole instead of a declination.
+POLE_NOTE = ("at a geographic pole the directions north and east are undefined, and so is the declination; "
+             "horizontal, down, intensity and dip are the field's limits at the pole")
+
+
+def model_field(site) -> dict:
+    """The IGRF-14 field at ``site`` (:class:`navlib.sensors.earth_field.Site`) as a JSON-ready dict
+    (:meth:`navlib.sensors.earth_field.EarthField.to_dict`), finite everywhere: at a geographic pole
+    (``|lat_deg| = 90``) ``north_ut``, ``east_ut`` and ``declination_deg`` are None, ``note`` says why
+    (:data:`POLE_NOTE`), and the other values are the limits at the pole (:data:`POLE_STEP_DEG`)."""
+    from ..sensors.earth_field import Site, igrf_field
+    if abs(site.lat_deg) < 90.0:
+        return igrf_field(site).to_dict()
+    near = Site(float(np.copysign(90.0 - POLE_STEP_DEG, site.lat_deg)), site.lon_deg, site.height_m, site.date)
+    out = igrf_field(near).to_dict()
+    out.update(north_ut=None, east_ut=None, declination_deg=None, note=POLE_NOTE)
+    return out
+
+
 def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dict:
     """The local field the reference-free fit estimates beside the IGRF-14 model at ``site``
     (:class:`navlib.sensors.earth_field.Site`), and whether they differ beyond the uncertainty.
@@ -229,7 +399,6 @@ def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dic
     the sensor's scale): anomaly when ``|dip - dip_model| > 1.96 sigma + deg(CRUST_TOL_UT / F_model)``.
     Without a site only the estimate is returned."""
     from ..errors import check_param
-    from ..sensors.earth_field import igrf_field
     check_param("scale_tol", scale_tol, lo=0, hi=0.5)
     names, cov = parameter_covariance(fit, noise)
     iF = names.index("field_ut")
@@ -246,23 +415,25 @@ def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dic
         out["dip_std_deg"] = float(np.degrees(np.sqrt(g @ cov @ g)))
     if site is None:
         return out
-    model = igrf_field(site)
+    model = model_field(site)
+    model_f, model_dip = model["intensity_ut"], model["dip_deg"]
     out["model"] = {"name": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
-                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model.intensity_ut,
-                    "dip_deg": model.dip_deg, "declination_deg": model.declination_deg}
-    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model.intensity_ut
-    out["intensity_difference_ut"] = F - model.intensity_ut
+                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model_f,
+                    "dip_deg": model_dip, "declination_deg": model["declination_deg"],
+                    **({"note": model["note"]} if "note" in model else {})}
+    tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model_f
+    out["intensity_difference_ut"] = F - model_f
     out["intensity_tolerance_ut"] = tol_f
     anomalies = []
-    if abs(F - model.intensity_ut) > tol_f:
-        anomalies.append(f"intensity {F:.2f} uT against the model's {model.intensity_ut:.2f} uT "
+    if abs(F - model_f) > tol_f:
+        anomalies.append(f"intensity {F:.2f} uT against the model's {model_f:.2f} uT "
                          f"(beyond +-{tol_f:.2f} uT)")
     if "dip_deg" in out:
-        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model.intensity_ut))
-        out["dip_difference_deg"] = out["dip_deg"] - model.dip_deg
+        tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model_f))
+        out["dip_difference_deg"] = out["dip_deg"] - model_dip
         out["dip_tolerance_deg"] = tol_d
         if abs(out["dip_difference_deg"]) > tol_d:
-            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model.dip_deg:.2f} deg "
+            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model_dip:.2f} deg "
                              f"(beyond +-{tol_d:.2f} deg)")
     out["local_anomaly"] = bool(anomalies)
     out["message"] = ("local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "

@@ -150,13 +150,23 @@ def free_columns() -> list[Column]:
     return list(FREE_COLUMNS)
 
 
-def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str) -> float:
+def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str, circle: bool = False) -> float:
+    """The column's one value (its median), refused when it spreads by more than ``tol``.  ``circle``: a
+    longitude, compared on the circle (179.99 and -179.99 deg are 0.02 deg apart, and so are 359.99 and
+    0.01): the spread and the median of the differences from the first value, wrapped into [-180, 180)."""
     v = frame[col].to_numpy(float)
-    spread = float(np.ptp(v)) if len(v) else 0.0
+    if circle and len(v):
+        d = np.mod(v - v[0] + 180.0, 360.0) - 180.0
+        spread = float(np.ptp(d))
+        value = float(v[0] + np.median(d))
+        value = value + 360.0 if value < -180.0 else value - 360.0 if value > 360.0 else value
+    else:
+        spread = float(np.ptp(v)) if len(v) else 0.0
+        value = float(np.median(v)) if len(v) else float("nan")
     if spread > tol:
         raise InputError(f"{name}: column '{col}' varies by {spread:.4g} {unit} within the file (more than "
                          f"{tol:g} {unit}): one site per file")
-    return float(np.median(v))
+    return value
 
 
 def _date_of(frame: pd.DataFrame, name: str) -> str:
@@ -166,6 +176,13 @@ def _date_of(frame: pd.DataFrame, name: str) -> str:
     if bad.size:
         raise InputError(f"{name}: column 'date', row {bad[0] + 1}: {str(frame['date'].iloc[bad[0]])[:40]!r} is not an "
                          f"ISO 8601 date (YYYY-MM-DD or YYYY-MM-DDTHH:MM:SSZ)")
+    from ..sensors.earth_field import Site
+    for row in (int(np.argmin(when.to_numpy())), int(np.argmax(when.to_numpy()))):
+        try:
+            Site(0.0, 0.0, 0.0, when.iloc[row].date().isoformat())          # the years IGRF-14 covers
+        except InputError as err:
+            raise InputError(f"{name}: column 'date', row {row + 1}: {str(frame['date'].iloc[row])[:40]!r} is "
+                             f"outside the model's years ({str(err).split(': ', 1)[-1]})") from None
     days = (when.max() - when.min()).total_seconds() / 86400.0
     if days > DATE_TOL_DAYS:
         raise InputError(f"{name}: column 'date' spans {days:.0f} days (more than {DATE_TOL_DAYS}): one recording per "
@@ -179,9 +196,15 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
     ``--date``) override the columns :data:`SITE_COLUMNS`; otherwise latitude, longitude and height are the
     columns' medians and the date the middle of the ``date`` column (default: the Site's).  One-line
     InputError: only one of ``lat_deg``/``lon_deg``; a position spread beyond :data:`SITE_TOL_DEG` or
-    :data:`HEIGHT_TOL_M`, dates spanning more than :data:`DATE_TOL_DAYS` or not ISO 8601; a ``date`` with
-    no site (out-of-range values are refused by the loader, naming column and row)."""
+    :data:`HEIGHT_TOL_M` (longitudes compared on the circle), dates spanning more than
+    :data:`DATE_TOL_DAYS`, not ISO 8601 or outside IGRF-14's years; a date with no site (out-of-range values
+    are refused by the loader, naming column and row).  Each message names what the value came from: the
+    file (``name``, or the file the frame was read from: ``frame.attrs["source"]``) and its column, or the
+    option --site / --date."""
     from ..sensors.earth_field import Site
+    if name == "data":
+        name = frame.attrs.get("source", name)
+    date_given = date is not None
     if site is None:
         have = [c for c in ("lat_deg", "lon_deg") if c in frame]
         if len(have) == 1:
@@ -189,15 +212,19 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
                              f"'{({'lat_deg', 'lon_deg'} - set(have)).pop()}': give both, or --site")
         if have:
             site = (_one_value(frame, "lat_deg", SITE_TOL_DEG, "deg", name),
-                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name))
+                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name, circle=True))
             if "height_m" in frame:
                 site += (_one_value(frame, "height_m", HEIGHT_TOL_M, "m", name),)
     if date is None and "date" in frame:
         date = _date_of(frame, name)
     if site is None:
-        if date is not None:
+        if date_given:
             raise InputError("parameter --date: a date without a site: give --site LAT,LON[,HEIGHT_M] or the "
                              "columns lat_deg, lon_deg")
+        if date is not None:
+            raise InputError(f"{name}: column 'date' without a site (no columns lat_deg, lon_deg, no --site): the "
+                             f"field check needs where as well as when; add the columns or give --site "
+                             f"LAT,LON[,HEIGHT_M]")
         return None
     site = tuple(float(v) for v in site)
     return Site(site[0], site[1], site[2] if len(site) > 2 else 0.0, *((date,) if date is not None else ()))
