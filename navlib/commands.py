@@ -7,6 +7,7 @@ import contextlib
 import json
 import os
 import sys
+from pathlib import Path
 from dataclasses import replace
 
 from . import engine
@@ -21,7 +22,7 @@ from .workbench.effects import resolve
 from .workbench.fit import fit_model
 from .workbench.loop import check_report_folder, loop, write_report
 from .workbench.calibration import apply_file, calibrate_file
-from .workbench.magnetometer_free import FREE_EFFECTS
+from .workbench.magnetometer_free import FREE_EFFECTS, SYSTEM as FREE_SYSTEM, site_of
 from .workbench.rates import DEFAULT_RATIOS, rates
 
 
@@ -163,6 +164,8 @@ def _loop(args) -> int:
         if args.report:
             check_report_folder(args.report)        # again, under the claim: a report finished meanwhile
         system, users, names, data, file = _prepare(args)
+        if system is FREE_SYSTEM:                   # where and when, checked before the loop, not after it
+            site_of(data, site, date, Path(file).name)
         result = loop(system, data, names, user_effects=users, alpha=args.alpha)
         # the system's own end-of-loop report (e.g. the local field against IGRF at the site)
         check, lines = system.final_check(result, site, date) if system.final_check is not None else (None, [])

@@ -117,7 +117,12 @@ def _file(tmp_path, sim, name="rec.csv", **cols):
     return p
 
 
-def test_a_date_column_without_a_site_names_the_file_and_column(sim, tmp_path, capsys):
+def test_a_date_column_without_a_site_names_the_file_and_column(sim, tmp_path, capsys, monkeypatch):
+    import navlib.commands
+
+    def no_loop(*a, **k):
+        raise AssertionError("the loop ran before the site was checked")
+    monkeypatch.setattr(navlib.commands, "loop", no_loop)
     p = _file(tmp_path, sim, date="2021-01-01")
     for args in (["calibrate", "magnetometer", str(p), "--out", str(tmp_path / "c.json")],
                  ["loop", "magnetometer_free", str(p), "--model", "hard_iron"]):
