@@ -14,11 +14,12 @@ export PYDEVD_DISABLE_FILE_VALIDATION := 1
 # single-threaded reductions keep stored notebook numbers identical from run to run.
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: help venv book screenshots test test-lib test-notebooks test-results notebooks bench lock clean
+.PHONY: help venv book screenshots check test test-lib test-notebooks test-results notebooks bench lock clean
 
 help:
 	@echo "make book      - execute every notebook (papermill) and build the HTML book in book/_build/html"
 	@echo "make screenshots - render every built page with headless Chromium (1400 px) into book/_build/screenshots"
+	@echo "make check     - ruff lint + the library tests not marked slow (the daily tier, a few minutes)"
 	@echo "make test      - library tests (pytest) + nbval on the stored notebooks + their results vs notebooks/results"
 	@echo "make notebooks - re-execute notebooks/*.ipynb in place (regenerate the stored outputs and notebooks/results)"
 	@echo "make bench     - run the speed benchmarks in benchmarks/"
@@ -50,6 +51,11 @@ screenshots: $(STAMP)
 	@test -f book/_build/html/index.html || { echo "no built book: run 'make book' first" >&2; exit 1; }
 	@command -v chromium > /dev/null || { echo "chromium is missing: install it with 'apt-get install -y chromium' (Debian package chromium)" >&2; exit 2; }
 	@$(PY) -m navlib.booktools screenshots book/_build/html book/_build/screenshots --width 1400
+
+# The daily tier: lint, then the library tests not marked slow (pyproject markers), in two processes.
+check: $(STAMP)
+	@$(VENV)/bin/ruff check navlib tests benchmarks
+	@$(PY) -m pytest -q tests -p no:cacheprovider -m "not slow" $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # The library tests and nbval run at the same time (each is CPU-bound only part of the time: together they
 # keep both cores busy; each one's output is printed when it ends), then the results files are compared.

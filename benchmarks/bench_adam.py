@@ -43,7 +43,6 @@ def autograd_trajectories(theta0, xn, tn, n_hidden, params, threads=None):
     """The former trainer: autograd back-propagation and torch's default Adam (same signature as
     ``navlib.methods.bpnet._adam_trajectories``), on ``threads`` torch threads (None: torch's default, as
     the former code ran)."""
-    m = n_hidden
     caller = torch.get_num_threads()
     torch.set_num_threads(threads or caller)
     try:

@@ -30,7 +30,6 @@ from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
 
 from navlib.data.compass_sweeps import load_sweeps, split_sweeps  # noqa: E402
 from navlib.errors import InputError  # noqa: E402

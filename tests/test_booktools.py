@@ -58,7 +58,7 @@ def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
 
 # ------------------------------------------------------------------ the presentation checks of check-html
 from navlib.booktools import (MAX_PRE_CHARS, api_markdown, check_page, check_results, compare_results,  # noqa: E402
-                              navlib_modules, status_markdown, validate_results)
+                              navlib_modules, validate_results)
 
 OUT = '<div class="cell_output docutils container">{}</div>'
 PRE = '<div class="output stream highlight-myst-ansi notranslate"><div class="highlight"><pre>{}</pre></div></div>'

@@ -14,8 +14,7 @@ from navlib.errors import InputError
 from navlib.methods import kalman as km
 from navlib.methods.mlp import MLPParams, train_mlp
 from navlib.sensors import ins15
-from navlib.sensors.strapdown import (ImuSpec, InitialError, StarSensorSpec, misalignment, rotvec_to_dcm,
-                                      strapdown)
+from navlib.sensors.strapdown import (ImuSpec, InitialError, StarSensorSpec, misalignment, strapdown)
 from navlib.sensors.trajectory import (EARTH_RATE_RAD_S, FlightProfile, dcm_to_euler, euler_rate_matrix,
                                        euler_to_dcm, generate, gravity, radii)
 from navlib import verdicts
@@ -701,7 +700,7 @@ def test_residual_feature_claim():
 def test_star_sensor_time_offset_is_the_rate_times_the_offset():
     """Closed form, small angle: a star sensor late by tau reports C(t - tau) = C(t) exp(-[w_nb^b tau x]),
     an attitude error of -w tau about the body axes (here the yaw rate of the S-turns, up to a few deg/s)."""
-    from navlib.sensors.strapdown import InitialError, StarSensorSpec, dcm_to_rotvec, strapdown
+    from navlib.sensors.strapdown import StarSensorSpec, dcm_to_rotvec, strapdown
     from navlib.sensors.trajectory import FlightProfile, generate
     tr = generate(FlightProfile(kind="s_turns", duration_s=20.0, imu_rate_hz=100.0, manoeuvre_seed=3))
     tau_ms = 20.0

@@ -12,21 +12,18 @@ import pytest
 from navlib.data.compass_sweeps import split_sweeps
 
 from navlib.sensors.compass import PAPER_A_EARTH, SweepConfig, simulate_train_test
-from navlib.methods.compensator import HeadingTarget
 from navlib.methods.de import DEParams
 from navlib import verdicts
-from navlib.studies.paper_a import (LS_MODELS, RULE_READINGS, fit_family, LEGACY_NAMES, METHODS, READINGS,
+from navlib.studies.paper_a import (LS_MODELS, RULE_READINGS, METHODS, READINGS,
                                     R1 as READINGS_R1, StudyParams, Sweeps,
                                     claims, compensate, fit_method, floor_curve, implied_noise_ut, largest_noise,
-                                    method_id, noise_study, ordering_probability, ordering_rate, ordering_table,
+                                    noise_study, ordering_probability, ordering_rate, ordering_table,
                                     paired_rms_difference, seed_study,
                                     summarize, test_errors as heading_errors, verdict_table)
 from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, glitch_study,
-    node_count_curve, nodes_to_goal_runs, prepare_patent_data, small_sample_study, small_sample_summary)
+    node_count_curve, nodes_to_goal_runs, prepare_patent_data, small_sample_study)
 from navlib.studies.patent_b import claims as patent_b_claims
 from navlib.errors import InputError
-from navlib.angles import wrap_deg
-from navlib.methods.smith import design, eight_position_indices, fit_smith
 from navlib.paths import data_path
 
 

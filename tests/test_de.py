@@ -109,7 +109,6 @@ def test_parent_and_jrand_draws_are_distinct_and_uniform():
 
 def _trials(pop, cr, bound=1e9, f=1.0, seed=0):
     pop = np.ascontiguousarray(pop[None], dtype=float)
-    fit = np.zeros(pop.shape[:2])
     trial = np.empty_like(pop)
     n = pop.shape[1]
     de_trials(pop, xoshiro_states(generators([seed])), np.full((1, n), float(f)), np.full((1, n), float(cr)),

@@ -1,11 +1,8 @@
 """The reference-free loop's breakdown of what remains (issue 34): each factor finds the structure built
 into it, the sentence names the one that holds the most, and the loop's outputs carry it."""
 import json
-import subprocess
-import sys
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from navlib.workbench import free_breakdown as fb

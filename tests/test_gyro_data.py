@@ -1,5 +1,4 @@
 """Transcription checks for paper C's Tables 2-5 and validation of drift tables."""
-import re
 
 import numpy as np
 import pandas as pd

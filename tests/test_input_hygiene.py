@@ -18,7 +18,7 @@ from navlib.data.compass_sweeps import load_sweeps
 from navlib.data.gyro_tables import drift_measurements
 from navlib.data.tables import Column, read_table
 from navlib.data.tumble import TUMBLE_FILE, read_tumble
-from navlib.errors import InputError, UserCodeError
+from navlib.errors import InputError
 from navlib.paths import ROOT, data_path
 from navlib.studies.workbench import REALDATA
 from navlib.workbench import Effect, get_system, load_effects

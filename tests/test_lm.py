@@ -213,7 +213,7 @@ def test_lm_matches_scipy_least_squares_on_a_multi_output_net():
     def jac(th):
         return ff.jacobian(th, xn, 3, 4, 2).reshape(th.shape[0], y.size, -1)
 
-    ours = _against_least_squares(res, jac, start)
+    _against_least_squares(res, jac, start)       # asserts inside
 
 
 def test_train_feedforward_learns_and_stops_on_validation():

@@ -10,7 +10,6 @@ import pytest
 from navlib import cli
 from navlib.errors import InputError
 from navlib.sensors.earth_field import Site, igrf_field
-from navlib.workbench import calibration as C
 from navlib.workbench import magnetometer_free as MF
 
 

@@ -13,7 +13,7 @@ from navlib.studies import workbench as wb
 from navlib.workbench import Effect, load_effects
 from navlib.workbench.diagnose import diagnose
 from navlib.workbench.effects import CATALOGUES
-from navlib.workbench.fit import fit_model, load, simulate
+from navlib.workbench.fit import fit_model, simulate
 from navlib.workbench.loop import loop
 from navlib.workbench.magnetometer import field_summary, load_magnetometer, simulate_magnetometer
 from navlib.workbench.trials import out_of_catalogue_trial

@@ -117,7 +117,7 @@ class CompassErrors:
                 raise InputError(f"parameter {name}={getattr(self, name)!r}: must be three finite numbers")
         s = np.asarray(self.soft_iron, dtype=float)
         if s.shape != (3, 3) or not np.all(np.isfinite(s)):
-            raise InputError(f"parameter soft_iron: must be a 3x3 matrix of finite numbers")
+            raise InputError("parameter soft_iron: must be a 3x3 matrix of finite numbers")
         if np.any(np.abs(np.asarray(self.scale_error)) >= 0.5):
             raise InputError("parameter scale_error: each axis must be within (-0.5, 0.5)")
 

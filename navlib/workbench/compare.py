@@ -33,7 +33,6 @@ split rules and fitting.  The compass's (:data:`COMPASS`) fits paper A's and doc
 """
 from __future__ import annotations
 
-import math
 import os
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
