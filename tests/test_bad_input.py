@@ -165,6 +165,7 @@ def test_negative_noise_parameter():
         replace(CompassErrors(), noise_ut=-0.1)
 
 
+@pytest.mark.slow
 def test_cli_refuses_to_overwrite_and_exits_2(tmp_path):
     out = tmp_path / "s.csv"
     ok = subprocess.run([sys.executable, "-m", "navlib", "simulate-compass", str(out)], capture_output=True,

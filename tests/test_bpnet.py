@@ -54,6 +54,7 @@ def test_output_jacobian_matches_finite_differences():
             np.testing.assert_allclose(jac[:, :, d], fd, atol=1e-7)
 
 
+@pytest.mark.slow
 def test_second_order_and_adam_fit_a_smooth_map():
     """LM reaches the exact map from most starts.  Adam from U(-1, 1) in 3000 epochs learns the trend but
     hardly the two-cycle wiggle (a straight line leaves 1.95 deg RMS; Adam's median is just under it, its

@@ -243,6 +243,7 @@ def test_per_run_innovation_test_is_the_pooled_test_on_each_run_alone():
     assert not any(np.isclose(z, p.table.set_index("candidate").loc["gyro scale factor z", "chi2"]) for p in per)
 
 
+@pytest.mark.slow
 def test_mlp_learns_a_smooth_map():
     rng = np.random.default_rng(0)
     x = rng.uniform(-2, 2, (400, 2))
@@ -285,6 +286,7 @@ def test_bad_component_parameters(make, name):
         make()
 
 
+@pytest.mark.slow
 def test_notebook_stops_at_validation_with_one_line(tmp_path):
     pm = pytest.importorskip("papermill")
     from navlib.paths import NOTEBOOK_DIR
@@ -532,6 +534,7 @@ def test_too_few_runs_cannot_be_judged_with_the_reason():
     assert c["cel_imp45_held"].estimate is None and "needs at least 6" in c["cel_imp45_held"].reason
 
 
+@pytest.mark.slow
 def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run():
     spec = StudySpec(duration_s=30.0, n_train_runs=2, n_test_runs=3, n_repeats=2, epochs=5, n_timings=6,
                      timing_epochs=2, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0),

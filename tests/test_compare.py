@@ -287,6 +287,7 @@ def _same(a: C.CompareResult, b: C.CompareResult):
     assert a.to_dict() == b.to_dict()
 
 
+@pytest.mark.slow
 def test_a_local_cluster_gives_the_numbers_of_one_process(one_process):
     _same(one_process, _fast_compare(workers=2))
     e = one_process.errors["elm"]
@@ -334,5 +335,6 @@ def remote(tmp_path_factory):
                 p.kill()
 
 
+@pytest.mark.slow
 def test_a_scheduler_started_here_gives_the_numbers_of_one_process(one_process, remote):
     _same(one_process, _fast_compare(scheduler=remote))

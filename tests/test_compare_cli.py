@@ -53,6 +53,7 @@ def sim_file(tmp_path_factory):
 
 @pytest.mark.skipif(not BROAD05.exists(), reason=f"BROAD's real level sweeps are not here ({BROAD05}): "
                                                  "python -m navlib.data.broad makes them from BROAD's .mat files")
+@pytest.mark.slow
 def test_broad_trial_05_with_the_default_methods(capsys, tmp_path):
     """The real file: two sweeps, so the sweep split; its gaps (no reading near 135 and 225 deg in sweep 2)
     leave the 8-position LS out of the default list with the reason; every other method runs."""

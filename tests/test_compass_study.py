@@ -483,6 +483,7 @@ def test_patent_b_small_sample_claim_per_trainer():
     assert small_claim(0.3)[1].reproduced is False       # ELM gap 0.25 deg vs Adam's 0.08 deg
 
 
+@pytest.mark.slow
 def test_parallel_studies_give_the_same_numbers(sw):
     """Workers only change where runs execute: seed and noise studies equal with 1 and 2 processes."""
     p = StudyParams(de=DEParams(max_generations=40), lm=replace(StudyParams().lm, epochs=20))

@@ -17,6 +17,7 @@ from navlib.paths import data_path
 
 @pytest.mark.parametrize("system,noises,n", [("compass", (0.05, 0.3), None), ("drift", (1e-4, 4e-4), 16),
                                              ("drift", (2e-4,), 40)])
+@pytest.mark.slow
 def test_hidden_effects_are_named_and_noise_is_noise(system, noises, n):
     study = hidden_effect_study(system, ratios=(3.0, 8.0), noises=noises, seeds=range(6), n=n,
                                 none_seeds=range(60))

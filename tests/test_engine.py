@@ -42,6 +42,7 @@ def _pid(_):
     return os.getpid()
 
 
+@pytest.mark.slow
 def test_local_cluster_gives_the_numbers_of_one_process(reference):
     two = _drift_study(workers=2)
     pd.testing.assert_frame_equal(reference, two)
@@ -53,6 +54,7 @@ def test_local_cluster_gives_the_numbers_of_one_process(reference):
         == [np.sqrt(float(k)) for k in range(30)]
 
 
+@pytest.mark.slow
 def test_patent_b_paper_d_and_paper_e_studies_on_two_workers_equal_one():
     from dataclasses import replace
     from navlib.data.compass_sweeps import split_sweeps
@@ -145,6 +147,7 @@ if __name__ == "__main__":
 """
 
 
+@pytest.mark.slow
 def test_local_workers_start_with_one_blas_thread(tmp_path):
     """The one-thread variables reach a local worker before numpy loads in it: they are in the environment
     its process started with (the nannies' pre-spawn environment), so a caller whose environment sets none
@@ -272,6 +275,7 @@ def remote(tmp_path_factory):
                 p.kill()
 
 
+@pytest.mark.slow
 def test_a_cluster_of_separate_processes_gives_the_same_numbers(reference, remote, monkeypatch):
     pd.testing.assert_frame_equal(_drift_study(scheduler=remote), reference)
     pids = engine.run(_pid, [(k,) for k in range(8)], scheduler=remote)
@@ -285,6 +289,7 @@ def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "navlib", *map(str, args)], capture_output=True, text=True, env=env)
 
 
+@pytest.mark.slow
 def test_cli_rates_same_on_the_cluster_and_here(remote):
     here = run_cli("rates", "drift", "--trials", "2", "--null-trials", "3", "--noise", "1e-4,3e-4", "--workers", "1",
                    "--json")
@@ -356,6 +361,7 @@ def test_paper_d_and_e_draws_have_their_own_seeds():
 
 
 # ------------------------------------------------------------------------------------------ rates
+@pytest.mark.slow
 def test_cli_rates_gives_every_rate_with_its_wilson_interval():
     from navlib import verdicts
     r = run_cli("rates", "compass", "--trials", "1", "--null-trials", "2", "--noise", "0.1", "--workers", "1",
@@ -378,6 +384,7 @@ def test_cli_rates_gives_every_rate_with_its_wilson_interval():
 @pytest.mark.parametrize("args, names", [
     (("--noise", "abc"), "--noise='abc'"), (("--trials", "0"), "trials=0"), (("--ratio", "-1"), "ratio=-1"),
     (("--scheduler", "not an address"), "scheduler"), (("--workers", "0"), "workers=0")])
+@pytest.mark.slow
 def test_cli_rates_bad_input_is_one_line(args, names):
     r = run_cli("rates", "drift", *args)
     assert r.returncode == 2 and names in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
@@ -390,12 +397,14 @@ GYRO = ROOT / "notebooks" / "gyro.ipynb"
 @pytest.mark.parametrize("param, names", [
     ("n_sedes=3", "'n_sedes' is not in the parameters cell"), ("n_seeds=3,x", "n_seeds='x': expected a whole number"),
     ("goal_kind=", "empty value"), ("n_seeds", "NAME=V1,V2"), ("n_seeds=2,2", "value '2' given twice")])
+@pytest.mark.slow
 def test_cli_grid_refuses_bad_parameters_before_any_run(tmp_path, param, names):
     r = run_cli("grid", GYRO, "--param", param, "--out", tmp_path / "out", "--workers", "1")
     assert r.returncode == 2 and names in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_cli_grid_refuses_a_folder_with_files_and_says_papermill_is_missing(tmp_path, capsys, monkeypatch):
     (tmp_path / "old.txt").write_text("mine")
     r = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", tmp_path, "--workers", "1")
@@ -407,6 +416,7 @@ def test_cli_grid_refuses_a_folder_with_files_and_says_papermill_is_missing(tmp_
     assert "grid needs papermill" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_cli_grid_runs_a_chapter_on_the_cluster(remote, tmp_path):
     out = tmp_path / "grid"
     r = run_cli("grid", GYRO, "--param", "input_unit=arcmin,deg", "--param", "n_seeds=2", "--out", out,

@@ -118,6 +118,7 @@ def test_every_checked_column_has_a_finite_limit(tmp_path):
     assert read_table(p, [])["value"].tolist() == ["1", "1e300"]          # not described: not checked
 
 
+@pytest.mark.slow
 def test_ignored_columns_are_really_ignored(tmp_path, compass):
     """NaN, text and bytes that are not UTF-8 in columns no model uses change nothing."""
     data, clean = compass
@@ -378,6 +379,7 @@ def test_every_broken_effects_file_exits_2_naming_file_and_effect(tmp_path, comp
     assert expect in one_line(err), err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["import_error", "exit_at_import", "raises", "nan"])
 def test_broken_effects_exit_2_from_a_real_process(tmp_path, compass, case):
     """Through ``python -m navlib`` (on main: 'internal error' exit 1, or exit 0 with no output)."""
@@ -439,6 +441,7 @@ def test_prints_of_an_effects_file_do_not_spoil_the_json(tmp_path, compass, caps
 
 
 # ----------------------------------------------------------------------------------------------- CLI
+@pytest.mark.slow
 def test_a_closed_pipe_ends_quietly(compass):
     """``loop ... | head -1`` printed "error: : Broken pipe"; the reader here is gone before anything is
     written, so the write fails for certain."""
@@ -453,6 +456,7 @@ def test_a_closed_pipe_ends_quietly(compass):
     assert shell.stderr == "" and shell.stdout.split() == ["step", "model", "rms", "(deg)", "held-out", "rms", "(deg)", "named"]
 
 
+@pytest.mark.slow
 def test_the_report_folder_is_refused_before_the_fit(tmp_path, compass):
     """The report check comes first: it wins over a data file that would only fail later, in the fit."""
     _, path = compass

@@ -28,6 +28,8 @@ from packaging.requirements import Requirement
 from packaging.utils import canonicalize_name
 from packaging.version import Version
 
+pytestmark = pytest.mark.slow     # wheel and venv builds: not in make check
+
 ROOT = Path(__file__).resolve().parent.parent
 SOURCES = ("pyproject.toml", "README.md", "navlib", "data")     # what the wheel is built from
 CORE = {"numpy", "scipy", "pandas", "matplotlib", "numba", "ppigrf", "threadpoolctl"}

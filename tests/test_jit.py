@@ -52,6 +52,7 @@ def test_fast_math_flags_keep_every_operation_exactly_rounded():
     assert "contract" in jit.FASTMATH
 
 
+@pytest.mark.slow
 def test_kernels_compiled_for_avx2_and_for_the_host_give_the_same_bits():
     """DE runs and the fitness compiled for LLVM's 'haswell' (AVX2: 8 floats a vector) equal the
     ones compiled for this machine (16 with AVX-512 where it has them), bit for bit: no result depends on the

@@ -11,6 +11,7 @@ from navlib.studies import paper_d as D
 torch.set_num_threads(1)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hidden", ["tansig", "logsig"])
 def test_mlp_fits_a_smooth_map_and_is_seeded(hidden):
     rng = np.random.default_rng(0)

@@ -44,6 +44,7 @@ def nbval(path):
                           cwd=path.parent, capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow
 def test_nbval_skips_glued_images_and_html_and_tagged_cells_but_compares_glued_text(stored):
     run = nbval(stored)
     assert run.returncode == 0, run.stdout[-2000:]

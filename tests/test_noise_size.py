@@ -78,6 +78,7 @@ def _corrupted(seed: int, deg: float):
     return d
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [2, 3])
 def test_a_reference_corrupted_in_segments_is_not_called_noise(seed):
     """Issue 35: the correlated-noise model once absorbed such an error and the loop ended "consistent with

@@ -31,6 +31,7 @@ def _wait_for(path, proc, timeout_s=120.0):
     ("60", grid.MARKER, None),                                      # interrupted in the first run: no folder
     ("0.1,60", "slow_001.ipynb", [grid.MARKER, "slow_001.ipynb"]),  # after one run: marked incomplete
 ])
+@pytest.mark.slow
 def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, wait_for, left):
     pytest.importorskip("papermill")
     nb = tiny_notebook(tmp_path / "slow.ipynb", parameters="n = 1.0", body=SLOW)

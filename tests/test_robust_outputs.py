@@ -73,6 +73,7 @@ def test_a_second_grid_on_the_same_folder_stops_before_writing(tmp_path, monkeyp
     assert sorted(p.name for p in out.iterdir()) == ["grid.csv", "tiny_001.ipynb", "tiny_002.ipynb"]
 
 
+@pytest.mark.slow
 def test_two_grid_processes_started_together_one_writes(tmp_path):
     """Two real ``navlib grid`` processes on one new folder: one succeeds, the other exits 2 with one line,
     and the folder holds the winner's runs only (grid.csv, notebooks, no marker)."""

@@ -87,6 +87,7 @@ def test_cli_bad_input_exit_2(tmp_path):
     assert r.returncode == 2 and "column 'position_deg', row 4 (file line 5): 7.5 is not on" in r.stderr
 
 
+@pytest.mark.slow
 def test_unit_picks_one_accelerometer_of_a_file_that_holds_several(tmp_path):
     both = A.load_accelerometer(TUMBLE_FILE, unit="B")
     assert set(both["unit"]) == {"B"} and len(both) == int((pd.read_csv(TUMBLE_FILE)["unit"] == "B").sum())

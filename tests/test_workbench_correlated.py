@@ -11,6 +11,8 @@ import pytest
 from navlib import verdicts
 from navlib.workbench.trials import correlated_noise_rates, correlated_noise_study
 
+pytestmark = pytest.mark.slow     # Monte Carlo rates over 100 trials per case: not in make check
+
 TARGET = 0.95
 TRIALS = 100
 

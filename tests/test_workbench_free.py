@@ -58,6 +58,7 @@ def _trials(rho, seeds, nulls):
     return named, quiet
 
 
+@pytest.mark.slow
 def test_each_hidden_effect_named_and_quiet_without_one():
     named, quiet = _trials(0.0, 2, 3)
     assert set(named.hidden) == set(MF.FREE_EFFECTS)
@@ -65,6 +66,7 @@ def test_each_hidden_effect_named_and_quiet_without_one():
     assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
 
 
+@pytest.mark.slow
 def test_hidden_effects_with_ar1_noise_of_correlation_09():
     # a few trials only; the full run is benchmarks/workbench_free_rates.py (rates in its docstring)
     named, quiet = _trials(0.9, 1, 2)
@@ -72,6 +74,7 @@ def test_hidden_effects_with_ar1_noise_of_correlation_09():
     assert quiet.correct.astype(bool).sum() >= len(quiet) - 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [5, 10])
 def test_noise_model_on_the_sensor_axes_not_on_the_invariants(seed):
     """AR(1) noise of 0.9 on the axes, seen through the turning field direction: an AR model of the

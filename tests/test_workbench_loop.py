@@ -50,6 +50,7 @@ def test_structure_amplitudes_are_bounded_by_the_residual(seed):
     assert max(s.amplitude for s in d.structure) <= 3 * d.rms
 
 
+@pytest.mark.slow
 def test_loop_json_schema_and_report(tmp_path):
     p = tmp_path / "c.csv"
     simulate("compass", {"yaw_deg": 1.0, "hard_x": 0.2, "soft_e": 0.04}, noise=0.1, seed=0).to_csv(p, index=False)
@@ -71,6 +72,7 @@ def test_loop_json_schema_and_report(tmp_path):
     assert (tmp_path / "rep" / "loop.md").read_text() == md
 
 
+@pytest.mark.slow
 def test_user_effect_is_named_and_explains_the_structure(tmp_path):
     data = three_cycle()
     without = loop("compass", data, ["misalignment", "hard_iron", "soft_iron"])
@@ -87,6 +89,7 @@ def test_user_effect_is_named_and_explains_the_structure(tmp_path):
     assert json.loads(r.stdout)["steps"][0]["missing"] == "quadrantal"
 
 
+@pytest.mark.slow
 def test_effect_definitions_are_checked(tmp_path):
     with pytest.raises(InputError, match="one unit per parameter"):
         Effect("x", ("a", "b"), ("deg",), "m", system="compass", contribution=lambda p, d: 0)
@@ -108,6 +111,7 @@ def test_diagnose_lets_a_bug_in_an_effect_through():
     assert not isinstance(err.value, InputError) and isinstance(err.value.__cause__, ZeroDivisionError)
 
 
+@pytest.mark.slow
 def test_debug_flag_shows_the_traceback(tmp_path):
     bad = tmp_path / "b.csv"
     bad.write_text("true_heading_deg,measured_heading_deg\n1,x\n")
@@ -117,6 +121,7 @@ def test_debug_flag_shows_the_traceback(tmp_path):
     assert debug.returncode != 0 and "Traceback" in debug.stderr and "InputError" in debug.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["three-cycle error", "four-cycle error", "step between sweeps", "drift in time"])
 def test_errors_outside_the_catalogue_name_nothing_but_are_not_noise(kind):
     rows = [out_of_catalogue_trial(kind, 6.0, 0.1, seed) for seed in range(4)]
@@ -148,6 +153,7 @@ def write(tmp_path, frame, name="m.csv"):
     return p
 
 
+@pytest.mark.slow
 def test_magnetometer_bad_input(tmp_path):
     good = simulate_magnetometer({}, n=60, seed=0)
     assert len(load_magnetometer(write(tmp_path, good))) == 60
@@ -333,6 +339,7 @@ def test_real_data_claims_exact_per_file_and_wilson_over_trials():
 
 
 # ------------------------------------------------------------------------------------ trial seeds (issue 19)
+@pytest.mark.slow
 def test_every_trial_of_a_study_has_its_own_seed():
     from navlib.workbench.trials import hidden_effect_study, out_of_catalogue_study
     st = hidden_effect_study("drift", ratios=(3.0, 10.0), noises=(1e-4, 3e-4), seeds=range(2), n=6,

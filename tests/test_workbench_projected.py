@@ -145,6 +145,7 @@ print(json.dumps({"kib": grown, "lag1": m.lag1, "order": m.order}))
 """
 
 
+@pytest.mark.slow
 def test_whitening_and_the_likelihood_of_50000_observations_stay_linear_in_memory():
     """50,000 observations (25,000 rows of two invariants): colouring, whitening 11 columns and the REML
     estimate together grow the process's peak memory by well under 200 MiB, where one n x n float matrix

@@ -48,6 +48,7 @@ def trial05_clean_loops(trial05):
     return loop("magnetometer", trial05.drop(index=WILD_ROW), []), loop("magnetometer", trial05, [])
 
 
+@pytest.mark.slow
 @REAL
 @pytest.mark.parametrize("value", [300.0, 1e10])
 def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_clean_answer(
@@ -67,6 +68,7 @@ def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_
     assert res.to_dict()["rows_used"] == len(trial05) - 1
 
 
+@pytest.mark.slow
 def test_one_wild_sample_in_a_simulated_recording_is_set_aside():
     data = simulate_hand_turned({"hard_x_ut": 8.0, "soft_xy": 0.02}, duration_s=40, noise_ut=0.3, seed=5)
     clean = loop("magnetometer", data, [])
@@ -84,7 +86,9 @@ def test_compass_sweeps_with_one_reading_off_by_120_deg_reach_the_clean_answer()
     bad = clean.copy()
     bad.loc[50, "measured_heading_deg"] = (bad.loc[50, "measured_heading_deg"] + 120.0) % 360.0
     old = diagnose(fit_model("compass", bad, ["misalignment", "hard_iron", "soft_iron"]), screen=False)
-    assert old.rms > 5.0 and old.consistent_with_noise              # issue 18: 7.65 deg "consistent with noise"
+    # issue 18: 7.65 deg was once "consistent with noise"; since issue 35 the size check (noise_size) says
+    # it is not, even without the screen -- but only the screen finds the reading and the clean answer
+    assert old.rms > 5.0 and not old.consistent_with_noise and old.noise_size.problem
     res, ref = loop("compass", bad, ["misalignment"]), loop("compass", clean, ["misalignment"])
     assert [(o["row"], o["column"]) for o in res.outliers] == [(51, "measured_heading_deg")]
     assert res.outliers[0]["residual"] == pytest.approx(120.0, abs=1.0)
@@ -163,6 +167,7 @@ def _clean_sets():
     return out
 
 
+@pytest.mark.slow
 def test_the_screen_sets_no_row_aside_on_clean_simulated_data():
     """False alarms of the screen: over clean simulated compass sweeps, drift tables and hand-turned
     magnetometer recordings (white and AR(1) 0.9 noise) at most 2 % of the data sets lose a row (the
@@ -173,6 +178,7 @@ def test_the_screen_sets_no_row_aside_on_clean_simulated_data():
 
 
 # ---------------------------------------------------------------------------------------- output
+@pytest.mark.slow
 def test_json_text_and_report_list_the_rows_set_aside(tmp_path):
     bad = load("compass", SWEEPS)
     bad.loc[50, "measured_heading_deg"] = (bad.loc[50, "measured_heading_deg"] + 120.0) % 360.0
@@ -269,6 +275,7 @@ def test_restricted_likelihood_recovers_the_correlation_that_residuals_understat
     assert np.mean(naive) < 0.86 and abs(np.mean(reml) - 0.9) < 0.025, (np.mean(naive), np.mean(reml))
 
 
+@pytest.mark.slow
 def test_the_noise_model_is_reported():
     data = simulate_hand_turned({"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=2)
     res = loop("magnetometer", data, [])
@@ -378,6 +385,7 @@ def test_the_report_counts_rows_not_observations():
     assert c.report().splitlines()[0].endswith(f"rows: {c.n}")
 
 
+@pytest.mark.slow
 def test_the_bootstrap_level_of_correlated_noise_is_reported_and_reproducible():
     """On correlated noise the family is calibrated by the parametric bootstrap: its level is stored, the
     same seed gives the same level, and the text report states it."""
