@@ -9,7 +9,7 @@ only through its ``order`` and ``pos``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dtrtrs
+from scipy.linalg.lapack import dpotrf, dpotri, dpotrs, dtrtrs
 
 
 def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
@@ -27,52 +27,134 @@ def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
     return phi, v
 
 
+def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`levinson` and its derivatives with respect to each partial autocorrelation (forward mode):
+    ``(phi, v, dphi, dv)`` with ``dphi[l, m, j] = d phi[m, j] / d kappa_l`` and ``dv[l, m] = d v[m] / d kappa_l``,
+    from the recursion differentiated::
+
+        d phi[m, m]   = [l = m]
+        d phi[m, 1:m] = d phi[m-1, 1:m] - kappa_m d phi[m-1, m-1:0:-1] - [l = m] phi[m-1, m-1:0:-1]
+        d v[m]        = (1 - kappa_m^2) d v[m-1] - [l = m] 2 kappa_m v[m-1]
+    """
+    kappa = np.asarray(kappa, float)
+    p = len(kappa)
+    phi = np.zeros((p + 1, p + 1))
+    v = np.ones(p + 1)
+    dphi = np.zeros((p, p + 1, p + 1))
+    dv = np.zeros((p, p + 1))
+    for m in range(1, p + 1):
+        km = kappa[m - 1]
+        back = phi[m - 1, m - 1:0:-1]
+        phi[m, m] = km
+        phi[m, 1:m] = phi[m - 1, 1:m] - km * back
+        dphi[:, m, 1:m] = dphi[:, m - 1, 1:m] - km * dphi[:, m - 1, m - 1:0:-1]
+        dphi[m - 1, m, 1:m] -= back
+        dphi[m - 1, m, m] = 1.0
+        v[m] = v[m - 1] * (1.0 - km * km)
+        dv[:, m] = dv[:, m - 1] * (1.0 - km * km)
+        dv[m - 1, m] -= 2.0 * km * v[m - 1]
+    return phi, v, dphi, dv
+
+
 class _Prepared:
     """The parts of :class:`_Restricted` that depend only on the regressors' basis ``Q`` and the series (not
-    on the residual): computed once when many residual vectors share them (a bootstrap)."""
+    on the residual): computed once when many residual vectors share them (a bootstrap).
+
+    The samples fall into ``P + 1`` *groups* by their place in their segment: group ``g < P`` holds the
+    samples ``g`` into their segment, group ``P`` (the bulk) those ``P`` or more in.  At any order
+    ``p <= P`` every sample of a group is whitened with the same coefficients (order ``m_g = min(g, p)``;
+    :class:`_Restricted`) from its own and its ``g`` (bulk: ``P``) previous samples, so the Gram matrix of
+    the whitened columns needs only each group's lagged cross-products
+    ``C_gij = sum_(t in g) z_(t-i) z_(t-j)'`` (``i, j <= min(g, P)``).  Here those of ``Q``, as the sums
+    ``Gq_s = C_gij + C_gji`` (``C_gii`` when ``i = j``) over the unordered pairs ``s = (g, i <= j)``."""
 
     def __init__(self, Q: np.ndarray, series: "Series", max_order: int):
         Zq = np.asarray(Q, float)[series.order]
         self.k, self.P, self.n = Zq.shape[1], int(max_order), len(Zq)
+        P, k = self.P, self.k
         self.pos = series.pos
-        self.bulk = np.flatnonzero(self.pos >= self.P)
-        self.lq = [Zq[self.bulk - i] for i in range(self.P + 1)]
-        self.C = [[self.lq[i].T @ self.lq[j] for j in range(self.P + 1)] for i in range(self.P + 1)]
-        self.early = np.flatnonzero(self.pos < self.P)
-        self.early_pos = self.pos[self.early]
-        self.elags = [Zq[self.early]] + [Zq[np.maximum(self.early - j, 0)] for j in range(1, self.P)]
+        group = np.minimum(self.pos, P)
+        #: samples per group
+        self.count = np.bincount(group, minlength=P + 1)
+        #: each group's lagged samples: ``idx[g][j]`` = the group's samples, j steps back (in their segment)
+        self.idx = [np.flatnonzero(group == g)[None, :] - np.arange(g + 1)[:, None] for g in range(P + 1)]
+        #: the regressors' lags, transposed: ``lag_q[g][j]`` = ``Q[idx[g][j]]'`` (k, n_g)
+        self.lag_q = [np.ascontiguousarray(Zq[ix].transpose(0, 2, 1)) for ix in self.idx]
+        #: ordered pairs ``(g, i, j)`` and unordered ones (``i <= j``), group by group
+        self.pairs = np.array([(g, i, j) for g in range(P + 1) for i in range(g + 1) for j in range(g + 1)])
+        self.sym = self.pairs[self.pairs[:, 1] <= self.pairs[:, 2]]
+        Gq = np.empty((len(self.sym), k, k))
+        for s, (g, i, j) in enumerate(self.sym):
+            c = self.lag_q[g][i] @ self.lag_q[g][j].T
+            Gq[s] = c if i == j else c + c.T
+        #: ``Gq_s`` flattened, (pairs, k * k)
+        self.Gq = Gq.reshape(len(self.sym), k * k)
+
+    def cross(self, Ze: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The residual-dependent cross-products of columns ``Ze`` (n, B; series order): ``Cqr`` (ordered
+        pairs, k, B), ``sum_(t in g) q_(t-i) e_(t-j)``, and ``Crr`` (unordered pairs, B),
+        ``sum_(t in g) e_(t-i) e_(t-j)`` doubled when ``i < j``."""
+        Cqr, Crr = [], []
+        for g, ix in enumerate(self.idx):
+            R = Ze[ix]                                          # (g + 1, n_g, B): the group's lags
+            C = np.einsum("ikn,jnb->ijkb", self.lag_q[g], R, optimize=True)
+            Cqr.append(C.reshape((g + 1) ** 2, self.k, Ze.shape[1]))
+            C = np.einsum("inb,jnb->ijb", R, R, optimize=True)
+            i, j = np.triu_indices(g + 1)
+            Crr.append(np.where((i < j)[:, None], 2.0, 1.0) * C[i, j])
+        return np.concatenate(Cqr), np.concatenate(Crr)
+
+    def weights(self, kappa, gradient: bool = False) -> tuple:
+        """At partial autocorrelations ``kappa`` (order ``p <= P``): the weights of the ordered and unordered
+        pairs, ``A_gi A_gj`` with ``A_g = (1, -phi_(m_g, 1..m_g), 0, ...) / sqrt(v_(m_g))``, ``m_g = min(g, p)``
+        (the whitening of group ``g``), and ``log det R = sum_g n_g log v_(m_g)``.  ``gradient``: also their
+        derivatives with respect to each ``kappa_l`` (rows; :func:`levinson_derivatives`), from
+        ``d A_gi = -d phi_(m_g, i) / sqrt(v_(m_g)) - A_gi d v_(m_g) / (2 v_(m_g))`` and
+        ``d (A_gi A_gj) = d A_gi A_gj + A_gi d A_gj``."""
+        p = len(kappa)
+        if p > self.P:
+            raise ValueError("order above the cache's")
+        phi, v, dphi, dv = levinson_derivatives(kappa) if gradient else levinson(kappa) + (None, None)
+        m = np.minimum(np.arange(self.P + 1), p)
+        scale = 1.0 / np.sqrt(v[m])
+        A = np.zeros((self.P + 1, self.P + 1))
+        A[:, 0] = 1.0
+        A[:, 1:p + 1] = -phi[m, 1:]
+        A *= scale[:, None]
+        (g, i, j), (gs, is_, js) = self.pairs.T, self.sym.T
+        out = (A[g, i] * A[g, j], A[gs, is_] * A[gs, js], float(self.count @ np.log(v[m])))
+        if not gradient:
+            return out
+        rel = dv[:, m] / v[m]                                   # d log v_(m_g) / d kappa_l: (p, P + 1)
+        dA = np.zeros((p, self.P + 1, self.P + 1))
+        dA[:, :, 1:p + 1] = -dphi[:, m, 1:] * scale[None, :, None]
+        dA -= 0.5 * rel[:, :, None] * A[None]
+        dw = dA[:, g, i] * A[g, j] + A[g, i] * dA[:, g, j]
+        dws = dA[:, gs, is_] * A[gs, js] + A[gs, is_] * dA[:, gs, js]
+        return out + (dw, dws, rel @ self.count)
 
 
 class _Restricted:
     """The REML log likelihood (module docstring) of AR partial autocorrelations for a residual ``r`` with
     regressors of orthonormal basis ``Q``, fast: with ``Z = [Q, r]`` the Gram matrix of the whitened
-    columns is ``sum_t w_t w_t'``; for the samples at least ``P = max_order`` into their segment
-    ``w_t = sum_j a_j z_(t-j) / sqrt(v_p)`` (``a_0 = 1``, ``a_j = -phi_pj``), so their part is
-    ``sum_ij a_i a_j C_ij / v_p`` with the lagged cross-products ``C_ij = sum_t z_(t-i) z_(t-j)'`` computed
-    once; the few samples nearer a segment start are whitened directly."""
+    columns is ``M = sum_t w_t w_t'``; a sample of group ``g`` (:class:`_Prepared`) is whitened as
+    ``w_t = sum_j a_j z_(t-j) / sqrt(v_m)`` (order ``m = min(g, p)``, ``a_0 = 1``, ``a_j = -phi_mj``), so::
+
+        M = sum_g sum_ij A_gi A_gj C_gij,   A_gj = a_j / sqrt(v_m),
+        C_gij = sum_(t in g) z_(t-i) z_(t-j)'
+
+    with the lagged cross-products ``C_gij`` computed once; then ``G = M_QQ`` (``X' R^-1 X`` for
+    orthonormal ``X``), ``b = M_Qr``, ``RSS_W = M_rr - b' G^-1 b`` (Cholesky factor of ``G``)."""
 
     def __init__(self, r: np.ndarray, Q: np.ndarray, series: "Series", max_order: int,
                  prepared: "_Prepared | None" = None):
         pre = prepared if prepared is not None and prepared.P >= int(max_order) else \
             _Prepared(Q, series, int(max_order))
+        self.pre = pre
         self.k, self.P, self.n = pre.k, pre.P, pre.n
         ro = np.asarray(r, float)[series.order]
-        rl = [ro[pre.bulk - i] for i in range(self.P + 1)]
-        k = self.k
-        self.C = []
-        for i in range(self.P + 1):
-            row = []
-            for j in range(self.P + 1):
-                c = np.empty((k + 1, k + 1))
-                c[:k, :k] = pre.C[i][j]
-                c[:k, k] = pre.lq[i].T @ rl[j]
-                c[k, :k] = rl[i] @ pre.lq[j]
-                c[k, k] = rl[i] @ rl[j]
-                row.append(c)
-            self.C.append(row)
-        self.early, self.early_pos, self.pos = pre.early, pre.early_pos, pre.pos
-        self.lags = [np.column_stack([pre.elags[0], ro[self.early]])] + \
-            [np.column_stack([pre.elags[j], ro[np.maximum(self.early - j, 0)]]) for j in range(1, self.P)]
+        Cqr, Crr = pre.cross(ro[:, None])
+        self.Cqr, self.Crr = Cqr[:, :, 0], Crr[:, 0]
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -85,34 +167,62 @@ class _Restricted:
         rss, logdet_r, _ = self._parts(kappa)
         return -0.5 * (self.n * np.log(max(rss, 1e-300) / self.n) + logdet_r)
 
+    def value_and_gradient(self, kappa) -> tuple[float, np.ndarray]:
+        """``l_R`` and its gradient with respect to ``kappa``: with ``y = G^-1 b`` and the pair weights'
+        derivatives (:meth:`_Prepared.weights`)::
+
+            d RSS_W = d M_rr - 2 y' d b + y' d G y,   d log det G = tr(G^-1 d G),
+            d l_R   = -1/2 [ (N - k) d RSS_W / RSS_W  +  d log det R  +  d log det G ]
+
+        where ``d G = sum_s dw_s Gq_s`` and likewise ``d b``, ``d M_rr``: each term is a weighted sum of the
+        pairs' contractions ``y' Gq_s y``, ``tr(G^-1 Gq_s)``, ``y' Cqr_o``."""
+        pre, k = self.pre, self.k
+        w, ws, logdet_r, dw, dws, dlogdet_r = pre.weights(kappa, gradient=True)
+        c = float(ws @ self.Crr)
+        drss = dws @ self.Crr
+        if k:
+            G = (ws @ pre.Gq).reshape(k, k)
+            b = w @ self.Cqr
+            L, info = dpotrf(G, lower=1, clean=1)
+            if info == 0:                               # Cholesky: G is positive definite
+                y = dpotrs(L, b, lower=1)[0]
+                Gi = dpotri(L, lower=1)[0]
+                Gi = np.tril(Gi) + np.tril(Gi, -1).T
+                logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
+            else:                                       # numerically singular: the eigenvalues, floored
+                ev, U = np.linalg.eigh(G)
+                ev = np.maximum(ev, 1e-300)
+                Gi = (U / ev) @ U.T
+                y = Gi @ b
+                logdet_g = float(np.sum(np.log(ev)))
+            rss = c - float(b @ y)
+            hq = (pre.Gq.reshape(-1, k, k) @ y) @ y                 # y' Gq_s y
+            drss = drss + dws @ hq - 2.0 * (dw @ (self.Cqr @ y))
+            dlogdet_g = dws @ (pre.Gq @ Gi.ravel())                 # tr(G^-1 Gq_s)
+        else:
+            rss, logdet_g, dlogdet_g = c, 0.0, 0.0
+        if rss <= 1e-300:
+            rss, drss = 1e-300, 0.0 * drss
+        value = -0.5 * ((self.n - self.k) * np.log(rss) + logdet_r + logdet_g)
+        return value, -0.5 * ((self.n - self.k) * drss / rss + dlogdet_r + dlogdet_g)
+
     def _parts(self, kappa) -> tuple[float, float, float]:
         """``(RSS_W, log det R, log det X' R^-1 X)`` at ``kappa``."""
-        p = len(kappa)
-        if p > self.P:
-            raise ValueError("order above the cache's")
-        phi, v = levinson(kappa)
-        a = np.r_[1.0, -phi[p, 1:p + 1]] if p else np.ones(1)
-        M = sum(a[i] * a[j] * self.C[i][j] for i in range(p + 1) for j in range(p + 1)) / v[p]
-        m = np.minimum(self.early_pos, p)
-        w = self.lags[0].copy()
-        for j in range(1, min(p, self.P - 1) + 1):     # samples near a segment start: their own order
-            use = m >= j
-            w[use] -= phi[m[use], j][:, None] * self.lags[j][use]
-        w /= np.sqrt(v[m])[:, None]
-        M = M + w.T @ w
+        w, ws, logdet_r = self.pre.weights(kappa)
         k = self.k
-        logdet_r = float(np.sum(np.log(v[np.minimum(self.pos, p)]))) if p else 0.0
-        if k:
-            try:                                        # Cholesky: G = M[:k, :k] is positive definite
-                L = np.linalg.cholesky(M[:k, :k])
-                z = dtrtrs(L, M[:k, k], lower=1)[0]
-                rss = float(M[k, k] - z @ z)
-                logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-            except np.linalg.LinAlgError:               # numerically singular: the eigenvalues, floored
-                ev, U = np.linalg.eigh(M[:k, :k])
-                ev = np.maximum(ev, 1e-300)
-                rss = float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev))
-                logdet_g = float(np.sum(np.log(ev)))
-        else:
-            rss, logdet_g = float(M[0, 0]), 0.0
+        c = float(ws @ self.Crr)
+        if not k:
+            return c, logdet_r, 0.0
+        G = (ws @ self.pre.Gq).reshape(k, k)
+        b = w @ self.Cqr
+        try:                                            # Cholesky: G is positive definite
+            L = np.linalg.cholesky(G)
+            z = dtrtrs(L, b, lower=1)[0]
+            rss = c - float(z @ z)
+            logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
+        except np.linalg.LinAlgError:                   # numerically singular: the eigenvalues, floored
+            ev, U = np.linalg.eigh(G)
+            ev = np.maximum(ev, 1e-300)
+            rss = c - float(np.sum((U.T @ b) ** 2 / ev))
+            logdet_g = float(np.sum(np.log(ev)))
         return rss, logdet_r, logdet_g

@@ -634,25 +634,16 @@ def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray 
     basis's own blocks (:class:`_Prepared` of order 1), when many calls share the basis."""
     pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
     Ze = np.asarray(E, float)[series.order]
-    bulk, early = pre.bulk, pre.early
-    q0, q1, e0, e1 = pre.lq[0], pre.lq[1], Ze[bulk], Ze[bulk - 1]
-    Cqq = (pre.C[0][0], pre.C[0][1] + pre.C[1][0], pre.C[1][1])
-    Cqe = (q0.T @ e0, q0.T @ e1 + q1.T @ e0, q1.T @ e1)
-    Cee = (np.einsum("ij,ij->j", e0, e0), 2 * np.einsum("ij,ij->j", e0, e1), np.einsum("ij,ij->j", e1, e1))
-    qe, ee = pre.elags[0], Ze[early]
-    Eqq, Eqe, Eee = qe.T @ qe, qe.T @ ee, np.einsum("ij,ij->j", ee, ee)
+    Cqe, Cee = pre.cross(Ze)
     n, k = pre.n, pre.k
     reml = np.empty((len(grid), Ze.shape[1]))
     ml = np.empty_like(reml)
     for g, phi in enumerate(grid):
-        v = 1.0 - phi * phi
-        mee = (Cee[0] - phi * Cee[1] + phi * phi * Cee[2]) / v + Eee
-        logdet_r = len(bulk) * np.log(v)
+        w, ws, logdet_r = pre.weights((phi,))
+        mee = ws @ Cee
         if k:
-            mqq = (Cqq[0] - phi * Cqq[1] + phi * phi * Cqq[2]) / v + Eqq
-            mqe = (Cqe[0] - phi * Cqe[1] + phi * phi * Cqe[2]) / v + Eqe
-            L = np.linalg.cholesky(mqq)
-            z = dtrtrs(L, mqe, lower=1)[0]
+            L = np.linalg.cholesky((ws @ pre.Gq).reshape(k, k))
+            z = dtrtrs(L, np.tensordot(w, Cqe, axes=1), lower=1)[0]
             rss = mee - np.einsum("ij,ij->j", z, z)
             logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
         else:
