@@ -479,6 +479,21 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
     return Q
 
 
+def _objective(loglik) -> tuple:
+    """What :func:`estimate` minimises over ``a = atanh(kappa)`` (L-BFGS-B): ``fun`` and ``jac`` for
+    ``scipy.optimize.minimize``.  With an analytic gradient (:meth:`_Restricted.value_and_gradient`),
+    ``-l_R`` and ``-d l_R / d a = -(1 - kappa^2) d l_R / d kappa`` together (``jac=True``); else ``-l_R``
+    alone (finite differences)."""
+    if not hasattr(loglik, "value_and_gradient"):
+        return lambda a: -loglik(np.tanh(a)), None
+
+    def fun(a):
+        kappa = np.tanh(a)
+        value, grad = loglik.value_and_gradient(kappa)
+        return -value, -grad * (1.0 - kappa * kappa)
+    return fun, True
+
+
 def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
              max_order: int = MAX_ORDER, *, order: int | None = None, interval: bool = True,
              basis: np.ndarray | None = None, prepared: _Prepared | None = None,
@@ -511,7 +526,8 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         # a fixed order from a given start (a bootstrap replicate starts at the data's estimate): that order only
         lim = np.arctanh(KAPPA_MAX)
         x0 = np.arctanh(np.clip(np.asarray(start_at, float)[:order], -KAPPA_MAX, KAPPA_MAX))
-        sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
+        fun, jac = _objective(loglik)
+        sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
                        options={"maxiter": 60})
         best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
         logliks.append(best[1])
@@ -527,8 +543,9 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         else:
             x0 = np.arctanh(np.clip(np.r_[start, 0.0], -KAPPA_MAX, KAPPA_MAX))
             lim = np.arctanh(KAPPA_MAX)
-            sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B",
-                           bounds=[(-lim, lim)] * p, options={"maxiter": 60})
+            fun, jac = _objective(loglik)
+            sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * p,
+                           options={"maxiter": 60})
             kappa, ll = tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun)
             ll0 = loglik(np.r_[start, 0.0])
             if ll0 > ll:                                # never worse than the previous order
