@@ -283,9 +283,13 @@ def _shape_bases(Q: np.ndarray, shapes: list, noise: NoiseModel | None,
     denominator degrees of freedom; shapes the model already spans, or with too few rows left, are
     skipped."""
     white = noise is not None and noise.correlated
+    return _unspanned(Q, [noise.whiten(X0) if white else X0 for X0 in shapes], n)
+
+
+def _unspanned(Q: np.ndarray, shapes: list, n: int) -> list[tuple[int, np.ndarray, int, int]]:
+    """:func:`_shape_bases` of shapes already whitened (or of independent samples)."""
     out = []
-    for i, X0 in enumerate(shapes):
-        X = noise.whiten(X0) if white else X0
+    for i, X in enumerate(shapes):
         X = X / np.maximum(np.linalg.norm(X, axis=0), 1e-300)
         Xp = X - Q @ (Q.T @ X)
         # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns;
@@ -401,7 +405,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     noise = sc.noise
     B = bootstrap_replicates(alpha)
     K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))     # >= 2: B >= 2.5 / alpha - 1
-    family = _Family(fit, fits)
+    family = _Family(fit, fits, noise.series)
     rng = np.random.default_rng(child(seed, _BOOTSTRAP_KEY))
     ser = noise.series
     bases = select_bases(*sc.regressors, ser, fit.n, order=noise.order)   # with the basis-only blocks
@@ -420,13 +424,20 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
 
 class _Family:
     """The tests of one diagnosis, re-run on simulated residual vectors: each candidate's nested GLS F test
-    and each structure shape's, with the noise model each vector's own estimate."""
+    and each structure shape's, with the noise model each vector's own estimate.  The columns every
+    replicate whitens (the model's Jacobian, the candidates', the shapes) are kept side by side in series
+    order (``series``), so each noise model whitens them in one call."""
 
-    def __init__(self, fit: Fit, fits: dict):
+    def __init__(self, fit: Fit, fits: dict, series):
         self.n = fit.n
-        self.J0 = fit.jacobian
         self.cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
+        self.cands = [c for c in self.cands if c[1] > 0 and c[2] > 0]
         self.shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
+        blocks = [np.asarray(fit.jacobian, float).reshape(self.n, -1)] + \
+            [np.asarray(J1, float).reshape(self.n, -1) for J1, _, _ in self.cands] + self.shapes
+        self.edges = np.cumsum([0] + [b.shape[1] for b in blocks])
+        self.order = series.order
+        self.F = np.column_stack(blocks)[self.order]
         self._cache: dict = {}
 
     def minima(self, E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> np.ndarray:
@@ -451,18 +462,21 @@ class _Family:
 
     def _bases(self, nm: NoiseModel) -> tuple:
         """The whitened model's and candidates' orthonormal bases and the shapes' (:func:`_shape_bases`)
-        under the noise model ``nm``; the last few are kept, since replicates share grid correlations."""
+        under the noise model ``nm`` (all columns whitened in one call); the last few are kept, since
+        replicates share grid correlations."""
         key = tuple(nm.kappa)
         if key not in self._cache:
-            Q0 = _projector(nm.whiten(self.J0))
-            Q1s = [(_projector(nm.whiten(J1)), q, df2) for J1, q, df2 in self.cands if q > 0 and df2 > 0]
+            WF = nm.whiten(self.F, ordered=True)
+            blocks = [WF[:, a:b] for a, b in zip(self.edges[:-1], self.edges[1:])]
+            Q0 = _projector(blocks[0])
+            Q1s = [(_projector(W1), q, df2) for W1, (_, q, df2) in zip(blocks[1:], self.cands)]
             if len(self._cache) >= _KEEP_BASES:
                 self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = (Q0, Q1s, _shape_bases(Q0, self.shapes, nm, self.n))
+            self._cache[key] = (Q0, Q1s, _unspanned(Q0, blocks[1 + len(self.cands):], self.n))
         return self._cache[key]
 
     def _min_p(self, E: np.ndarray, nm: NoiseModel) -> np.ndarray:
-        W = nm.whiten(E) if nm.correlated else E
+        W = nm.whiten(E[self.order], ordered=True)
         Q0, Q1s, shape_bases = self._bases(nm)
         e0 = W - Q0 @ (Q0.T @ W)
         rss0 = np.einsum("ij,ij->j", e0, e0)

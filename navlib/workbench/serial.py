@@ -258,12 +258,13 @@ def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) ->
     return e
 
 
-def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
+def whiten(x: np.ndarray, kappa, series: Series, *, ordered: bool = False) -> np.ndarray:
     """``W x`` in series order: each sample minus its best linear prediction from the previous
     ``min(pos, p)`` samples of its segment, divided by the root of that prediction's error variance
-    (relative to the process variance).  ``x``: (N,) or (N, k) in observation order."""
+    (relative to the process variance).  ``x``: (N,) or (N, k) in observation order, or already in series
+    order (``x[series.order]``) with ``ordered`` (columns whitened many times under different models)."""
     x = np.asarray(x, float)
-    xo = x[series.order]
+    xo = x if ordered else x[series.order]
     p = len(kappa)
     if p == 0:
         return xo
@@ -369,9 +370,10 @@ class NoiseModel:
         sees."""
         return self.n_obs / self.inflation
 
-    def whiten(self, x: np.ndarray) -> np.ndarray:
-        """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent."""
-        return whiten(x, self.kappa, self.series) if self.correlated else np.asarray(x, float)
+    def whiten(self, x: np.ndarray, ordered: bool = False) -> np.ndarray:
+        """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent;
+        ``ordered``: ``x`` is already in series order (:func:`whiten`)."""
+        return whiten(x, self.kappa, self.series, ordered=ordered) if self.correlated else np.asarray(x, float)
 
     def to_dict(self) -> dict:
         """The noise model in ``--json``: what ordered the series (``time_s``, ``file order`` or None), AR
