@@ -91,3 +91,15 @@ def test_the_estimate_with_the_analytic_gradient_is_the_maximum():
     best = lik(nm.kappa)
     for e in np.r_[np.eye(3), -np.eye(3)]:
         assert lik(np.add(nm.kappa, 1e-3 * e)) <= best + 1e-6
+
+
+@pytest.mark.parametrize("kappa", [(), (0.7,), (0.8, -0.3), (0.5, 0.2, 0.4)])
+def test_whiten_transpose_is_the_adjoint_of_whitening(kappa):
+    """``whiten_transpose`` is ``W'`` (the matrix of ``whiten`` in series order, columns of the identity), so
+    ``W' W`` is the inverse AR correlation."""
+    ser, n = _series(seed=17, rows=40)
+    N = len(ser.order)
+    W = serial.whiten(np.eye(N), kappa, ser, ordered=True)
+    y = np.random.default_rng(18).standard_normal((N, 2))
+    assert np.allclose(serial.whiten_transpose(y, kappa, ser), W.T @ y)
+    assert np.allclose(serial.whiten_transpose(y[:, 0], kappa, ser), W.T @ y[:, 0])

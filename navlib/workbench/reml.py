@@ -9,7 +9,7 @@ only through its ``order`` and ``pos``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dpotrf, dpotri, dpotrs, dtrtrs
+from scipy.linalg.lapack import dpotrf, dtrtri, dtrtrs
 
 
 def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
@@ -36,23 +36,27 @@ def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
         d phi[m, 1:m] = d phi[m-1, 1:m] - kappa_m d phi[m-1, m-1:0:-1] - [l = m] phi[m-1, m-1:0:-1]
         d v[m]        = (1 - kappa_m^2) d v[m-1] - [l = m] 2 kappa_m v[m-1]
     """
-    kappa = np.asarray(kappa, float)
+    kappa = [float(k) for k in kappa]                   # plain floats: p is a few, numpy calls cost more
     p = len(kappa)
-    phi = np.zeros((p + 1, p + 1))
-    v = np.ones(p + 1)
-    dphi = np.zeros((p, p + 1, p + 1))
-    dv = np.zeros((p, p + 1))
+    phi = [[0.0] * (p + 1) for _ in range(p + 1)]
+    v = [1.0] * (p + 1)
+    dphi = [[[0.0] * (p + 1) for _ in range(p + 1)] for _ in range(p)]
+    dv = [[0.0] * (p + 1) for _ in range(p)]
     for m in range(1, p + 1):
         km = kappa[m - 1]
-        back = phi[m - 1, m - 1:0:-1]
-        phi[m, m] = km
-        phi[m, 1:m] = phi[m - 1, 1:m] - km * back
-        dphi[:, m, 1:m] = dphi[:, m - 1, 1:m] - km * dphi[:, m - 1, m - 1:0:-1]
-        dphi[m - 1, m, 1:m] -= back
-        dphi[m - 1, m, m] = 1.0
-        v[m] = v[m - 1] * (1.0 - km * km)
-        dv[:, m] = dv[:, m - 1] * (1.0 - km * km)
-        dv[m - 1, m] -= 2.0 * km * v[m - 1]
+        for j in range(1, m):
+            phi[m][j] = phi[m - 1][j] - km * phi[m - 1][m - j]
+            for d in dphi:
+                d[m][j] = d[m - 1][j] - km * d[m - 1][m - j]
+            dphi[m - 1][m][j] -= phi[m - 1][m - j]
+        phi[m][m] = km
+        dphi[m - 1][m][m] = 1.0
+        v[m] = v[m - 1] * (1.0 - km ** 2)
+        for d in dv:
+            d[m] = d[m - 1] * (1.0 - km ** 2)
+        dv[m - 1][m] -= 2.0 * km * v[m - 1]
+    dphi, dv = np.array(dphi).reshape(p, p + 1, p + 1), np.array(dv).reshape(p, p + 1)
+    phi, v = np.array(phi), np.array(v)
     return phi, v, dphi, dv
 
 
@@ -83,6 +87,7 @@ class _Prepared:
         #: ordered pairs ``(g, i, j)`` and unordered ones (``i <= j``), group by group
         self.pairs = np.array([(g, i, j) for g in range(P + 1) for i in range(g + 1) for j in range(g + 1)])
         self.sym = self.pairs[self.pairs[:, 1] <= self.pairs[:, 2]]
+        self._flat = [(x[:, 0] * (P + 1) + x[:, 1], x[:, 0] * (P + 1) + x[:, 2]) for x in (self.pairs, self.sym)]
         Gq = np.empty((len(self.sym), k, k))
         for s, (g, i, j) in enumerate(self.sym):
             c = self.lag_q[g][i] @ self.lag_q[g][j].T
@@ -95,13 +100,15 @@ class _Prepared:
         pairs, k, B), ``sum_(t in g) q_(t-i) e_(t-j)``, and ``Crr`` (unordered pairs, B),
         ``sum_(t in g) e_(t-i) e_(t-j)`` doubled when ``i < j``."""
         Cqr, Crr = [], []
+        B, k = Ze.shape[1], self.k
         for g, ix in enumerate(self.idx):
             R = Ze[ix]                                          # (g + 1, n_g, B): the group's lags
-            C = np.einsum("ikn,jnb->ijkb", self.lag_q[g], R, optimize=True)
-            Cqr.append(C.reshape((g + 1) ** 2, self.k, Ze.shape[1]))
-            C = np.einsum("inb,jnb->ijb", R, R, optimize=True)
+            # one product for every (i, j): rows (i, q) of the regressors' lags, columns (j, b) of the residuals'
+            n_g = ix.shape[1]
+            C = self.lag_q[g].reshape((g + 1) * k, n_g) @ R.transpose(1, 0, 2).reshape(n_g, (g + 1) * B)
+            Cqr.append(C.reshape(g + 1, k, g + 1, B).transpose(0, 2, 1, 3).reshape((g + 1) ** 2, k, B))
             i, j = np.triu_indices(g + 1)
-            Crr.append(np.where((i < j)[:, None], 2.0, 1.0) * C[i, j])
+            Crr.append(np.where((i < j)[:, None], 2.0, 1.0) * np.einsum("snb,snb->sb", R[i], R[j]))
         return np.concatenate(Cqr), np.concatenate(Crr)
 
     def weights(self, kappa, gradient: bool = False) -> tuple:
@@ -116,21 +123,23 @@ class _Prepared:
             raise ValueError("order above the cache's")
         phi, v, dphi, dv = levinson_derivatives(kappa) if gradient else levinson(kappa) + (None, None)
         m = np.minimum(np.arange(self.P + 1), p)
-        scale = 1.0 / np.sqrt(v[m])
+        vm = v[m]
+        scale = 1.0 / np.sqrt(vm)
         A = np.zeros((self.P + 1, self.P + 1))
         A[:, 0] = 1.0
         A[:, 1:p + 1] = -phi[m, 1:]
         A *= scale[:, None]
-        (g, i, j), (gs, is_, js) = self.pairs.T, self.sym.T
-        out = (A[g, i] * A[g, j], A[gs, is_] * A[gs, js], float(self.count @ np.log(v[m])))
+        A = A.ravel()                                           # A[g * (P + 1) + i]: the pairs' flat indices
+        (oi, oj), (si, sj) = self._flat
+        out = (A[oi] * A[oj], A[si] * A[sj], float(self.count @ np.log(vm)))
         if not gradient:
             return out
-        rel = dv[:, m] / v[m]                                   # d log v_(m_g) / d kappa_l: (p, P + 1)
+        rel = dv[:, m] / vm                                     # d log v_(m_g) / d kappa_l: (p, P + 1)
         dA = np.zeros((p, self.P + 1, self.P + 1))
         dA[:, :, 1:p + 1] = -dphi[:, m, 1:] * scale[None, :, None]
-        dA -= 0.5 * rel[:, :, None] * A[None]
-        dw = dA[:, g, i] * A[g, j] + A[g, i] * dA[:, g, j]
-        dws = dA[:, gs, is_] * A[gs, js] + A[gs, is_] * dA[:, gs, js]
+        dA = dA.reshape(p, A.size) - 0.5 * np.repeat(rel, self.P + 1, axis=1) * A
+        dw = dA[:, oi] * A[oj] + A[oi] * dA[:, oj]
+        dws = dA[:, si] * A[sj] + A[si] * dA[:, sj]
         return out + (dw, dws, rel @ self.count)
 
 
@@ -147,14 +156,17 @@ class _Restricted:
     orthonormal ``X``), ``b = M_Qr``, ``RSS_W = M_rr - b' G^-1 b`` (Cholesky factor of ``G``)."""
 
     def __init__(self, r: np.ndarray, Q: np.ndarray, series: "Series", max_order: int,
-                 prepared: "_Prepared | None" = None):
-        pre = prepared if prepared is not None and prepared.P >= int(max_order) else \
-            _Prepared(Q, series, int(max_order))
+                 prepared: "_Prepared | None" = None, cross: tuple | None = None):
+        """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (:meth:`_Prepared.cross` of one
+        column), when computed for many residual vectors at once."""
+        usable = prepared is not None and prepared.P >= int(max_order)
+        pre = prepared if usable else _Prepared(Q, series, int(max_order))
         self.pre = pre
         self.k, self.P, self.n = pre.k, pre.P, pre.n
-        ro = np.asarray(r, float)[series.order]
-        Cqr, Crr = pre.cross(ro[:, None])
-        self.Cqr, self.Crr = Cqr[:, :, 0], Crr[:, 0]
+        if cross is None or not usable:
+            Cqr, Crr = pre.cross(np.asarray(r, float)[series.order][:, None])
+            cross = (Cqr[:, :, 0], Crr[:, 0])
+        self.Cqr, self.Crr = cross
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -184,21 +196,21 @@ class _Restricted:
             G = (ws @ pre.Gq).reshape(k, k)
             b = w @ self.Cqr
             L, info = dpotrf(G, lower=1, clean=1)
-            if info == 0:                               # Cholesky: G is positive definite
-                y = dpotrs(L, b, lower=1)[0]
-                Gi = dpotri(L, lower=1)[0]
-                Gi = np.tril(Gi) + np.tril(Gi, -1).T
+            Li, info = dtrtri(L, lower=1) if info == 0 else (None, 1)
+            if info == 0:                               # Cholesky: G = L L' is positive definite
+                Gi = Li.T @ Li
                 logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
             else:                                       # numerically singular: the eigenvalues, floored
                 ev, U = np.linalg.eigh(G)
                 ev = np.maximum(ev, 1e-300)
                 Gi = (U / ev) @ U.T
-                y = Gi @ b
                 logdet_g = float(np.sum(np.log(ev)))
+            y = Gi @ b
             rss = c - float(b @ y)
-            hq = (pre.Gq.reshape(-1, k, k) @ y) @ y                 # y' Gq_s y
+            # y' Gq_s y and tr(G^-1 Gq_s) of every pair in one product
+            hq, hg = (pre.Gq @ np.column_stack([np.outer(y, y).ravel(), Gi.ravel()])).T
             drss = drss + dws @ hq - 2.0 * (dw @ (self.Cqr @ y))
-            dlogdet_g = dws @ (pre.Gq @ Gi.ravel())                 # tr(G^-1 Gq_s)
+            dlogdet_g = dws @ hg
         else:
             rss, logdet_g, dlogdet_g = c, 0.0, 0.0
         if rss <= 1e-300:

@@ -288,6 +288,28 @@ def whiten(x: np.ndarray, kappa, series: Series, *, ordered: bool = False) -> np
     return out
 
 
+def whiten_transpose(y: np.ndarray, kappa, series: Series) -> np.ndarray:
+    """``W' y`` for ``y`` (N,) or (N, k) in series order, in series order: the adjoint of :func:`whiten`, so
+    ``W' W x = R^-1 x`` (``R`` the AR correlation on each segment).  Sample ``t`` of order
+    ``m = min(pos_t, p)`` gives ``y_t / sqrt(v_m)`` to itself and ``-phi_mj y_t / sqrt(v_m)`` to sample
+    ``t - j`` (``j <= m``: within its segment).  Not for a series with a :class:`Projection`."""
+    y = np.asarray(y, float)
+    p = len(kappa)
+    if p == 0:
+        return y.copy()
+    if series.projection is not None:
+        raise ValueError("whiten_transpose: a projected series is whitened by its filter")
+    phi, v = levinson(kappa)
+    m = np.minimum(series.pos, p)
+    scale = 1.0 / np.sqrt(v[m])
+    z = y * (scale[:, None] if y.ndim == 2 else scale)
+    out = z.copy()
+    for j in range(1, p + 1):
+        c = phi[m[j:], j]                                 # 0 where pos_t < j (phi[m, j] = 0 for j > m)
+        out[:-j] -= (c[:, None] if y.ndim == 2 else c) * z[j:]
+    return out
+
+
 def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     """The inverse of :func:`whiten`: from independent unit samples ``u`` (N, or N x B, in *series order*,
     N = ``len(series.order)``) the stationary AR process with partial autocorrelations ``kappa`` and unit
@@ -499,13 +521,15 @@ def _objective(loglik) -> tuple:
 def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
              max_order: int = MAX_ORDER, *, order: int | None = None, interval: bool = True,
              basis: np.ndarray | None = None, prepared: _Prepared | None = None,
-             start_at: tuple | None = None) -> NoiseModel:
+             start_at: tuple | None = None, cross: tuple | None = None) -> NoiseModel:
     """REML estimate of the AR noise model of ``residuals`` given the ``regressors`` a fit took out of
     them (module docstring), the order chosen by AIC over ``0..max_order``, or fixed at ``order``.
     ``interval``: also the profile-likelihood interval of ``kappa_1`` (``bounds``).  No series:
     independent.  ``basis``: :func:`basis_on` of the regressors, if already computed; ``prepared``: its
     residual-free likelihood parts (:class:`_Prepared`), likewise; ``start_at``: with a fixed ``order`` of 2
-    or more, optimise that order only, from these partial autocorrelations."""
+    or more, optimise that order only, from these partial autocorrelations; ``cross``: the residual's
+    cross-products with ``prepared`` (:meth:`_Prepared.cross`), computed for many residual vectors at once
+    (:func:`select_many`)."""
     r = np.asarray(residuals, float)
     if series is None:
         return NoiseModel((), None, len(r))
@@ -519,7 +543,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         max_order = min(max_order, 1)
         loglik = _ProjectedLik(r, Q, series)
     else:
-        loglik = _Restricted(r, Q, series, max(max_order, 1), prepared)
+        loglik = _Restricted(r, Q, series, max(max_order, 1), prepared, cross)
     best = ((), loglik(()))
     logliks = [best[1]]
     aic_best = -2 * best[1] if order is None else np.inf
@@ -584,7 +608,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
 
 def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series | None, *,
            order: int | None = None, interval: bool = True, bases: Bases | None = None,
-           start_at: tuple | None = None) -> NoiseModel:
+           start_at: tuple | None = None, cross: tuple = (None, None)) -> NoiseModel:
     """The noise model around the better of two sets of regressors: ``base`` (the model's Jacobian) or
     ``base`` and ``extra`` (the structure shapes).  Each set gets its REML estimate (:func:`estimate`);
     the set with the lower BIC of the plain likelihood (:func:`criterion`) is used.
@@ -595,18 +619,33 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     0.73-0.98 with the shapes, 0.79-0.94 without); but a structure outside the model, if present and left
     out, is taken for correlated noise and hidden by it.  The likelihood decides which is the case.
     ``around`` in the result says which set was used; ``bases``: :func:`select_bases` of the regressors,
-    if already computed (a bootstrap re-estimates on many residual vectors)."""
+    if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
+    cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
-    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at)
+    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at,
+                  cross=cross[0])
     if extra is None or not np.size(extra) or series is None:
         return replace(mb, around="model")
     me = estimate(residuals, None if qe is not None else np.column_stack([base, extra]), series, order=order,
-                  interval=interval, basis=qe, prepared=pe, start_at=start_at)
+                  interval=interval, basis=qe, prepared=pe, start_at=start_at, cross=cross[1])
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
         return replace(me, around="model and structure shapes")
     n = len(series.order)
     better = criterion(me.ml, me.regressors + me.order, n) < criterion(mb.ml, mb.regressors + mb.order, n)
     return replace(me, around="model and structure shapes") if better else replace(mb, around="model")
+
+
+def select_many(E: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series, bases: Bases, *,
+                order: int, start_at: tuple | None = None) -> list[NoiseModel]:
+    """:func:`select` (no interval) on each column of ``E`` (residual vectors in observation order: a
+    bootstrap's replicates), the columns' cross-products with both regressor sets' likelihood parts
+    (``bases`` of that ``order``: :func:`select_bases`) computed in one product per set."""
+    Ze = np.asarray(E, float)[series.order]
+    parts = [pre.cross(Ze) if pre is not None and pre.P >= max(order, 1) else None
+             for pre in (bases.prepared_base, bases.prepared_extra)]
+    return [select(E[:, b], base, extra, series, order=order, interval=False, bases=bases, start_at=start_at,
+                   cross=tuple(None if c is None else (c[0][:, :, b], c[1][:, b]) for c in parts))
+            for b in range(E.shape[1])]
 
 
 def criterion(ml, parameters: int, n: int):
