@@ -415,16 +415,19 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     rng = np.random.default_rng(child(seed, _BOOTSTRAP_KEY))
     ser = noise.series
     memo = _reestimates(sc, seed, B, fit.n)
-    U = rng.standard_normal((len(ser.order), B))            # every replicate's draw, made once
+    U = None
     minima = np.empty(0)
     # a projected noise model (:class:`navlib.workbench.serial.Projection`) re-estimates every replicate on
     # one grid of filters (each a pass over the series): all replicates in one batch
     batch = B if ser.projection is not None else _BATCH
     for start in range(0, B, batch):
-        E = colour(U[:, start:start + batch], noise.kappa, ser, fit.n)
-        if start not in memo["models"]:
-            memo["models"][start] = _reestimate(E, memo["bases"], noise, sc.regressors)
-        minima = np.r_[minima, family.minima(E, memo["models"][start])]
+        if start not in memo["batches"]:
+            if U is None:
+                U = rng.standard_normal((len(ser.order), B))    # every replicate's draw, made once
+            E = colour(U[:, start:start + batch], noise.kappa, ser, fit.n)
+            memo["batches"][start] = (E, _reestimate(E, memo["bases"], noise, sc.regressors))
+        E, models = memo["batches"][start]
+        minima = np.r_[minima, family.minima(E, models)]
         if np.sum(minima <= p_min) >= K:
             return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", len(minima), True)
     return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", B)
@@ -433,7 +436,8 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
 def _reestimates(sc: Screening, seed: int, B: int, n: int) -> dict:
     """What the bootstrap of :func:`_bootstrap_level` re-estimates on the screen ``sc`` with ``seed``:
     ``bases`` (:func:`navlib.workbench.serial.select_bases` of the screen's regressors, with the basis-only
-    likelihood parts) and ``models``, the replicates' noise models by batch, filled as batches are drawn.
+    likelihood parts) and ``batches``: by the index of its first replicate, each batch's simulated noise and
+    the replicates' noise models (:func:`_reestimate`), filled as batches are drawn.
     The same inputs (the same noise model and regressors, by identity: the diagnoses of one loop) give the
     same memo; it is dropped with the noise model."""
     from .serial import select_bases
@@ -442,7 +446,7 @@ def _reestimates(sc: Screening, seed: int, B: int, n: int) -> dict:
     memo = _REESTIMATES.get(key)
     if memo is None or memo["noise"]() is not noise or memo["regressors"] is not sc.regressors:
         _REESTIMATES.clear()
-        memo = {"noise": weakref.ref(noise), "regressors": sc.regressors, "models": {},
+        memo = {"noise": weakref.ref(noise), "regressors": sc.regressors, "batches": {},
                 "bases": select_bases(*sc.regressors, noise.series, n, order=noise.order)}
         _REESTIMATES[key] = memo
         weakref.finalize(noise, _REESTIMATES.pop, key, None)

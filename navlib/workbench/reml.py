@@ -1,10 +1,14 @@
-"""The restricted (REML) log likelihood of the AR noise model of :mod:`navlib.workbench.serial`, fast, and the
-Durbin-Levinson recursion it shares with the whitening there.
+"""The restricted (REML) log likelihood of the AR noise model of :mod:`navlib.workbench.serial`, fast, with its
+analytic gradient, and the Durbin-Levinson recursion (and its derivatives) it shares with the whitening there.
 
 The likelihood and its notation are those of :mod:`navlib.workbench.serial` (module docstring: the
-estimate): ``l_R(kappa) = -1/2 [(N - k) log RSS_W + log det R + log det (X' R^-1 X)]``.  This module does not
-import :mod:`~navlib.workbench.serial` (which imports it); a :class:`~navlib.workbench.serial.Series` is used
-only through its ``order`` and ``pos``.
+estimate): ``l_R(kappa) = -1/2 [(N - k) log RSS_W + log det R + log det (X' R^-1 X)]``.  Every Gram matrix
+of whitened columns is a weighted sum of lagged cross-products of the columns, computed once
+(:class:`_Prepared`); the weights, and their derivatives, come from the Durbin-Levinson coefficients
+(:meth:`_Prepared.weights`), so an evaluation of ``l_R`` and its gradient costs a few small products
+(:class:`_Restricted`), whatever the length of the series.  This module does not import
+:mod:`~navlib.workbench.serial` (which imports it); a :class:`~navlib.workbench.serial.Series` is used only
+through its ``order`` and ``pos``.
 """
 from __future__ import annotations
 
@@ -70,7 +74,9 @@ class _Prepared:
     :class:`_Restricted`) from its own and its ``g`` (bulk: ``P``) previous samples, so the Gram matrix of
     the whitened columns needs only each group's lagged cross-products
     ``C_gij = sum_(t in g) z_(t-i) z_(t-j)'`` (``i, j <= min(g, P)``).  Here those of ``Q``, as the sums
-    ``Gq_s = C_gij + C_gji`` (``C_gii`` when ``i = j``) over the unordered pairs ``s = (g, i <= j)``."""
+    ``Gq_s = C_gij + C_gji`` (``C_gii`` when ``i = j``) over the unordered pairs ``s = (g, i <= j)``; ``Q``
+    need not be orthonormal for them (the bootstrap's tests use them for any columns:
+    :class:`navlib.workbench.diagnose._Family`)."""
 
     def __init__(self, Q: np.ndarray, series: "Series", max_order: int):
         Zq = np.asarray(Q, float)[series.order]

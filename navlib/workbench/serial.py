@@ -65,7 +65,9 @@ with many smooth regressors look less correlated than the noise was: least-squar
 autocorrelations, and plain ML, are biased towards zero, which would leave the tests too liberal; REML
 removes most of that bias for AR errors in regression (Cheang and Reinsel 2000, JASA 95:1173).  The order
 ``p`` is chosen by AIC (Akaike 1974, IEEE Trans. Autom. Control 19:716), forward: orders 1, 2, ... up to
-``MAX_ORDER`` while each lowers the AIC.
+``MAX_ORDER`` while each lowers the AIC.  The likelihood is evaluated from lagged cross-products of the
+regressors and the residual, computed once, and maximised over ``atanh(kappa)`` by L-BFGS-B with its
+analytic gradient (:mod:`navlib.workbench.reml`).
 """
 from __future__ import annotations
 
