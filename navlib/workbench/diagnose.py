@@ -500,7 +500,8 @@ class _Family:
         X = np.column_stack(blocks)
         self.F = X[series.order]
         self.pre = _Prepared(X, series, max(order, 1)) if self.gram else None
-        self._cache: dict = {}
+        self._cache: dict = {}                         # by noise model: _factors (Gram path)
+        self._whitened: dict = {}                      # and _bases (whitened path)
 
     def minima(self, E: np.ndarray, models: list) -> np.ndarray:
         """The smallest p of the family on each column of ``E`` (residual vectors in observation order), each
@@ -569,15 +570,15 @@ class _Family:
         under the noise model ``nm`` (all columns whitened in one call); the last few are kept, since
         replicates share grid correlations."""
         key = tuple(nm.kappa)
-        if key not in self._cache:
+        if key not in self._whitened:
             WF = nm.whiten(self.F, ordered=True)
             blocks = [WF[:, s] for s in self.spans]
             Q0 = _projector(blocks[0])
             Q1s = [(_projector(W1), q, df2) for W1, (q, df2) in zip(blocks[1:], self.tests)]
-            if len(self._cache) >= _KEEP_BASES:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = (Q0, Q1s, _unspanned(Q0, blocks[1 + len(self.tests):], self.n))
-        return self._cache[key]
+            if len(self._whitened) >= _KEEP_BASES:
+                self._whitened.pop(next(iter(self._whitened)))
+            self._whitened[key] = (Q0, Q1s, _unspanned(Q0, blocks[1 + len(self.tests):], self.n))
+        return self._whitened[key]
 
     def _min_p_whitened(self, Eo: np.ndarray, nm: NoiseModel) -> np.ndarray:
         """:meth:`_min_p` on whitened columns (a projected series): ``Eo`` in series order."""
