@@ -88,15 +88,15 @@ class _Prepared:
         self.count = np.bincount(group, minlength=P + 1)
         #: each group's lagged samples: ``idx[g][j]`` = the group's samples, j steps back (in their segment)
         self.idx = [np.flatnonzero(group == g)[None, :] - np.arange(g + 1)[:, None] for g in range(P + 1)]
-        #: the regressors' lags, transposed: ``lag_q[g][j]`` = ``Q[idx[g][j]]'`` (k, n_g)
-        self.lag_q = [np.ascontiguousarray(Zq[ix].transpose(0, 2, 1)) for ix in self.idx]
+        #: the regressors' lags: ``lag_q[g][j]`` = ``Q[idx[g][j]]`` (n_g, k)
+        self.lag_q = [Zq[ix] for ix in self.idx]
         #: ordered pairs ``(g, i, j)`` and unordered ones (``i <= j``), group by group
         self.pairs = np.array([(g, i, j) for g in range(P + 1) for i in range(g + 1) for j in range(g + 1)])
         self.sym = self.pairs[self.pairs[:, 1] <= self.pairs[:, 2]]
         self._flat = [(x[:, 0] * (P + 1) + x[:, 1], x[:, 0] * (P + 1) + x[:, 2]) for x in (self.pairs, self.sym)]
         Gq = np.empty((len(self.sym), k, k))
         for s, (g, i, j) in enumerate(self.sym):
-            c = self.lag_q[g][i] @ self.lag_q[g][j].T
+            c = self.lag_q[g][i].T @ self.lag_q[g][j]
             Gq[s] = c if i == j else c + c.T
         #: ``Gq_s`` flattened, (pairs, k * k)
         self.Gq = Gq.reshape(len(self.sym), k * k)
@@ -109,9 +109,9 @@ class _Prepared:
         B, k = Ze.shape[1], self.k
         for g, ix in enumerate(self.idx):
             R = Ze[ix]                                          # (g + 1, n_g, B): the group's lags
-            # one product for every (i, j): rows (i, q) of the regressors' lags, columns (j, b) of the residuals'
-            n_g = ix.shape[1]
-            C = self.lag_q[g].reshape((g + 1) * k, n_g) @ R.transpose(1, 0, 2).reshape(n_g, (g + 1) * B)
+            # one product per regressors' lag i for every (j, b): the residuals' lags side by side
+            Rj = R.transpose(1, 0, 2).reshape(ix.shape[1], (g + 1) * B)
+            C = np.stack([lag.T @ Rj for lag in self.lag_q[g]])   # (i, q, (j, b))
             Cqr.append(C.reshape(g + 1, k, g + 1, B).transpose(0, 2, 1, 3).reshape((g + 1) ** 2, k, B))
             i, j = np.triu_indices(g + 1)
             Crr.append(np.where((i < j)[:, None], 2.0, 1.0) * np.einsum("snb,snb->sb", R[i], R[j]))
