@@ -71,3 +71,24 @@ def test_the_diagnoses_of_a_loop_share_the_bootstrap_and_its_numbers():
     again = dg.diagnose(fit.add("hard_iron"), screen=sc)
     assert first.calibration.method == "parametric bootstrap"
     assert second.calibration == again.calibration
+
+
+def test_all_replicates_at_once_equal_one_noise_model_at_a_time(family_case):
+    """``_min_p_many`` (each column whitened with its own coefficients, the Gram blocks factored together)
+    against ``_min_p`` column by column; ``whiten_each`` against ``whiten`` and ``whiten_transpose``."""
+    fit, fits, ser = family_case
+    fam = dg._Family(fit, fits, ser, 3)
+    kappas = [(0.5, 0.3, 0.2), (0.9, -0.4, 0.1), (0.1, 0.0, -0.3), (0.5, 0.3, 0.2)]
+    models = [serial.NoiseModel(k, ser, fit.n) for k in kappas]
+    E = serial.colour(np.random.default_rng(4).standard_normal((len(ser.order), 4)), (0.6, 0.2), ser, fit.n)
+    E[:, 1] += 0.05 * fits["soft_iron"].jacobian[:, -1]
+    Eo = E[ser.order]
+    many = fam._min_p_many(Eo, models)
+    one = [fam._min_p(Eo[:, [b]], nm)[0] for b, nm in enumerate(models)]
+    assert np.allclose(many, one, rtol=1e-8, atol=0)
+    assert np.array_equal(fam.minima(E, models), many)
+    W = serial.whiten_each(Eo, kappas, ser)
+    Wt = serial.whiten_each(Eo, kappas, ser, transpose=True)
+    for b, k in enumerate(kappas):
+        assert np.allclose(W[:, b], serial.whiten(Eo[:, b], k, ser, ordered=True), rtol=1e-13, atol=1e-13)
+        assert np.allclose(Wt[:, b], serial.whiten_transpose(Eo[:, b], k, ser), rtol=1e-13, atol=1e-13)

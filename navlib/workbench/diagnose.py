@@ -507,14 +507,61 @@ class _Family:
         """The smallest p of the family on each column of ``E`` (residual vectors in observation order), each
         under its own noise model (``models``, :func:`_reestimate`); columns with the same model share it."""
         out = np.ones(E.shape[1])
-        groups: dict = {}
-        for b, nm in enumerate(models):
-            groups.setdefault(tuple(nm.kappa) if nm.correlated else (), []).append(b)
         Eo = np.asarray(E, float)[self.series.order]
-        for cols in groups.values():
-            run = self._min_p if self.gram else self._min_p_whitened
-            out[cols] = run(Eo[:, cols], models[cols[0]])
+        orders: dict = {}
+        for b, nm in enumerate(models):
+            orders.setdefault(nm.order if nm.correlated else 0, []).append(b)
+        for cols in orders.values():
+            if self.gram:
+                try:                                   # every column at once, each under its own model
+                    out[cols] = self._min_p_many(Eo[:, cols], [models[b] for b in cols])
+                    continue
+                except np.linalg.LinAlgError:          # a Gram block numerically singular: one model at a time
+                    pass
+            groups: dict = {}
+            for b in cols:
+                groups.setdefault(tuple(models[b].kappa) if models[b].correlated else (), []).append(b)
+            for same in groups.values():
+                run = self._min_p if self.gram else self._min_p_whitened
+                out[same] = run(Eo[:, same], models[same[0]])
         return out
+
+    def _min_p_many(self, Eo: np.ndarray, models: list) -> np.ndarray:
+        """:meth:`_min_p` of every column of ``Eo`` (series order) under its own noise model ``models[b]``
+        (all of one order) at once: each column whitened with its own coefficients
+        (:func:`navlib.workbench.serial.whiten_each`), the Gram matrices ``H`` stacked and factored together
+        (batched LAPACK); raises ``LinAlgError`` when a block is not numerically positive definite."""
+        from .serial import whiten_each
+        kappas = [tuple(nm.kappa) if nm.correlated else () for nm in models]
+        We = whiten_each(Eo, kappas, self.series)
+        c = np.einsum("ij,ij->j", We, We)                                           # e' R^-1 e
+        h = (self.F.T @ whiten_each(We, kappas, self.series, transpose=True)).T     # F' R^-1 e: (B, m)
+        m = self.F.shape[1]
+        H = (np.array([self.pre.weights(k)[1] for k in kappas]) @ self.pre.Gq).reshape(-1, m, m)
+        a0 = self.spans[0]
+        L0, z0 = _cholesky_solve(H[:, a0, a0], h[:, a0])
+        fit0 = np.einsum("bi,bi->b", z0, z0)
+        rss0 = c - fit0
+        best = np.ones(Eo.shape[1])
+        for s, (q, df2) in zip(self.spans[1:], self.tests):
+            z1 = _cholesky_solve(H[:, s, s], h[:, s])[1]
+            fit1 = np.einsum("bi,bi->b", z1, z1)
+            best = np.minimum(best, _f_p(fit1 - fit0, c - fit1, q, df2))
+        k0 = a0.stop - a0.start
+        for s in self.spans[1 + len(self.tests):]:
+            Hss = H[:, s, s]
+            d = np.maximum(np.sqrt(np.maximum(np.diagonal(Hss, axis1=1, axis2=2), 0.0)), 1e-300)     # (B, q)
+            Bm = _lower_solve(L0, H[:, a0, s]) / d[:, None, :]
+            w, V = np.linalg.eigh(Hss / (d[:, :, None] * d[:, None, :]) - Bm.transpose(0, 2, 1) @ Bm)
+            keep = w > SPANNED ** 2
+            y = np.einsum("bsr,bs->br", V, h[:, s] / d - np.einsum("bks,bk->bs", Bm, z0))
+            drop = np.sum(np.where(keep, y * y / np.where(keep, w, 1.0), 0.0), axis=1)
+            q = np.sum(keep, axis=1)
+            df2 = self.n - k0 - q
+            ok = (q > 0) & (df2 >= 3)                  # else the model spans the shape, or too few rows
+            p = _f_p(drop, rss0 - drop, np.maximum(q, 1), np.maximum(df2, 1))
+            best = np.minimum(best, np.where(ok, p, 1.0))
+        return best
 
     def _factors(self, kappa: tuple) -> tuple:
         """Under the AR noise ``kappa``: ``T0`` and each candidate's ``T1`` (inverse factors of the blocks of
@@ -595,6 +642,20 @@ class _Family:
             drop = np.sum((u.T @ e0) ** 2, axis=0)
             best = np.minimum(best, _f_p(drop, rss0 - drop, q, df2))
         return best
+
+
+def _lower_solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``L^-1 b`` for stacked lower-triangular ``L`` (B, k, k) and ``b`` (B, k) or (B, k, r)."""
+    if not L.shape[1]:
+        return np.zeros(b.shape)
+    return np.linalg.solve(L, b[..., None])[..., 0] if b.ndim == 2 else np.linalg.solve(L, b)
+
+
+def _cholesky_solve(G: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For stacked ``G`` (B, k, k) positive definite and ``b`` (B, k): the Cholesky factors ``L`` and
+    ``z = L^-1 b`` (``|z|^2 = b' G^-1 b``); ``LinAlgError`` if a ``G`` is not numerically positive definite."""
+    L = np.linalg.cholesky(G) if G.shape[1] else G
+    return L, _lower_solve(L, b)
 
 
 def _inverse_factor(G: np.ndarray) -> np.ndarray:

@@ -312,6 +312,35 @@ def whiten_transpose(y: np.ndarray, kappa, series: Series) -> np.ndarray:
     return out
 
 
+def whiten_each(x: np.ndarray, kappas: list, series: Series, *, transpose: bool = False) -> np.ndarray:
+    """Each column of ``x`` (N, B; series order) under its own partial autocorrelations ``kappas[b]`` (all
+    of one order, no :class:`Projection`): ``W_b x_b`` (:func:`whiten`), or ``W_b' x_b`` with ``transpose``
+    (:func:`whiten_transpose`); series order out.  Sample ``t`` of order ``m = min(pos_t, p)`` and column ``b``
+    uses ``phi_b[m, j]`` (0 for ``j > m``: within its segment) and ``1 / sqrt(v_b[m])``."""
+    x = np.asarray(x, float)
+    p = len(kappas[0]) if len(kappas) else 0
+    if any(len(k) != p for k in kappas):
+        raise ValueError("whiten_each: the columns' models must have one order")
+    if p == 0:
+        return x.copy()
+    if series.projection is not None:
+        raise ValueError("whiten_each: a projected series is whitened by its filter")
+    lev = [levinson(k) for k in kappas]
+    phi, v = np.stack([f for f, _ in lev]), np.stack([w for _, w in lev])     # (B, p + 1, p + 1), (B, p + 1)
+    m = np.minimum(series.pos, p)
+    scale = 1.0 / np.sqrt(v[:, m].T)                                           # (N, B)
+    if transpose:
+        z = x * scale
+        out = z.copy()
+        for j in range(1, p + 1):
+            out[:-j] -= phi[:, m[j:], j].T * z[j:]
+        return out
+    out = x.copy()
+    for j in range(1, p + 1):
+        out[j:] -= phi[:, m[j:], j].T * x[:-j]
+    return out * scale
+
+
 def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     """The inverse of :func:`whiten`: from independent unit samples ``u`` (N, or N x B, in *series order*,
     N = ``len(series.order)``) the stationary AR process with partial autocorrelations ``kappa`` and unit
