@@ -65,7 +65,9 @@ with many smooth regressors look less correlated than the noise was: least-squar
 autocorrelations, and plain ML, are biased towards zero, which would leave the tests too liberal; REML
 removes most of that bias for AR errors in regression (Cheang and Reinsel 2000, JASA 95:1173).  The order
 ``p`` is chosen by AIC (Akaike 1974, IEEE Trans. Autom. Control 19:716), forward: orders 1, 2, ... up to
-``MAX_ORDER`` while each lowers the AIC.
+``MAX_ORDER`` while each lowers the AIC.  The likelihood is evaluated from lagged cross-products of the
+regressors and the residual, computed once, and maximised over ``atanh(kappa)`` by L-BFGS-B with its
+analytic gradient (:mod:`navlib.workbench.reml`).
 """
 from __future__ import annotations
 
@@ -79,6 +81,7 @@ from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
+from .reml import _Prepared, _Restricted, levinson  # noqa: F401  (re-exported: serial's names)
 
 #: A time step more than this many times the median step starts a new segment.
 GAP_FACTOR = 2.5
@@ -257,27 +260,13 @@ def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) ->
     return e
 
 
-def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
-    """Durbin-Levinson: from partial autocorrelations ``kappa`` (length p) the AR coefficients of every
-    order, ``phi[m, 1..m]`` (row m = order m), and the prediction-error variances ``v[m]`` relative to the
-    process variance, ``v[m] = prod_{j<=m} (1 - kappa_j^2)``."""
-    kappa = np.asarray(kappa, float)
-    p = len(kappa)
-    phi = np.zeros((p + 1, p + 1))
-    v = np.ones(p + 1)
-    for m in range(1, p + 1):
-        phi[m, m] = kappa[m - 1]
-        phi[m, 1:m] = phi[m - 1, 1:m] - kappa[m - 1] * phi[m - 1, m - 1:0:-1]
-        v[m] = v[m - 1] * (1.0 - kappa[m - 1] ** 2)
-    return phi, v
-
-
-def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
+def whiten(x: np.ndarray, kappa, series: Series, *, ordered: bool = False) -> np.ndarray:
     """``W x`` in series order: each sample minus its best linear prediction from the previous
     ``min(pos, p)`` samples of its segment, divided by the root of that prediction's error variance
-    (relative to the process variance).  ``x``: (N,) or (N, k) in observation order."""
+    (relative to the process variance).  ``x``: (N,) or (N, k) in observation order, or already in series
+    order (``x[series.order]``) with ``ordered`` (columns whitened many times under different models)."""
     x = np.asarray(x, float)
-    xo = x[series.order]
+    xo = x if ordered else x[series.order]
     p = len(kappa)
     if p == 0:
         return xo
@@ -299,6 +288,57 @@ def whiten(x: np.ndarray, kappa, series: Series) -> np.ndarray:
     scale = 1.0 / np.sqrt(v[order])
     out[early] = acc * (scale[:, None] if xo.ndim == 2 else scale)
     return out
+
+
+def whiten_transpose(y: np.ndarray, kappa, series: Series) -> np.ndarray:
+    """``W' y`` for ``y`` (N,) or (N, k) in series order, in series order: the adjoint of :func:`whiten`, so
+    ``W' W x = R^-1 x`` (``R`` the AR correlation on each segment).  Sample ``t`` of order
+    ``m = min(pos_t, p)`` gives ``y_t / sqrt(v_m)`` to itself and ``-phi_mj y_t / sqrt(v_m)`` to sample
+    ``t - j`` (``j <= m``: within its segment).  Not for a series with a :class:`Projection`."""
+    y = np.asarray(y, float)
+    p = len(kappa)
+    if p == 0:
+        return y.copy()
+    if series.projection is not None:
+        raise ValueError("whiten_transpose: a projected series is whitened by its filter")
+    phi, v = levinson(kappa)
+    m = np.minimum(series.pos, p)
+    scale = 1.0 / np.sqrt(v[m])
+    z = y * (scale[:, None] if y.ndim == 2 else scale)
+    out = z.copy()
+    for j in range(1, p + 1):
+        c = phi[m[j:], j]                                 # 0 where pos_t < j (phi[m, j] = 0 for j > m)
+        out[:-j] -= (c[:, None] if y.ndim == 2 else c) * z[j:]
+    return out
+
+
+def whiten_each(x: np.ndarray, kappas: list, series: Series, *, transpose: bool = False) -> np.ndarray:
+    """Each column of ``x`` (N, B; series order) under its own partial autocorrelations ``kappas[b]`` (all
+    of one order, no :class:`Projection`): ``W_b x_b`` (:func:`whiten`), or ``W_b' x_b`` with ``transpose``
+    (:func:`whiten_transpose`); series order out.  Sample ``t`` of order ``m = min(pos_t, p)`` and column ``b``
+    uses ``phi_b[m, j]`` (0 for ``j > m``: within its segment) and ``1 / sqrt(v_b[m])``."""
+    x = np.asarray(x, float)
+    p = len(kappas[0]) if len(kappas) else 0
+    if any(len(k) != p for k in kappas):
+        raise ValueError("whiten_each: the columns' models must have one order")
+    if p == 0:
+        return x.copy()
+    if series.projection is not None:
+        raise ValueError("whiten_each: a projected series is whitened by its filter")
+    lev = [levinson(k) for k in kappas]
+    phi, v = np.stack([f for f, _ in lev]), np.stack([w for _, w in lev])     # (B, p + 1, p + 1), (B, p + 1)
+    m = np.minimum(series.pos, p)
+    scale = 1.0 / np.sqrt(v[:, m].T)                                           # (N, B)
+    if transpose:
+        z = x * scale
+        out = z.copy()
+        for j in range(1, p + 1):
+            out[:-j] -= phi[:, m[j:], j].T * z[j:]
+        return out
+    out = x.copy()
+    for j in range(1, p + 1):
+        out[j:] -= phi[:, m[j:], j].T * x[:-j]
+    return out * scale
 
 
 def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
@@ -383,9 +423,10 @@ class NoiseModel:
         sees."""
         return self.n_obs / self.inflation
 
-    def whiten(self, x: np.ndarray) -> np.ndarray:
-        """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent."""
-        return whiten(x, self.kappa, self.series) if self.correlated else np.asarray(x, float)
+    def whiten(self, x: np.ndarray, ordered: bool = False) -> np.ndarray:
+        """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent;
+        ``ordered``: ``x`` is already in series order (:func:`whiten`)."""
+        return whiten(x, self.kappa, self.series, ordered=ordered) if self.correlated else np.asarray(x, float)
 
     def to_dict(self) -> dict:
         """The noise model in ``--json``: what ordered the series (``time_s``, ``file order`` or None), AR
@@ -412,97 +453,6 @@ class NoiseModel:
         return (f"serially correlated, AR({self.order}){seen} with lag-1 correlation {self.lag1:.2f} "
                 f"(interval {self.bounds[0]:.2f}..{self.bounds[1]:.2f}; series in {self.series.source}): tests "
                 f"on whitened residuals, {slow}")
-
-
-class _Prepared:
-    """The parts of :class:`_Restricted` that depend only on the regressors' basis ``Q`` and the series (not
-    on the residual): computed once when many residual vectors share them (a bootstrap)."""
-
-    def __init__(self, Q: np.ndarray, series: Series, max_order: int):
-        Zq = np.asarray(Q, float)[series.order]
-        self.k, self.P, self.n = Zq.shape[1], int(max_order), len(Zq)
-        self.pos = series.pos
-        self.bulk = np.flatnonzero(self.pos >= self.P)
-        self.lq = [Zq[self.bulk - i] for i in range(self.P + 1)]
-        self.C = [[self.lq[i].T @ self.lq[j] for j in range(self.P + 1)] for i in range(self.P + 1)]
-        self.early = np.flatnonzero(self.pos < self.P)
-        self.early_pos = self.pos[self.early]
-        self.elags = [Zq[self.early]] + [Zq[np.maximum(self.early - j, 0)] for j in range(1, self.P)]
-
-
-class _Restricted:
-    """The REML log likelihood (module docstring) of AR partial autocorrelations for a residual ``r`` with
-    regressors of orthonormal basis ``Q``, fast: with ``Z = [Q, r]`` the Gram matrix of the whitened
-    columns is ``sum_t w_t w_t'``; for the samples at least ``P = max_order`` into their segment
-    ``w_t = sum_j a_j z_(t-j) / sqrt(v_p)`` (``a_0 = 1``, ``a_j = -phi_pj``), so their part is
-    ``sum_ij a_i a_j C_ij / v_p`` with the lagged cross-products ``C_ij = sum_t z_(t-i) z_(t-j)'`` computed
-    once; the few samples nearer a segment start are whitened directly."""
-
-    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int,
-                 prepared: "_Prepared | None" = None):
-        pre = prepared if prepared is not None and prepared.P >= int(max_order) else \
-            _Prepared(Q, series, int(max_order))
-        self.k, self.P, self.n = pre.k, pre.P, pre.n
-        ro = np.asarray(r, float)[series.order]
-        rl = [ro[pre.bulk - i] for i in range(self.P + 1)]
-        k = self.k
-        self.C = []
-        for i in range(self.P + 1):
-            row = []
-            for j in range(self.P + 1):
-                c = np.empty((k + 1, k + 1))
-                c[:k, :k] = pre.C[i][j]
-                c[:k, k] = pre.lq[i].T @ rl[j]
-                c[k, :k] = rl[i] @ pre.lq[j]
-                c[k, k] = rl[i] @ rl[j]
-                row.append(c)
-            self.C.append(row)
-        self.early, self.early_pos, self.pos = pre.early, pre.early_pos, pre.pos
-        self.lags = [np.column_stack([pre.elags[0], ro[self.early]])] + \
-            [np.column_stack([pre.elags[j], ro[np.maximum(self.early - j, 0)]]) for j in range(1, self.P)]
-
-    def __call__(self, kappa) -> float:
-        rss, logdet_r, logdet_g = self._parts(kappa)
-        return -0.5 * ((self.n - self.k) * np.log(max(rss, 1e-300)) + logdet_r + logdet_g)
-
-    def ml(self, kappa) -> float:
-        """The plain (not restricted) log likelihood, the noise variance profiled out and constants common
-        to every model of these data dropped: ``-1/2 [N log(RSS_W / N) + log det R]`` -- comparable between
-        regressor sets, which the restricted one is not."""
-        rss, logdet_r, _ = self._parts(kappa)
-        return -0.5 * (self.n * np.log(max(rss, 1e-300) / self.n) + logdet_r)
-
-    def _parts(self, kappa) -> tuple[float, float, float]:
-        """``(RSS_W, log det R, log det X' R^-1 X)`` at ``kappa``."""
-        p = len(kappa)
-        if p > self.P:
-            raise ValueError("order above the cache's")
-        phi, v = levinson(kappa)
-        a = np.r_[1.0, -phi[p, 1:p + 1]] if p else np.ones(1)
-        M = sum(a[i] * a[j] * self.C[i][j] for i in range(p + 1) for j in range(p + 1)) / v[p]
-        m = np.minimum(self.early_pos, p)
-        w = self.lags[0].copy()
-        for j in range(1, min(p, self.P - 1) + 1):     # samples near a segment start: their own order
-            use = m >= j
-            w[use] -= phi[m[use], j][:, None] * self.lags[j][use]
-        w /= np.sqrt(v[m])[:, None]
-        M = M + w.T @ w
-        k = self.k
-        logdet_r = float(np.sum(np.log(v[np.minimum(self.pos, p)]))) if p else 0.0
-        if k:
-            try:                                        # Cholesky: G = M[:k, :k] is positive definite
-                L = np.linalg.cholesky(M[:k, :k])
-                z = dtrtrs(L, M[:k, k], lower=1)[0]
-                rss = float(M[k, k] - z @ z)
-                logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-            except np.linalg.LinAlgError:               # numerically singular: the eigenvalues, floored
-                ev, U = np.linalg.eigh(M[:k, :k])
-                ev = np.maximum(ev, 1e-300)
-                rss = float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev))
-                logdet_g = float(np.sum(np.log(ev)))
-        else:
-            rss, logdet_g = float(M[0, 0]), 0.0
-        return rss, logdet_r, logdet_g
 
 
 class _ProjectedLik:
@@ -584,16 +534,33 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
     return Q
 
 
+def _objective(loglik) -> tuple:
+    """What :func:`estimate` minimises over ``a = atanh(kappa)`` (L-BFGS-B): ``fun`` and ``jac`` for
+    ``scipy.optimize.minimize``.  With an analytic gradient (:meth:`_Restricted.value_and_gradient`),
+    ``-l_R`` and ``-d l_R / d a = -(1 - kappa^2) d l_R / d kappa`` together (``jac=True``); else ``-l_R``
+    alone (finite differences)."""
+    if not hasattr(loglik, "value_and_gradient"):
+        return lambda a: -loglik(np.tanh(a)), None
+
+    def fun(a):
+        kappa = np.tanh(a)
+        value, grad = loglik.value_and_gradient(kappa)
+        return -value, -grad * (1.0 - kappa * kappa)
+    return fun, True
+
+
 def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
              max_order: int = MAX_ORDER, *, order: int | None = None, interval: bool = True,
              basis: np.ndarray | None = None, prepared: _Prepared | None = None,
-             start_at: tuple | None = None) -> NoiseModel:
+             start_at: tuple | None = None, cross: tuple | None = None) -> NoiseModel:
     """REML estimate of the AR noise model of ``residuals`` given the ``regressors`` a fit took out of
     them (module docstring), the order chosen by AIC over ``0..max_order``, or fixed at ``order``.
     ``interval``: also the profile-likelihood interval of ``kappa_1`` (``bounds``).  No series:
     independent.  ``basis``: :func:`basis_on` of the regressors, if already computed; ``prepared``: its
     residual-free likelihood parts (:class:`_Prepared`), likewise; ``start_at``: with a fixed ``order`` of 2
-    or more, optimise that order only, from these partial autocorrelations."""
+    or more, optimise that order only, from these partial autocorrelations; ``cross``: the residual's
+    cross-products with ``prepared`` (:meth:`_Prepared.cross`), computed for many residual vectors at once
+    (:func:`select_many`)."""
     r = np.asarray(residuals, float)
     if series is None:
         return NoiseModel((), None, len(r))
@@ -607,7 +574,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         max_order = min(max_order, 1)
         loglik = _ProjectedLik(r, Q, series)
     else:
-        loglik = _Restricted(r, Q, series, max(max_order, 1), prepared)
+        loglik = _Restricted(r, Q, series, max(max_order, 1), prepared, cross)
     best = ((), loglik(()))
     logliks = [best[1]]
     aic_best = -2 * best[1] if order is None else np.inf
@@ -616,7 +583,8 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         # a fixed order from a given start (a bootstrap replicate starts at the data's estimate): that order only
         lim = np.arctanh(KAPPA_MAX)
         x0 = np.arctanh(np.clip(np.asarray(start_at, float)[:order], -KAPPA_MAX, KAPPA_MAX))
-        sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
+        fun, jac = _objective(loglik)
+        sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
                        options={"maxiter": 60})
         best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
         logliks.append(best[1])
@@ -632,8 +600,9 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         else:
             x0 = np.arctanh(np.clip(np.r_[start, 0.0], -KAPPA_MAX, KAPPA_MAX))
             lim = np.arctanh(KAPPA_MAX)
-            sol = minimize(lambda a: -loglik(np.tanh(a)), x0, method="L-BFGS-B",
-                           bounds=[(-lim, lim)] * p, options={"maxiter": 60})
+            fun, jac = _objective(loglik)
+            sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * p,
+                           options={"maxiter": 60})
             kappa, ll = tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun)
             ll0 = loglik(np.r_[start, 0.0])
             if ll0 > ll:                                # never worse than the previous order
@@ -670,7 +639,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
 
 def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series | None, *,
            order: int | None = None, interval: bool = True, bases: Bases | None = None,
-           start_at: tuple | None = None) -> NoiseModel:
+           start_at: tuple | None = None, cross: tuple = (None, None)) -> NoiseModel:
     """The noise model around the better of two sets of regressors: ``base`` (the model's Jacobian) or
     ``base`` and ``extra`` (the structure shapes).  Each set gets its REML estimate (:func:`estimate`);
     the set with the lower BIC of the plain likelihood (:func:`criterion`) is used.
@@ -681,18 +650,33 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     0.73-0.98 with the shapes, 0.79-0.94 without); but a structure outside the model, if present and left
     out, is taken for correlated noise and hidden by it.  The likelihood decides which is the case.
     ``around`` in the result says which set was used; ``bases``: :func:`select_bases` of the regressors,
-    if already computed (a bootstrap re-estimates on many residual vectors)."""
+    if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
+    cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
-    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at)
+    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at,
+                  cross=cross[0])
     if extra is None or not np.size(extra) or series is None:
         return replace(mb, around="model")
     me = estimate(residuals, None if qe is not None else np.column_stack([base, extra]), series, order=order,
-                  interval=interval, basis=qe, prepared=pe, start_at=start_at)
+                  interval=interval, basis=qe, prepared=pe, start_at=start_at, cross=cross[1])
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
         return replace(me, around="model and structure shapes")
     n = len(series.order)
     better = criterion(me.ml, me.regressors + me.order, n) < criterion(mb.ml, mb.regressors + mb.order, n)
     return replace(me, around="model and structure shapes") if better else replace(mb, around="model")
+
+
+def select_many(E: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series, bases: Bases, *,
+                order: int, start_at: tuple | None = None) -> list[NoiseModel]:
+    """:func:`select` (no interval) on each column of ``E`` (residual vectors in observation order: a
+    bootstrap's replicates), the columns' cross-products with both regressor sets' likelihood parts
+    (``bases`` of that ``order``: :func:`select_bases`) computed in one product per set."""
+    Ze = np.asarray(E, float)[series.order]
+    parts = [pre.cross(Ze) if pre is not None and pre.P >= max(order, 1) else None
+             for pre in (bases.prepared_base, bases.prepared_extra)]
+    return [select(E[:, b], base, extra, series, order=order, interval=False, bases=bases, start_at=start_at,
+                   cross=tuple(None if c is None else (c[0][:, :, b], c[1][:, b]) for c in parts))
+            for b in range(E.shape[1])]
 
 
 def criterion(ml, parameters: int, n: int):
@@ -739,25 +723,16 @@ def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray 
     basis's own blocks (:class:`_Prepared` of order 1), when many calls share the basis."""
     pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
     Ze = np.asarray(E, float)[series.order]
-    bulk, early = pre.bulk, pre.early
-    q0, q1, e0, e1 = pre.lq[0], pre.lq[1], Ze[bulk], Ze[bulk - 1]
-    Cqq = (pre.C[0][0], pre.C[0][1] + pre.C[1][0], pre.C[1][1])
-    Cqe = (q0.T @ e0, q0.T @ e1 + q1.T @ e0, q1.T @ e1)
-    Cee = (np.einsum("ij,ij->j", e0, e0), 2 * np.einsum("ij,ij->j", e0, e1), np.einsum("ij,ij->j", e1, e1))
-    qe, ee = pre.elags[0], Ze[early]
-    Eqq, Eqe, Eee = qe.T @ qe, qe.T @ ee, np.einsum("ij,ij->j", ee, ee)
+    Cqe, Cee = pre.cross(Ze)
     n, k = pre.n, pre.k
     reml = np.empty((len(grid), Ze.shape[1]))
     ml = np.empty_like(reml)
     for g, phi in enumerate(grid):
-        v = 1.0 - phi * phi
-        mee = (Cee[0] - phi * Cee[1] + phi * phi * Cee[2]) / v + Eee
-        logdet_r = len(bulk) * np.log(v)
+        w, ws, logdet_r = pre.weights((phi,))
+        mee = ws @ Cee
         if k:
-            mqq = (Cqq[0] - phi * Cqq[1] + phi * phi * Cqq[2]) / v + Eqq
-            mqe = (Cqe[0] - phi * Cqe[1] + phi * phi * Cqe[2]) / v + Eqe
-            L = np.linalg.cholesky(mqq)
-            z = dtrtrs(L, mqe, lower=1)[0]
+            L = np.linalg.cholesky((ws @ pre.Gq).reshape(k, k))
+            z = dtrtrs(L, np.tensordot(w, Cqe, axes=1), lower=1)[0]
             rss = mee - np.einsum("ij,ij->j", z, z)
             logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
         else:
