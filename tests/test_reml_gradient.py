@@ -27,11 +27,11 @@ def test_levinson_derivatives_are_those_of_the_recursion(kappa):
     phi, v, dphi, dv = reml.levinson_derivatives(kappa)
     assert np.array_equal(phi, reml.levinson(kappa)[0]) and np.array_equal(v, reml.levinson(kappa)[1])
     h = 1e-6
-    for l in range(len(kappa)):
-        up, down = reml.levinson(np.add(kappa, h * np.eye(len(kappa))[l])), \
-            reml.levinson(np.subtract(kappa, h * np.eye(len(kappa))[l]))
-        assert np.allclose(dphi[l], (up[0] - down[0]) / (2 * h), atol=1e-8)
-        assert np.allclose(dv[l], (up[1] - down[1]) / (2 * h), atol=1e-8)
+    for j in range(len(kappa)):
+        up, down = reml.levinson(np.add(kappa, h * np.eye(len(kappa))[j])), \
+            reml.levinson(np.subtract(kappa, h * np.eye(len(kappa))[j]))
+        assert np.allclose(dphi[j], (up[0] - down[0]) / (2 * h), atol=1e-8)
+        assert np.allclose(dv[j], (up[1] - down[1]) / (2 * h), atol=1e-8)
 
 
 @pytest.mark.parametrize("k", [0, 1, 7])

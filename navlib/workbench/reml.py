@@ -12,8 +12,13 @@ through its ``order`` and ``pos``.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.linalg.lapack import dpotrf, dtrtri, dtrtrs
+
+if TYPE_CHECKING:                       # annotations only: serial imports this module
+    from .serial import Series
 
 
 def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
@@ -78,7 +83,7 @@ class _Prepared:
     need not be orthonormal for them (the bootstrap's tests use them for any columns:
     :class:`navlib.workbench.diagnose._Family`)."""
 
-    def __init__(self, Q: np.ndarray, series: "Series", max_order: int):
+    def __init__(self, Q: np.ndarray, series: Series, max_order: int):
         Zq = np.asarray(Q, float)[series.order]
         self.k, self.P, self.n = Zq.shape[1], int(max_order), len(Zq)
         P, k = self.P, self.k
@@ -161,7 +166,7 @@ class _Restricted:
     with the lagged cross-products ``C_gij`` computed once; then ``G = M_QQ`` (``X' R^-1 X`` for
     orthonormal ``X``), ``b = M_Qr``, ``RSS_W = M_rr - b' G^-1 b`` (Cholesky factor of ``G``)."""
 
-    def __init__(self, r: np.ndarray, Q: np.ndarray, series: "Series", max_order: int,
+    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int,
                  prepared: "_Prepared | None" = None, cross: tuple | None = None):
         """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (:meth:`_Prepared.cross` of one
         column), when computed for many residual vectors at once."""
