@@ -7,10 +7,6 @@ from __future__ import annotations
 import csv
 import inspect
 import json
-import os
-import subprocess
-import sys
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -18,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navlib import engine, names, verdicts
+from navlib import names, verdicts
 from navlib.angles import wrap_deg
 from navlib.data.compass_sweeps import load_sweeps
 from navlib.errors import InputError
@@ -294,45 +290,6 @@ def test_a_local_cluster_gives_the_numbers_of_one_process(one_process):
     assert e.shape == (5, 242) and len({row.tobytes() for row in e}) == 5     # every seed its own run
 
 
-@pytest.fixture(scope="module")
-def remote(tmp_path_factory):
-    """A scheduler and 2 single-threaded workers started here on 127.0.0.1 as separate processes; stopped
-    after the module."""
-    folder = tmp_path_factory.mktemp("cluster")
-    sched_file = folder / "scheduler.json"
-    path = [str(ROOT), os.environ.get("PYTHONPATH", "")]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in path if p), OPENBLAS_NUM_THREADS="1",
-               OMP_NUM_THREADS="1")
-    env.pop(engine.ENV_SCHEDULER, None)
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                               "--port", "0", "--no-dashboard", "--scheduler-file", str(sched_file)],
-                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
-        t0 = time.time()
-        while not sched_file.exists() and time.time() - t0 < 60:
-            time.sleep(0.2)
-        address = json.loads(sched_file.read_text())["address"]
-        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                       "--nworkers", "2", "--nthreads", "1", "--host", "127.0.0.1",
-                                       "--no-dashboard"], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        engine.client(scheduler=address).wait_for_workers(2, timeout=60)
-        yield address
-    finally:
-        for key in [k for k in engine._CLIENTS if k[0] == "remote"]:
-            try:
-                engine._CLIENTS[key].shutdown()                 # stops the scheduler and its workers
-            except (OSError, RuntimeError, TimeoutError):
-                pass
-            engine._close(key)
-        for p in reversed(procs):
-            if p.poll() is None:
-                p.terminate()
-        for p in reversed(procs):
-            try:
-                p.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                p.kill()
 
 
 @pytest.mark.slow
