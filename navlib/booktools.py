@@ -859,9 +859,9 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
              "  - claims"]
             + rows + [":::", "", "Claims: reproduced / not reproduced / cannot be judged, of all the source's "
                       "claims. Each claim of a source's claims register counts once, under the reading its "
-                      "chapter finds most plausible (the others are shown there as sensitivity); the claims "
-                      "judged again on real data are counted apart: "
-                      + "; ".join(details) + "."])
+                      "chapter finds most plausible (the others are shown there as sensitivity): "
+                      + "; ".join(details) + ". The claims judged again on real data (\"on real data\") "
+                      "are counted apart."])
 
 
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],

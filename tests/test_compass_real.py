@@ -74,8 +74,8 @@ def test_tables_are_complete_and_their_verdicts_come_from_the_one_rule(real):
 @needs_data
 def test_real_claims_carry_data_real_the_simulated_wording_and_the_primary_reading(real, paper):
     cs = cr.real_claims(real, paper)
-    assert cs and all(c.data == "real" and c.source == "paper" for c in cs)
     entries = {t: e for e in registry.entries("compass") for t in e.rows}
+    assert cs and all(c.data == "real" and c.source == entries[c.claim].origin for c in cs)
     assert all(c.claim in entries for c in cs)                  # the simulated rows' own words
     primary = [c for c in cs if "; " not in c.reading]
     assert {c.claim for c in primary} == {"the back-tuned ELM improves the uncompensated heading",

@@ -306,9 +306,10 @@ def _reading(entry: registry.Entry, rec: Recording) -> str:
 
 def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
     """The claims of :func:`real_claim_specs` on each recording, as :class:`navlib.report.Claim` with
-    ``data="real"``, the simulated row's wording, the register entry's primary reading (trial 05's rows; the
-    pooled sessions' rows add the recording to the reading) and paper A's printed ranges (``paper``, the
-    rows of ``data/paper_a_error_ranges.csv``) as the paper's text.
+    ``data="real"``, the simulated row's wording, the register entry's origin as ``source`` (the paper's
+    claim or the book's own comparison), its primary reading (trial 05's rows; the pooled sessions' rows
+    add the recording to the reading) and paper A's printed ranges (``paper``, the rows of
+    ``data/paper_a_error_ranges.csv``) as the paper's text.
 
     "X beats Y": RMS(Y) - RMS(X) of the held-out rows over the same seeds
     (:func:`navlib.studies.paper_a.paired_rms_difference`), boundary 0, holds above; "one run shows LS > BP
@@ -333,7 +334,7 @@ def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
             reading = _reading(e, rec)
             how = ((f"{e.primary_reading}: the full DE stage, then MATLAB trainlm",) if e.register == "paper_a"
                    else ("our a-priori ELM settings (the chapter's)",))
-            common = dict(paper=_paper_text(e, spec, paper), reading=reading, source="paper", data="real",
+            common = dict(paper=_paper_text(e, spec, paper), reading=reading, source=e.origin, data="real",
                           key=spec.key + ("" if rec.primary else f"_{rec.key}"))
             if missing:                        # left out (the LS without its 8 headings): one row per entry
                 if spec.claim != e.primary_claim:
@@ -432,8 +433,9 @@ def answer(real: RealCompass | None, claims: list[Claim]) -> dict[str, str]:
 
 def verdict_changes(real_claims_: list[Claim], simulated: list[Claim]) -> pd.DataFrame:
     """Every real-data claim beside the verdict of the same claim under the same reading on our simulated
-    compass (``simulated``: the chapter's claims): claim, recording, the two verdicts and whether they
-    differ ("not run on real data" where the real claim has no statistic)."""
+    compass (``simulated``: the chapter's claims): claim, recording, the two verdicts (their cases are in
+    the claims' records) and whether they differ ("not run on real data" where the real claim has no
+    statistic)."""
     sim = {(c.claim, c.reading): c.verdict for c in simulated if c.data == "simulated"}
     rows = []
     for c in real_claims_:
@@ -443,7 +445,7 @@ def verdict_changes(real_claims_: list[Claim], simulated: list[Claim]) -> pd.Dat
         differs = ("not run on real data" if c.estimate is None else "–" if s == "–" else
                    "yes" if s != c.verdict else "no")
         rows.append({"claim": c.claim, "recording": rec.label, "simulated compass": s,
-                     "real compass": c.verdict_label, "differs": differs})
+                     "real compass": c.verdict, "differs": differs})
     return pd.DataFrame(rows, columns=["claim", "recording", "simulated compass", "real compass", "differs"])
 
 
