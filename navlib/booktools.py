@@ -599,18 +599,34 @@ def _md_cell(text) -> str:
 COUNTED = ("reproduced", "not reproduced", "cannot be judged", "no difference")
 BAR_COLOURS = {"reproduced": "#2e7d32", "not reproduced": "#c62828", "cannot be judged": "#9e9e9e",
                "no difference": "#1565c0"}
-def claim_counts(results: dict[str, dict]) -> dict[str, dict[str, dict[str, int]]]:
+def claim_counts(results: dict[str, dict], data: str = "simulated") -> dict[str, dict[str, dict[str, int]]]:
     """The one source of the book's counts: per chapter and source (``"paper"``, ``"book"``), how many of
-    the chapter's claims (every claim of its results file) are reproduced, not reproduced and cannot be
-    judged.  The landing page shows these; each chapter's *Results at a glance* must show the same
-    (``check-html`` compares them on the built pages)."""
+    the chapter's claims (every claim of its results file judged on ``data``: ``"simulated"``, the
+    default, or ``"real"``, the claims judged again on real measurements, counted apart) are reproduced,
+    not reproduced and cannot be judged.  The landing page shows these; each chapter's *Results at a
+    glance* must show the same (``check-html`` compares them on the built pages).  A record without a
+    ``data`` field (a file written before it existed) is simulated."""
+    if data not in verdicts.DATA:
+        raise InputError(f"claim_counts: data={data!r}: must be 'simulated' or 'real'")
     out = {}
     for chapter, res in results.items():
         counts = {src: dict.fromkeys(COUNTED, 0) for src in verdicts.SOURCES}
         for c in res.get("claims", []):
-            counts[c.get("source", "paper")][verdicts.verdict_name(c.get("reproduced"), c.get("basis"))] += 1
+            if claims_mod.data_of(c) == data:
+                counts[c.get("source", "paper")][verdicts.verdict_name(c.get("reproduced"), c.get("basis"))] += 1
         out[chapter] = counts
     return out
+
+
+def real_text(counts: dict[str, int], whose: str = "paper's") -> str:
+    """"paper's claims on real data: 2 of 7 reproduced, 3 not reproduced, 2 cannot be judged" ("" for
+    none)."""
+    n = sum(counts.values())
+    if not n:
+        return ""
+    text = (f"{whose} claims on real data: {counts['reproduced']} of {n} reproduced, {counts['not reproduced']} "
+            f"not reproduced, {counts['cannot be judged']} cannot be judged")
+    return text + (f", {counts['no difference']} no difference" if counts.get("no difference") else "")
 
 
 def _reason_key(c: dict) -> str | None:
@@ -750,6 +766,7 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
     that defines the verdicts.  The chapters that wrote no results file are listed after the table.
     ``sources`` (:func:`read_chapter_sources`) gives each notebook's short title and source.""" 
     counts = claim_counts(results)
+    real = claim_counts(results, "real")
     rows = []
     missing = []
     for chapter, doc, title, source in _chapters(results, notebooks, sources):
@@ -766,9 +783,11 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
                f'data-paper="{" ".join(str(cnt["paper"][k]) for k in COUNTED)}" '
                f'data-book="{" ".join(str(cnt["book"][k]) for k in COUNTED)}"></span>')
         src_text = f"<br>{_md_cell(source)}" if source else ""
+        on_real = "".join(f"<br>{_md_cell(real_text(real[chapter][s], w))}"
+                          for s, w in (("paper", "paper's"), ("book", "book's own")) if sum(real[chapter][s].values()))
         rows += [f"* - {{doc}}`{_md_cell(title)} <{doc}>`{tag}{src_text}", f"  - {_md_cell(sentence)}",
                  f"  - {stacked_bar(cnt[src])}<br>paper's: {_counts_cell(cnt['paper'])}<br>"
-                 f"book's own: {_counts_cell(cnt['book'])}"]
+                 f"book's own: {_counts_cell(cnt['book'])}{on_real}"]
     if rows:
         lines = [":::{list-table}", ":header-rows: 1", ":class: navbook-summary", ":widths: 30 45 25", "",
                  "* - chapter and source", "  - in one sentence",
@@ -788,6 +807,13 @@ def status_markdown(results: dict[str, dict], notebooks: list[Path],
                   + ", ".join(f'<span style="color:{BAR_COLOURS[k]}">&#9632;</span> {k}' for k in COUNTED)
                   + ". Each chapter's *Results at a glance* lists the same claims; the readings are "
                   "[below](status-by-reading)."]
+        total_real = {src: {k: sum(real[c][src][k] for c in real) for k in COUNTED} for src in verdicts.SOURCES}
+        if sum(total_real["paper"].values()) + sum(total_real["book"].values()):
+            lines += ["", "Judged again on real measurements and counted apart from the claims above (the same "
+                      "claims, on real data instead of our simulators): "
+                      + "; ".join(real_text(total_real[s], w) for s, w in (("paper", "the papers'"),
+                                                                         ("book", "the book's own"))
+                                  if sum(total_real[s].values())) + "."]
     return "\n".join(lines) + "\n\n" + verdict_box() + "\n"
 
 
@@ -803,9 +829,13 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
     for name, chapter in pairs:
         res = results[chapter]
         recs = [c for c in res.get("claims", []) if "sensitivity" in c]
-        mine = [c for c in recs if c.get("register") == name and c.get("source") == "paper"]
+        mine = [c for c in recs if c.get("register") == name and c.get("source") == "paper"
+                and claims_mod.data_of(c) == "simulated"]
         if not mine:
             continue
+        real = [c for c in recs if c.get("register") == name and c.get("source") == "paper"
+                and claims_mod.data_of(c) == "real"]
+        n_real = {k: sum(c["verdict"] == k for c in real) for k in COUNTED}
         head = next((c for c in mine if c.get("headline")), None)
         n = {k: sum(c["verdict"] == k for c in mine) for k in COUNTED}
         st = {k: sum(c.get("status") == k for c in mine) for k in ("judged", "open", "not checkable")}
@@ -816,7 +846,8 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
                  f'  - <span class="navbook-headline"><b>{html.escape(verdict)}</b></span>'
                  + (f"<br>({_md_cell(head['primary_reading'])})" if head and head.get("status") == "judged"
                     else ""),
-                 f"  - {stacked_bar(n, width_px=80)} {_counts_cell(n)} of {len(mine)}"]
+                 f"  - {stacked_bar(n, width_px=80)} {_counts_cell(n)} of {len(mine)}"
+                 + (f"<br>on real data: {_counts_cell(n_real)} of {len(real)}" if real else "")]
         details.append(f"{claims_mod.SOURCE_NAMES[name]} {st['judged']} judged, {st['open']} not yet computed, "
                        f"{st['not checkable']} not checkable"
                        + (f", {noted} contradiction{'s' if noted != 1 else ''} noted" if noted else ""))
@@ -829,7 +860,8 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
             + rows + [":::", "", "Claims: reproduced / not reproduced / cannot be judged, of all the source's "
                       "claims. Each claim of a source's claims register counts once, under the reading its "
                       "chapter finds most plausible (the others are shown there as sensitivity): "
-                      + "; ".join(details) + "."])
+                      + "; ".join(details) + ". The claims judged again on real data (\"on real data\") "
+                      "are counted apart."])
 
 
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
@@ -845,21 +877,25 @@ def readings_markdown(results: dict[str, dict], notebooks: list[Path],
             continue
         claims = [c for c in flat_claims(results[chapter]) if c.get("rule") != "no statistic"
                   or c.get("reason") not in ("not yet computed", "not checkable")]
-        readings = list(dict.fromkeys((c.get("source", "paper"), c.get("reading", "as printed"))
-                                      for c in claims))
+        readings = list(dict.fromkeys((c.get("source", "paper"), c.get("reading", "as printed"),
+                                       claims_mod.data_of(c)) for c in claims))
         parts += [f"::::{{dropdown}} {_md_cell(title)}: {len(claims)} rows (claims under readings), "
                   f"{len(readings)} readings", "",
                   f"{{doc}}`The chapter <{doc}>`.", "",
                   "| reading | claims | reproduced | not reproduced | cannot be judged |", "|---|---|---|---|---|"]
-        for src in verdicts.SOURCES:
-            for s, r in readings:
-                if s != src:
-                    continue
-                cs = [c for c in claims if c.get("source", "paper") == s and c.get("reading", "as printed") == r]
-                label = reading_label(r) + (" (the book's own claims)" if s == "book" else "")
-                rep = sum(c.get("reproduced") is True for c in cs)
-                nrep = sum(c.get("reproduced") is False for c in cs)
-                parts.append(f"| {_md_cell(label)} | {len(cs)} | {rep} | {nrep} | {_md_cell(_reasons_text(cs))} |")
+        for data in verdicts.DATA:
+            for src in verdicts.SOURCES:
+                for s, r, d in readings:
+                    if s != src or d != data:
+                        continue
+                    cs = [c for c in claims if c.get("source", "paper") == s and c.get("reading", "as printed") == r
+                          and claims_mod.data_of(c) == d]
+                    label = (reading_label(r) + (" (the book's own claims)" if s == "book" else "")
+                             + (" (on real data)" if d == "real" else ""))
+                    rep = sum(c.get("reproduced") is True for c in cs)
+                    nrep = sum(c.get("reproduced") is False for c in cs)
+                    parts.append(f"| {_md_cell(label)} | {len(cs)} | {rep} | {nrep} | "
+                                 f"{_md_cell(_reasons_text(cs))} |")
         parts += ["", "::::", ""]
     return "\n".join(parts)
 
@@ -1013,6 +1049,8 @@ def claim_problems(c: dict) -> list[str]:
             p.append(f"{k} missing or empty")
     if c.get("source") not in verdicts.SOURCES:
         p.append(f"source {c.get('source')!r}: must be 'paper' or 'book'")
+    if "data" in c and c["data"] not in verdicts.DATA:       # files written before the field have none
+        p.append(f"data {c.get('data')!r}: must be 'simulated' or 'real'")
     rule = c.get("rule")
     if rule not in verdicts.RULES:
         p.append(f"rule {rule!r}: must be one of {sorted(verdicts.RULES)}")
@@ -1198,7 +1236,11 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
                 p.append(f"{name}: methods[{label!r}].{k} = {a}, reference {b} "
                          f"(tolerance {rtol:g} relative + {atol:g})")
     fc, rc = flat_claims(fresh), flat_claims(ref)
-    ids = [c.get("id") for c in fresh.get("claims") or []], [c.get("id") for c in ref.get("claims") or []]
+    def ids_of(res):       # a record judged on real data is its entry's id marked "(real)"
+        return [c.get("id") if claims_mod.data_of(c) == "simulated" else f"{c.get('id')} (real)"
+                for c in res.get("claims") or []]
+
+    ids = ids_of(fresh), ids_of(ref)
     if ids[0] != ids[1]:
         p.append(f"{name}: claim ids {ids[0]} differ from the reference's {ids[1]}")
     if len(fc) != len(rc):
@@ -1207,6 +1249,9 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
         for k in ("claim", "reading", "paper", "source", "rule", "holds_when", "by_construction"):
             if a.get(k) != b.get(k):
                 p.append(f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}")
+        if claims_mod.data_of(a) != claims_mod.data_of(b):    # a missing field is "simulated"
+            p.append(f"{name}: claims[{i}].data {claims_mod.data_of(a)!r} differs from the reference "
+                     f"{claims_mod.data_of(b)!r}")
         if a.get("reproduced") != b.get("reproduced"):
             p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
                      f"{a.get('reproduced')}, reference {b.get('reproduced')}")

@@ -234,6 +234,40 @@ def _unjudged(e: Entry, cat: str | None = None) -> dict:
             "primary_reading": e.primary_reading if cat == "not run" else f"none ({cat})"}
 
 
+def data_of(record: Mapping) -> str:
+    """What a row or record was judged on: ``"simulated"`` or ``"real"`` (a record written before the
+    field existed is ``"simulated"``)."""
+    return record.get("data") or "simulated"
+
+
+def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None) -> dict:
+    """The record of a judged entry from its rows ``mine`` (all on one kind of data): the primary row's
+    fields, the other rows as ``sensitivity``; "not run" when the primary row (or every row) is missing."""
+    if not mine:                  # none of its rows run: other parameters, or no real measurements
+        rec = _unjudged(e, "not run")
+        rec["why"] = ("not run: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): with these "
+                      "parameters, or without the real measurements they need (../shared/realdata), they "
+                      "are not computed")
+        return {**rec, **base, "sensitivity": [], "across": {"rows": 0, "same": 0, "verdicts": {}}}
+    prim = [r for r in mine if r["claim"] == e.primary_claim and r["reading"] == e.primary_reading]
+    if len(prim) > 1:
+        raise InputError(f"claims_{e.register}.csv, {e.id}: two results rows {e.primary_claim!r} under the "
+                         f"primary reading {e.primary_reading!r}" + (" on real data" if base.get("data") == "real"
+                                                                      else ""))
+    if not prim:                  # a rerun with other parameters: the primary reading was not run
+        rec = _unjudged(e, "not run")
+        rec["why"] = (f"not run: the primary reading {e.primary_reading!r} of {e.primary_claim!r} was not "
+                      f"run with these parameters; the {len(mine)} row(s) that were are its sensitivity")
+        return {**rec, **base, "sensitivity": [{**r, "source": e.origin} for r in mine],
+                "across": {"rows": 0, "same": 0, "verdicts": {}}}
+    p = prim[0]
+    others = [{**r, "source": e.origin} for r in mine if r is not p]
+    rec = {**p, **base, "claim": e.claim, "row_claim": p["claim"], "source": e.origin,
+           "primary_reading": p["reading"], "sensitivity": others}
+    rec["across"] = _across(rec, others, worlds)
+    return rec
+
+
 def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None = None) -> list[dict]:
     """One record per register entry of ``chapter`` (except inconsistencies): for a judged entry its
     primary row's fields (``claim`` is the register's wording, ``row_claim`` the row's), the register's
@@ -241,8 +275,19 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
     ``why_primary``, ``dimensions`` (the register's sensitivity column), ``source`` (the register's
     origin), the other rows as ``sensitivity`` (each a row record with the same fields) and ``across``
     (:func:`across_text`); an open or not-checkable entry has no statistic and says why.  ``rows`` are
-    :meth:`navlib.report.Claim.record` dicts; ``worlds`` the drawn-world verdicts of the rows, if any."""
+    :meth:`navlib.report.Claim.record` dicts; ``worlds`` the drawn-world verdicts of the rows, if any.
+
+    Rows judged on real measurements (``"data": "real"``) are kept apart: each judged entry with such
+    rows gets a second record, ``"data": "real"``, after every record of simulated rows (which carry
+    ``"data": "simulated"`` and are what they would be without the real rows).  Its primary row is the
+    real row of the entry's primary claim under its primary reading, the entry's other real rows are its
+    sensitivity, and no drawn world applies to it.  The real rows use the simulated rows' wording, so a
+    reader can set the two verdicts side by side; the book counts the real records apart."""
     rows = [dict(r) for r in rows]
+    for r in rows:
+        if data_of(r) not in verdicts.DATA:
+            raise InputError(f"chapter {chapter!r}: results row {r.get('claim')!r}: data={r.get('data')!r} "
+                             f"must be 'simulated' or 'real'")
     es = entries(chapter)
     if not es:
         raise InputError(f"chapter {chapter!r} has no claims register (navlib.claims.REGISTERS)")
@@ -254,50 +299,28 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
                                  f"{owner[text].id}")
             owner[text] = e
     files = ", ".join(f"data/claims_{n}.csv" for n in registers(chapter))
-    by_entry: dict[str, list[dict]] = {}
+    by_entry: dict[tuple[str, str], list[dict]] = {}
     for r in rows:
         e = owner.get(r["claim"])
         if e is None:
             raise InputError(f"chapter {chapter!r}: results row {r['claim']!r} ({r['reading']}) belongs to no "
                              f"entry of {files}: add it to an entry's rows")
-        by_entry.setdefault(e.id, []).append(_with_margin(r, e))
-    out = []
+        by_entry.setdefault((e.id, data_of(r)), []).append(_with_margin(r, e))
+    out, real = [], []
     for e in es:
         if e.status == "noted":
             continue
         base = {"id": e.id, "register": e.register, "kind": e.kind, "status": e.status, "headline": e.headline,
                 "quote": e.quote, "quote_zh": e.quote_zh, "where": e.where, "why_primary": e.why_primary,
-                "dimensions": e.sensitivity, "needs": e.needs}
+                "dimensions": e.sensitivity, "needs": e.needs, "data": "simulated"}
         if e.status != "judged":
             out.append({**_unjudged(e), **base, "sensitivity": [],
                         "across": {"rows": 0, "same": 0, "verdicts": {}}})
             continue
-        mine = by_entry.get(e.id, [])
-        if not mine:                  # none of its rows run: other parameters, or no real measurements
-            rec = _unjudged(e, "not run")
-            rec["why"] = ("not run: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): with these "
-                          "parameters, or without the real measurements they need (../shared/realdata), they "
-                          "are not computed")
-            out.append({**rec, **base, "sensitivity": [], "across": {"rows": 0, "same": 0, "verdicts": {}}})
-            continue
-        prim = [r for r in mine if r["claim"] == e.primary_claim and r["reading"] == e.primary_reading]
-        if len(prim) > 1:
-            raise InputError(f"claims_{e.register}.csv, {e.id}: two results rows {e.primary_claim!r} under the "
-                             f"primary reading {e.primary_reading!r}")
-        if not prim:                  # a rerun with other parameters: the primary reading was not run
-            rec = _unjudged(e, "not run")
-            rec["why"] = (f"not run: the primary reading {e.primary_reading!r} of {e.primary_claim!r} was not "
-                          f"run with these parameters; the {len(mine)} row(s) that were are its sensitivity")
-            out.append({**rec, **base, "sensitivity": [{**r, "source": e.origin} for r in mine],
-                        "across": {"rows": 0, "same": 0, "verdicts": {}}})
-            continue
-        p = prim[0]
-        others = [{**r, "source": e.origin} for r in mine if r is not p]
-        rec = {**p, **base, "claim": e.claim, "row_claim": p["claim"], "source": e.origin,
-               "primary_reading": p["reading"], "sensitivity": others}
-        rec["across"] = _across(rec, others, worlds)
-        out.append(rec)
-    return out
+        out.append(_judged(e, by_entry.get((e.id, "simulated"), []), base, worlds))
+        if (e.id, "real") in by_entry:
+            real.append(_judged(e, by_entry[(e.id, "real")], {**base, "data": "real"}, None))
+    return out + real
 
 
 def inconsistencies(chapter: str) -> list[dict]:
@@ -308,7 +331,7 @@ def inconsistencies(chapter: str) -> list[dict]:
 
 def headlines(records: Iterable[Mapping]) -> list[dict]:
     """The headline record of each register among ``records`` (:func:`evaluate`'s), in order."""
-    return [r for r in records if r.get("headline")]
+    return [r for r in records if r.get("headline") and data_of(r) == "simulated"]
 
 
 def tally(records: Iterable[Mapping]) -> dict[str, int]:
@@ -319,5 +342,5 @@ def tally(records: Iterable[Mapping]) -> dict[str, int]:
     return out
 
 
-__all__ = ["Entry", "REGISTERS", "SOURCE_NAMES", "across_text", "entries", "evaluate", "headlines",
+__all__ = ["Entry", "REGISTERS", "SOURCE_NAMES", "across_text", "data_of", "entries", "evaluate", "headlines",
            "inconsistencies", "load_register", "parse_register", "registers", "tally"]

@@ -449,7 +449,10 @@ class Claim:
     generated reason); ``ours``: an optional short text shown before the interval (e.g. "4.21 vs 9.58
     deg"); ``key``: a name for the prose (:func:`glue_claims`); ``volatile``: the statistic is measured on
     this machine's clock (a timing), so a rerun reproduces its verdict but not its numbers (the results
-    check then compares the verdict and the texts only)."""
+    check then compares the verdict and the texts only); ``data``: what the statistic was computed on,
+    ``"simulated"`` (our simulators, the default) or ``"real"`` (real measurements): the book counts
+    claims on real data apart (the glance box, the landing page), with the same wording as the simulated
+    row so the two can be compared."""
 
     claim: str
     paper: str
@@ -469,6 +472,7 @@ class Claim:
     spec: str = "{:.3g}"
     volatile: bool = False
     margin: float | None = None
+    data: str = "simulated"
 
     def __post_init__(self):
         for f in ("claim", "paper", "reading"):
@@ -476,6 +480,8 @@ class Claim:
                 raise InputError(f"Claim.{f} is empty")
         if self.source not in verdicts.SOURCES:
             raise InputError(f"Claim.source={self.source!r}: must be 'paper' or 'book'")
+        if self.data not in verdicts.DATA:
+            raise InputError(f"Claim.data={self.data!r}: must be 'simulated' or 'real'")
         if not isinstance(self.decided_by, tuple) or not all(isinstance(d, str) and d.strip()
                                                                for d in self.decided_by):
             raise InputError(f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts")
@@ -602,10 +608,12 @@ class Claim:
                 "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
                 "reason": verdicts.reason_category(self.basis, self.reason),
                 "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile),
-                "margin": None if self.margin is None else plain(self.margin)}
+                "margin": None if self.margin is None else plain(self.margin), "data": self.data}
 
 
 GLANCE_COLUMNS = ["claim", "reading", "paper", "ours: value [95 % interval]", "boundary", "verdict"]
+#: How the book names the claims judged on real measurements (``Claim.data == "real"``), counted apart.
+ON_REAL = "on real data"
 
 
 def _glance_frame(claims: list[Claim]) -> pd.DataFrame:
@@ -650,7 +658,7 @@ def reading_label(reading: str) -> str:
 
 #: The (claim, reading) pairs shown in a glance box in this process (:func:`write_results` warns about the
 #: claims it writes that none showed: the landing page counts them, the chapter's glance box would not).
-_GLANCED: set[tuple[str, str]] = set()
+_GLANCED: set[tuple[str, str, str]] = set()
 #: A glance table with more rows than this is folded by reading on the page (one dropdown per reading).
 GLANCE_OPEN_ROWS = 12
 #: Where a chapter page's glance box links the definitions of the verdicts (the landing page's box).
@@ -780,10 +788,13 @@ class Answer:
         self.noted = registry.inconsistencies(chapter)
 
     def _groups(self):
-        for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims")):
-            recs = [r for r in self.records if r["source"] == src]
-            if recs:
-                yield src, title, recs
+        """(source, title, records) per source, the records on real data (``"data": "real"``) after the
+        simulated ones and counted apart."""
+        for data, suffix in (("simulated", ""), ("real", f" {ON_REAL}")):
+            for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims")):
+                recs = [r for r in self.records if r["source"] == src and registry.data_of(r) == data]
+                if recs:
+                    yield src, title + suffix, recs
 
     def tables(self) -> list[Table]:
         out = []
@@ -805,9 +816,12 @@ class Answer:
         for r in registry.headlines(self.records):
             parts.append(f'<p class="navbook-headline">{_inline_md(headline_sentence(r))}</p>')
         for src, title, recs in self._groups():
-            parts.append(f'<p class="navbook-glance-note">{html.escape(title)}: {_rec_tally(recs)} '
-                         f'(one row per claim, judged under its primary reading; '
-                         f'<a href="{VERDICTS_HREF}">what the verdicts mean</a>)</p>')
+            real = registry.data_of(recs[0]) == "real"
+            note = (f'{html.escape(title)}: {_rec_tally(recs)} (one row per claim, judged under its primary '
+                    f'reading; <a href="{VERDICTS_HREF}">what the verdicts mean</a>)')
+            # the claims judged again on real data: counted apart, their tables behind a fold
+            parts.append(f'<details class="navbook-real"><summary class="navbook-glance-note">{note}</summary>'
+                         if real else f'<p class="navbook-glance-note">{note}</p>')
             for name in registry.registers(self.chapter):
                 mine = [r for r in recs if r["register"] == name]
                 if mine:
@@ -815,6 +829,8 @@ class Answer:
                         parts.append(f"<p><b>{html.escape(registry.SOURCE_NAMES[name])}</b>: "
                                      f"{_rec_tally(mine)}</p>")
                     parts.append(Table(_answer_frame(mine), index=False, readable=False)._repr_html_())
+            if real:
+                parts.append("</details>")
         if self.noted:
             parts.append(f"<details><summary>Where the paper contradicts itself ({len(self.noted)})</summary>"
                          + Table(self.tables()[-1].frame, index=False, readable=False)._repr_html_()
@@ -826,7 +842,8 @@ class Answer:
         """Every claim behind one fold, a dropdown per claim: the paper's words and where, the primary
         reading and why, and every row (each reading, noise level, split; the primary first)."""
         n = sum(1 + len(r["sensitivity"]) for r in self.records if r.get("row_claim"))
-        inner = [f"<details><summary>{html.escape(r['id'])} {html.escape(r['claim'])}: "
+        inner = [f"<details><summary>{html.escape(r['id'])} {html.escape(r['claim'])}"
+                 f"{' (' + ON_REAL + ')' if registry.data_of(r) == 'real' else ''}: "
                  f"{html.escape(registry.across_text(r) if r.get('row_claim') else record_label(r))}</summary>"
                  + _claim_fold(r) + "</details>" for r in self.records]
         return (f'<details><summary>The paper\'s words, the primary reading and why, and every claim under '
@@ -855,27 +872,25 @@ class Glance:
 
     def __init__(self, claims: Iterable[Claim]):
         claims = list(claims)
-        self.paper = [c for c in claims if c.source == "paper"]
-        self.book = [c for c in claims if c.source == "book"]
-        _GLANCED.update((c.claim, c.reading) for c in claims)
+        sim = [c for c in claims if c.data == "simulated"]
+        self.paper = [c for c in sim if c.source == "paper"]
+        self.book = [c for c in sim if c.source == "book"]
+        self.real = {src: [c for c in claims if c.data == "real" and c.source == src] for src in verdicts.SOURCES}
+        _GLANCED.update((c.claim, c.reading, c.data) for c in claims)
+
+    def _groups(self):
+        """(caption, claims) per source, the claims on real data after the simulated ones, each apart."""
+        for cs, title in ((self.paper, "The paper's claims"), (self.book, "The book's own claims"),
+                          (self.real["paper"], f"The paper's claims {ON_REAL}"),
+                          (self.real["book"], f"The book's own claims {ON_REAL}")):
+            if cs:
+                yield f"{title}: {tally(cs)}", cs
 
     def tables(self) -> list[Table]:
-        out = []
-        if self.paper:
-            out.append(Table(_glance_frame(self.paper), index=False,
-                             caption=f"The paper's claims: {tally(self.paper)}"))
-        if self.book:
-            out.append(Table(_glance_frame(self.book), index=False,
-                             caption=f"The book's own claims: {tally(self.book)}"))
-        return out
+        return [Table(_glance_frame(cs), index=False, caption=caption) for caption, cs in self._groups()]
 
     def _repr_html_(self) -> str:
-        out = []
-        if self.paper:
-            out.append(_glance_html(self.paper, f"The paper's claims: {tally(self.paper)}"))
-        if self.book:
-            out.append(_glance_html(self.book, f"The book's own claims: {tally(self.book)}"))
-        return "\n".join(out)
+        return "\n".join(_glance_html(cs, caption) for caption, cs in self._groups())
 
     def __repr__(self) -> str:
         return "\n\n".join(repr(t) for t in self.tables())
@@ -891,7 +906,7 @@ def glance(claims: Iterable[Claim], chapter: str | None = None,
     records = register_records(claims, chapter, worlds)
     if records is None:
         return Glance(claims)
-    _GLANCED.update((c.claim, c.reading) for c in claims)
+    _GLANCED.update((c.claim, c.reading, c.data) for c in claims)
     return Answer(records, chapter)
 
 
@@ -902,6 +917,7 @@ class _Outcome:
     source: str
     verdict: str
     category: str | None      # the key of verdicts.REASONS of a claim that cannot be judged
+    data: str = "simulated"   # what it was judged on (Claim.data)
 
 
 def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
@@ -910,7 +926,8 @@ def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
         c = c.record()
     try:
         return _Outcome(str(c["claim"]), str(c.get("reading", "")), str(c["source"]), str(c["verdict"]),
-                        c.get("reason") if c["verdict"] == "cannot be judged" else None)
+                        c.get("reason") if c["verdict"] == "cannot be judged" else None,
+                        registry.data_of(c))
     except (KeyError, TypeError, AttributeError):
         raise InputError(f"a claim record without claim, source and verdict: {str(c)[:80]}") from None
 
@@ -941,16 +958,19 @@ class Showed:
     paper's claims, the book's own), the tally with the reasons of the claims that cannot be judged, and
     one line per claim with its verdicts over the readings."""
 
-    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"], found: Mapping[str, str] | None = None):
+    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"], found: Mapping[Any, str] | None = None):
         outs = [_outcome(c) for c in claims]
-        parts = [(title, [c for c in outs if c.source == src])
+        parts = [(title + suffix, [c for c in outs if c.source == src and c.data == data])
+                 for data, suffix in (("simulated", ""), ("real", f" {ON_REAL}"))
                  for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims"))]
         self.parts = [(t, cs) for t, cs in parts if cs]
         self.found = dict(found or {})
 
     def _rows(self, cs: list[_Outcome]) -> pd.DataFrame:
+        """One row per claim; ``found`` is looked up by ``(claim, data)``, then by the claim alone."""
         names = list(dict.fromkeys(c.claim for c in cs))
-        return pd.DataFrame([{"claim": n, "what we found": self.found.get(n) or
+        data = cs[0].data if cs else "simulated"
+        return pd.DataFrame([{"claim": n, "what we found": self.found.get((n, data)) or self.found.get(n) or
                               _claim_outcome([c for c in cs if c.claim == n])}
                              for n in names], columns=["claim", "what we found"])
 
@@ -984,9 +1004,9 @@ def showed(claims: Iterable[Claim], chapter: str | None = None,
     records = register_records(claims, chapter, worlds)
     if records is None:
         return Showed(claims)
-    found = {r["claim"]: record_label(r) + (f" (primary reading; {registry.across_text(r)})"
-                                            if r.get("status") == "judged" and r.get("row_claim") else "")
-             for r in records}
+    found = {(r["claim"], registry.data_of(r)): record_label(r) + (
+        f" (primary reading; {registry.across_text(r)})" if r.get("status") == "judged" and r.get("row_claim")
+        else "") for r in records}
     return Showed([{**r, "reading": "primary"} for r in records], found)
 
 
@@ -1062,14 +1082,16 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if not all(isinstance(c, Claim) for c in claims):
         raise InputError(f"write_results({chapter!r}): claims must be navlib.report.Claim objects")
     keys = [(c.claim, c.reading) for c in claims]
-    if len(set(keys)) != len(keys):
-        dup = next(k for k in keys if keys.count(k) > 1)
-        raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}")
+    both = [(c.claim, c.reading, c.data) for c in claims]
+    if len(set(both)) != len(both):
+        dup = next(k for k in both if both.count(k) > 1)
+        raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}"
+                         + (" on real data" if dup[2] == "real" else ""))
     records = register_records(claims, chapter if register else None, worlds)
     out["claims"] = records if records is not None else [c.record() for c in claims]
     if records is not None:
         out["inconsistencies"] = registry.inconsistencies(chapter)
-    unseen = [k for k in keys if k not in _GLANCED]
+    unseen = [k for k in both if k not in _GLANCED]
     if _GLANCED and unseen:                 # a chapter that shows a glance box, but not all of its claims
         import warnings
         warnings.warn(f"write_results({chapter!r}): {len(unseen)} of the {len(keys)} claims are in no glance "
@@ -1129,18 +1151,19 @@ def read_result(path: str | os.PathLike) -> dict:
 
 
 def claims_summary(results: Mapping[str, dict]) -> pd.DataFrame:
-    """Per chapter, source (the paper's claims or the book's own) and reading: claims reproduced, not
-    reproduced, cannot be judged (for the landing page)."""
+    """Per chapter, source (the paper's claims or the book's own), data (``simulated`` or ``real``: the
+    claims judged on real measurements apart) and reading: claims reproduced, not reproduced, cannot be
+    judged (for the landing page)."""
     rows = []
     for chapter, res in results.items():
         for c in res.get("claims", []):
-            rows.append({"chapter": chapter, "source": c.get("source", "paper"),
+            rows.append({"chapter": chapter, "source": c.get("source", "paper"), "data": registry.data_of(c),
                          "reading": c.get("reading", "as printed"), "reproduced": c.get("reproduced")})
-    cols = ["chapter", "source", "reading", "claims", "reproduced", "not reproduced", "cannot be judged"]
+    cols = ["chapter", "source", "data", "reading", "claims", "reproduced", "not reproduced", "cannot be judged"]
     if not rows:
         return pd.DataFrame(columns=cols)
     df = pd.DataFrame(rows)
-    g = df.groupby(["chapter", "source", "reading"], sort=False)["reproduced"]
+    g = df.groupby(["chapter", "source", "data", "reading"], sort=False)["reproduced"]
     return pd.DataFrame({"claims": g.size(),
                          "reproduced": g.apply(lambda s: int((s == True).sum())),  # noqa: E712
                          "not reproduced": g.apply(lambda s: int((s == False).sum())),  # noqa: E712

@@ -51,6 +51,8 @@ LEVEL = 0.95
 SIDES = ("above", "below")
 Side = Literal["above", "below"]
 SOURCES = ("paper", "book")
+#: What a claim was judged on: our simulators (the default) or real measurements; the book counts the two apart.
+DATA = ("simulated", "real")
 VERDICTS = ("reproduced", "not reproduced", "cannot be judged", "no difference")
 #: Why a claim cannot be judged (``basis`` of :func:`decide`); ``"equivalent"``: no difference at the
 #: claim's equivalence margin.

@@ -172,10 +172,16 @@ def _glance_html(chapter):
 @pytest.mark.parametrize("chapter", CHAPTERS)
 def test_every_register_entry_is_in_the_results_file_and_the_chapters_opening(chapter):
     res = json.loads((ROOT / "notebooks" / "results" / f"{chapter}.json").read_text(encoding="utf-8"))
-    ids = [c.get("id") for c in res["claims"]]
+    sim = [c for c in res["claims"] if claims.data_of(c) == "simulated"]
+    real = [c for c in res["claims"] if claims.data_of(c) == "real"]     # counted apart: one more per entry
+    ids = [c.get("id") for c in sim]
     noted = [c["id"] for c in res.get("inconsistencies", [])]
     html = _glance_html(chapter)
-    by_id = {c.get("id"): c for c in res["claims"]}
+    by_id = {c.get("id"): c for c in sim}
+    assert len({c["id"] for c in real}) == len(real) and {c["id"] for c in real} <= set(ids)
+    assert res["claims"] == sim + real                                  # the real records after the others
+    for c in real:
+        assert all(claims.data_of(s) == "real" for s in c["sensitivity"])
     for e in claims.entries(chapter):
         where = noted if e.status == "noted" else ids
         if e.status == "judged" and e.id in by_id:      # with the chapter's defaults every primary row is run

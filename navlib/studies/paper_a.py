@@ -709,12 +709,15 @@ def verdict_table(claim_list, readings=None) -> pd.DataFrame:
     (``read_results()["compass"]["claims"]``, the chapter's way); ``readings`` selects and orders the
     columns (default: every reading found).  "-": the claim is not judged in that reading (a reading of
     ADE's rules judges only the claims that involve ADE-BP).  A results file's record carries its other
-    readings in ``sensitivity`` (:func:`navlib.claims.evaluate`): they are rows of the table too."""
+    readings in ``sensitivity`` (:func:`navlib.claims.evaluate`): they are rows of the table too.  Claims
+    judged on real data (``data == "real"``, :mod:`navlib.studies.compass_real`) are left out: the table
+    is of our simulated compass."""
     recs = []
     for c in claim_list:
         if isinstance(c, Mapping):
-            recs += [c, *c.get("sensitivity", ())]
-        else:
+            if c.get("data", "simulated") == "simulated":
+                recs += [c, *c.get("sensitivity", ())]
+        elif c.data == "simulated":
             recs.append({"claim": c.claim, "reading": c.reading, "verdict": c.verdict})
     missing = [k for k in ("claim", "reading", "verdict") if recs and k not in recs[0]]
     if missing:
