@@ -16,6 +16,13 @@ from test_robust_outputs import ENV, FAKE, tiny_notebook
 SLOW = "import time\ntime.sleep(float(n))"
 
 
+def _ctrl_c_as_at_a_terminal():
+    """In the child before exec: SIGINT back to its default action.  A shell starts a background job (``make
+    test &``, CI runners) with SIGINT ignored, the ignoring is inherited, and Python then installs no
+    KeyboardInterrupt handler: the command would rightly sleep through the signal."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _wait_for(path, proc, timeout_s=120.0):
     t0 = time.monotonic()
     while not path.exists():
@@ -38,7 +45,7 @@ def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, w
     out = tmp_path / "out"
     p = subprocess.Popen([sys.executable, "-m", "navlib", "grid", str(nb), "--param", f"n={values}", "--out", str(out),
                           "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
-                         start_new_session=True)
+                         start_new_session=True, preexec_fn=_ctrl_c_as_at_a_terminal)
     try:
         _wait_for(out / wait_for, p)
         os.killpg(p.pid, signal.SIGINT)                  # as a terminal's Ctrl-C: the kernel gets it too
