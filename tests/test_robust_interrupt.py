@@ -19,8 +19,9 @@ SLOW = "import time\ntime.sleep(float(n))"
 def _ctrl_c_as_at_a_terminal():
     """In the child before exec: SIGINT back to its default action.  A shell starts a background job (``make
     test &``, CI runners) with SIGINT ignored, the ignoring is inherited, and Python then installs no
-    KeyboardInterrupt handler: the command would rightly sleep through the signal."""
+    KeyboardInterrupt handler: the command would rightly sleep through the signal.  Likewise a blocked signal."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})     # and not blocked either (also inherited)
 
 
 def _wait_for(path, proc, timeout_s=120.0):
