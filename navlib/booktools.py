@@ -484,7 +484,7 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
     ``book/_ext/navbook_attrdoc.py``); on the command line's page (``cli_page``), an option written with a
     typographic dash or quote, or an option of a command line that the command's parser does not have
     (each line of the page that starts with a command name), or whose ``--help``, run for real, fails or
-    does not show it (:func:`_help_problems`)."""
+    does not show it (``_help_problems``)."""
     out = []
     n = text.count('Type<span class="colon">:</span>')
     if n:
