@@ -378,7 +378,7 @@ POLE_NOTE = ("at a geographic pole the directions north and east are undefined, 
 
 def model_field(site) -> dict:
     """The IGRF-14 field at ``site`` (:class:`navlib.sensors.earth_field.Site`) as a JSON-ready dict
-    (:meth:`navlib.sensors.earth_field.EarthField.to_dict`), finite everywhere: at a geographic pole
+    (``EarthField.to_dict`` of :mod:`navlib.sensors.earth_field`), finite everywhere: at a geographic pole
     (``|lat_deg| = 90``) ``north_ut``, ``east_ut`` and ``declination_deg`` are None, ``note`` says why
     (:data:`POLE_NOTE`), and the other values are the limits at the pole (:data:`POLE_STEP_DEG`)."""
     from ..sensors.earth_field import Site, igrf_field

@@ -6,8 +6,8 @@ gravity direction is to blame).
 For each invariant (the magnitude ``|u| - F``; with an accelerometer the dip invariant) and each factor the
 rows are grouped into cells and the residual's variance is split into between-cell and within-cell parts::
 
-    share = sum_c n_c (rbar_c - rbar)^2 / sum_i (r_i - rbar)^2          (eta squared)
-    amplitude = sqrt(sum_c n_c (rbar_c - rbar)^2 / n)                   (rms of the cell means, uT)
+    share = sum_c n_c (rbar_c - rbar)^2 / sum_i (r_i - rbar)^2     (eta squared)
+    amplitude = sqrt(sum_c n_c (rbar_c - rbar)^2 / n)       (rms of the cell means, uT)
 
 Factors: **time** (ten cells of equal count over ``time_s``); **turn rate** (four cells over ``|omega|``,
 from the gyro columns, or where there are none the turn of the corrected field's direction between

@@ -5,7 +5,7 @@ The likelihood and its notation are those of :mod:`navlib.workbench.serial` (mod
 estimate): ``l_R(kappa) = -1/2 [(N - k) log RSS_W + log det R + log det (X' R^-1 X)]``.  Every Gram matrix
 of whitened columns is a weighted sum of lagged cross-products of the columns, computed once
 (:class:`_Prepared`); the weights, and their derivatives, come from the Durbin-Levinson coefficients
-(:meth:`_Prepared.weights`), so an evaluation of ``l_R`` and its gradient costs a few small products
+(``_Prepared.weights``), so an evaluation of ``l_R`` and its gradient costs a few small products
 (:class:`_Restricted`), whatever the length of the series.  This module does not import
 :mod:`~navlib.workbench.serial` (which imports it); a :class:`~navlib.workbench.serial.Series` is used only
 through its ``order`` and ``pos``.
@@ -42,7 +42,8 @@ def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
     from the recursion differentiated::
 
         d phi[m, m]   = [l = m]
-        d phi[m, 1:m] = d phi[m-1, 1:m] - kappa_m d phi[m-1, m-1:0:-1] - [l = m] phi[m-1, m-1:0:-1]
+        d phi[m, 1:m] = d phi[m-1, 1:m] - kappa_m d phi[m-1, m-1:0:-1]
+                        - [l = m] phi[m-1, m-1:0:-1]
         d v[m]        = (1 - kappa_m^2) d v[m-1] - [l = m] 2 kappa_m v[m-1]
     """
     kappa = [float(k) for k in kappa]                   # plain floats: p is a few, numpy calls cost more
@@ -168,7 +169,7 @@ class _Restricted:
 
     def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int,
                  prepared: "_Prepared | None" = None, cross: tuple | None = None):
-        """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (:meth:`_Prepared.cross` of one
+        """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (``_Prepared.cross`` of one
         column), when computed for many residual vectors at once."""
         usable = prepared is not None and prepared.P >= int(max_order)
         pre = prepared if usable else _Prepared(Q, series, int(max_order))
@@ -192,7 +193,7 @@ class _Restricted:
 
     def value_and_gradient(self, kappa) -> tuple[float, np.ndarray]:
         """``l_R`` and its gradient with respect to ``kappa``: with ``y = G^-1 b`` and the pair weights'
-        derivatives (:meth:`_Prepared.weights`)::
+        derivatives (``_Prepared.weights``)::
 
             d RSS_W = d M_rr - 2 y' d b + y' d G y,   d log det G = tr(G^-1 d G),
             d l_R   = -1/2 [ (N - k) d RSS_W / RSS_W  +  d log det R  +  d log det G ]

@@ -559,7 +559,7 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
     independent.  ``basis``: :func:`basis_on` of the regressors, if already computed; ``prepared``: its
     residual-free likelihood parts (:class:`_Prepared`), likewise; ``start_at``: with a fixed ``order`` of 2
     or more, optimise that order only, from these partial autocorrelations; ``cross``: the residual's
-    cross-products with ``prepared`` (:meth:`_Prepared.cross`), computed for many residual vectors at once
+    cross-products with ``prepared`` (``_Prepared.cross``), computed for many residual vectors at once
     (:func:`select_many`)."""
     r = np.asarray(residuals, float)
     if series is None:
