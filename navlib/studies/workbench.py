@@ -824,7 +824,7 @@ def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float
         return {"trial": label, "rows": len(data), "rows set aside": 0, "noise model": "-", "effects added": "-",
                 "final rms (uT)": float("nan"), "outcome": "refused: " + str(err).split(": ", 1)[-1][:60],
                 "field (uT)": float("nan"), "field 95% (uT)": float("nan"), "dip (deg)": float("nan"),
-                "dip 95% (deg)": float("nan"), "what remains": "-"}
+                "dip 95% (deg)": float("nan"), "what is left": "-"}
     check, _ = FREE.final_check(res, BROAD_SITE, None)
     noise = res.screening.noise
     return {"trial": label, "rows": len(data),
@@ -833,7 +833,7 @@ def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float
             "effects added": added(res), "final rms (uT)": res.final.rms, "outcome": res.outcome(),
             "field (uT)": check["intensity_ut"], "field 95% (uT)": 1.96 * check["intensity_std_ut"],
             "dip (deg)": check["dip_deg"], "dip 95% (deg)": 1.96 * check["dip_std_deg"],
-            "what remains": "-" if res.consistent_with_noise else _top_factor(res), "staircase": staircase_of(res)}
+            "what is left": "-" if res.consistent_with_noise else _top_factor(res), "staircase": staircase_of(res)}
 
 
 def _top_factor(res: LoopResult) -> str:
@@ -842,7 +842,7 @@ def _top_factor(res: LoopResult) -> str:
     if table.empty:
         return "-"
     top = table.loc[table["share"].idxmax()]
-    return f"{top['factor']} ({top['invariant']}, {100 * top['share']:.0f} %)"
+    return f"{top['factor']} ({'|m|' if top['invariant'] == 'magnitude' else 'dip'}) {100 * top['share']:.0f}%"
 
 
 def free_undisturbed_loops(row_step: int = FREE_ROW_STEP, alpha: float | None = None, workers: int = 1,
