@@ -27,34 +27,34 @@ help:
 
 venv: $(STAMP)
 
-$(STAMP): environment.lock pyproject.toml
+$(STAMP): environment.lock pyproject.toml book/pyproject.toml
 	@echo "== creating $(VENV) from environment.lock"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	@$(PY) -m pip install --quiet --disable-pip-version-check -r environment.lock 2>&1 | { grep -v "is ignored: it is neither" || true; }
-	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . 2>&1 | { grep -v "is ignored: it is neither" || true; }
+	@$(PY) -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e . -e book 2>&1 | { grep -v "is ignored: it is neither" || true; }
 	@$(PY) -m ipykernel install --sys-prefix --name python3 > /dev/null
 	@touch $(STAMP)
 
 book: $(STAMP)
 	@rm -rf $(GENERATED)
-	@$(PY) -m navlib.booktools compile
-	@$(PY) -m navlib.booktools execute --out $(GENERATED) $(NOTEBOOKS)
-	@$(PY) -m navlib.booktools status $(GENERATED)/results --notebooks $(GENERATED) --out $(GENERATED)/status.md
-	@$(PY) -m navlib.booktools api-modules --out $(GENERATED)/api_modules.md
+	@$(PY) -m navbook compile
+	@$(PY) -m navbook execute --out $(GENERATED) $(NOTEBOOKS)
+	@$(PY) -m navbook status $(GENERATED)/results --notebooks $(GENERATED) --out $(GENERATED)/status.md
+	@$(PY) -m navbook api-modules --out $(GENERATED)/api_modules.md
 	@echo "== building the HTML book"
 	@$(VENV)/bin/jupyter-book build book -W -n --keep-going --quiet
-	@$(PY) -m navlib.booktools check-html book/_build/html
+	@$(PY) -m navbook check-html book/_build/html
 	@echo "== book built: book/_build/html/index.html"
 
 # Screenshots of every built page (run `make book` first). Needs the Debian package chromium.
 screenshots: $(STAMP)
 	@test -f book/_build/html/index.html || { echo "no built book: run 'make book' first" >&2; exit 1; }
 	@command -v chromium > /dev/null || { echo "chromium is missing: install it with 'apt-get install -y chromium' (Debian package chromium)" >&2; exit 2; }
-	@$(PY) -m navlib.booktools screenshots book/_build/html book/_build/screenshots --width 1400
+	@$(PY) -m navbook screenshots book/_build/html book/_build/screenshots --width 1400
 
 # The daily tier: lint, then the library tests not marked slow (pyproject markers), in two processes.
 check: $(STAMP)
-	@$(VENV)/bin/ruff check navlib tests benchmarks
+	@$(VENV)/bin/ruff check navlib book/navbook tests benchmarks
 	@$(PY) -m pytest -q tests -p no:cacheprovider -m "not slow" $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # The library tests and nbval run at the same time (each is CPU-bound only part of the time: together they
@@ -80,18 +80,18 @@ test-lib: $(STAMP)
 # work; the numbers do not depend on it (TEST_WORKERS=1: one at a time).
 test-notebooks: $(STAMP)
 	@rm -rf $(GENERATED)/results
-	@$(PY) -m navlib.booktools compile
+	@$(PY) -m navbook compile
 	@NAVBOOK_RESULTS_DIR=$(CURDIR)/$(GENERATED)/results $(PY) -m pytest -q -p no:cacheprovider --nbval \
 	    --nbval-current-env --nbval-sanitize-with notebooks/sanitize.cfg notebooks \
 	    $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # The fresh results files against the committed references notebooks/results/<chapter>.json (make notebooks).
 test-results: $(STAMP)
-	@$(PY) -m navlib.booktools check-results --fresh $(GENERATED)/results --reference notebooks/results $(NOTEBOOKS)
+	@$(PY) -m navbook check-results --fresh $(GENERATED)/results --reference notebooks/results $(NOTEBOOKS)
 
 notebooks: $(STAMP)
-	@$(PY) -m navlib.booktools compile
-	@$(PY) -m navlib.booktools execute --in-place $(NOTEBOOKS)
+	@$(PY) -m navbook compile
+	@$(PY) -m navbook execute --in-place $(NOTEBOOKS)
 
 bench: $(STAMP)
 	@for b in benchmarks/*.py; do echo "== $$b"; $(PY) $$b; done

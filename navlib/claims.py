@@ -5,7 +5,7 @@ statement of the paper once: its words and where they are, the statistic, bounda
 and, where the paper can be read several ways, the **primary reading** (the most plausible one, with a
 sentence on why) and the dimensions along which the verdict is shown to move.  A chapter's study code
 judges each statement under every reading, noise level or split it runs (one results row each, a
-:class:`navlib.report.Claim`); :func:`evaluate` folds those rows into **one record per register entry**:
+:class:`Claim`); :func:`evaluate` folds those rows into **one record per register entry**:
 the primary row's statistic, interval, boundary, floor and verdict (by the book's one rule,
 :func:`navlib.verdicts.decide`), the other rows as its ``sensitivity`` list, and a summary of how the
 verdict moves across them (and across drawn worlds, e.g. the compass chapter's five drawn compasses).
@@ -23,14 +23,213 @@ from __future__ import annotations
 
 import csv
 import functools
+import math
 import re
 from dataclasses import dataclass
 from typing import Iterable, Mapping
 
+import numpy as np
+
 from . import verdicts
 from .errors import InputError
+from .formatting import fmt, plain
 from .paths import data_path
 
+# ------------------------------------------------------------------------------------- one results row
+@dataclass(frozen=True)
+class Claim:
+    """One claim (the paper's or the book's own) and our verdict on it, under one reading of the paper.
+
+    The verdict is never set by hand: it follows from the statistic's 95 % interval, the ``boundary``
+    and the side on which the claim holds (``holds_when``), the noise ``floor`` of our experiment and
+    whether the statistic is true ``by_construction`` of our simulator, by the one rule of
+    :func:`navlib.verdicts.decide`.
+
+    ``claim``: the claim in a few words; ``paper``: what the paper prints (text with units, or "(not in
+    the paper)" for the book's own claims); ``source``: ``"paper"`` or ``"book"``; ``statistic``: what the
+    interval is of, with its unit; ``estimate``: a :class:`navlib.verdicts.Estimate` (value, interval,
+    rule), None when there is no statistic; ``unit``: the unit shown beside numbers; ``decided_by``: the
+    simulator or method assumptions the verdict depends on; ``why``: the reason in words (required when
+    the claim cannot be judged for lack of a statistic or by construction; otherwise added to the
+    generated reason); ``ours``: an optional short text shown before the interval (e.g. "4.21 vs 9.58
+    deg"); ``key``: a name for the prose (the book's ``glue_claims``); ``volatile``: the statistic is measured on
+    this machine's clock (a timing), so a rerun reproduces its verdict but not its numbers (the results
+    check then compares the verdict and the texts only); ``data``: what the statistic was computed on,
+    ``"simulated"`` (our simulators, the default) or ``"real"`` (real measurements): the book counts
+    claims on real data apart (the glance box, the landing page), with the same wording as the simulated
+    row so the two can be compared."""
+
+    claim: str
+    paper: str
+    reading: str = "as printed"
+    source: str = "paper"
+    statistic: str = ""
+    estimate: verdicts.Estimate | None = None
+    boundary: float | None = None
+    holds_when: str | None = None
+    unit: str = ""
+    floor: verdicts.Floor | None = None
+    by_construction: bool = False
+    decided_by: tuple[str, ...] = ()
+    why: str = ""
+    ours: str = ""
+    key: str = ""
+    spec: str = "{:.3g}"
+    volatile: bool = False
+    margin: float | None = None
+    data: str = "simulated"
+
+    def __post_init__(self):
+        for f in ("claim", "paper", "reading"):
+            if not str(getattr(self, f)).strip():
+                raise InputError(f"Claim.{f} is empty")
+        if self.source not in verdicts.SOURCES:
+            raise InputError(f"Claim.source={self.source!r}: must be 'paper' or 'book'")
+        if self.data not in verdicts.DATA:
+            raise InputError(f"Claim.data={self.data!r}: must be 'simulated' or 'real'")
+        if not isinstance(self.decided_by, tuple) or not all(isinstance(d, str) and d.strip()
+                                                               for d in self.decided_by):
+            raise InputError(f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts")
+        if self.estimate is not None:
+            if not isinstance(self.estimate, verdicts.Estimate):
+                raise InputError(f"Claim.estimate: a navlib.verdicts.Estimate, got "
+                                 f"{type(self.estimate).__name__}")
+            if not str(self.statistic).strip():
+                raise InputError(f"Claim {self.claim!r}: say what the statistic is (with its unit)")
+            if self.boundary is None or not math.isfinite(float(self.boundary)):
+                raise InputError(f"Claim {self.claim!r}: a statistic needs a finite boundary")
+            if self.holds_when not in verdicts.SIDES:
+                raise InputError(f"Claim {self.claim!r}: holds_when={self.holds_when!r}: must be 'above' "
+                                 f"or 'below'")
+        elif not self.why.strip():
+            raise InputError(f"Claim {self.claim!r}: without a statistic, 'why' must say why")
+        if self.by_construction and not self.why.strip():
+            raise InputError(f"Claim {self.claim!r}: true by construction: 'why' must say which setting")
+        if self.floor is not None and not isinstance(self.floor, verdicts.Floor):
+            raise InputError("Claim.floor: a navlib.verdicts.Floor")
+        if self.key and not self.key.isidentifier():
+            raise InputError(f"Claim.key={self.key!r}: use letters, digits and underscores")
+
+    # -- the rule
+    @property
+    def interval(self) -> tuple[float, float] | None:
+        return None if self.estimate is None else self.estimate.interval
+
+    @property
+    def rule(self) -> str:
+        return "no statistic" if self.estimate is None else self.estimate.rule
+
+    def _decision(self) -> tuple[bool | None, str]:
+        return verdicts.decide(self.interval, self.boundary, self.holds_when, self.floor,
+                               self.by_construction, self.margin)
+
+    @property
+    def reproduced(self) -> bool | None:
+        return self._decision()[0]
+
+    @property
+    def basis(self) -> str:
+        return self._decision()[1]
+
+    @property
+    def verdict(self) -> str:
+        return verdicts.verdict_name(*self._decision())
+
+    @property
+    def verdict_label(self) -> str:
+        """The verdict with the case that applies: *cannot be judged: below our noise floor* and the like
+        (:func:`navlib.verdicts.verdict_label`)."""
+        return verdicts.verdict_label(self.reproduced, self.basis, self.reason)
+
+    # -- display
+    def _num(self, v) -> str:
+        return fmt(v, self.spec) + (f" {self.unit}" if self.unit else "")
+
+    def _bound(self) -> str:
+        return fmt(self.boundary, "{:.4g}") + (f" {self.unit}" if self.unit else "")
+
+    @property
+    def boundary_text(self) -> str:
+        if self.boundary is None:
+            return "–"
+        return ("< " if self.holds_when == "below" else "> ") + self._bound()
+
+    @property
+    def interval_text(self) -> str:
+        """``value [lo, hi] unit`` (the 95 % interval), or "–" without a statistic."""
+        e = self.estimate
+        if e is None:
+            return "–"
+        if e.rule == "exact":
+            return self._num(e.value) + " (exact)"
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{fmt(e.value, self.spec)} [{fmt(e.lo, self.spec)}, {fmt(e.hi, self.spec)}]{unit}"
+
+    @property
+    def ours_text(self) -> str:
+        return f"{self.ours}; {self.interval_text}" if self.ours and self.estimate is not None else (
+            self.ours or self.interval_text)
+
+    @property
+    def reason(self) -> str:
+        """Why the verdict is what it is, in words (never empty for *cannot be judged*)."""
+        basis, extra = self.basis, self.why.strip()
+        if basis == "straddles":
+            lo, hi = self.interval
+            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
+                    f"{self._bound()}")
+        elif basis == "noise floor":
+            f = self.floor
+            flo, fhi = f.interval
+            ftext = self._num(f.value) + ("" if flo == fhi else
+                                          f" [{fmt(flo, self.spec)}, {fmt(fhi, self.spec)}]")
+            lo, hi = self.interval
+            text = (f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
+                    f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
+                    f"(set by {f.assumption}); it would need {f.needs}")
+        elif basis == "equivalent":
+            lo, hi = self.interval
+            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] lies within the "
+                    f"equivalence margin {self._bound()} +- {fmt(self.margin, '{:.4g}')}")
+        else:
+            text = ""
+        return "; ".join(t for t in (text, extra) if t)
+
+    def record(self) -> dict:
+        """The claim as stored in a results file (the book's ``write_results``)."""
+        e = self.estimate
+        return {"claim": self.claim, "reading": self.reading, "source": self.source, "paper": self.paper,
+                "ours": self.ours_text, "statistic": self.statistic or None, "unit": self.unit,
+                "rule": self.rule, "estimate": None if e is None else plain(e.value),
+                "interval": None if e is None else [plain(e.lo), plain(e.hi)],
+                "n": None if e is None else int(e.n),
+                "boundary": None if self.boundary is None else plain(self.boundary),
+                "holds_when": self.holds_when,
+                "floor": None if self.floor is None else {"value": plain(self.floor.value),
+                                                          "interval": [plain(v) for v in self.floor.interval],
+                                                          "assumption": self.floor.assumption,
+                                                          "needs": self.floor.needs},
+                "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
+                "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
+                "reason": verdicts.reason_category(self.basis, self.reason),
+                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile),
+                "margin": None if self.margin is None else plain(self.margin), "data": self.data}
+
+
+def method_stats(rms, min_err=None, max_err=None) -> dict:
+    """Headline statistics of one method over seeds: median, 10th and 90th percentile of the RMS error,
+    median of the per-run minimum and maximum error, and the number of seeds (runs)."""
+    r = np.asarray(rms, float)
+    out = {"median_rms": float(np.median(r)), "p10_rms": float(np.quantile(r, 0.1)),
+           "p90_rms": float(np.quantile(r, 0.9)), "n_seeds": int(r.size)}
+    if min_err is not None:
+        out["median_min"] = float(np.median(np.asarray(min_err, float)))
+    if max_err is not None:
+        out["median_max"] = float(np.median(np.asarray(max_err, float)))
+    return out
+
+
+# ------------------------------------------------------------------------------------------- registers
 #: The registers each chapter's rows are judged against (file ``data/claims_<name>.csv``).
 REGISTERS = {"compass": ("paper_a", "patent_b"), "gyro": ("paper_c",), "accelerometer": ("paper_d",),
              "celestial": ("paper_e",), "workbench": ("workbench",)}
@@ -275,7 +474,7 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
     ``why_primary``, ``dimensions`` (the register's sensitivity column), ``source`` (the register's
     origin), the other rows as ``sensitivity`` (each a row record with the same fields) and ``across``
     (:func:`across_text`); an open or not-checkable entry has no statistic and says why.  ``rows`` are
-    :meth:`navlib.report.Claim.record` dicts; ``worlds`` the drawn-world verdicts of the rows, if any.
+    :meth:`Claim.record` dicts; ``worlds`` the drawn-world verdicts of the rows, if any.
 
     Rows judged on real measurements (``"data": "real"``) are kept apart: each judged entry with such
     rows gets a second record, ``"data": "real"``, after every record of simulated rows (which carry

@@ -42,14 +42,7 @@ Commands:
       is checked key by key first (A 3x3, b_ut 3 finite numbers, A's condition number at most 10, ...), and
       the corrected field's median strength against expected_field_strength_ut: beyond 25 % refused (nothing
       written), beyond 10 % a warning line (navlib.workbench.calibration: COND_LIMIT, FIELD_*_REL).
-  grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
-      one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
-      file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
-      statistics, claim verdicts).  DIR is claimed before the first run (a marker file grid.incomplete,
-      created atomically, removed after grid.csv): a second grid on DIR stops with one line, and a grid stopped
-      by an error or Ctrl-C leaves the marker saying DIR is incomplete.  Needs papermill.
-
-rates, compare and grid run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
+rates and compare run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
 variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.  An address that
 does not connect within 5 s, or then does not send dask's handshake within 5 s more (a silent port, another
@@ -79,7 +72,7 @@ shows the full traceback of any error (for bug reports).  The parser needs nothi
 library: ``--help`` answers before the workbench is loaded (:mod:`navlib.commands` holds the commands).  Output into a closed pipe (``| head -1``) ends
 quietly, with status 141 like a process stopped by SIGPIPE.  Ctrl-C prints one line ("interrupted") and
 exits with status 130, like a process stopped by SIGINT; an output folder it stopped half-written keeps its
-marker file (grid.incomplete, loop.incomplete) saying it is incomplete, and the line names it (a folder
+marker file (loop.incomplete) saying it is incomplete, and the line names it (a folder
 nothing was written into yet is removed again: it never looks complete).
 """
 from __future__ import annotations
@@ -89,6 +82,7 @@ import importlib
 import os
 import re
 import sys
+from typing import Callable
 
 from .errors import InputError, UserCodeError
 from .names import (CALIBRATION_MODEL, COMPARE_BIN_DEG, COMPARE_DEFAULT_METHODS, COMPARE_LS_TOLERANCE_DEG,
@@ -209,17 +203,9 @@ def build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument("--workers", type=int, default=None, help=WORKERS_HELP)
     cmp_.add_argument("--scheduler", default=None,
                       help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
-    grid = sub.add_parser("grid", help="run a chapter notebook over a grid of its parameters",
-                          description="one papermill run of NOTEBOOK per point of the grid, each with its own "
-                                      "results file; DIR gets the executed notebooks and grid.csv")
-    grid.add_argument("notebook", help="a notebook with a cell tagged 'parameters'")
-    grid.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2",
-                      help="a parameter and its values (repeat for more parameters)")
-    grid.add_argument("--out", required=True, help="new or empty folder for the outputs")
-    for cmd in (rates, grid):
-        cmd.add_argument("--workers", type=int, default=None, help=WORKERS_HELP)
-        cmd.add_argument("--scheduler", default=None,
-                         help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
+    rates.add_argument("--workers", type=int, default=None, help=WORKERS_HELP)
+    rates.add_argument("--scheduler", default=None,
+                       help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
     rates.add_argument("--json", action="store_true", help="print one JSON object")
     return ap
 
@@ -269,11 +255,21 @@ def site_argument(argv: list[str]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(site_argument(list(sys.argv[1:] if argv is None else argv)))
+    return run_command(args, lambda a: _command(a.command)(a), "navlib")
+
+
+def run_command(args, dispatch: Callable[[argparse.Namespace], int], prog: str) -> int:
+    """Run ``dispatch(args)`` (``args.command`` names the command, ``args.debug`` asks for tracebacks) by
+    the command line's conventions: bad input (:class:`navlib.errors.InputError`, a user file's
+    :class:`navlib.errors.UserCodeError`, an ``OSError``) is one line ``PROG COMMAND: error: ...`` and
+    status 2; a bug is one line and status 1; Ctrl-C is one line and status 130; output into a closed pipe
+    stops quietly (status 141); ``--debug`` lets every error through with its traceback.  Other command
+    lines built on navlib (the book's tooling) use it too."""
     try:
         if args.debug:                              # let every error through with its traceback
-            status = _command(args.command)(args)
+            status = dispatch(args)
         else:
-            status = _run(args)
+            status = _run(args, dispatch, prog)
         sys.stdout.flush()                          # a closed pipe shows here, not at interpreter exit
     except BrokenPipeError:
         # the reader went away (``| head -1``): stop quietly; stdout goes to devnull so that Python's
@@ -285,7 +281,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.debug:                              # the traceback shows where it was
             raise
         # Ctrl-C: one line (and the output folder it left incomplete, if any: navlib.data.tables.FolderClaim)
-        print(f"navlib {args.command}: interrupted{_notes(err)}", file=sys.stderr)
+        print(f"{prog} {args.command}: interrupted{_notes(err)}", file=sys.stderr)
         # CPython remembers a KeyboardInterrupt that passed through an exec() of a string (fastjsonschema
         # compiles nbformat's schema that way) and, under ``python -m``, ends the process by SIGINT after
         # main returned, as if nobody had handled it; an exec of a string that completes resets that memory
@@ -301,20 +297,20 @@ def _notes(err: BaseException) -> str:
     return "".join(f"; {n}" for n in notes if n)
 
 
-def _run(args) -> int:
+def _run(args, dispatch, prog: str) -> int:
     try:
-        return _command(args.command)(args)
+        return dispatch(args)
     except BrokenPipeError:
         raise
     except (InputError, UserCodeError) as err:
-        print(f"navlib {args.command}: error: {err}{_notes(err)}", file=sys.stderr)
+        print(f"{prog} {args.command}: error: {err}{_notes(err)}", file=sys.stderr)
         return 2
     except OSError as err:
         where = f"{err.filename}: " if err.filename else ""
-        print(f"navlib {args.command}: error: {where}{err.strerror or err}{_notes(err)}", file=sys.stderr)
+        print(f"{prog} {args.command}: error: {where}{err.strerror or err}{_notes(err)}", file=sys.stderr)
         return 2
     except Exception as err:                        # a bug, not bad input: one line; --debug shows the traceback
-        print(f"navlib {args.command}: internal error: {type(err).__name__}: {err}".splitlines()[0]
+        print(f"{prog} {args.command}: internal error: {type(err).__name__}: {err}".splitlines()[0]
               + " (run with --debug for the traceback)" + _notes(err), file=sys.stderr)
         return 1
 

@@ -270,16 +270,6 @@ def _compare(args) -> int:
     return 0
 
 
-def _grid(args) -> int:
-    from .grid import run_grid                      # papermill and the notebook machinery: only here
-    rows = run_grid(args.notebook, args.param, args.out, workers=_workers(args), scheduler=args.scheduler)
-    failed = [r for r in rows if r["status"].startswith("failed")]
-    print(f"{len(rows)} runs, {len(rows) - len(failed)} ok; {os.path.join(args.out, 'grid.csv')}")
-    for r in failed:
-        print(f"run {r['run']}: {r['status']}", file=sys.stderr)
-    return 1 if failed else 0
-
-
 #: Command name -> function (the commands ``navlib.cli.build_parser`` offers).
 COMMANDS = {"examples": _examples, "simulate-compass": _simulate_compass, "diagnose": _diagnose, "loop": _loop, "rates": _rates,
-            "grid": _grid, "calibrate": _calibrate, "apply": _apply, "field": _field, "compare": _compare}
+            "calibrate": _calibrate, "apply": _apply, "field": _field, "compare": _compare}

@@ -13,7 +13,7 @@
   install, where the workbench chapter marks its real-data claims not judged).  ``NOTEBOOK_DIR`` (``ROOT /
   "notebooks"``) means something only in a checkout (tests).
 
-Results files go where the caller says (:func:`navlib.report.results_dir`), never into the package.
+Results files go where the caller says (the book's ``navbook.report.results_dir``), never into the package.
 """
 from __future__ import annotations
 

@@ -32,7 +32,7 @@ ratio over the same seeds or runs (:func:`paired_difference`, :func:`paired_rati
 interval (:func:`wilson`); statistics of a real table on a bootstrap over its rows (:func:`bootstrap`); a
 deterministic computation on real data (no randomness anywhere) has a zero-width interval (:func:`exact`).
 
-:func:`decide` is the rule; ``booktools check-results`` calls it again on every stored claim, so a verdict
+:func:`decide` is the rule; the book's ``check-results`` calls it again on every stored claim, so a verdict
 that does not follow from its interval, boundary, side and floor fails the test.
 """
 from __future__ import annotations

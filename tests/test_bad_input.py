@@ -128,7 +128,8 @@ def test_write_never_overwrites(tmp_path, good):
 def test_csv_and_results_writers_share_one_overwrite_rule(tmp_path, good):
     """write_new_csv and report.write_results both create their file through tables.write_new: an existing
     path, even a symbolic link to a file not there yet, is refused with each writer's own one line."""
-    from navlib import report, verdicts
+    from navbook import report
+    from navlib import verdicts
     claim = report.Claim("c", "p", statistic="x, deg", estimate=verdicts.exact(0.5), boundary=1.0,
                          holds_when="below")
     for name, call, says in [

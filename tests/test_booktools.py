@@ -5,7 +5,7 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from navlib.booktools import check_html, missing_figures, strip_metadata
+from navbook.booktools import check_html, missing_figures, strip_metadata
 
 
 def test_check_html_flags_remote_assets(tmp_path):
@@ -43,7 +43,7 @@ def test_missing_figures_detects_plot_cells_without_images():
 
 
 def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
-    from navlib.booktools import execute
+    from navbook.booktools import execute
 
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell("x = 1"))
@@ -57,7 +57,7 @@ def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ the presentation checks of check-html
-from navlib.booktools import (MAX_PRE_CHARS, api_markdown, check_page, check_results, compare_results,  # noqa: E402
+from navbook.booktools import (MAX_PRE_CHARS, api_markdown, check_page, check_results, compare_results,  # noqa: E402
                               navlib_modules, validate_results)
 
 OUT = '<div class="cell_output docutils container">{}</div>'
@@ -122,7 +122,8 @@ def _nb(path, write_call, title="Electronic compass"):
 def _claim(text, reproduced, reading="as printed", source="paper"):
     """A stored claim whose interval gives ``reproduced`` by the rule (boundary 1, holds below)."""
     interval = {True: [0.2, 0.5], False: [1.5, 2.0], None: [0.5, 1.5]}[reproduced]
-    from navlib import report, verdicts
+    from navbook import report
+    from navlib import verdicts
     c = report.Claim(text, "-0.22..0.20 deg", reading=reading, source=source, statistic="rms, deg",
                      estimate=verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20),
                      boundary=1.0, holds_when="below", unit="deg")
@@ -131,10 +132,11 @@ def _claim(text, reproduced, reading="as printed", source="paper"):
 
 def test_api_markdown_lists_every_navlib_module():
     mods = navlib_modules()
-    assert {"navlib.angles", "navlib.report", "navlib.booktools", "navlib.studies.paper_a"} <= set(mods)
+    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.booktools", "navlib.studies.paper_a"} <= set(mods)
+    assert not [m for m in mods if m in ("navlib.report", "navlib.booktools", "navlib.grid")]
     assert "navlib.__main__" not in mods
     md = api_markdown(mods)
-    assert md.count(".. automodule:: navlib.") == len(mods)
+    assert md.count(".. automodule:: ") == len(mods)
 
 
 # ------------------------------------------------------------------ results check
@@ -231,14 +233,14 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, 
     """The kernel writes its results file where execute tells it (a temporary folder in
     $NAVBOOK_RESULTS_DIR, not a library default such as the notebook folder's ./results or the book's
     folder); execute copies it beside the notebook and restores the caller's environment."""
-    from navlib.booktools import execute
-    from navlib.report import RESULTS_ENV
+    from navbook.booktools import execute
+    from navbook.report import RESULTS_ENV
 
     monkeypatch.delenv(RESULTS_ENV, raising=False)
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell(
         "import os\n"
-        "from navlib import report\n"
+        "from navbook import report\n"
         "from navlib import verdicts\n"
         "p = report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
         "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])\n"
@@ -266,7 +268,7 @@ def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
 
 
 def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
-    from navlib.booktools import check_chapter_opening
+    from navbook.booktools import check_chapter_opening
 
     glance = '<div class="admonition"><p class="admonition-title">Results at a glance</p><table></table></div>'
     cell = '<div class="cell docutils container"><pre>n_seeds = 20</pre></div>'
@@ -283,7 +285,7 @@ def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
 
 
 def test_chapter_pages_must_close_with_what_the_chapter_showed():
-    from navlib.booktools import check_chapter_closing
+    from navbook.booktools import check_chapter_closing
 
     def box(title, paper, book=None):
         tallies = f"<p>The paper's claims: {paper[0]} of {sum(paper)} reproduced, {paper[1]} not reproduced, " \
@@ -324,7 +326,7 @@ def test_compare_results_checks_intervals_except_for_a_volatile_timing():
 def test_compare_results_compares_tables_of_records_exactly(tmp_path):
     """write_results(tables=...) writes top-level lists (the compass chapter's "robustness"); a changed or
     missing record is a difference from the reference."""
-    from navlib import report
+    from navbook import report
     claim = report.Claim("c", "p", statistic="x, deg", estimate=None, boundary=0.0, holds_when="above",
                          why="no statistic")
     rows = [{"compass": "C1", "claim": "c", "reading": "r", "verdict": "reproduced"}]
@@ -340,7 +342,7 @@ def test_compare_results_compares_tables_of_records_exactly(tmp_path):
 
 
 def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run():
-    from navlib.booktools import check_api_page
+    from navbook.booktools import check_api_page
     ok = ("<dl><dt>loop SYSTEM FILE.csv --model START [--json] [--report DIR]</dt>"
           "<dd><p>the whole loop</p></dd><dt>field --site LAT,LON [--date YYYY-MM-DD] [--json]</dt></dl>")
     assert check_api_page(ok, cli_page=True) == []
@@ -358,7 +360,7 @@ def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run
 def test_commands_on_the_cli_page_are_run_with_help():
     """Each command the page shows runs ``python -m navlib COMMAND --help`` in a new process: a command
     that fails, or whose help lacks an option the page shows, is a problem."""
-    from navlib.booktools import _help_problems
+    from navbook.booktools import _help_problems
     assert _help_problems({"loop": {"--json", "--report"}, "field": {"--site"}}) == []
     assert _help_problems({"loop": {"--json", "--jsonl"}}) == [
         "'navlib loop --help' does not show --jsonl, which the page shows"]

@@ -75,7 +75,7 @@ def test_claims_and_verdict_table(sw):
     vt = verdict_table(cl)
     assert list(vt.columns) == list(READINGS)
     # the chapter builds this table from the results file's records: same table
-    from navlib.report import read_result, write_results
+    from navbook.report import read_result, write_results
     import tempfile
     with tempfile.TemporaryDirectory() as tmp:
         written = read_result(write_results("compass", claims=cl, folder=tmp))["claims"]

@@ -107,7 +107,9 @@ def test_without_tqdm_a_forced_progress_bar_is_quietly_left_out(monkeypatch):
 
 def test_a_missing_optional_package_is_one_line_naming_the_extra(monkeypatch):
     """dask.distributed, papermill and torch: one message, an InputError (and a ModuleNotFoundError)."""
-    from navlib import _optional, grid
+    from navbook import grid
+
+    from navlib import _optional
     for module in ("distributed", "papermill", "torch"):
         monkeypatch.setitem(sys.modules, module, None)
     with pytest.raises(InputError) as err:
@@ -242,9 +244,9 @@ def test_a_cluster_of_separate_processes_gives_the_same_numbers(reference, remot
     pd.testing.assert_frame_equal(_drift_study(), reference)
 
 
-def run_cli(*args):
+def run_cli(*args, prog="navlib"):
     env = {k: v for k, v in os.environ.items() if k != engine.ENV_SCHEDULER}
-    return subprocess.run([sys.executable, "-m", "navlib", *map(str, args)], capture_output=True, text=True, env=env)
+    return subprocess.run([sys.executable, "-m", prog, *map(str, args)], capture_output=True, text=True, env=env)
 
 
 @pytest.mark.slow
@@ -357,7 +359,7 @@ GYRO = ROOT / "notebooks" / "gyro.ipynb"
     ("goal_kind=", "empty value"), ("n_seeds", "NAME=V1,V2"), ("n_seeds=2,2", "value '2' given twice")])
 @pytest.mark.slow
 def test_cli_grid_refuses_bad_parameters_before_any_run(tmp_path, param, names):
-    r = run_cli("grid", GYRO, "--param", param, "--out", tmp_path / "out", "--workers", "1")
+    r = run_cli("grid", GYRO, "--param", param, "--out", tmp_path / "out", "--workers", "1", prog="navbook")
     assert r.returncode == 2 and names in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert not (tmp_path / "out").exists()
 
@@ -365,9 +367,9 @@ def test_cli_grid_refuses_bad_parameters_before_any_run(tmp_path, param, names):
 @pytest.mark.slow
 def test_cli_grid_refuses_a_folder_with_files_and_says_papermill_is_missing(tmp_path, capsys, monkeypatch):
     (tmp_path / "old.txt").write_text("mine")
-    r = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", tmp_path, "--workers", "1")
+    r = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", tmp_path, "--workers", "1", prog="navbook")
     assert r.returncode == 2 and "not empty" in r.stderr and (tmp_path / "old.txt").read_text() == "mine"
-    from navlib import cli
+    from navbook import cli
     monkeypatch.setitem(sys.modules, "papermill", None)                    # import papermill fails
     assert cli.main(["grid", str(GYRO), "--param", "n_seeds=2", "--out", str(tmp_path / "new"), "--workers", "1"]) == 2
     err = capsys.readouterr().err
@@ -378,7 +380,7 @@ def test_cli_grid_refuses_a_folder_with_files_and_says_papermill_is_missing(tmp_
 def test_cli_grid_runs_a_chapter_on_the_cluster(remote, tmp_path):
     out = tmp_path / "grid"
     r = run_cli("grid", GYRO, "--param", "input_unit=arcmin,deg", "--param", "n_seeds=2", "--out", out,
-                "--scheduler", remote)
+                "--scheduler", remote, prog="navbook")
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""                                                 # the kernels' chatter stays in the runs
     rows = pd.read_csv(out / "grid.csv")
@@ -394,5 +396,5 @@ def test_cli_grid_runs_a_chapter_on_the_cluster(remote, tmp_path):
     nb = json.loads((out / "gyro_002.ipynb").read_text())
     injected = next(c for c in nb["cells"] if "injected-parameters" in c["metadata"].get("tags", []))
     assert 'input_unit = "deg"' in "".join(injected["source"]) and "n_seeds = 2" in "".join(injected["source"])
-    r2 = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", out, "--scheduler", remote)
+    r2 = run_cli("grid", GYRO, "--param", "n_seeds=2", "--out", out, "--scheduler", remote, prog="navbook")
     assert r2.returncode == 2 and "not empty" in r2.stderr                # never writes over earlier outputs

@@ -37,7 +37,9 @@ EXTRA_ONLY = {"torch", "dask", "distributed", "papermill", "nbformat", "nbval", 
               "ipykernel", "sphinx-mathjax-offline", "sphinxcontrib-bibtex", "pytest"}
 #: modules the command line must not import (optional extras and the book's build tooling)
 NOT_IMPORTED = ("torch", "dask", "distributed", "papermill", "nbformat", "myst_nb", "IPython",
-                "navlib.booktools")
+                "navbook")
+#: the book's tooling, which lives in book/navbook and is not part of navlib's wheel
+BOOK_TOOLING = ("navbook", "navlib.booktools", "navlib.report", "navlib.report_style", "navlib.grid")
 
 
 def plain_env() -> dict:
@@ -165,7 +167,9 @@ def test_the_wheel_carries_every_module_and_data_file(wheel):
     assert not missing, f"not in the wheel (add the package to [tool.setuptools] packages): {missing[:5]}"
     data = {p.name for p in (ROOT / "data").iterdir() if p.suffix in (".csv", ".md")}
     assert data and {f"navlib/_data/{n}" for n in data} <= names
-    assert not any(n.startswith(("tests/", "notebooks/", "book/", "data/")) for n in names)
+    assert not any(n.startswith(("tests/", "notebooks/", "book/", "data/", "navbook/")) for n in names)
+    tooling = [n for n in names if n.removesuffix(".py").replace("/", ".") in BOOK_TOOLING]
+    assert not tooling, f"the book's tooling is in navlib's wheel: {tooling}"
 
 
 def test_metadata_needs_no_torch_and_no_book_tooling(metadata):
@@ -255,16 +259,17 @@ def test_a_torch_module_says_which_extra_to_install(installed):
                         "pip install 'navlib[nets]'")
 
 
-def test_results_go_to_the_current_directory_never_into_the_package(installed):
+def test_the_plain_install_has_no_book_tooling_and_judges_claims(installed):
+    """navlib's claims and verdicts work without the book; the book's tooling is not there."""
     python, _, elsewhere = installed
-    code = ("from navlib import report, verdicts; "
-            "c = report.Claim('c', 'p', statistic='x, deg', estimate=verdicts.exact(0.5), boundary=1.0, "
-            "holds_when='below'); print(report.write_results('demo', claims=[c]).resolve())")
-    out = check(run([python, "-c", code], cwd=elsewhere))
-    assert Path(out.stdout.strip()) == (elsewhere / "results" / "demo.json").resolve()
-    again = run([python, "-c", code], cwd=elsewhere)
-    assert again.returncode == 1 and "already there" in again.stderr.strip().splitlines()[-1]
-    shutil.rmtree(elsewhere / "results")
+    probe = ("import importlib.util as u; "
+             f"print([m for m in {BOOK_TOOLING!r} if u.find_spec(m) is not None])")
+    assert check(run([python, "-c", probe], cwd=elsewhere)).stdout.strip() == "[]"
+    code = ("from navlib import verdicts; from navlib.claims import Claim; "
+            "c = Claim('c', 'p', statistic='x, deg', estimate=verdicts.exact(0.5), boundary=1.0, "
+            "holds_when='below'); print(c.verdict)")
+    assert check(run([python, "-c", code], cwd=elsewhere)).stdout.strip() == "reproduced"
+    assert not list(elsewhere.iterdir())
 
 
 def test_the_editable_install_finds_the_data_files_through_importlib_resources(tmp_path):

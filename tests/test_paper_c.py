@@ -8,7 +8,7 @@ import pytest
 from navlib import verdicts
 from navlib.errors import InputError
 from navlib.paths import data_path
-from navlib.report import Claim
+from navlib.claims import Claim
 from navlib.sensors import ins
 from navlib.studies import paper_c as pc
 

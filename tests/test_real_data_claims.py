@@ -9,8 +9,9 @@ from html import unescape
 import nbformat
 import pytest
 
-from navlib import booktools as bt
-from navlib import claims, report, verdicts
+from navbook import booktools as bt
+from navbook import report
+from navlib import claims, verdicts
 from navlib.errors import InputError
 
 HEADER = ",".join(claims.COLUMNS)

@@ -9,8 +9,9 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
-from navlib import report, report_style as rs  # noqa: E402
-from navlib.booktools import shrunk_figures  # noqa: E402
+from navbook import report  # noqa: E402
+from navlib import plotstyle as rs  # noqa: E402
+from navbook.booktools import shrunk_figures  # noqa: E402
 from navlib.errors import InputError  # noqa: E402
 from navlib.workbench.fit import fit_model, simulate  # noqa: E402
 from navlib.workbench.loop import LoopResult, loop, loop_figure, noise_band, staircase_figure, step_labels  # noqa: E402
@@ -41,7 +42,7 @@ def test_panel_grid_rejects_bad_input_naming_the_parameter():
 def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
     monkeypatch.setattr(report, "READABLE_TABLES", False)          # restored after the test
     with plt.rc_context():
-        rs.use_style()
+        report.use_style()
         assert plt.rcParams["font.size"] >= 11 and plt.rcParams["figure.figsize"][0] <= rs.MAX_WIDTH_IN
         assert rs.MAX_WIDTH_IN * rs.DPI <= rs.COLUMN_PX
         fig, axes = rs.panels(2)

@@ -4,7 +4,7 @@ the parameter, what does not convert."""
 import pandas as pd
 import pytest
 
-from navlib import cli, grid
+from navbook import cli, grid
 from navlib.errors import InputError
 from test_robust_outputs import tiny_notebook
 
@@ -73,5 +73,5 @@ def test_the_notebook_gets_numbers_not_text(tmp_path, capsys):
     capsys.readouterr()
     assert cli.main(["grid", str(nb), "--param", "n=4,four", "--out", str(tmp_path / "no"), "--workers", "1"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == ("navlib grid: error: grid: parameter n='four': expected a whole number (the notebook's default "
+    assert err == ("navbook grid: error: grid: parameter n='four': expected a whole number (the notebook's default "
                    "is 2)") and not (tmp_path / "no").exists()

@@ -9,7 +9,9 @@ import time
 
 import pytest
 
-from navlib import cli, commands, grid
+from navbook import cli as book_cli, grid
+
+from navlib import cli, commands
 from navlib.data import broad
 from test_robust_outputs import ENV, FAKE, tiny_notebook
 
@@ -44,7 +46,7 @@ def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, w
     pytest.importorskip("papermill")
     nb = tiny_notebook(tmp_path / "slow.ipynb", parameters="n = 1.0", body=SLOW)
     out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-m", "navlib", "grid", str(nb), "--param", f"n={values}", "--out", str(out),
+    p = subprocess.Popen([sys.executable, "-m", "navbook", "grid", str(nb), "--param", f"n={values}", "--out", str(out),
                           "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
                          start_new_session=True, preexec_fn=_ctrl_c_as_at_a_terminal)
     try:
@@ -56,9 +58,9 @@ def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, w
             p.kill()
     assert p.returncode == cli.INTERRUPTED and len(err.strip().splitlines()) == 1, err
     if left is None:
-        assert err.strip() == "navlib grid: interrupted" and not out.exists()
+        assert err.strip() == "navbook grid: interrupted" and not out.exists()
     else:
-        assert err.strip() == f"navlib grid: interrupted; {out} is incomplete ({grid.MARKER} says so)"
+        assert err.strip() == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)"
         assert sorted(x.name for x in out.iterdir()) == left and not (out / "grid.csv").exists()
         assert "interrupted (Ctrl-C)" in (out / grid.MARKER).read_text()
 
@@ -77,12 +79,12 @@ def test_keyboard_interrupt_in_process(tmp_path, monkeypatch, capsys):
 
     monkeypatch.setattr(grid, "run_point", second_interrupted)
     args = ["grid", str(nb), "--param", "n=1,2", "--out", str(out), "--workers", "1"]
-    assert cli.main(args) == 130
-    assert capsys.readouterr().err == f"navlib grid: interrupted; {out} is incomplete ({grid.MARKER} says so)\n"
+    assert book_cli.main(args) == 130
+    assert capsys.readouterr().err == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)\n"
     # --debug: the traceback shows where it was
     calls.clear()
     with pytest.raises(KeyboardInterrupt):
-        cli.main(["--debug", "grid", str(nb), "--param", "n=1,2", "--out", str(tmp_path / "debug"), "--workers", "1"])
+        book_cli.main(["--debug", "grid", str(nb), "--param", "n=1,2", "--out", str(tmp_path / "debug"), "--workers", "1"])
 
 
 def test_an_interrupted_loop_leaves_no_report_folder(tmp_path, monkeypatch, capsys):

@@ -13,7 +13,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from navlib import cli, commands, engine, grid
+from navbook import cli as book_cli, grid
+
+from navlib import cli, commands, engine
 from navlib.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,7 +64,7 @@ def test_a_second_grid_on_the_same_folder_stops_before_writing(tmp_path, monkeyp
         _wait_for(out / grid.MARKER)
         assert sorted(p.name for p in out.iterdir()) == [grid.MARKER]
         capsys.readouterr()
-        assert cli.main(["grid", str(nb), "--param", "n=3", "--out", str(out), "--workers", "1"]) == 2
+        assert book_cli.main(["grid", str(nb), "--param", "n=3", "--out", str(out), "--workers", "1"]) == 2
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and f"grid --out {out}: another run is writing there" in err, err
         assert sorted(p.name for p in out.iterdir()) == [grid.MARKER]         # the second wrote nothing
@@ -75,13 +77,13 @@ def test_a_second_grid_on_the_same_folder_stops_before_writing(tmp_path, monkeyp
 
 @pytest.mark.slow
 def test_two_grid_processes_started_together_one_writes(tmp_path):
-    """Two real ``navlib grid`` processes on one new folder: one succeeds, the other exits 2 with one line,
+    """Two real ``navbook grid`` processes on one new folder: one succeeds, the other exits 2 with one line,
     and the folder holds the winner's runs only (grid.csv, notebooks, no marker)."""
     pytest.importorskip("papermill")
     nb = tiny_notebook(tmp_path / "tiny.ipynb")
     out = tmp_path / "out"
     values = {"a": "1", "b": "5,6"}
-    procs = {k: subprocess.Popen([sys.executable, "-m", "navlib", "grid", str(nb), "--param", f"n={v}", "--out", str(out),
+    procs = {k: subprocess.Popen([sys.executable, "-m", "navbook", "grid", str(nb), "--param", f"n={v}", "--out", str(out),
                                   "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV)
              for k, v in values.items()}
     done = {k: (p.communicate(timeout=300), p.returncode) for k, p in procs.items()}
@@ -109,7 +111,7 @@ def test_a_grid_that_fails_before_writing_leaves_no_folder(tmp_path, monkeypatch
             if existed:
                 out.mkdir()
             capsys.readouterr()
-            assert cli.main(["grid", str(nb), "--param", "n=3", "--out", str(out), "--scheduler", address]) == 2
+            assert book_cli.main(["grid", str(nb), "--param", "n=3", "--out", str(out), "--scheduler", address]) == 2
             err = capsys.readouterr().err.strip()
             assert len(err.splitlines()) == 1 and "sent no dask handshake" in err, err
             assert out.is_dir() == existed and (not existed or not any(out.iterdir()))
@@ -129,7 +131,7 @@ def test_a_grid_stopped_after_a_run_says_the_folder_is_incomplete(tmp_path, monk
         return FAKE
 
     monkeypatch.setattr(grid, "run_point", second_fails)
-    assert cli.main(["grid", str(nb), "--param", "n=1,2", "--out", str(out), "--workers", "1"]) == 2
+    assert book_cli.main(["grid", str(nb), "--param", "n=1,2", "--out", str(out), "--workers", "1"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.endswith(f"; {out} is incomplete ({grid.MARKER} says so)"), err
     assert sorted(p.name for p in out.iterdir()) == [grid.MARKER, "tiny_001.ipynb"]            # no grid.csv

@@ -452,7 +452,7 @@ def claim_folder(folder: str | os.PathLike, marker: str, *, what: str, label: st
     marker : str
         The marker's file name inside ``folder`` (e.g. ``"grid.incomplete"``).
     what : str
-        Who writes (``"navlib grid"``), for the marker's text.
+        Who writes (``"navbook grid"``), for the marker's text.
     label : str
         What the user gave (``"grid --out"``), the start of every message.
     empty : bool

@@ -6,7 +6,7 @@ the paper's) or where the verdict moves between drawn compasses, only real measu
 module runs the workbench's comparison (:func:`navlib.workbench.compare.compare`, ``navlib compare
 compass``) on BROAD's real level sweeps (Laidig et al. 2021, CC BY 4.0; ``../shared/realdata/broad/level``,
 read there and never copied into the repository) and judges those claims again on them, each as a
-:class:`navlib.report.Claim` with ``data="real"`` and the simulated row's wording.
+:class:`navlib.claims.Claim` with ``data="real"`` and the simulated row's wording.
 
 Two recordings, two questions (:data:`RECORDINGS`):
 
@@ -50,7 +50,7 @@ from .. import verdicts
 from ..errors import InputError, check_param
 from ..methods.compass_methods import LS_MODELS, METHODS, MethodParams
 from ..paths import ROOT
-from ..report import Claim
+from ..claims import Claim
 from ..workbench.compare import CompareResult, compare
 from ..workbench.compare import report_figure as _compare_figure
 from .paper_a import ordering_rate, paired_rms_difference, per_seed
@@ -305,7 +305,7 @@ def _reading(entry: registry.Entry, rec: Recording) -> str:
 
 
 def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
-    """The claims of :func:`real_claim_specs` on each recording, as :class:`navlib.report.Claim` with
+    """The claims of :func:`real_claim_specs` on each recording, as :class:`navlib.claims.Claim` with
     ``data="real"``, the simulated row's wording, the register entry's origin as ``source`` (the paper's
     claim or the book's own comparison), its primary reading (trial 05's rows; the pooled sessions' rows
     add the recording to the reading) and paper A's printed ranges (``paper``, the rows of
@@ -478,7 +478,7 @@ def real_figure(real: RealCompass, paper: pd.DataFrame, key: str = "trial05"):
         spare[0].legend(list(handles.values()), list(handles), loc="center",
                         title=f"{real.recording(key).label}, held out:")
     else:
-        from ..report_style import legend_below
+        from ..plotstyle import legend_below
         legend_below(fig.axes[-1], handles=list(handles.values()), labels=list(handles), ncol=3)
     return fig
 

@@ -27,7 +27,7 @@ from ..methods.compass_methods import (ADE_DEFAULT_RULES, ADE_RULE_READINGS, ELM
                                        fit_method, fitting_units, label, method_id, unit_cost, _rule_reading)
 from ..methods.seeding import sequence
 from .. import verdicts
-from ..report import Claim, method_stats
+from ..claims import Claim, method_stats
 from ..sensors.compass import PAPER_A_EARTH, CompassErrors, simulate_sweep, simulate_train_test
 from ..data.compass_sweeps import split_sweeps
 from .. import engine
@@ -453,7 +453,7 @@ def _rng(r) -> str:
 def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | None = None,
            implied_ut: float | None = None, default_ut: float | None = None,
            floor: pd.DataFrame | None = None) -> list[Claim]:
-    """Paper A's claims, one :class:`navlib.report.Claim` per (claim, reading), judged by the one rule of
+    """Paper A's claims, one :class:`navlib.claims.Claim` per (claim, reading), judged by the one rule of
     :mod:`navlib.verdicts`:
 
     - "X beats Y": the paired difference RMS(Y) - RMS(X) over the same seeds (boundary 0, holds above;
@@ -705,7 +705,7 @@ NOISE_METHODS = tuple(m for m in MAIN_METHODS if not any(m == ade for ade in RUL
 
 def verdict_table(claim_list, readings=None) -> pd.DataFrame:
     """Claims x readings: the verdict of each claim under each reading; ``claim_list`` holds
-    :class:`navlib.report.Claim` objects (:func:`claims`) or the claim records of a results file
+    :class:`navlib.claims.Claim` objects (:func:`claims`) or the claim records of a results file
     (``read_results()["compass"]["claims"]``, the chapter's way); ``readings`` selects and orders the
     columns (default: every reading found).  "-": the claim is not judged in that reading (a reading of
     ADE's rules judges only the claims that involve ADE-BP).  A results file's record carries its other
@@ -748,7 +748,7 @@ def rule_reading_table(claim_list, base: str) -> pd.DataFrame:
 
 
 def results_methods(runs: pd.DataFrame) -> dict:
-    """``{label: method_stats}`` for :func:`navlib.report.write_results` (one label per reading and
+    """``{label: method_stats}`` for the book's ``write_results`` (one label per reading and
     trainer)."""
     return {METHODS[m].label: method_stats(g.rms_deg, g.min_deg, g.max_deg) for m, g in
             runs.groupby("method", sort=False)}

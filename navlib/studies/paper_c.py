@@ -60,7 +60,7 @@ from ..errors import InputError, check_param
 from .. import engine, seeding
 from ..methods.rbf import InputScaler, RBFNet, leave_one_out, newrb, spread_from_gaussian_width
 from ..paths import data_path
-from ..report import Claim, method_stats
+from ..claims import Claim, method_stats
 from ..sensors import ins, thermal_gyro
 
 InputUnit = Literal["deg", "arcmin", "arcsec"]
@@ -1372,7 +1372,7 @@ def _ordinal(n: int) -> str:
 
 
 def claims(params: StudyParams = StudyParams()) -> list[Claim]:
-    """Paper C's claims and our verdicts, one :class:`navlib.report.Claim` per reading of the ambiguous
+    """Paper C's claims and our verdicts, one :class:`navlib.claims.Claim` per reading of the ambiguous
     method (input unit deg or arcmin; goal as MSE, SSE or RMS), each judged by the book's one rule
     (:mod:`navlib.verdicts`).
 
@@ -1403,7 +1403,7 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
 
     Returns
     -------
-    list of navlib.report.Claim
+    list of navlib.claims.Claim
     """
     lim = fact("claimed_accuracy")
     seed = params.sim.seed
@@ -1566,7 +1566,7 @@ def methods_summary(params: StudyParams = StudyParams()) -> dict:
     Returns
     -------
     dict
-        label -> :func:`navlib.report.method_stats` dictionary.
+        label -> :func:`navlib.claims.method_stats` dictionary.
     """
     rows = hot_leave_one_out(params).rows
     x2, y2, _, _ = _hot_xy()
@@ -1924,7 +1924,7 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
 
     Returns
     -------
-    list of navlib.report.Claim
+    list of navlib.claims.Claim
     """
     lim, seed = fact("claimed_accuracy"), params.sim.seed
     x2, y2, x3, y3 = _hot_xy()
@@ -2034,7 +2034,7 @@ def cold_world_claims(params: StudyParams = StudyParams(), workers: int = 1,
 
     Returns
     -------
-    list of navlib.report.Claim
+    list of navlib.claims.Claim
     """
     study = cold_thermal_study(params, workers, scheduler)
     k_r = _k_r_table4()
@@ -2238,7 +2238,7 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
 
     Returns
     -------
-    list of navlib.report.Claim
+    list of navlib.claims.Claim
     """
     lim = fact("claimed_accuracy")
     gain = _unit_position_gain(params)

@@ -36,7 +36,8 @@ import pandas as pd
 
 from scipy import optimize, stats
 
-from .. import engine, report, verdicts
+from .. import engine, verdicts
+from ..claims import Claim, method_stats
 from ..errors import InputError, check_param
 from ..data.tables import Column, read_table
 from ..methods.anfis import AnfisOptions, anfis
@@ -706,7 +707,7 @@ def drift_claims(params: PaperDParams, paper: pd.DataFrame, seeds) -> list:
              "largest |bias drift| of unit A's 0/180 deg bias test against 55 degC", "accel_drift_bias")):
         b = _paper_value(paper, key_p)
         v = d[col].to_numpy()
-        out.append(report.Claim(
+        out.append(Claim(
             f"{what} up to {b:g} mg vs 55 degC", f"{b:g} mg", reading="simulator defaults",
             statistic=f"{where}, median over seeds, mg", estimate=verdicts.median_ci(v), boundary=b,
             holds_when="above", unit="mg", by_construction=True, why=setting,
@@ -754,7 +755,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
     # -- the paper's order (section 5.2, Table 2): one claim per inequality, paired over the same seeds
     for hi, lo, key in (("ANN", "ANFIS", "accel_order_ann"), ("FIS", "ANFIS", "accel_order_fis"),
                         ("ANFIS", best, "accel_order_anfis")):
-        out.append(report.Claim(
+        out.append(Claim(
             f"{hi} RMSE > {lo} RMSE", f"{p_rmse[hi]:.0f} > {p_rmse[lo]:.0f} ug", reading="held-out temperatures",
             statistic=f"RMSE {hi} - RMSE {lo}, held-out temperatures, same seeds, ug",
             estimate=verdicts.paired_difference(test[hi], test[lo]), boundary=0.0, holds_when="above", unit=ug,
@@ -769,7 +770,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
              f"the exact model on the training readings, 1 in {round(1 / floors['train_share'])} its own target"),
             ("test", test, floors["test"], "held-out temperatures", "accel_rmse_test", "sqrt(2) x noise")):
         need = b4 / (f / sigma) if sigma > 0 else float("inf")
-        out.append(report.Claim(
+        out.append(Claim(
             f"{best} RMSE {b4:g} ug", f"{b4:g} ug", reading=reading,
             statistic=f"RMSE of {best} against the measured 55 degC target, {reading}, median over seeds, ug",
             estimate=verdicts.median_ci(tab[best]), boundary=b4, holds_when="below", unit=ug,
@@ -787,7 +788,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
         f = base_ug / floors["test"] if sigma > 0 else float("inf")
         model_ug = np.sqrt(max(base_ug ** 2 - floors["test"] ** 2, 0.0))   # the baseline's error without noise
         need = model_ug / np.sqrt(2.0 * (k ** 2 - 1.0))
-        out.append(report.Claim(
+        out.append(Claim(
             f"{best} 1-2 orders of magnitude better than {base}", f"{p_rmse[base] / b4:.0f}x "
             f"({p_rmse[base]:.0f} vs {b4:g} ug)", reading="held-out temperatures",
             statistic=f"RMSE {base} / RMSE {best}, held-out temperatures, same seeds",
@@ -806,7 +807,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
     p_after = _paper_value(paper, "unit_b_after") * 1000
     fb = floors["unit B max"]
     n_t, n_p = floors["unit B shape"]
-    out.append(report.Claim(
+    out.append(Claim(
         f"second unit compensated to {p_after:g} ug max",
         f"{_paper_value(paper, 'unit_b_before'):.2f} mg -> {p_after:g} ug",
         reading=f"batch spread {params.batch_spread_rel:g}",
@@ -826,7 +827,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
 
     # -- the book's own baseline: what a calibration engineer does first
     phys = "physical (poly K0, K1, K2)"
-    out.append(report.Claim(
+    out.append(Claim(
         f"{best} beats a polynomial K0, K1, K2 calibration", "(not in the paper)", reading="held-out temperatures",
         source="book", statistic=f"RMSE polynomial - RMSE {best}, held-out temperatures, same seeds, ug",
         estimate=verdicts.paired_difference(test[phys], test[best]), boundary=0.0, holds_when="above", unit=ug,
@@ -838,7 +839,7 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
     # -- FIS more accurate than ANN (section 5.2, only through the printed RMSEs): the same paired
     # difference as the order above (kept last so that the first seven claims stay the order, the 4 ug and
     # the two "1-2 orders" claims the chapter's split table shows)
-    out.append(report.Claim(
+    out.append(Claim(
         "ANN RMSE > FIS RMSE", f"{p_rmse['ANN']:.0f} > {p_rmse['FIS']:.0f} ug", reading="held-out temperatures",
         statistic="RMSE ANN - RMSE FIS, held-out temperatures, same seeds, ug",
         estimate=verdicts.paired_difference(test["ANN"], test["FIS"]), boundary=0.0, holds_when="above", unit=ug,
@@ -849,11 +850,11 @@ def claims(err: pd.DataFrame, drift: pd.DataFrame, paper: pd.DataFrame, params: 
 
 
 def method_summary(err: pd.DataFrame, s: str = "test") -> dict:
-    """Per method :func:`navlib.report.method_stats` of the RMSE (ug) over seeds on set ``s``."""
+    """Per method :func:`navlib.method_stats` of the RMSE (ug) over seeds on set ``s``."""
     out = {}
     for m in METHODS:
         g = err[(err["method"] == m) & (err["set"] == s)]
-        out[m] = report.method_stats(1000 * g["RMSE_mg"], None, 1000 * g["ME_mg"])
+        out[m] = method_stats(1000 * g["RMSE_mg"], None, 1000 * g["ME_mg"])
     return out
 
 
@@ -883,7 +884,7 @@ def _paper_rmse_ug(paper: pd.DataFrame) -> dict:
 
 
 def _ratio_claim(test: pd.DataFrame, base: str, k: float, floor_ug: float, sigma: float, paper: pd.DataFrame,
-                 claim: str, paper_text: str, reading: str, decided: tuple, key: str = "") -> report.Claim:
+                 claim: str, paper_text: str, reading: str, decided: tuple, key: str = "") -> Claim:
     """``IAFSA-SCM-ANFIS`` ``k`` times better than ``base``: the paired ratio of the RMSE over the same
     seeds against the boundary ``k``; the floor is the largest ratio the noise lets us show (``base``'s
     median RMSE over ``floor_ug``, the best IAFSA-SCM-ANFIS can show) and what noise ``k`` would need."""
@@ -893,7 +894,7 @@ def _ratio_claim(test: pd.DataFrame, base: str, k: float, floor_ug: float, sigma
     model_ug = np.sqrt(max(base_ug ** 2 - floor_ug ** 2, 0.0))          # the baseline's error without noise
     ratio = floor_ug / sigma if sigma > 0 else np.sqrt(2.0)              # floor per ug of noise
     need = model_ug / (ratio * np.sqrt(k ** 2 - 1.0))
-    return report.Claim(
+    return Claim(
         claim, paper_text, reading=reading,
         statistic=f"RMSE {base} / RMSE {best}, {reading.split(';')[0]}, same seeds",
         estimate=verdicts.paired_ratio(test[base], test[best]), boundary=k, holds_when="above", unit="x",
@@ -958,13 +959,13 @@ def reading_claims(err: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame,
     out = []
     for hi, lo, k in (("ANN", "ANFIS", "order_ann"), ("FIS", "ANFIS", "order_fis"), ("ANFIS", best, "order_anfis"),
                       ("ANN", "FIS", "order_ann_fis")):
-        out.append(report.Claim(
+        out.append(Claim(
             f"{hi} RMSE > {lo} RMSE", f"{p[hi]:.0f} > {p[lo]:.0f} ug", reading=reading,
             statistic=f"RMSE {hi} - RMSE {lo}, test readings, same seeds, ug",
             estimate=verdicts.paired_difference(test[hi], test[lo]), boundary=0.0, holds_when="above", unit="ug",
             decided_by=decided, ours=f"{test[hi].median():.1f} vs {test[lo].median():.1f} ug", key=key(k)))
     b4 = p[best]
-    out.append(report.Claim(
+    out.append(Claim(
         f"{best} RMSE {b4:g} ug", f"{b4:g} ug", reading=reading,
         statistic=f"RMSE of {best} against the measured 55 degC target, test readings, median over seeds, ug",
         estimate=verdicts.median_ci(test[best]), boundary=b4, holds_when="below", unit="ug",
@@ -1054,7 +1055,7 @@ def tuner_claims(err: pd.DataFrame, params: PaperDParams) -> list:
                               "accel_vs_afsa"),
                              ("grid-SCM-ANFIS", "a grid of ra x rb/ra with the same number of genfis2 fits",
                               "accel_vs_grid")):
-        out.append(report.Claim(
+        out.append(Claim(
             f"{best} beats {what}", "(not in the paper)", reading="held-out temperatures", source="book",
             statistic=f"RMSE {other} - RMSE {best}, held-out temperatures, same seeds, ug",
             estimate=verdicts.paired_difference(test[other], test[best]), boundary=0.0, holds_when="above",
@@ -1168,7 +1169,7 @@ def unit_b_spread_claims(ub: pd.DataFrame, params: PaperDParams, paper: pd.DataF
         if np.isclose(s, params.batch_spread_rel):
             continue
         v = g.sort_values("seed")[f"{method} max |e| (ug)"]
-        out.append(report.Claim(
+        out.append(Claim(
             f"second unit compensated to {p_after:g} ug max",
             f"{_paper_value(paper, 'unit_b_before'):.2f} mg -> {p_after:g} ug", reading=f"batch spread {s:g}",
             statistic=f"largest |error| on unit B with unit A's {method}, median over seeds, ug",
@@ -1180,7 +1181,7 @@ def unit_b_spread_claims(ub: pd.DataFrame, params: PaperDParams, paper: pd.DataF
             ours=f"units' difference alone {g['units' + chr(39) + ' difference (ug)'].median():.1f} ug",
             spec="{:.4g}"))
     n = need["spread for 9.3 ug"].dropna()
-    out.append(report.Claim(
+    out.append(Claim(
         f"second unit compensated to {p_after:g} ug max", f"{p_after:g} ug",
         reading="the batch spread it needs (units' difference alone, no noise)", source="paper",
         statistic="batch spread at which unit A's exact model leaves 9.3 ug on unit B's noise-free outputs, "

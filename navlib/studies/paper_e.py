@@ -43,7 +43,8 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 import pandas as pd
 
-from .. import engine, report, verdicts
+from .. import engine, verdicts
+from ..claims import Claim, method_stats
 from ..data.tables import Column, read_table
 from ..errors import InputError, check_param
 from ..methods import kalman as km
@@ -875,7 +876,7 @@ def _time_ratio(t45, t6, ratio_p: float):
     return est, why
 
 
-def claims(data: StudyData) -> list[report.Claim]:
+def claims(data: StudyData) -> list[Claim]:
     """The paper's claims and the book's own, each judged by the one rule of :mod:`navlib.verdicts`.
 
     Paper's: BPKF beats the KF by more than 30 % in level flight with 45 raw gains and with 6 QR features
@@ -906,7 +907,7 @@ def claims(data: StudyData) -> list[report.Claim]:
             held = mode == "held-out"
             est, why = verdicts.attempt(improvement_pct, *_paired(per_run(data, case, mode, "BPKF"),
                                                       per_run(data, case, mode, "KF")))
-            out.append(report.Claim(
+            out.append(Claim(
                 f"BPKF beats KF by > {thr:g} % (level, {feats})", f"> {thr:g} % (with and without QR)",
                 reading="held-out runs" if held else "in-sample (same run): the net scored on its training data",
                 statistic=f"median over runs of the paired improvement 100 (1 - RMS BPKF / RMS KF), {rms3}, %",
@@ -919,7 +920,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     lm45, lm6 = lm_timing_pairs(data)
     est, why = _time_ratio(lm45, lm6, ratio_p)
     ep = data.lm_timing.pivot(index="timing", columns="n_in", values="epochs").sort_index()
-    out.append(report.Claim(
+    out.append(Claim(
         "QR features train an order of magnitude faster (45 vs 6 inputs)",
         f"{t45_p:.4f} s vs {t6_p:.4f} s, average time of one training ({ratio_p:.1f}x)",
         reading="one whole training as MATLAB trains (trainlm, MATLAB defaults, dividerand 70/15/15, "
@@ -936,7 +937,7 @@ def claims(data: StudyData) -> list[report.Claim]:
 
     t45, t6 = timing_pairs(data)
     est, why = _time_ratio(t45, t6, ratio_p)
-    out.append(report.Claim(
+    out.append(Claim(
         "QR features train an order of magnitude faster (45 vs 6 inputs)",
         f"{t45_p:.4f} s vs {t6_p:.4f} s per training ({ratio_p:.1f}x)",
         reading="second reading: time per pass of full-batch Adam (fixed epochs), this machine",
@@ -950,7 +951,7 @@ def claims(data: StudyData) -> list[report.Claim]:
 
     est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "level_raw45", "held-out", "BPKF"),
                                                         per_run(data, "level_qr6", "held-out", "BPKF")))
-    out.append(report.Claim(
+    out.append(Claim(
         "6 QR features no less accurate than 45 raw gains", "not worse, slightly better",
         reading="held-out runs; no tolerance (holds above 0)",
         statistic=f"median over held-out runs of the paired difference RMS 45 inputs - RMS 6 QR, {rms3}, arcsec",
@@ -959,7 +960,7 @@ def claims(data: StudyData) -> list[report.Claim]:
 
     est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "sturn_qr6", "held-out", "BPKF", "yaw"),
                                                         per_run(data, "sturn_qr6_rate", "held-out", "BPKF", "yaw")))
-    out.append(report.Claim(
+    out.append(Claim(
         "Angular-rate inputs improve yaw in S-manoeuvres", "yaw error drops (Figs 6-9)",
         reading="held-out runs, another manoeuvre sequence",
         statistic="median over held-out runs of the paired difference yaw RMS 6 QR - yaw RMS 6 QR + 3 rates, arcsec",
@@ -972,12 +973,12 @@ def claims(data: StudyData) -> list[report.Claim]:
     w9 = per_run(data, "sturn_qr6_rate", "held-out", "BPKF", "worst")
     wkf = per_run(data, "sturn_qr6_rate", "held-out", "KF", "worst")
     est_kf, why_kf = verdicts.attempt(verdicts.median_ci, wkf.to_numpy())
-    kf_claim = report.Claim(
+    kf_claim = Claim(
         f"The plain KF (no network) is within {bound:g} arcsec too", "(not in the paper)", source="book",
         reading="held-out S-turn runs, our device", statistic=worst, estimate=est_kf, boundary=bound,
         holds_when="below", unit="arcsec", decided_by=(device, star), why=why_kf, key="cel_kf_within")
     est, why = verdicts.attempt(verdicts.median_ci, w9.to_numpy())
-    out.append(report.Claim(
+    out.append(Claim(
         f"With rates, attitude error within {bound:g} arcsec (1 sigma)", f"<= {bound:g} arcsec (1 sigma)",
         reading="held-out runs, our device", statistic=worst, estimate=est, boundary=bound, holds_when="below",
         unit="arcsec", ours=f"9-input BPKF (plain KF {float(np.median(wkf)):.2f} arcsec)",
@@ -986,7 +987,7 @@ def claims(data: StudyData) -> list[report.Claim]:
 
     est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "sturn_raw45", "held-out", "BPKF"),
                                                                      per_run(data, "sturn_qr6", "held-out", "BPKF")))
-    out.append(report.Claim(
+    out.append(Claim(
         "QR keeps the gain's features; more inputs overfit (conclusion 3, S-turns)",
         "6 QR no worse than 45 raw gains", reading="held-out S-turn runs, another manoeuvre sequence; no tolerance",
         statistic=f"median over held-out runs of the paired difference RMS 45 raw - RMS 6 QR, {rms3}, arcsec",
@@ -997,7 +998,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         held = mode == "held-out"
         est, why = verdicts.attempt(improvement_pct, *_paired(per_run(data, "level_resid3", mode, "BPKF"),
                                                               per_run(data, "level_resid3", mode, "KF")))
-        out.append(report.Claim(
+        out.append(Claim(
             "Features built from the filter residual are not effective (level)",
             "not effective (the paper's rejected variant)",
             reading=("held-out runs" if held else "in-sample (same run): the net scored on its training data")
@@ -1013,7 +1014,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     for angle, tag in (("all", ""), ("yaw", "_yaw")):
         est, why = verdicts.attempt(improvement_pct, *_paired(per_run(data, "sturn_qr6", "held-out", "BPKF", angle),
                                                               per_run(data, "sturn_qr6", "held-out", "KF", angle)))
-        out.append(report.Claim(
+        out.append(Claim(
             no_rate["claim"] + ("" if angle == "all" else ", yaw alone"), no_rate["paper"],
             reading=f"held-out runs, another manoeuvre sequence, gyro scale factor {sp.gyro_scale_ppm:g} ppm",
             statistic=no_rate["statistic"].format("RMS over the three angles per run" if angle == "all" else "yaw RMS"),
@@ -1033,7 +1034,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         what = "yaw" if angle == "yaw" else "three-angle"
         est, why = verdicts.attempt(verdicts.paired_ratio, *_paired(phase_per_run(data, method, "turning", angle),
                                                                     phase_per_run(data, method, "steady", angle)))
-        out.append(report.Claim(
+        out.append(Claim(
             TURN_CLAIM + suffix, "accuracy drops while the yaw axis manoeuvres (Fig 6)",
             reading=f"held-out runs, another manoeuvre sequence, gyro scale factor {sp.gyro_scale_ppm:g} ppm",
             statistic=turn_stat.format(what, what, method), estimate=est, boundary=1.0, holds_when="above",
@@ -1046,7 +1047,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         tag = _level_key(level)
         est, why = verdicts.attempt(improvement_pct, *_paired(sweep_per_run(data, level, "BPKF 6 QR + 3 rates"),
                                                               sweep_per_run(data, level, "KF")))
-        out.append(report.Claim(
+        out.append(Claim(
             f"BPKF beats KF by > {thr:g} % (S-turns, 6 QR + 3 rates), scale factor {level:g} ppm",
             f"> {thr:g} %", reading=f"held-out S-turn runs, gyro scale factor {level:g} ppm",
             statistic=f"median over held-out runs of the paired improvement 100 (1 - RMS BPKF / RMS KF), {rms3}, %",
@@ -1056,7 +1057,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         est, why = verdicts.attempt(verdicts.paired_difference,
                                     *_paired(sweep_per_run(data, level, "BPKF 6 QR", "yaw"),
                                              sweep_per_run(data, level, "BPKF 6 QR + 3 rates", "yaw")))
-        out.append(report.Claim(
+        out.append(Claim(
             f"Angular-rate inputs improve yaw in S-manoeuvres, scale factor {level:g} ppm", "yaw error drops",
             reading=f"held-out S-turn runs, gyro scale factor {level:g} ppm",
             statistic="median over held-out runs of the paired difference yaw RMS 6 QR - yaw RMS 6 QR + 3 rates, arcsec",
@@ -1065,7 +1066,7 @@ def claims(data: StudyData) -> list[report.Claim]:
             key=f"cel_sw_rates_{tag}"))
         est, why = verdicts.attempt(improvement_pct, *_paired(sweep_per_run(data, level, "BPKF 6 QR"),
                                                               sweep_per_run(data, level, "KF")))
-        out.append(report.Claim(
+        out.append(Claim(
             f"{no_rate['claim']}, scale factor {level:g} ppm", no_rate["paper"],
             reading=f"held-out S-turn runs, gyro scale factor {level:g} ppm",
             statistic=no_rate["statistic"].format(rms3), estimate=est, boundary=thr, holds_when="below", unit="%",
@@ -1075,7 +1076,7 @@ def claims(data: StudyData) -> list[report.Claim]:
             est, why = verdicts.attempt(verdicts.paired_ratio, *_paired(
                 phase_per_run(data, "BPKF 6 QR", "turning", "yaw", level, sp.sweep_repeats),
                 phase_per_run(data, "BPKF 6 QR", "steady", "yaw", level, sp.sweep_repeats)))
-            out.append(report.Claim(
+            out.append(Claim(
                 f"{TURN_CLAIM}, scale factor {level:g} ppm", "accuracy drops while the yaw axis manoeuvres (Fig 6)",
                 reading=f"held-out S-turn runs, gyro scale factor {level:g} ppm",
                 statistic=turn_stat.format("yaw", "yaw", "BPKF 6 QR"), estimate=est, boundary=1.0,
@@ -1087,7 +1088,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     out.append(kf_claim)
     est, why = verdicts.attempt(verdicts.paired_difference, *_paired(per_run(data, "sturn_qr6_rate", "held-out", "BPKF"),
                                                                      per_run(data, "sturn_raw45", "held-out", "BPKF")))
-    out.append(report.Claim(
+    out.append(Claim(
         "In S-turns the 45 raw gains beat 6 QR + 3 rates (against conclusion 3)", "(not in the paper)",
         source="book", reading="held-out S-turn runs; no tolerance (holds above 0)",
         statistic=f"median over held-out runs of the paired difference RMS 6 QR + 3 rates - RMS 45 raw, {rms3}, arcsec",
@@ -1096,7 +1097,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     expected = MISSING_EFFECT if sp.gyro_scale_ppm else "none"
     gr = data.glr_runs[data.glr_runs["kind"] == "s_turns"]
     k, n = int((gr["named"] == expected).sum()), int(len(gr))
-    out.append(report.Claim(
+    out.append(Claim(
         "The innovations name the missing effect in most runs", "(not in the paper)", source="book",
         reading="GLR test on each S-turn run alone (train and test runs)",
         statistic=f"rate of runs in which the test (Bonferroni, alpha 0.01) names {expected}",
@@ -1110,7 +1111,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     blind = (f"star-sensor time offset {lat_txt} ms, no gyro scale factor",
              f"yaw S-manoeuvre +-{sp.yaw_amplitude_deg:g} deg", star)
     k, n = int((lat["named"] != "none").sum()), int(len(lat))
-    out.append(report.Claim(
+    out.append(Claim(
         "With an effect outside its candidates the innovation test names none of them", "(not in the paper)",
         source="book", reading=f"star-sensor time offset ({lat_txt} ms); GLR test on each S-turn run alone",
         statistic="rate of runs in which the test (Bonferroni, alpha 0.01) names a candidate (every name is wrong)",
@@ -1118,7 +1119,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         ours=f"{k}/{n} runs", decided_by=blind, why="" if n else "no runs with a time offset",
         key="cel_blind_named"))
     k, n = int(lat["flagged"].sum()), int(len(lat))
-    out.append(report.Claim(
+    out.append(Claim(
         "The generalised innovation test flags the time offset", "(not in the paper)", source="book",
         reading=f"star-sensor time offset ({lat_txt} ms); innovations regressed on rates and their derivatives",
         statistic="rate of S-turn runs in which the generalised test (alpha 0.01) flags structure",
@@ -1127,7 +1128,7 @@ def claims(data: StudyData) -> list[report.Claim]:
         key="cel_blind_flag"))
     quiet = _diag(data, False)
     k, n = int(quiet["flagged"].sum()), int(len(quiet))
-    out.append(report.Claim(
+    out.append(Claim(
         "The generalised test is quiet when nothing is missing", "(not in the paper)", source="book",
         reading="no scale factor, no time offset; S-turn runs each alone",
         statistic="rate of runs in which the generalised test (alpha 0.01) flags structure (false alarms)",
@@ -1141,7 +1142,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     own = d[(d["level_ppm"] == float(sp.gyro_scale_ppm)) & (d["latency_ms"] == float(sp.star_latency_ms))
             & (d["runs"] == "test")]
     ko, no = int(own["flagged_aug"].sum()), int(len(own))
-    out.append(report.Claim(
+    out.append(Claim(
         "Adding the scale-factor states leaves the time offset's structure in place", "(not in the paper)",
         source="book",
         reading=f"star-sensor time offset ({lat_txt} ms); generalised test on the augmented KF, held-out runs",
@@ -1154,7 +1155,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     est, why = verdicts.attempt(verdicts.paired_difference,
                     *_paired(per_run(data, "sturn_qr6_rate", "held-out", "BPKF"),
                              per_run(data, "sturn_qr6_rate", "held-out", "augmented KF")))
-    out.append(report.Claim(
+    out.append(Claim(
         "The filter with scale-factor states matches or beats the 9-input BPKF", "(not in the paper)",
         source="book", reading="held-out runs; no tolerance (holds above 0)",
         statistic=f"median over held-out runs of the paired difference RMS 9-input BPKF - RMS augmented KF, {rms3}, arcsec",
@@ -1164,7 +1165,7 @@ def claims(data: StudyData) -> list[report.Claim]:
     return out
 
 
-def _loop_claims(data: StudyData, star: str) -> list[report.Claim]:
+def _loop_claims(data: StudyData, star: str) -> list[Claim]:
     """The book's claims on the decision rule (:func:`navlib.methods.kalman.innovation_loop`), each a Wilson
     rate over S-turn runs each alone (train and test runs): with an effect outside the candidates (time
     offset, rate-proportional error) it names none; with the study's gyro scale factor it names it; with
@@ -1178,7 +1179,7 @@ def _loop_claims(data: StudyData, star: str) -> list[report.Claim]:
     lat_txt = ", ".join(f"{v:g}" for v in sp.latency_ms_levels)
     sm_txt = ", ".join(f"{v:g}" for v in sp.smear_levels_arcsec_per_deg_s)
     est = verdicts.wilson(k, n) if n else None
-    out.append(report.Claim(
+    out.append(Claim(
         "With effects outside its candidates the filter loop names none of them", "(not in the paper)",
         source="book",
         reading=(f"star-sensor time offset ({lat_txt} ms) and rate-proportional error ({sm_txt} arcsec per "
@@ -1196,7 +1197,7 @@ def _loop_claims(data: StudyData, star: str) -> list[report.Claim]:
               & (_smear(own) == float(sp.star_smear_arcsec_per_deg_s))]
     expected = MISSING_EFFECT if sp.gyro_scale_ppm else km.NOTHING
     k, n = int((own["decision"] == expected).sum()), int(len(own))
-    out.append(report.Claim(
+    out.append(Claim(
         "The filter loop names the gyro scale factor and its state removes the structure", "(not in the paper)",
         source="book", reading=f"gyro scale factor {sp.gyro_scale_ppm:g} ppm; the loop on each S-turn run alone",
         statistic=f"rate of runs in which {rule} answers {expected}",
@@ -1206,7 +1207,7 @@ def _loop_claims(data: StudyData, star: str) -> list[report.Claim]:
         why="" if n else "no S-turn runs", key="cel_loop_named"))
     quiet = _diag(data, False)
     k, n = int((quiet["decision"] != km.NOTHING).sum()), int(len(quiet))
-    out.append(report.Claim(
+    out.append(Claim(
         "With nothing missing the filter loop answers nothing missing", "(not in the paper)", source="book",
         reading="no scale factor, no star-sensor error; the loop on each S-turn run alone",
         statistic=f"rate of runs in which {rule} names a candidate or finds structure (false alarms)",
@@ -1398,7 +1399,7 @@ def method_summary(data: StudyData) -> dict:
         kind = "level" if case.startswith("level") else "S-turns"
         label = {"KF": f"KF ({kind})", "augmented KF": "augmented KF (S-turns)"}.get(
             method, f"BPKF {CASE_LABEL[case].split(' (')[0]}")
-        out[label] = report.method_stats(grp["rms_arcsec"].to_numpy())
+        out[label] = method_stats(grp["rms_arcsec"].to_numpy())
     return out
 
 

@@ -21,7 +21,7 @@ from ..methods.seeding import generators
 from ..sensors.compass import heading_from_field
 from ..sensors.planar import fit_planar_model
 from .. import engine, verdicts
-from ..report import Claim
+from ..claims import Claim
 from .paper_a import (ELM_METHODS, LS_MODELS, METHODS, TRAINING_ONLY, StudyParams, Sweeps, _ls_assumption,
                       fit_method, method_id,
                       paired_seed_difference, per_seed, rms_deg)

@@ -26,7 +26,7 @@ from ..data.gyro_tables import drift_measurements
 from ..methods.ellipsoid import lm_ellipsoid
 from ..paths import ROOT, data_path
 from .. import engine, verdicts
-from ..report import Claim
+from ..claims import Claim
 from ..workbench.diagnose import DEFAULT_ALPHA, diagnose
 from ..workbench.effects import CATALOGUES
 from ..workbench.fit import effect_rms, fit_model, load, simulate

@@ -613,7 +613,7 @@ def report_figure(result: CompareResult):
     columns), the run of median RMS, the test rows of each fold in their own colour and no line across a gap
     wider than :data:`GAP_DEG`: paper A's Figs 3 and 4 drawn for the user's file."""
     import matplotlib.pyplot as plt
-    from ..report_style import legend_below, panels
+    from ..plotstyle import legend_below, panels
 
     t = result.table()
     n = len(t) + (len(t) % 2 if len(t) > 1 else 0)          # an even count: two columns
@@ -646,7 +646,7 @@ def write_report(result: CompareResult, paths) -> tuple[Path, Path]:
     """Write the claimed files (:func:`claimed_report`): ``compare.md`` (the folds, the table, what was not
     run, the verdict rule) and ``compare.png`` (:func:`report_figure`)."""
     import matplotlib.pyplot as plt
-    from ..report_style import DPI
+    from ..plotstyle import DPI
 
     md, png = (Path(p) for p in paths)
     fig = report_figure(result)

@@ -259,11 +259,11 @@ def staircase_figure(result, ax=None, title: str | None = None,
                      legend: bool = True):
     """The loop as a picture, full column width: a staircase with one step per effect added (labelled
     with the effect), the rms after each step on a log axis, the held-out rms as a marker (none for a loop
-    without a held-out set) and the noise floor as a band (:func:`navlib.report_style.staircase`).
+    without a held-out set) and the noise floor as a band (:func:`navlib.plotstyle.staircase`).
     ``result`` is a :class:`LoopResult` (the band as in :func:`staircase_of`) or a :class:`Staircase`
     (``title`` then replaces its title).  Draws on ``ax`` if given (``legend=False``: no legend, e.g. for
     :func:`staircase_grid`); returns the figure."""
-    from .. import report_style as rs
+    from .. import plotstyle as rs
 
     st = result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
     own = ax is None
@@ -293,7 +293,7 @@ def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
     across the column width, one legend below the grid; tick labels are the effects added (without the
     ``+``), slanted where they do not fit.  Returns the figure."""
     import matplotlib.pyplot as plt
-    from .. import report_style as rs
+    from .. import plotstyle as rs
 
     items = [(k, v if isinstance(v, Staircase) else staircase_of(v)) for k, v in dict(staircases).items()]
     if not items:
@@ -330,7 +330,7 @@ def report_figure(result: LoopResult):
     below that the residuals at each step (legends below each panel, short labels: the steps are named on
     the staircase)."""
     import matplotlib.pyplot as plt
-    from .. import report_style as rs
+    from .. import plotstyle as rs
 
     with plt.rc_context(rs.RC):
         fig = plt.figure(figsize=(rs.MAX_WIDTH_IN, 10.6), layout="constrained")
@@ -432,7 +432,7 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
     import matplotlib.pyplot as plt                 # report_figure made the figure through pyplot: release it
-    from ..report_style import DPI
+    from ..plotstyle import DPI
     fig = report_figure(result)
     fig.savefig(png, dpi=DPI)
     plt.close(fig)

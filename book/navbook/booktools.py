@@ -2,7 +2,7 @@
 landing page's status table and the API page's module list, check the chapters' results files, and take
 screenshots of every page.
 
-Subcommands of ``python -m navlib.booktools``:
+Subcommands of ``python -m navbook``:
 
 ``execute --out book/_generated notebooks/*.ipynb``
     Execute each notebook with papermill into the book's generated folder (one progress line per notebook);
@@ -33,7 +33,6 @@ Subcommands of ``python -m navlib.booktools``:
 """
 from __future__ import annotations
 
-import argparse
 import base64
 import csv
 import fcntl
@@ -52,9 +51,10 @@ import time
 from html.parser import HTMLParser
 from pathlib import Path
 
-from . import claims as claims_mod
-from . import verdicts
-from .errors import InputError
+from navlib import claims as claims_mod
+from navlib import verdicts
+from navlib.errors import InputError
+
 from .report import RESULTS_ENV, read_results, reading_label
 from .report import record_label as report_label
 
@@ -351,7 +351,7 @@ def check_page(text: str, content: bool = True) -> list[str]:
 
 
 GLANCE = "Results at a glance"
-#: The admonition that closes every chapter (:func:`navlib.report.showed`).
+#: The admonition that closes every chapter (:func:`navbook.report.showed`).
 SHOWED = "What this chapter showed"
 #: The known problems of the :data:`LAYOUT_KINDS` per page, in the book folder (``book/``).
 BASELINE_FILE = "check_html_baseline.json"
@@ -491,7 +491,7 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
         out.append(f"{n} description(s) split into a 'Type:' field")
     if not cli_page:
         return out
-    from .cli import build_parser
+    from navlib.cli import build_parser
     sub = next(a for a in build_parser()._actions if a.dest == "command").choices
     body = html.unescape(re.sub(r"<[^>]+>", "", re.sub(r"</(?:p|dt|dd|li|pre|div)>|<br\s*/?>", "\n", text)))
     shown: dict[str, set] = {}
@@ -867,7 +867,7 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
                       sources: dict[str, tuple[str, str]] | None = None) -> str:
     """The landing page's per-reading rows (MyST markdown): one dropdown per chapter, in the order of
-    ``notebooks``, with a row per source and reading (its readable label, :func:`navlib.report.reading_label`): claims,
+    ``notebooks``, with a row per source and reading (its readable label, :func:`navbook.report.reading_label`): claims,
     reproduced, not reproduced, and cannot be judged with the cases that apply."""
     parts = ["(status-by-reading)=", "## Claims by reading", "",
              "Where a paper's method or claim can be read in more than one way, each reading is judged on its "
@@ -925,12 +925,18 @@ def write_status(results_dir: Path, notebooks_dir: Path, out: Path, toc: Path | 
 
 # ------------------------------------------------------------------------------------------ API page
 def navlib_modules() -> list[str]:
-    """Every module of the ``navlib`` package (``__main__`` excluded), top-level modules first."""
+    """Every module of the ``navlib`` package, then of the book's tooling ``navbook`` (``__main__``
+    excluded), top-level modules first."""
     import navlib
 
-    names = [m.name for m in pkgutil.walk_packages(navlib.__path__, "navlib.")
-             if not m.name.endswith("__main__")]
-    return sorted(names, key=lambda n: (n.count("."), n))
+    import navbook
+
+    names = []
+    for pkg in (navlib, navbook):
+        mods = [m.name for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
+                if not m.name.endswith("__main__")]
+        names += sorted(mods, key=lambda n: (n.count("."), n))
+    return names
 
 
 def api_markdown(modules: list[str]) -> str:
@@ -951,10 +957,10 @@ API_LAYERS = (
     ("studies", "Studies: one module per source", ("navlib.studies",)),
     ("data", "Data: loaders with validation", ("navlib.data", "navlib.paths")),
     ("cli", "Command line", ("navlib.cli", "navlib.commands")),
-    ("foundations", "Shared tools: verdicts, results, engine, seeds",
-     ("navlib.verdicts", "navlib.report", "navlib.engine", "navlib.seeding", "navlib.grid", "navlib.angles",
-      "navlib.errors", "navlib._optional")),
-    ("internals", "Build internals (the book's tooling, not part of the user API)", ("navlib.booktools",)),
+    ("foundations", "Shared tools: claims, verdicts, engine, seeds, figure style",
+     ("navlib.claims", "navlib.verdicts", "navlib.formatting", "navlib.plotstyle", "navlib.engine",
+      "navlib.seeding", "navlib.angles", "navlib.errors", "navlib._optional")),
+    ("internals", "The book's tooling (package navbook, not in navlib's wheel)", ("navbook",)),
 )
 
 
@@ -1157,7 +1163,7 @@ def flat_claims(res: dict) -> list[dict]:
 
 
 def validate_results(res: dict, name: str) -> list[str]:
-    """Schema problems of one results file (see ``navlib.report.write_results``)."""
+    """Schema problems of one results file (see ``navbook.report.write_results``)."""
     p = []
     if not isinstance(res, dict):
         return [f"{name}: not a JSON object"]
@@ -1303,7 +1309,7 @@ def check_results(fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: f
         ref_path, fresh_path = ref_dir / f"{chapter}.json", fresh_dir / f"{chapter}.json"
         if not ref_path.exists():
             problems.append(f"{ref_path}: missing reference for {nb}: regenerate it with "
-                            f"'.venv/bin/python -m navlib.booktools execute --in-place {nb}' (or make "
+                            f"'.venv/bin/python -m navbook execute --in-place {nb}' (or make "
                             f"notebooks) and commit it")
             continue
         if not fresh_path.exists():
@@ -1384,13 +1390,16 @@ _HEADLINES_JS = r"""(() => [...document.querySelectorAll('.navbook-headline')].m
   text: (el.innerText || '').trim().slice(0, 80)})))()"""
 
 
+#: A figure displayed below this share of its natural width is flagged (:func:`shrunk_figures`).
+MIN_DISPLAY_SHARE = 0.75
+
+
 def shrunk_figures(figures, min_share: float | None = None) -> list[dict]:
     """The figures displayed below ``min_share`` (default
-    :data:`navlib.report_style.MIN_DISPLAY_SHARE`, 75 %) of their natural width, each
+    :data:`MIN_DISPLAY_SHARE`, 75 %) of their natural width, each
     ``{"heading", "src", "natural_px", "shown_px", "share"}``, from records of the page's images
     (``natural_px``: the image's own width; ``shown_px``: its width on the page).  Images not loaded or
     not shown (a width of 0) are not figures on the page and are skipped."""
-    from .report_style import MIN_DISPLAY_SHARE
 
     limit = MIN_DISPLAY_SHARE if min_share is None else float(min_share)
     if not 0 < limit <= 1:
@@ -1659,7 +1668,7 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         return 1
     if shrunk:
         print(f"screenshots: {sum(map(len, shrunk.values()))} figure(s) on {len(shrunk)} page(s) shown below "
-              f"75 % of their natural width (draw them at most 7.5 in wide: navlib.report.use_style, "
+              f"75 % of their natural width (draw them at most 7.5 in wide: navbook.report.use_style, "
               f"report.panels)", file=sys.stderr)
         return 1
     return 0
@@ -1674,8 +1683,8 @@ def compile_kernels() -> int:
     from dataclasses import replace as _replace                      # noqa: PLC0415
     import numpy as np                                                # noqa: PLC0415
     import pandas as pd                                               # noqa: PLC0415
-    from .methods.de import DEParams                                  # noqa: PLC0415
-    from .studies import paper_a                                      # noqa: PLC0415
+    from navlib.methods.de import DEParams                            # noqa: PLC0415
+    from navlib.studies import paper_a                                # noqa: PLC0415
     t0 = time.perf_counter()
     x = np.linspace(-10.0, 370.0, 24)
     t = np.linspace(0.0, 360.0, 24)
@@ -1687,66 +1696,3 @@ def compile_kernels() -> int:
                                                          "bp_matlab_val", "elm_backtuned"))
     print(f"compiled kernels ready in {time.perf_counter() - t0:.1f} s")
     return 0
-
-
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m navlib.booktools")
-    sub = ap.add_subparsers(dest="cmd", required=True)
-    ex = sub.add_parser("execute", help="execute notebooks with papermill")
-    ex.add_argument("notebooks", nargs="+", type=Path)
-    g = ex.add_mutually_exclusive_group(required=True)
-    g.add_argument("--out", type=Path, help="folder for the executed copies (results go to OUT/results)")
-    g.add_argument("--in-place", action="store_true",
-                   help="re-execute the stored notebooks; store results in notebooks/results")
-    ch = sub.add_parser("check-html", help="check the built pages")
-    ch.add_argument("html_dir", type=Path)
-    ch.add_argument("--baseline", type=Path, default=None,
-                    help="known problems per page (JSON; default: check_html_baseline.json in the book "
-                         "folder, two levels above HTML_DIR, if present)")
-    st = sub.add_parser("status", help="write the landing page's status table from the results files")
-    st.add_argument("results_dir", type=Path)
-    st.add_argument("--notebooks", type=Path, required=True, help="folder of the executed notebooks")
-    st.add_argument("--out", type=Path, required=True)
-    st.add_argument("--toc", type=Path, default=None,
-                    help="the book's _toc.yml (chapter order; default: _toc.yml in OUT's parent folder)")
-    api = sub.add_parser("api-modules", help="write the API page's automodule list")
-    api.add_argument("--out", type=Path, required=True)
-    cr = sub.add_parser("check-results", help="compare fresh results files with the committed references")
-    cr.add_argument("notebooks", nargs="+", type=Path)
-    cr.add_argument("--fresh", type=Path, required=True)
-    cr.add_argument("--reference", type=Path, required=True)
-    cr.add_argument("--rtol", type=float, default=RTOL)
-    cr.add_argument("--atol", type=float, default=ATOL)
-    sub.add_parser("compile", help="compile the numba kernels once (cached on disk)")
-    sc = sub.add_parser("screenshots", help="render every page with headless Chromium")
-    sc.add_argument("html_dir", type=Path)
-    sc.add_argument("out_dir", type=Path)
-    sc.add_argument("--width", type=int, default=1400)
-    sc.add_argument("--chromium", default=None)
-    args = ap.parse_args(argv)
-    try:
-        return _run(args)
-    except InputError as err:
-        print(f"booktools {args.cmd}: {err}", file=sys.stderr)
-        return 2
-
-
-def _run(args) -> int:
-    if args.cmd == "execute":
-        return execute(args.notebooks, args.out, args.in_place)
-    if args.cmd == "check-html":
-        default = Path(args.html_dir).absolute().parents[1] / BASELINE_FILE
-        return check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
-    if args.cmd == "status":
-        return write_status(args.results_dir, args.notebooks, args.out, args.toc)
-    if args.cmd == "api-modules":
-        return write_api(args.out)
-    if args.cmd == "compile":
-        return compile_kernels()
-    if args.cmd == "check-results":
-        return check_results(args.fresh, args.reference, args.notebooks, args.rtol, args.atol)
-    return screenshots(args.html_dir, args.out_dir, args.width, args.chromium)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,11 +1,11 @@
-"""A chapter over a grid of its parameters (``python -m navlib grid NOTEBOOK --param NAME=V1,V2 ... --out DIR``).
+"""A chapter over a grid of its parameters (``python -m navbook grid NOTEBOOK --param NAME=V1,V2 ... --out DIR``).
 
 One papermill run of the notebook per point of the grid (the Cartesian product of the values given), each a
 task of :mod:`navlib.engine` (local worker processes, or the cluster at a scheduler address), each with
 its own results file.  ``DIR`` (new or empty: never written into otherwise) gets
 
 - ``<notebook>_<k>.ipynb``: run ``k``'s executed notebook;
-- ``results/<notebook>_<k>/<chapter>.json``: the results file it wrote (:func:`navlib.report.write_results`);
+- ``results/<notebook>_<k>/<chapter>.json``: the results file it wrote (:func:`navbook.report.write_results`);
 - ``grid.csv``: one row per run: ``run``, ``notebook``, ``status`` (``ok`` or the failure in one line), the
   parameters, then every method statistic (``<method>: <statistic>``) and every claim's verdict and
   estimate (``<claim id>: verdict``, ``<claim id>: estimate``: the claims-register id, the verdict under
@@ -50,10 +50,11 @@ import time
 from pathlib import Path
 from typing import Any
 
-from . import engine
-from ._optional import require
-from .data.tables import claim_folder, write_new
-from .errors import InputError
+from navlib import engine
+from navlib._optional import require
+from navlib.data.tables import claim_folder, write_new
+from navlib.errors import InputError
+
 from .report import RESULTS_ENV
 
 #: Parameters a grid sets in every run unless the user sets them (notebooks that have them).

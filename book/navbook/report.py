@@ -3,7 +3,7 @@ figures, the chapter's claims with their verdicts, and the headline results file
 
 A chapter notebook uses it like this::
 
-    from navlib import report
+    from navbook import report
     report.use_style()      # figures for the 756 px column, 11-12 pt;
                             # tables with readable labels
     # an HTML table (text/plain kept for nbval)
@@ -39,13 +39,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-import numpy as np
 import pandas as pd
 
-from . import claims as registry
-from . import verdicts
-from .data.tables import write_new
-from .errors import InputError
+from navlib import claims as registry
+from navlib import verdicts
+from navlib.claims import Claim, method_stats  # noqa: F401  (the chapters' API: report.Claim, report.method_stats)
+from navlib.data.tables import write_new
+from navlib.errors import InputError
+from navlib.formatting import fmt, plain  # noqa: F401  (report.fmt, report.plain)
+from navlib import plotstyle
+# The figure style, for the chapters as report.panels(...), report.legend_below(...):
+from navlib.plotstyle import legend_below, legend_right, panel_grid, panels, staircase  # noqa: F401
 
 #: The environment variable that says where results files go (the book's build sets it to its own folder).
 RESULTS_ENV = "NAVBOOK_RESULTS_DIR"
@@ -61,38 +65,11 @@ _CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflo
 def results_dir() -> Path:
     """The folder results files go to: ``$NAVBOOK_RESULTS_DIR`` if it is set and not empty, else ``results/``
     in the current directory (library use; never a folder of the installed package).  ``make test``
-    sets the variable to ``book/_generated/results``; ``python -m navlib.booktools execute`` (``make book``,
+    sets the variable to ``book/_generated/results``; ``python -m navbook execute`` (``make book``,
     ``make notebooks``) sets it to a temporary folder for each notebook and copies the files written there
     to ``book/_generated/results`` (or ``notebooks/results``)."""
     env = os.environ.get(RESULTS_ENV)
     return Path(env) if env else Path.cwd() / "results"
-
-
-# ----------------------------------------------------------------------------------------------- numbers
-def plain(value: Any, digits: int = 6) -> Any:
-    """A JSON- and display-safe Python value: numpy scalars become Python numbers rounded to ``digits``
-    significant digits, NaN becomes None; strings, bools and None pass through."""
-    if value is None or isinstance(value, (str, bool)):
-        return value
-    if isinstance(value, (np.bool_,)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        v = float(value)
-        if not math.isfinite(v):
-            return None
-        return float(f"{v:.{digits}g}")
-    raise InputError(f"cannot store a {type(value).__name__} as a result value")
-
-
-def fmt(value: Any, spec: str = "{:.3g}") -> str:
-    """Format a number for prose or a table cell; NaN/None become an en dash."""
-    if value is None or (isinstance(value, (float, np.floating)) and not math.isfinite(float(value))):
-        return "–"
-    if isinstance(value, (np.floating, np.integer)):
-        value = value.item()
-    return spec.format(value)
 
 
 # ----------------------------------------------------------------------------------------------- tables
@@ -101,7 +78,7 @@ def _breakable(text: str) -> str:
     return re.sub(r"([_/,])(?=\S)", r"\1<wbr>", html.escape(str(text), quote=False))
 
 
-#: Set by :func:`navlib.report_style.use_style`: tables show readable labels (:func:`readable`) unless
+#: Set by :func:`use_style`: tables show readable labels (:func:`readable`) unless
 #: asked otherwise.
 READABLE_TABLES = False
 
@@ -185,7 +162,7 @@ class Table:
 
     ``formats`` maps column names to format strings (``"{:.3f}"``) or callables; unformatted float
     columns get 4 significant digits.  ``caption`` is shown above the table.  ``readable`` (default: on
-    after :func:`navlib.report_style.use_style`) shows the formatted table with readable labels
+    after :func:`use_style`) shows the formatted table with readable labels
     (:func:`readable`: no index-name row, flat row labels, units in parentheses) and no ``-0``;
     ``formats`` still name the original columns.  ``fold`` (a summary line, or True for the caption) puts a
     secondary table in a dropdown on the page, closed until the reader opens it (the plain text is the
@@ -425,190 +402,12 @@ def glue_png(name: str, path) -> None:
     _glue(name, Image(data=Path(path).read_bytes(), format="png"))
 
 
-# The book's figure style (navlib.report_style): use_style() in a chapter's first code cell.
-from .report_style import (legend_below, legend_right, panel_grid, panels,  # noqa: E402,F401
-                           staircase, use_style)
-
-
-# ----------------------------------------------------------------------------------------------- claims
-@dataclass(frozen=True)
-class Claim:
-    """One claim (the paper's or the book's own) and our verdict on it, under one reading of the paper.
-
-    The verdict is never set by hand: it follows from the statistic's 95 % interval, the ``boundary``
-    and the side on which the claim holds (``holds_when``), the noise ``floor`` of our experiment and
-    whether the statistic is true ``by_construction`` of our simulator, by the one rule of
-    :func:`navlib.verdicts.decide`.
-
-    ``claim``: the claim in a few words; ``paper``: what the paper prints (text with units, or "(not in
-    the paper)" for the book's own claims); ``source``: ``"paper"`` or ``"book"``; ``statistic``: what the
-    interval is of, with its unit; ``estimate``: a :class:`navlib.verdicts.Estimate` (value, interval,
-    rule), None when there is no statistic; ``unit``: the unit shown beside numbers; ``decided_by``: the
-    simulator or method assumptions the verdict depends on; ``why``: the reason in words (required when
-    the claim cannot be judged for lack of a statistic or by construction; otherwise added to the
-    generated reason); ``ours``: an optional short text shown before the interval (e.g. "4.21 vs 9.58
-    deg"); ``key``: a name for the prose (:func:`glue_claims`); ``volatile``: the statistic is measured on
-    this machine's clock (a timing), so a rerun reproduces its verdict but not its numbers (the results
-    check then compares the verdict and the texts only); ``data``: what the statistic was computed on,
-    ``"simulated"`` (our simulators, the default) or ``"real"`` (real measurements): the book counts
-    claims on real data apart (the glance box, the landing page), with the same wording as the simulated
-    row so the two can be compared."""
-
-    claim: str
-    paper: str
-    reading: str = "as printed"
-    source: str = "paper"
-    statistic: str = ""
-    estimate: verdicts.Estimate | None = None
-    boundary: float | None = None
-    holds_when: str | None = None
-    unit: str = ""
-    floor: verdicts.Floor | None = None
-    by_construction: bool = False
-    decided_by: tuple[str, ...] = ()
-    why: str = ""
-    ours: str = ""
-    key: str = ""
-    spec: str = "{:.3g}"
-    volatile: bool = False
-    margin: float | None = None
-    data: str = "simulated"
-
-    def __post_init__(self):
-        for f in ("claim", "paper", "reading"):
-            if not str(getattr(self, f)).strip():
-                raise InputError(f"Claim.{f} is empty")
-        if self.source not in verdicts.SOURCES:
-            raise InputError(f"Claim.source={self.source!r}: must be 'paper' or 'book'")
-        if self.data not in verdicts.DATA:
-            raise InputError(f"Claim.data={self.data!r}: must be 'simulated' or 'real'")
-        if not isinstance(self.decided_by, tuple) or not all(isinstance(d, str) and d.strip()
-                                                               for d in self.decided_by):
-            raise InputError(f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts")
-        if self.estimate is not None:
-            if not isinstance(self.estimate, verdicts.Estimate):
-                raise InputError(f"Claim.estimate: a navlib.verdicts.Estimate, got "
-                                 f"{type(self.estimate).__name__}")
-            if not str(self.statistic).strip():
-                raise InputError(f"Claim {self.claim!r}: say what the statistic is (with its unit)")
-            if self.boundary is None or not math.isfinite(float(self.boundary)):
-                raise InputError(f"Claim {self.claim!r}: a statistic needs a finite boundary")
-            if self.holds_when not in verdicts.SIDES:
-                raise InputError(f"Claim {self.claim!r}: holds_when={self.holds_when!r}: must be 'above' "
-                                 f"or 'below'")
-        elif not self.why.strip():
-            raise InputError(f"Claim {self.claim!r}: without a statistic, 'why' must say why")
-        if self.by_construction and not self.why.strip():
-            raise InputError(f"Claim {self.claim!r}: true by construction: 'why' must say which setting")
-        if self.floor is not None and not isinstance(self.floor, verdicts.Floor):
-            raise InputError("Claim.floor: a navlib.verdicts.Floor")
-        if self.key and not self.key.isidentifier():
-            raise InputError(f"Claim.key={self.key!r}: use letters, digits and underscores")
-
-    # -- the rule
-    @property
-    def interval(self) -> tuple[float, float] | None:
-        return None if self.estimate is None else self.estimate.interval
-
-    @property
-    def rule(self) -> str:
-        return "no statistic" if self.estimate is None else self.estimate.rule
-
-    def _decision(self) -> tuple[bool | None, str]:
-        return verdicts.decide(self.interval, self.boundary, self.holds_when, self.floor,
-                               self.by_construction, self.margin)
-
-    @property
-    def reproduced(self) -> bool | None:
-        return self._decision()[0]
-
-    @property
-    def basis(self) -> str:
-        return self._decision()[1]
-
-    @property
-    def verdict(self) -> str:
-        return verdicts.verdict_name(*self._decision())
-
-    @property
-    def verdict_label(self) -> str:
-        """The verdict with the case that applies: *cannot be judged: below our noise floor* and the like
-        (:func:`navlib.verdicts.verdict_label`)."""
-        return verdicts.verdict_label(self.reproduced, self.basis, self.reason)
-
-    # -- display
-    def _num(self, v) -> str:
-        return fmt(v, self.spec) + (f" {self.unit}" if self.unit else "")
-
-    def _bound(self) -> str:
-        return fmt(self.boundary, "{:.4g}") + (f" {self.unit}" if self.unit else "")
-
-    @property
-    def boundary_text(self) -> str:
-        if self.boundary is None:
-            return "–"
-        return ("< " if self.holds_when == "below" else "> ") + self._bound()
-
-    @property
-    def interval_text(self) -> str:
-        """``value [lo, hi] unit`` (the 95 % interval), or "–" without a statistic."""
-        e = self.estimate
-        if e is None:
-            return "–"
-        if e.rule == "exact":
-            return self._num(e.value) + " (exact)"
-        unit = f" {self.unit}" if self.unit else ""
-        return f"{fmt(e.value, self.spec)} [{fmt(e.lo, self.spec)}, {fmt(e.hi, self.spec)}]{unit}"
-
-    @property
-    def ours_text(self) -> str:
-        return f"{self.ours}; {self.interval_text}" if self.ours and self.estimate is not None else (
-            self.ours or self.interval_text)
-
-    @property
-    def reason(self) -> str:
-        """Why the verdict is what it is, in words (never empty for *cannot be judged*)."""
-        basis, extra = self.basis, self.why.strip()
-        if basis == "straddles":
-            lo, hi = self.interval
-            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
-                    f"{self._bound()}")
-        elif basis == "noise floor":
-            f = self.floor
-            flo, fhi = f.interval
-            ftext = self._num(f.value) + ("" if flo == fhi else
-                                          f" [{fmt(flo, self.spec)}, {fmt(fhi, self.spec)}]")
-            lo, hi = self.interval
-            text = (f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
-                    f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
-                    f"(set by {f.assumption}); it would need {f.needs}")
-        elif basis == "equivalent":
-            lo, hi = self.interval
-            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] lies within the "
-                    f"equivalence margin {self._bound()} +- {fmt(self.margin, '{:.4g}')}")
-        else:
-            text = ""
-        return "; ".join(t for t in (text, extra) if t)
-
-    def record(self) -> dict:
-        """The claim as stored in a results file (see :func:`write_results`)."""
-        e = self.estimate
-        return {"claim": self.claim, "reading": self.reading, "source": self.source, "paper": self.paper,
-                "ours": self.ours_text, "statistic": self.statistic or None, "unit": self.unit,
-                "rule": self.rule, "estimate": None if e is None else plain(e.value),
-                "interval": None if e is None else [plain(e.lo), plain(e.hi)],
-                "n": None if e is None else int(e.n),
-                "boundary": None if self.boundary is None else plain(self.boundary),
-                "holds_when": self.holds_when,
-                "floor": None if self.floor is None else {"value": plain(self.floor.value),
-                                                          "interval": [plain(v) for v in self.floor.interval],
-                                                          "assumption": self.floor.assumption,
-                                                          "needs": self.floor.needs},
-                "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
-                "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
-                "reason": verdicts.reason_category(self.basis, self.reason),
-                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile),
-                "margin": None if self.margin is None else plain(self.margin), "data": self.data}
+def use_style() -> None:
+    """The chapter's first call: the figure style of :mod:`navlib.plotstyle` (11-12 pt text, 100 DPI,
+    7.5 in default width), and :func:`table` showing readable labels (:func:`readable`)."""
+    global READABLE_TABLES
+    plotstyle.use_style()
+    READABLE_TABLES = True
 
 
 GLANCE_COLUMNS = ["claim", "reading", "paper", "ours: value [95 % interval]", "boundary", "verdict"]
@@ -1023,19 +822,6 @@ def glue_claims(claims: Iterable[Claim]) -> None:
 
 
 # ----------------------------------------------------------------------------------------------- results
-def method_stats(rms, min_err=None, max_err=None) -> dict:
-    """Headline statistics of one method over seeds: median, 10th and 90th percentile of the RMS error,
-    median of the per-run minimum and maximum error, and the number of seeds (runs)."""
-    r = np.asarray(rms, float)
-    out = {"median_rms": float(np.median(r)), "p10_rms": float(np.quantile(r, 0.1)),
-           "p90_rms": float(np.quantile(r, 0.9)), "n_seeds": int(r.size)}
-    if min_err is not None:
-        out["median_min"] = float(np.median(np.asarray(min_err, float)))
-    if max_err is not None:
-        out["median_max"] = float(np.median(np.asarray(max_err, float)))
-    return out
-
-
 def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = None,
                   methods: Mapping[str, Mapping[str, Any]] | None = None,
                   extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
@@ -1080,7 +866,7 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     if not claims:
         raise InputError(f"write_results({chapter!r}): a chapter states at least one claim")
     if not all(isinstance(c, Claim) for c in claims):
-        raise InputError(f"write_results({chapter!r}): claims must be navlib.report.Claim objects")
+        raise InputError(f"write_results({chapter!r}): claims must be navlib.claims.Claim objects")
     keys = [(c.claim, c.reading) for c in claims]
     both = [(c.claim, c.reading, c.data) for c in claims]
     if len(set(both)) != len(both):

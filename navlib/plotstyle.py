@@ -1,18 +1,17 @@
-"""One figure style for the book: figures drawn for the 756 px content column, legends outside the data,
-multi-panel strips stacked when side by side they would shrink below a readable size, and the workbench
-loop drawn as a staircase.
+"""One figure style for navlib's pictures (the book's chapters and the workbench's ``--report`` pages):
+figures drawn for a 756 px content column, legends outside the data, multi-panel strips stacked when side
+by side they would shrink below a readable size, and the workbench loop drawn as a staircase.
 
-A chapter applies it with one call in its first code cell::
+Applied with one call (the book's chapters call it through their own tooling)::
 
-    from navlib import report
-    report.use_style()          # fonts, sizes and DPI below;
-                                # tables with readable labels (report.readable)
+    from navlib import plotstyle
+    plotstyle.use_style()                      # fonts, sizes and DPI below
 
-and draws its figures with::
+and figures drawn with::
 
-    fig, axes = report.panels(3)            # one row if three panels fit the column,
-                                            # else stacked
-    report.legend_below(axes[0])            # the legend under the axes, never over the data
+    fig, axes = plotstyle.panels(3)            # one row if three panels fit the column,
+                                               # else stacked
+    plotstyle.legend_below(axes[0])            # the legend under the axes, never over the data
 
 **Sizes.**  The book's content column is :data:`COLUMN_PX` = 756 px wide at 1400 px; a figure is shown at
 its natural size when it is at most that wide, so figures are at most :data:`MAX_WIDTH_IN` = 7.5 in at
@@ -41,8 +40,6 @@ MAX_WIDTH_IN = 7.5
 MIN_PANEL_IN = 3.4
 #: Height of one panel (in) when panels are stacked or in one row.
 PANEL_HEIGHT_IN = 3.2
-#: A figure displayed below this share of its natural width is flagged by ``booktools screenshots``.
-MIN_DISPLAY_SHARE = 0.75
 
 #: The matplotlib settings of the style (rcParams).
 RC = {"figure.dpi": DPI, "savefig.dpi": DPI, "figure.figsize": (MAX_WIDTH_IN, 3.6),
@@ -53,14 +50,10 @@ RC = {"figure.dpi": DPI, "savefig.dpi": DPI, "figure.figsize": (MAX_WIDTH_IN, 3.
 
 
 def use_style() -> None:
-    """Apply the book's figure style (:data:`RC`: 11-12 pt text, 100 DPI, 7.5 in default width) to
-    matplotlib, and let :func:`navlib.report.table` show readable labels (:func:`navlib.report.readable`)."""
+    """Apply the figure style (:data:`RC`: 11-12 pt text, 100 DPI, 7.5 in default width) to matplotlib."""
     import matplotlib as mpl
 
     mpl.rcParams.update(RC)
-    from . import report
-
-    report.READABLE_TABLES = True
 
 
 def panel_grid(n_panels: int, width_in: float = MAX_WIDTH_IN, min_panel_in: float = MIN_PANEL_IN
