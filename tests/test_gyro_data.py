@@ -7,7 +7,7 @@ import pytest
 from navlib.errors import InputError
 from navlib.data.gyro_tables import (COLUMNS, TABLE_FILES, load_cold_test, load_cold_train, load_hot_test,
     load_hot_train, load_table, load_user_drift)
-from navlib.sensors.ins import LOCAL_LATITUDE_DEG
+from navlib.data.gyro_tables import LOCAL_LATITUDE_DEG
 from navlib.paths import data_path
 
 

@@ -17,8 +17,10 @@ import pandas as pd
 
 from ..errors import InputError
 from ..paths import data_path
-from ..sensors.ins import LOCAL_LATITUDE_DEG
 from .tables import Column, read_table, where
+
+#: Paper C's test site, the local latitude its 12 h latitude outputs are compared with (deg).
+LOCAL_LATITUDE_DEG = 28.222
 
 TABLE_FILES = {
     2: "gyro_table2_hot_train.csv",

@@ -48,11 +48,11 @@ from scipy.optimize import minimize_scalar
 from ..angles import ARCSEC, DEG
 from ..errors import InputError, check_param
 from ..seeding import child, sequence
+from ..data.gyro_tables import LOCAL_LATITUDE_DEG  # paper C, the test site (re-exported: ins.LOCAL_LATITUDE_DEG)
 
 DEG_H = DEG / 3600.0            # 1 deg/h in rad/s
 UG = 9.80665e-6                 # 1 micro-g in m/s^2
 NMI = 1852.0
-LOCAL_LATITUDE_DEG = 28.222     # paper C, the test site
 
 STATE_NAMES = ("phi_E", "phi_N", "phi_U", "dV_E", "dV_N", "dL", "dlon")
 
