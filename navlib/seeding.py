@@ -1,14 +1,21 @@
-"""The one seeding convention of navlib: run ``k`` of a study seeded ``base`` draws from
-``numpy.random.default_rng(np.random.SeedSequence(base).spawn(k + 1)[k])``.
+"""navlib's seeding helpers: every random stream is a child of a ``numpy.random.SeedSequence``, addressed
+by spawn keys, never derived by arithmetic on integers.
 
-A ``SeedSequence`` child is keyed by its index, so run ``k`` gets the same stream whether it is trained
-alone or in a batch with other runs (:func:`generators` builds the batch).  Every stochastic method takes
-its generator from here; nothing derives seeds by arithmetic.
+Run ``k`` of a study seeded ``base`` draws from ``default_rng(SeedSequence(base).spawn(k + 1)[k])``
+(:func:`generators`, :func:`generator`): a ``SeedSequence`` child is keyed by its index, so run ``k`` gets
+the same stream whether it is trained alone or in a batch with other runs.
 
 A task of a Monte Carlo study (:mod:`navlib.engine`) is seeded by its coordinates in the study:
 :func:`sequence` ``(entropy, *key)`` is ``SeedSequence(entropy, spawn_key=key)``, and :func:`child` gives
 the named parts of a task (its data, its training, ...) streams of their own.  Different keys give
 independent streams; where a task ran never changes its seed.
+
+Not every module goes through these helpers: a few simulators spawn their children in place with the same
+rule (``SeedSequence(seed).spawn(n)`` in :mod:`navlib.sensors.compass`, :mod:`navlib.sensors.strapdown`,
+:mod:`navlib.sensors.trajectory`; ``SeedSequence(entropy, spawn_key=...)`` in :mod:`navlib.sensors.ins` and
+some studies).  Rewriting them through :func:`sequence` would give the same streams only where the keys
+agree, and the book's stored numbers depend on them, so they are left as they are and documented where
+they are drawn.
 """
 from __future__ import annotations
 
