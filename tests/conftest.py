@@ -35,8 +35,8 @@ def remote(tmp_path_factory):
     single-threaded worker processes); stopped after the module (test_engine, test_compare)."""
     folder = tmp_path_factory.mktemp("cluster")
     sched_file = folder / "scheduler.json"
-    # the workers import this checkout's navlib, and this module for its helper functions
-    path = [str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]
+    # the workers import this checkout's navlib and navbook, and this module for its helper functions
+    path = [str(ROOT), str(ROOT / "book"), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in path if p),
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     env.pop(engine.ENV_SCHEDULER, None)
