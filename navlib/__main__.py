@@ -16,7 +16,7 @@ def run() -> int:
     """Entry point: one-thread defaults (a value already in the environment wins), then the CLI."""
     for name, value in ONE_THREAD.items():
         os.environ.setdefault(name, value)
-    from .cli import main
+    from .cli import main  # noqa: PLC0415  # lazy: the thread variables must be set before numpy loads
     return main()
 
 

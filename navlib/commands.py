@@ -24,13 +24,14 @@ from .workbench.loop import check_report_folder, loop, write_report
 from .workbench.calibration import apply_file, calibrate_file
 from .workbench.magnetometer_free import FREE_EFFECTS, SYSTEM as FREE_SYSTEM, site_of
 from .workbench.rates import DEFAULT_RATIOS, rates
+from .sensors.earth_field import Site
+from .workbench.calibration import field_lines, model_field
 
 
 def _site_values(args):
     """``(site, date)`` of --site/--date: ``(lat, lon[, height_m])`` or None, the date text or None; each
     checked here, before any work, against the limits of :class:`navlib.sensors.earth_field.Site` (one line
     naming the option)."""
-    from .sensors.earth_field import Site
     site = None
     if args.site is not None:
         site = _numbers("--site", args.site, None)
@@ -53,13 +54,11 @@ def _site_values(args):
 
 def _site(args):
     """The :class:`navlib.sensors.earth_field.Site` of --site/--date (``field``: --site required)."""
-    from .sensors.earth_field import Site
     v, date = _site_values(args)
     return Site(v[0], v[1], v[2] if len(v) == 3 else 0.0, *((date,) if date is not None else ()))
 
 
 def _field(args) -> int:
-    from .workbench.calibration import model_field
     site = _site(args)
     f = model_field(site)                           # at a pole: no north, east or declination, and a note
     if args.json:
@@ -204,7 +203,6 @@ def _calibrate(args) -> int:
     print("b (uT): " + ", ".join(f"{v:.4g} +- {e:.2g}" for v, e in zip(mc["b_ut"], mc["b_std_ut"])))
     print("A: " + "; ".join(", ".join(f"{v:.5f}" for v in row) for row in mc["A"]))
     if "field" in cal:
-        from .workbench.calibration import field_lines
         print("\n".join(field_lines(cal["field"])))
     print(f"wrote {path}")
     for w in cal.get("warnings", ()):
@@ -250,10 +248,9 @@ def _rates(args) -> int:
 def _compare(args) -> int:
     """``navlib compare``: the papers' methods fitted and scored on the user's file (the workbench's
     :mod:`navlib.workbench.compare`, imported here: it loads the networks, and with them torch)."""
-    from contextlib import nullcontext
-    from .workbench.compare import claimed_report, compare, write_report
+    from .workbench.compare import claimed_report, compare, write_report  # noqa: PLC0415  # lazy: torch
     file = _measurement_file(args)
-    with (claimed_report(args.report) if args.report else nullcontext()) as paths:
+    with (claimed_report(args.report) if args.report else contextlib.nullcontext()) as paths:
         result = compare(args.system, file, methods=args.methods, split=args.split, seeds=args.seeds, seed=args.seed,
                          margin=args.margin, workers=_workers(args), scheduler=args.scheduler,
                          ls_tolerance_deg=args.ls_tolerance, bin_deg=args.bin_deg)

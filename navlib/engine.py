@@ -208,7 +208,7 @@ def _one_thread() -> None:
 
 
 def _worker_plugin():
-    from distributed import WorkerPlugin
+    from distributed import WorkerPlugin  # noqa: PLC0415  # lazy: dask is an extra ([dist])
 
     class OneThread(WorkerPlugin):
         """Every worker: numerical libraries on one thread (the environment before they load; torch's
@@ -248,8 +248,8 @@ def client(workers: int = 1, scheduler: str | None = None):
 
 
 def _new_client(key, addr, workers):
-    import dask
-    from distributed import Client, LocalCluster
+    import dask  # noqa: PLC0415  # lazy: dask is an extra ([dist])
+    from distributed import Client, LocalCluster  # noqa: PLC0415  # lazy: as above
 
     if addr:
         probe_scheduler(addr)                     # a silent or foreign peer: one line, not a hang
@@ -353,7 +353,7 @@ def _show_progress(progress: bool | None) -> bool:
 def _bar(total: int, label: str, show: bool):
     if not show or not installed("tqdm"):            # tqdm is not a core dependency: no bar
         return None
-    from tqdm.auto import tqdm
+    from tqdm.auto import tqdm  # noqa: PLC0415  # lazy: optional, only for a progress bar
     return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,
                 dynamic_ncols=True)
 
@@ -424,7 +424,7 @@ def run(fn: Callable, tasks: Iterable[tuple], *, workers: int = 1, scheduler: st
 
 
 def _run_dask(c, fn, tasks, cost, label, bar, weight, on_result) -> list:
-    from distributed import as_completed
+    from distributed import as_completed  # noqa: PLC0415  # lazy: dask is an extra ([dist])
 
     n = len(tasks)
     order = sorted(range(n), key=lambda i: -cost[i]) if cost is not None else list(range(n))

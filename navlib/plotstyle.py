@@ -24,6 +24,7 @@ Matplotlib only: nothing here is imported by the CLI's loop unless a figure is a
 from __future__ import annotations
 
 import math
+import re
 from typing import Sequence
 
 import numpy as np
@@ -51,7 +52,7 @@ RC = {"figure.dpi": DPI, "savefig.dpi": DPI, "figure.figsize": (MAX_WIDTH_IN, 3.
 
 def use_style() -> None:
     """Apply the figure style (:data:`RC`: 11-12 pt text, 100 DPI, 7.5 in default width) to matplotlib."""
-    import matplotlib as mpl
+    import matplotlib as mpl  # noqa: PLC0415  # lazy: the command line imports this module without drawing
 
     mpl.rcParams.update(RC)
 
@@ -78,7 +79,7 @@ def panels(n_panels: int = 1, *, width_in: float = MAX_WIDTH_IN, panel_height_in
     row ``panel_height_in`` high, with a constrained layout (room is kept for legends placed by
     :func:`legend_below`).  Returns ``(fig, axes)``: one Axes for one panel, else a flat list in reading
     order."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: as above
 
     check_param("width_in", width_in, lo=0, lo_open=True, hi=MAX_WIDTH_IN)
     check_param("panel_height_in", panel_height_in, lo=0, lo_open=True, hi=12)
@@ -94,7 +95,7 @@ def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handl
     """Place ``ax``'s legend below the axes and their x tick labels and x label (outside the data),
     centred, in as many columns as fit the axes' width (at most four); with a constrained layout the
     figure keeps room for it.  Returns the Legend (None when nothing is labelled)."""
-    from matplotlib.transforms import ScaledTranslation
+    from matplotlib.transforms import ScaledTranslation  # noqa: PLC0415  # lazy: as above
 
     if handles is None:
         handles, labels = ax.get_legend_handles_labels()
@@ -131,8 +132,6 @@ def wrap_label(text: str, width: int) -> str:
     """``text`` on lines of at most ``width`` characters where it can be broken: after spaces and after the
     underscores of effect names (``scale_factor_temperature`` -> ``scale_factor_`` / ``temperature``); a
     piece longer than ``width`` stays whole."""
-    import re
-
     pieces = [p for p in re.split(r"(?<=[ _])", text) if p]
     lines, cur = [], ""
     for p in pieces:

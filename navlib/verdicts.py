@@ -175,7 +175,7 @@ def wilson(k: int, n: int, level: float = LEVEL) -> Estimate:
     """A rate ``k / n`` over independent trials with its Wilson score interval."""
     if not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer))) or n < 1 or not 0 <= k <= n:
         raise InputError(f"wilson: k={k!r}, n={n!r}: need whole numbers with 0 <= k <= n and n >= 1")
-    from scipy import stats     # here: importing scipy.stats costs every command-line start 0.3 s
+    from scipy import stats  # noqa: PLC0415  # lazy: importing scipy.stats costs every command-line start 0.3 s
 
     ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
     return Estimate(k / n, float(ci.low), float(ci.high), "wilson rate", int(n))
@@ -192,7 +192,7 @@ def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequ
     if not cols or any(c.shape[0] != cols[0].shape[0] for c in cols) or cols[0].shape[0] < 2:
         raise InputError("bootstrap: give at least one column, all of the same length >= 2")
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-    from scipy import stats     # here: as in wilson
+    from scipy import stats  # noqa: PLC0415  # lazy: as in wilson
 
     res = stats.bootstrap(tuple(cols), statistic, n_resamples=n_resamples, confidence_level=level,
                           method="percentile", paired=paired, vectorized=False,

@@ -94,7 +94,7 @@ def read_trial(path) -> dict:
     """The arrays of one BROAD trial file (``.mat``), checked: every variable of :data:`VARIABLES` present
     with ``n`` rows and its number of columns, ``sampling_rate`` a positive number.  Bad input: one line
     naming the file and the variable."""
-    from scipy.io import loadmat
+    from scipy.io import loadmat  # noqa: PLC0415  # lazy: only the .mat converter needs it
 
     p = Path(path)
     if not p.is_file():

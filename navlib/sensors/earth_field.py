@@ -78,7 +78,7 @@ class EarthField:
 def igrf_field(site: Site) -> EarthField:
     """The IGRF-14 main field at ``site`` (module docstring)."""
     try:
-        import ppigrf
+        import ppigrf  # noqa: PLC0415  # lazy: ppigrf reads its coefficient files at import (0.3 s)
     except ImportError:                                 # a core dependency; said in one line if absent
         raise InputError("the Earth-field model needs the package ppigrf (pip install ppigrf==2.1.0)") from None
     when = parse_date(site.date)

@@ -39,6 +39,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
 
 from ..angles import ARCSEC, DEG
 from ..errors import InputError, check_param
@@ -203,7 +204,6 @@ def delayed_attitude(traj: Trajectory, t_s, latency_ms: float) -> np.ndarray:
     k = np.searchsorted(traj.t_s, t_s)
     if latency_ms == 0.0 and np.array_equal(traj.t_s[np.minimum(k, len(traj.t_s) - 1)], t_s):
         return euler_to_dcm(traj.att[k])                    # on the IMU grid: the truth itself
-    from scipy.spatial.transform import Rotation, Slerp
     slerp = Slerp(traj.t_s, Rotation.from_matrix(euler_to_dcm(traj.att)))
     return slerp(np.clip(t_s - 1e-3 * latency_ms, traj.t_s[0], traj.t_s[-1])).as_matrix()
 
