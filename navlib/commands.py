@@ -25,7 +25,7 @@ from .workbench.calibration import apply_file, calibrate_file
 from .workbench.magnetometer_free import FREE_EFFECTS, SYSTEM as FREE_SYSTEM, site_of
 from .workbench.rates import DEFAULT_RATIOS, rates
 from .sensors.earth_field import Site
-from .workbench.calibration import field_lines, model_field
+from .workbench.local_field import field_lines, model_field
 
 
 def _site_values(args):

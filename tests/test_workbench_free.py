@@ -13,7 +13,7 @@ from navlib.errors import InputError
 from navlib.sensors.earth_field import Site, igrf_field
 from navlib.workbench import get_system
 from navlib.workbench import magnetometer_free as MF
-from navlib.workbench.calibration import field_check
+from navlib.workbench.local_field import field_check
 from navlib.workbench.diagnose import diagnose
 from navlib.workbench.fit import fit_model
 

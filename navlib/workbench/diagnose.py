@@ -74,7 +74,8 @@ from ..errors import check_param
 from ..errors import InputError
 from ..seeding import child
 from .effects import testable
-from .fit import Fit, drift_design, orth_basis
+from .fit import Fit, drift_design
+from .linalg import orth_basis
 from .noise_size import NoiseSize, noise_size
 from .screen import Screening, screen as screen_data
 from .serial import NoiseModel

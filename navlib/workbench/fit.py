@@ -26,6 +26,7 @@ from ..sensors.ins import latitude_error_per_drift
 from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
 from .effects import (COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, call_contribution, get_system,
                       register_system, resolve)
+from .linalg import orth_basis
 from .serial import ar1_noise
 from ..threads import one_blas_thread
 
@@ -171,28 +172,6 @@ def compare(*fits: Fit) -> pd.DataFrame:
 # Tall matrices (thousands of rows, tens of columns) are orthonormalised by classical Gram-Schmidt applied
 # twice (as accurate as Householder QR for our purposes) with matrix-vector products only: on a shared
 # machine a threaded LAPACK factorisation of even a 40 x 40 matrix can take a hundred times longer.
-def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
-    """An orthonormal basis of the column space of ``X``: columns are scaled to unit norm and a column is
-    dropped when less than ``rtol`` of it is left after removing the previous ones."""
-    n, k = X.shape
-    Q = np.zeros((n, k), order="F")                  # columns contiguous: Q[:, :r] is one block
-    r = 0
-    for j in range(k):
-        v = X[:, j].astype(float)
-        norm = np.linalg.norm(v)
-        if norm == 0:
-            continue
-        v = v / norm
-        for _ in range(2):
-            if r:
-                v = v - Q[:, :r] @ (Q[:, :r].T @ v)
-        left = np.linalg.norm(v)
-        if left > rtol:
-            Q[:, r] = v / left
-            r += 1
-    return np.ascontiguousarray(Q[:, :r])
-
-
 def lstsq(X: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Minimum-norm least-squares solution of ``X b = y`` via the (column-scaled) normal equations."""
     if X.shape[1] == 0:

@@ -73,6 +73,7 @@ from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
 from . import free_breakdown
 from .free_kernel import FreeKernel
+from .local_field import field_check, field_lines
 from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
 from .serial import ar1_noise
 
@@ -121,7 +122,7 @@ SIM_FIELD_UT, SIM_DIP_DEG = 43.54, 69.56
 SITE_COLUMNS = ("lat_deg", "lon_deg", "height_m", "date")
 #: Largest spread within one file of latitude or longitude (deg) and height (m): one site per file.  0.1 deg
 #: (about 11 km) and 500 m move the IGRF main field by well under the 0.3 uT crustal tolerance of the
-#: field check (:data:`navlib.workbench.calibration.CRUST_TOL_UT`).
+#: field check (:data:`navlib.workbench.local_field.CRUST_TOL_UT`).
 SITE_TOL_DEG, HEIGHT_TOL_M = 0.1, 500.0
 #: Largest spread of the ``date`` column (days): the main field changes by up to about 0.1 uT a year.
 DATE_TOL_DAYS = 366
@@ -510,8 +511,7 @@ def noise_directions(fit: Fit) -> np.ndarray:
 def loop_field_check(result, site=None, date: str | None = None) -> tuple[dict, list[str]]:
     """The system's ``final_check`` hook: the local field the loop's final model estimates, beside the
     IGRF-14 field at the recording's site (:func:`site_of`: ``site``/``date`` or the data's columns;
-    :func:`navlib.workbench.calibration.field_check`), as a dict and report lines."""
-    from .calibration import field_check, field_lines
+    :func:`navlib.workbench.local_field.field_check`), as a dict and report lines."""
     check = field_check(result.final, site_of(result.final.data, site, date),
                         result.screening.noise if result.screening is not None else None)
     return check, field_lines(check)

@@ -7,18 +7,13 @@ of whitened columns is a weighted sum of lagged cross-products of the columns, c
 (:class:`_Prepared`); the weights, and their derivatives, come from the Durbin-Levinson coefficients
 (``_Prepared.weights``), so an evaluation of ``l_R`` and its gradient costs a few small products
 (:class:`_Restricted`), whatever the length of the series.  This module does not import
-:mod:`~navlib.workbench.serial` (which imports it); a :class:`~navlib.workbench.serial.Series` is used only
-through its ``order`` and ``pos``.
+:mod:`~navlib.workbench.serial` (which imports it); the ``series``
+argument (a :class:`~navlib.workbench.serial.Series`) is used only through its ``order`` and ``pos``.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from scipy.linalg.lapack import dpotrf, dtrtri, dtrtrs
-
-if TYPE_CHECKING:                       # annotations only: serial imports this module
-    from .serial import Series
 
 
 def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
@@ -84,7 +79,7 @@ class _Prepared:
     need not be orthonormal for them (the bootstrap's tests use them for any columns:
     :class:`navlib.workbench.diagnose._Family`)."""
 
-    def __init__(self, Q: np.ndarray, series: Series, max_order: int):
+    def __init__(self, Q: np.ndarray, series, max_order: int):
         Zq = np.asarray(Q, float)[series.order]
         self.k, self.P, self.n = Zq.shape[1], int(max_order), len(Zq)
         P, k = self.P, self.k
@@ -167,7 +162,7 @@ class _Restricted:
     with the lagged cross-products ``C_gij`` computed once; then ``G = M_QQ`` (``X' R^-1 X`` for
     orthonormal ``X``), ``b = M_Qr``, ``RSS_W = M_rr - b' G^-1 b`` (Cholesky factor of ``G``)."""
 
-    def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series, max_order: int,
+    def __init__(self, r: np.ndarray, Q: np.ndarray, series, max_order: int,
                  prepared: "_Prepared | None" = None, cross: tuple | None = None):
         """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (``_Prepared.cross`` of one
         column), when computed for many residual vectors at once."""

@@ -64,7 +64,8 @@ from scipy import special
 
 from ..errors import InputError
 from .effects import testable
-from .fit import MEASURED, Fit, fit_model, measured_columns, orth_basis, residuals_on
+from .fit import MEASURED, Fit, fit_model, measured_columns, residuals_on
+from .linalg import orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability

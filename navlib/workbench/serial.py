@@ -81,6 +81,7 @@ from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
+from .linalg import orth_basis
 from .reml import _Prepared, _Restricted, levinson  # noqa: F401  (re-exported: serial's names)
 
 #: A time step more than this many times the median step starts a new segment.
@@ -523,7 +524,6 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
     """Orthonormal basis of ``regressors`` (N x k, observation order) on the observations of ``series``
     (zero elsewhere): what :func:`estimate` takes out of the residuals.  Computed once, it can be passed to
     :func:`estimate` as ``basis`` for many residual vectors."""
-    from .fit import orth_basis                      # local: fit imports this module's users
     inc = series.order
     if regressors is None or not np.size(regressors):
         return np.zeros((n_obs, 0))
