@@ -31,6 +31,7 @@ from ..data.tumble import COLUMNS as TUMBLE_COLUMNS, read_tumble, require_levels
 from ..errors import InputError
 from .effects import Effect, System, register_system
 from .fit import MEASURED, Fit, fit_linear, fit_model, user_columns
+from .loop import known_noise_band, loop
 from .diagnose import diagnose
 from .trials import SYSTEM_KEYS, _seed_label, run_trials, trial_seed, wilson
 
@@ -286,7 +287,6 @@ def unit_loop(data: pd.DataFrame, unit: str = "A", start=("bias",), noise_ug: fl
     rows, ``unit == unit``), from the model ``start``; with ``noise_ug`` (the noise per reading the data
     were simulated with) also the band where a correct model's rms would lie
     (:func:`navlib.workbench.loop.known_noise_band`, in mg).  Returns ``(LoopResult, band or None)``."""
-    from .loop import known_noise_band, loop
 
     if "unit" in data and unit not in set(data["unit"]):
         raise InputError(f"unit={unit!r}: the tumble frame holds {', '.join(map(str, dict.fromkeys(data['unit'])))}")

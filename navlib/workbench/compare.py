@@ -49,6 +49,7 @@ from ..errors import InputError, check_param
 from ..methods import compass_methods as cm
 from ..methods.seeding import sequence
 from ..methods.smith import nearest_positions
+from ..plotstyle import DPI, legend_below, panels
 
 SPLITS = ("sweep", "heading", "random")
 #: Runs of a stochastic method per engine task (a fixed size: the numbers never depend on the workers).
@@ -612,8 +613,7 @@ def report_figure(result: CompareResult):
     """Error against the x column (the compass: true heading) per method, one panel each (best first, two
     columns), the run of median RMS, the test rows of each fold in their own colour and no line across a gap
     wider than :data:`GAP_DEG`: paper A's Figs 3 and 4 drawn for the user's file."""
-    import matplotlib.pyplot as plt
-    from ..plotstyle import legend_below, panels
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
     t = result.table()
     n = len(t) + (len(t) % 2 if len(t) > 1 else 0)          # an even count: two columns
@@ -645,8 +645,7 @@ def report_figure(result: CompareResult):
 def write_report(result: CompareResult, paths) -> tuple[Path, Path]:
     """Write the claimed files (:func:`claimed_report`): ``compare.md`` (the folds, the table, what was not
     run, the verdict rule) and ``compare.png`` (:func:`report_figure`)."""
-    import matplotlib.pyplot as plt
-    from ..plotstyle import DPI
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
     md, png = (Path(p) for p in paths)
     fig = report_figure(result)

@@ -69,6 +69,8 @@ from itertools import permutations
 import numpy as np
 import pandas as pd
 from scipy import special
+from scipy.linalg.lapack import dpotrf, dtrtri
+from scipy.special import fdtrc
 
 from ..errors import check_param
 from ..errors import InputError
@@ -78,7 +80,9 @@ from .fit import Fit, drift_design
 from .linalg import orth_basis
 from .noise_size import NoiseSize, noise_size
 from .screen import Screening, screen as screen_data
-from .serial import NoiseModel
+from .reml import _Prepared
+from .serial import (NoiseModel, colour, select_ar1_many, select_bases, select_many, whiten, whiten_each,
+                     whiten_transpose)
 from ..threads import one_blas_thread
 
 SMALL_SAMPLE = 12
@@ -419,7 +423,6 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
 
     The simulated noise and its re-estimates depend only on the screen (noise model, regressors) and the
     seed, not on the model tested: the diagnoses of one loop share them (:func:`_reestimates`)."""
-    from .serial import colour
     noise = sc.noise
     B = bootstrap_replicates(alpha)
     K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))     # >= 2: B >= 2.5 / alpha - 1
@@ -452,7 +455,6 @@ def _reestimates(sc: Screening, seed: int, B: int, n: int) -> dict:
     the replicates' noise models (:func:`_reestimate`), filled as batches are drawn.
     The same inputs (the same noise model and regressors, by identity: the diagnoses of one loop) give the
     same memo; it is dropped with the noise model."""
-    from .serial import select_bases
     noise = sc.noise
     key = (id(noise), id(sc.regressors), seed, B, n)
     memo = _REESTIMATES.get(key)
@@ -470,7 +472,6 @@ def _reestimate(E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> l
     the data's (:func:`navlib.workbench.serial.select` around ``regressors``, whose orthonormal ``bases`` are
     given; the AR order fixed at the data's).  AR(1): every column's correlation on the grid at once
     (:func:`navlib.workbench.serial.select_ar1_many`)."""
-    from .serial import select_ar1_many, select_many
     if noise.order == 1:
         return [NoiseModel((float(k),), noise.series, len(E)) for k in select_ar1_many(E, bases, noise.series)]
     return select_many(E, *regressors, noise.series, bases, order=noise.order, start_at=noise.kappa)
@@ -497,7 +498,6 @@ class _Family:
     whitens the columns (all in one call) and the tests run on them (:meth:`_min_p_whitened`)."""
 
     def __init__(self, fit: Fit, fits: dict, series, order: int):
-        from .reml import _Prepared
         self.n = fit.n
         cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
         cands = [c for c in cands if c[1] > 0 and c[2] > 0]
@@ -543,7 +543,6 @@ class _Family:
         (all of one order) at once: each column whitened with its own coefficients
         (:func:`navlib.workbench.serial.whiten_each`), the Gram matrices ``H`` stacked and factored together
         (batched LAPACK); raises ``LinAlgError`` when a block is not numerically positive definite."""
-        from .serial import whiten_each
         kappas = [tuple(nm.kappa) if nm.correlated else () for nm in models]
         We = whiten_each(Eo, kappas, self.series)
         c = np.einsum("ij,ij->j", We, We)                                           # e' R^-1 e
@@ -604,7 +603,6 @@ class _Family:
     def _min_p(self, Eo: np.ndarray, nm: NoiseModel) -> np.ndarray:
         """The smallest p of the family on the columns ``Eo`` (series order), all under the noise model
         ``nm``, from inner products (class docstring)."""
-        from .serial import whiten, whiten_transpose
         kappa = tuple(nm.kappa) if nm.correlated else ()
         T, shapes = self._factors(kappa)
         We = whiten(Eo, kappa, self.series, ordered=True)
@@ -674,7 +672,6 @@ def _inverse_factor(G: np.ndarray) -> np.ndarray:
     """``T`` with ``T G T' = I`` on the range of ``G`` (``|T h|^2 = h' G^+ h``): the inverse of the Cholesky
     factor, or for a numerically singular ``G`` the eigenvectors over the roots of the eigenvalues above
     ``1e-12`` of the largest."""
-    from scipy.linalg.lapack import dpotrf, dtrtri
     if not G.shape[0]:
         return np.zeros((0, 0))
     L, info = dpotrf(G, lower=1, clean=1)
@@ -689,7 +686,6 @@ def _inverse_factor(G: np.ndarray) -> np.ndarray:
 
 def _f_p(drop: np.ndarray, rss1: np.ndarray, q: int, df2: int) -> np.ndarray:
     """p of the nested F test (:func:`_f_test`), vectorised: ``F = (drop / q) / (rss1 / df2)``."""
-    from scipy.special import fdtrc
     f = np.maximum(drop / q, 0.0) / np.maximum(rss1 / df2, 1e-300)
     return np.where(rss1 > 0, fdtrc(q, df2, f), np.where(drop > 0, 0.0, 1.0))
 

@@ -16,6 +16,8 @@ import pandas as pd
 
 from ..angles import wrap_deg
 from ..errors import InputError, check_param
+from .. import plotstyle as rs
+from ..plotstyle import DPI
 from .diagnose import Diagnosis, diagnose
 from .effects import Effect, get_system
 from .fit import Fit, fit_model
@@ -186,7 +188,7 @@ def noise_band(result: LoopResult, level: float = 0.95) -> tuple[float, float] |
     ``sqrt(RSS / chi2_{(1+level)/2}(n - p)) .. sqrt(RSS / chi2_{(1-level)/2}(n - p))`` with ``n``
     observations and ``p`` parameters (white noise assumed; never below the data's numerical floor).
     None when the screen fitted no richer model or it leaves no degrees of freedom."""
-    from scipy.stats import chi2
+    from scipy.stats import chi2  # noqa: PLC0415  # lazy: scipy.stats costs 0.6 s at the CLI's start
 
     sc = result.screening
     rich = None if sc is None else sc.rich
@@ -206,7 +208,7 @@ def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -
     """Where the rms of a correct model's residuals lies when the noise is known: white noise of standard
     deviation ``sigma`` on ``n`` observations and ``p = n_params`` fitted parameters give
     ``rms^2 = sigma^2 chi2(n - p) / n``; the band is its central ``level`` interval."""
-    from scipy.stats import chi2
+    from scipy.stats import chi2  # noqa: PLC0415  # lazy: scipy.stats costs 0.6 s at the CLI's start
 
     check_param("sigma", sigma, lo=0, lo_open=True)
     check_param("n_params", n_params, lo=0, hi=n - 1, integer=True)
@@ -263,7 +265,6 @@ def staircase_figure(result, ax=None, title: str | None = None,
     ``result`` is a :class:`LoopResult` (the band as in :func:`staircase_of`) or a :class:`Staircase`
     (``title`` then replaces its title).  Draws on ``ax`` if given (``legend=False``: no legend, e.g. for
     :func:`staircase_grid`); returns the figure."""
-    from .. import plotstyle as rs
 
     st = result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
     own = ax is None
@@ -292,8 +293,7 @@ def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
     panel title to :class:`Staircase` or :class:`LoopResult` (e.g. one per trial), ``ncols`` panels a row
     across the column width, one legend below the grid; tick labels are the effects added (without the
     ``+``), slanted where they do not fit.  Returns the figure."""
-    import matplotlib.pyplot as plt
-    from .. import plotstyle as rs
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
     items = [(k, v if isinstance(v, Staircase) else staircase_of(v)) for k, v in dict(staircases).items()]
     if not items:
@@ -329,8 +329,7 @@ def report_figure(result: LoopResult):
     (:func:`staircase_figure`) on top; below it the measurement against the start and final models, and
     below that the residuals at each step (legends below each panel, short labels: the steps are named on
     the staircase)."""
-    import matplotlib.pyplot as plt
-    from .. import plotstyle as rs
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
     with plt.rc_context(rs.RC):
         fig = plt.figure(figsize=(rs.MAX_WIDTH_IN, 10.6), layout="constrained")
@@ -376,7 +375,7 @@ def _measurement_panel(ax, result: LoopResult, short: bool = False) -> None:
 def loop_figure(result: LoopResult):
     """Three panels: measurement against the start and final models, residuals at each step, the error
     falling (rms and held-out rms per step)."""
-    import matplotlib.pyplot as plt                 # only for the picture: the CLI's loop runs without it
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
     fits, unit = result.fits, result.final.unit
     fig, axes = plt.subplots(1, 3, figsize=(12, 4))
     ax = axes[0]
@@ -431,8 +430,7 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     folder = Path(folder)
     png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    import matplotlib.pyplot as plt                 # report_figure made the figure through pyplot: release it
-    from ..plotstyle import DPI
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
     fig = report_figure(result)
     fig.savefig(png, dpi=DPI)
     plt.close(fig)

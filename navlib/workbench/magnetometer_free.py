@@ -69,13 +69,17 @@ from scipy.spatial.transform import Rotation
 from ..data.tables import Column, read_table, require_variation
 from ..errors import InputError, check_param
 from ..methods.preprocess import field_gravity_dot
+from ..seeding import child
+from ..sensors.earth_field import Site
 from .effects import Effect, System, register_system
-from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
+from .diagnose import diagnose
+from .fit import MEASURED, Fit, best_least_squares, fit_model, user_columns, user_design
 from . import free_breakdown
 from .free_kernel import FreeKernel
 from .local_field import field_check, field_lines
 from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
 from .serial import ar1_noise
+from .trials import SYSTEM_KEYS, _seed_label, run_trials, trial_seed
 
 ACC = ("acc_x_ms2", "acc_y_ms2", "acc_z_ms2")
 DERIVED = ("field_norm_ut", "field_gravity_ut")
@@ -177,7 +181,6 @@ def _date_of(frame: pd.DataFrame, name: str) -> str:
     if bad.size:
         raise InputError(f"{name}: column 'date', row {bad[0] + 1}: {str(frame['date'].iloc[bad[0]])[:40]!r} is not an "
                          f"ISO 8601 date (YYYY-MM-DD or YYYY-MM-DDTHH:MM:SSZ)")
-    from ..sensors.earth_field import Site
     for row in (int(np.argmin(when.to_numpy())), int(np.argmax(when.to_numpy()))):
         try:
             Site(0.0, 0.0, 0.0, when.iloc[row].date().isoformat())          # the years IGRF-14 covers
@@ -202,7 +205,6 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
     are refused by the loader, naming column and row).  Each message names what the value came from: the
     file (``name``, or the file the frame was read from: ``frame.attrs["source"]``) and its column, or the
     option --site / --date."""
-    from ..sensors.earth_field import Site
     if name == "data":
         name = frame.attrs.get("source", name)
     date_given = date is not None
@@ -609,10 +611,6 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
     scales the hidden effect sees the same motion as the data; a motion that does not turn the sensor
     through enough directions for the catalogue (the loader would refuse the file) is drawn again from
     child ``(1, k)``, k = 1, 2, ... (``redraws`` in the result)."""
-    from ..seeding import child
-    from .diagnose import diagnose
-    from .fit import fit_model
-    from .trials import _seed_label
     cat = tuple(FREE_EFFECTS)
     if hidden is not None and hidden not in cat:
         raise InputError(f"unknown magnetometer_free effect '{hidden}'; known: {', '.join(cat)}")
@@ -667,7 +665,6 @@ def hidden_effect_study(ratios=(3.0, 10.0), noises=(0.3,), seeds=range(10), none
     :func:`navlib.workbench.trials.trial_seed` of its coordinates (study "hidden effect", or "correlated
     noise" when ``correlation`` is not 0, then this system, the recording's length in s, noise level, effect,
     size, seed number)."""
-    from .trials import SYSTEM_KEYS, run_trials, trial_seed
     check_param("correlation", correlation, lo=-1, hi=1, lo_open=True, hi_open=True)
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))

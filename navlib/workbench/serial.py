@@ -349,7 +349,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     series are 0).  ``whiten(colour(u)) == u``: the first samples of a segment are built with the
     Durbin-Levinson coefficients of their own order, the rest by the recursion of order p
     (``scipy.signal.lfilter``, its state carried over from the start-up)."""
-    from scipy.signal import lfilter
+    from scipy.signal import lfilter  # noqa: PLC0415  # lazy: scipy.signal costs 0.3 s at the CLI's start
     u = np.asarray(u, float)
     p = len(kappa)
     out = np.zeros((n_obs,) + u.shape[1:])
