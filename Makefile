@@ -13,6 +13,18 @@ export PYDEVD_DISABLE_FILE_VALIDATION := 1
 # One BLAS thread per process: on 2 shared cores threaded LAPACK stalls (50-400 ms on small solves) and
 # single-threaded reductions keep stored notebook numbers identical from run to run.
 export OPENBLAS_NUM_THREADS := 1
+# The same floating-point kernels on every x86-64 machine with AVX2, so that the stored notebook outputs are
+# what CI's machine computes too (CI failed on 2026-12-03 because its CPU took other kernels: numpy's AVX-512
+# exp/log1p/arctan/power, MKL's and OpenBLAS's per-CPU code paths change the last bits, and the trained
+# networks of chapters A and D amplify them into different tables).  Each library is pinned to its AVX2 path:
+# numpy (no X86_V4/AVX-512 loops), OpenBLAS (Haswell kernels), MKL inside torch (conditional numerical
+# reproducibility, AVX2 branch, strict: whatever the arrays' alignment) and torch's own vectorised kernels
+# (ATen AVX2).  numba's kernels need no pin: they give the same bits for any vector width (navlib.methods.jit).
+# navlib itself pins nothing: a library user gets the native kernels, equal to these within rounding.
+export NPY_DISABLE_CPU_FEATURES := X86_V4 AVX512_ICL AVX512_SPR
+export OPENBLAS_CORETYPE := Haswell
+export MKL_CBWR := AVX2,STRICT
+export ATEN_CPU_CAPABILITY := avx2
 
 .PHONY: help venv book screenshots check test test-lib test-notebooks test-results notebooks bench lock clean
 
