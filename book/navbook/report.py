@@ -664,7 +664,7 @@ class Glance:
     """The Results-at-a-glance tables: the paper's claims and the book's own claims apart, each row with
     the claim, the reading, the paper's number, ours with its 95 % interval, the boundary and the verdict
     with its reason.  Give it every claim of the chapter (the list passed to :func:`write_results`): the
-    landing page counts that list, and a glance that shows fewer claims disagrees with it (``booktools
+    landing page counts that list, and a glance that shows fewer claims disagrees with it (``navbook
     check-html`` compares the two).  On the page, a long list is folded by reading and each verdict says
     which case applies (:func:`navlib.verdicts.verdict_label`); the plain text (what nbval compares) is
     one table per source."""

@@ -11,7 +11,7 @@ import pytest  # noqa: E402
 
 from navbook import report  # noqa: E402
 from navlib import plotstyle as rs  # noqa: E402
-from navbook.booktools import shrunk_figures  # noqa: E402
+from navbook.screenshots import shrunk_figures  # noqa: E402
 from navlib.errors import InputError  # noqa: E402
 from navlib.workbench.fit import fit_model, simulate  # noqa: E402
 from navlib.workbench.loop import LoopResult, loop, loop_figure, noise_band, staircase_figure, step_labels  # noqa: E402

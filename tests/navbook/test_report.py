@@ -102,7 +102,7 @@ def test_write_and_read_results_round_trip(tmp_path):
     assert c["holds_when"] == "below" and c["source"] == "paper" and c["decided_by"] == ["noise 0.04 uT"]
     assert c["rule"] == "median over runs" and c["n"] == 20
     assert json.loads(path.read_text())["unit"] == "deg"
-    from navbook.booktools import validate_results
+    from navbook.results_check import validate_results
     assert validate_results(res, "compass.json") == []
 
 
