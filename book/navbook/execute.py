@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from .report import RESULTS_ENV
+from .results import RESULTS_ENV
 
 VOLATILE_NB_KEYS = ("papermill",)
 VOLATILE_CELL_KEYS = ("papermill", "execution", "collapsed", "scrolled")

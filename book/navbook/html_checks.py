@@ -219,7 +219,7 @@ def check_page(text: str, content: bool = True) -> list[str]:
 
 
 GLANCE = "Results at a glance"
-#: The admonition that closes every chapter (:func:`navbook.report.showed`).
+#: The admonition that closes every chapter (:func:`navbook.claim_boxes.showed`).
 SHOWED = "What this chapter showed"
 #: The known problems of the :data:`LAYOUT_KINDS` per page, in the book folder (``book/``).
 BASELINE_FILE = "check_html_baseline.json"

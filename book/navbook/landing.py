@@ -17,9 +17,10 @@ from navlib import claims as claims_mod
 from navlib import verdicts
 from navlib.errors import InputError
 
+from .claim_boxes import reading_label
+from .claim_boxes import record_label as report_label
 from .execute import results_chapter
-from .report import read_results, reading_label
-from .report import record_label as report_label
+from .results import read_results
 from .results_check import flat_claims
 
 def notebook_title(nb_path: Path) -> str:
@@ -313,7 +314,7 @@ def sources_markdown(results: dict[str, dict]) -> list[str]:
 def readings_markdown(results: dict[str, dict], notebooks: list[Path],
                       sources: dict[str, tuple[str, str]] | None = None) -> str:
     """The landing page's per-reading rows (MyST markdown): one dropdown per chapter, in the order of
-    ``notebooks``, with a row per source and reading (its readable label, :func:`navbook.report.reading_label`): claims,
+    ``notebooks``, with a row per source and reading (its readable label, :func:`navbook.claim_boxes.reading_label`): claims,
     reproduced, not reproduced, and cannot be judged with the cases that apply."""
     parts = ["(status-by-reading)=", "## Claims by reading", "",
              "Where a paper's method or claim can be read in more than one way, each reading is judged on its "

@@ -1,5 +1,5 @@
-"""Screenshots of every built page (``python -m navbook screenshots``), taken with headless Chromium
-driven over the DevTools protocol on a pipe, with the checks only a rendered page allows.
+"""Every built page rendered with headless Chromium (``python -m navbook screenshots``), with the checks
+only a rendered page allows; Chromium is driven over the DevTools protocol on a pipe.
 
 ``screenshots HTML_DIR OUT_DIR``
     Render every page with headless Chromium (1400 px wide, full page height), record the page heights and

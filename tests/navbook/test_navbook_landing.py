@@ -6,7 +6,7 @@ import nbformat
 import pandas as pd
 import pytest
 
-from navbook import api_pages, html_checks, landing, report, results_check
+from navbook import api_pages, claim_boxes, html_checks, landing, report, results_check
 from navlib import verdicts
 from navlib.errors import InputError
 
@@ -256,7 +256,7 @@ def test_module_summary_is_the_first_sentence_as_myst(monkeypatch):
 
 
 def test_write_results_warns_about_claims_no_glance_box_showed(tmp_path, monkeypatch):
-    monkeypatch.setattr(report, "_GLANCED", set())
+    monkeypatch.setattr(claim_boxes, "_GLANCED", set())
     report.glance(CLAIMS[:2])
     with pytest.warns(UserWarning, match="5 of the 7 claims are in no glance box"):
         report.write_results("compass", claims=CLAIMS, folder=tmp_path)

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navbook import report
+from navbook import glue, report
 
 from navlib import verdicts
 from navlib.errors import InputError
@@ -156,7 +156,7 @@ def test_claims_summary_counts_per_chapter_source_and_reading():
 
 def test_glue_claims_glues_verdict_and_detail(monkeypatch):
     glued = {}
-    monkeypatch.setattr(report, "_glue", lambda name, obj: glued.__setitem__(name, obj))
+    monkeypatch.setattr(glue, "_glue", lambda name, obj: glued.__setitem__(name, obj))
     report.glue_claims([_claim((1.5, 2.0), key="d_rmse"), _claim()])
     assert glued == {"d_rmse": "not reproduced",
                      "d_rmse_detail": "not reproduced: ours 1.75 [1.5, 2] deg, boundary < 1 deg"}
