@@ -150,7 +150,7 @@ def test_reader_missing_unit_column_and_too_few_levels(tmp_path):
 
 # ------------------------------------------------------------------------------- paper D's claims
 from navlib import verdicts  # noqa: E402
-from navbook.booktools import claim_problems  # noqa: E402
+from navbook.results_check import claim_problems  # noqa: E402
 from navlib.studies import paper_d as D  # noqa: E402
 
 BEST = "IAFSA-SCM-ANFIS"

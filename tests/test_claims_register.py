@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from navlib import claims, verdicts
-from navbook.booktools import claim_problems, register_problems
+from navbook.results_check import claim_problems, register_problems
 from navlib.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,7 +7,7 @@ import pytest
 
 from navlib import claims as register
 from navlib import verdicts
-from navbook.booktools import claim_problems
+from navbook.results_check import claim_problems
 from navlib.sensors.accelerometer import AccelCoefficients, TumbleExperiment
 from navlib.studies import paper_d as D
 

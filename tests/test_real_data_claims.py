@@ -9,8 +9,7 @@ from html import unescape
 import nbformat
 import pytest
 
-from navbook import booktools as bt
-from navbook import report
+from navbook import html_checks, landing, report, results_check
 from navlib import claims, verdicts
 from navlib.errors import InputError
 
@@ -51,8 +50,8 @@ def test_a_claim_says_what_it_was_judged_on_and_an_invalid_value_is_refused():
     assert _claim(data="real").record()["data"] == "real"
     with pytest.raises(InputError, match="Claim.data='measured': must be 'simulated' or 'real'"):
         _claim(data="measured")
-    assert bt.claim_problems(_claim(data="real").record()) == []
-    assert bt.claim_problems(dict(_claim().record(), data="field")) == [
+    assert results_check.claim_problems(_claim(data="real").record()) == []
+    assert results_check.claim_problems(dict(_claim().record(), data="field")) == [
         "data 'field': must be 'simulated' or 'real'"]
 
 
@@ -66,7 +65,7 @@ def test_the_same_claim_on_real_data_is_a_record_of_its_own_counted_apart(reg):
     assert real["verdict"] == "not reproduced" and real["claim"] == sim["claim"] == "X beats Y"
     assert [s["reading"] for s in real["sensitivity"]] == ["r1; other sessions"]
     assert claims.headlines(recs) == [sim]
-    assert all(bt.claim_problems(r) == [] and bt.register_problems(r) == [] for r in recs)
+    assert all(results_check.claim_problems(r) == [] and results_check.register_problems(r) == [] for r in recs)
     without = claims.evaluate("testch", [c.record() for c in rows if c.data == "simulated"])
     assert without == [{k: v for k, v in r.items()} for r in recs[:2]]       # real rows change nothing else
     # the chapter's boxes count them apart, under their own title
@@ -74,7 +73,7 @@ def test_the_same_claim_on_real_data_is_a_record_of_its_own_counted_apart(reg):
     html = unescape(answer._repr_html_())
     assert "The paper's claims: 2 of 2 reproduced" in html
     assert "The paper's claims on real data: 0 of 1 reproduced, 1 not reproduced" in html
-    assert bt.glance_counts(f'<p class="admonition-title">Results at a glance</p>{html}') == {
+    assert html_checks.glance_counts(f'<p class="admonition-title">Results at a glance</p>{html}') == {
         "paper": (2, 0, 0, 0)}
     shown = repr(report.showed(rows, chapter="testch"))
     assert "The paper's claims: 2 of 2 reproduced" in shown and "The paper's claims on real data: 0 of 1" in shown
@@ -101,35 +100,35 @@ def _results(data_of_b="real"):
 
 def test_landing_page_and_status_count_real_data_claims_apart(tmp_path):
     res = _results()
-    assert tuple(bt.claim_counts(res)["compass"]["paper"].values()) == (1, 0, 1, 0)
-    assert tuple(bt.claim_counts(res, "real")["compass"]["paper"].values()) == (1, 1, 0, 0)
+    assert tuple(landing.claim_counts(res)["compass"]["paper"].values()) == (1, 0, 1, 0)
+    assert tuple(landing.claim_counts(res, "real")["compass"]["paper"].values()) == (1, 1, 0, 0)
     with pytest.raises(InputError, match="data='both'"):
-        bt.claim_counts(res, "both")
+        landing.claim_counts(res, "both")
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell('report.write_results("compass", claims=c)'))
     nbformat.write(nb, tmp_path / "compass.ipynb")
     nb = tmp_path / "compass.ipynb"
-    md = bt.status_markdown(res, [nb])
+    md = landing.status_markdown(res, [nb])
     assert 'data-paper="1 0 1 0"' in md                       # the glance box's count: simulated only
     assert "paper's: 1 / 0 / 1<br>book's own: –<br>paper's claims on real data: 1 of 2 reproduced, 1 not " \
            "reproduced, 0 cannot be judged" in md
     assert "**1 of 2** of the papers' claims reproduce" in md
     assert "counted apart from the claims above" in md and "the papers' claims on real data: 1 of 2" in md
-    by_reading = bt.readings_markdown(res, [nb])
+    by_reading = landing.readings_markdown(res, [nb])
     assert "| R1 | 2 | 1 | 0 |" in by_reading and "| R1 (on real data) | 2 | 1 | 1 | 0 |" in by_reading
 
 
 def test_check_results_compares_the_field_and_old_files_read_as_simulated():
     fresh, ref = _results(), _results()
-    assert bt.compare_results(fresh, ref, "compass.json") == []
-    assert bt.validate_results(fresh["compass"], "compass.json") == []
+    assert results_check.compare_results(fresh, ref, "compass.json") == []
+    assert results_check.validate_results(fresh["compass"], "compass.json") == []
     moved = _results(data_of_b="simulated")["compass"]
     moved["claims"][3] = dict(moved["claims"][3], claim="b")
-    problems = bt.compare_results(moved, ref["compass"], "compass.json")
+    problems = results_check.compare_results(moved, ref["compass"], "compass.json")
     assert any("claims[3].data 'simulated' differs from the reference 'real'" in p for p in problems)
     old = {"chapter": "compass", "claims": [{k: v for k, v in c.items() if k != "data"}
                                             for c in fresh["compass"]["claims"][:2]]}
     new = {"chapter": "compass", "claims": fresh["compass"]["claims"][:2]}
-    assert bt.compare_results(new, old, "compass.json") == [] and bt.validate_results(old, "compass.json") == []
-    assert tuple(bt.claim_counts({"compass": old})["compass"]["paper"].values()) == (1, 0, 1, 0)
+    assert results_check.compare_results(new, old, "compass.json") == [] and results_check.validate_results(old, "compass.json") == []
+    assert tuple(landing.claim_counts({"compass": old})["compass"]["paper"].values()) == (1, 0, 1, 0)
     assert claims.data_of({}) == "simulated"

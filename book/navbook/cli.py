@@ -38,7 +38,12 @@ from pathlib import Path
 from navlib.cli import run_command
 from navlib.names import WORKERS_HELP
 
-from . import booktools as bt
+from .api_pages import write_api
+from .execute import execute
+from .html_checks import BASELINE_FILE, check_html
+from .landing import write_status
+from .results_check import ATOL, RTOL, check_results
+from .screenshots import screenshots
 
 
 class _Parser(argparse.ArgumentParser):
@@ -74,8 +79,8 @@ def build_parser() -> argparse.ArgumentParser:
     cr.add_argument("notebooks", nargs="+", type=Path)
     cr.add_argument("--fresh", type=Path, required=True)
     cr.add_argument("--reference", type=Path, required=True)
-    cr.add_argument("--rtol", type=float, default=bt.RTOL)
-    cr.add_argument("--atol", type=float, default=bt.ATOL)
+    cr.add_argument("--rtol", type=float, default=RTOL)
+    cr.add_argument("--atol", type=float, default=ATOL)
     sub.add_parser("compile", help="compile the numba kernels once (cached on disk)")
     sc = sub.add_parser("screenshots", help="render every page with headless Chromium")
     sc.add_argument("html_dir", type=Path)
@@ -109,20 +114,26 @@ def _grid(args) -> int:
     return 1 if failed else 0
 
 
+def _compile(args) -> int:
+    from .kernels import compile_kernels  # noqa: PLC0415  # lazy: a study and torch (2 s), for this command only
+
+    return compile_kernels()
+
+
 def _check_html(args) -> int:
-    default = Path(args.html_dir).absolute().parents[1] / bt.BASELINE_FILE
-    return bt.check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
+    default = Path(args.html_dir).absolute().parents[1] / BASELINE_FILE
+    return check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
 
 
 #: Command name -> function.
 COMMANDS = {
-    "execute": lambda a: bt.execute(a.notebooks, a.out, a.in_place),
+    "execute": lambda a: execute(a.notebooks, a.out, a.in_place),
     "check-html": _check_html,
-    "status": lambda a: bt.write_status(a.results_dir, a.notebooks, a.out, a.toc),
-    "api-modules": lambda a: bt.write_api(a.out),
-    "compile": lambda a: bt.compile_kernels(),
-    "check-results": lambda a: bt.check_results(a.fresh, a.reference, a.notebooks, a.rtol, a.atol),
-    "screenshots": lambda a: bt.screenshots(a.html_dir, a.out_dir, a.width, a.chromium),
+    "status": lambda a: write_status(a.results_dir, a.notebooks, a.out, a.toc),
+    "api-modules": lambda a: write_api(a.out),
+    "compile": _compile,
+    "check-results": lambda a: check_results(a.fresh, a.reference, a.notebooks, a.rtol, a.atol),
+    "screenshots": lambda a: screenshots(a.html_dir, a.out_dir, a.width, a.chromium),
     "grid": _grid,
 }
 

@@ -5,7 +5,7 @@ task of :mod:`navlib.engine` (local worker processes, or the cluster at a schedu
 its own results file.  ``DIR`` (new or empty: never written into otherwise) gets
 
 - ``<notebook>_<k>.ipynb``: run ``k``'s executed notebook;
-- ``results/<notebook>_<k>/<chapter>.json``: the results file it wrote (:func:`navbook.report.write_results`);
+- ``results/<notebook>_<k>/<chapter>.json``: the results file it wrote (:func:`navbook.results.write_results`);
 - ``grid.csv``: one row per run: ``run``, ``notebook``, ``status`` (``ok`` or the failure in one line), the
   parameters, then every method statistic (``<method>: <statistic>``) and every claim's verdict and
   estimate (``<claim id>: verdict``, ``<claim id>: estimate``: the claims-register id, the verdict under
@@ -55,7 +55,7 @@ from navlib._optional import require
 from navlib.data.tables import claim_folder, write_new
 from navlib.errors import InputError
 
-from .report import RESULTS_ENV
+from .results import RESULTS_ENV
 
 #: Parameters a grid sets in every run unless the user sets them (notebooks that have them).
 RUN_DEFAULTS = {"n_workers": 1}

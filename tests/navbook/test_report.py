@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from navbook import report
+from navbook import glue, report
 
 from navlib import verdicts
 from navlib.errors import InputError
@@ -102,7 +102,7 @@ def test_write_and_read_results_round_trip(tmp_path):
     assert c["holds_when"] == "below" and c["source"] == "paper" and c["decided_by"] == ["noise 0.04 uT"]
     assert c["rule"] == "median over runs" and c["n"] == 20
     assert json.loads(path.read_text())["unit"] == "deg"
-    from navbook.booktools import validate_results
+    from navbook.results_check import validate_results
     assert validate_results(res, "compass.json") == []
 
 
@@ -156,7 +156,7 @@ def test_claims_summary_counts_per_chapter_source_and_reading():
 
 def test_glue_claims_glues_verdict_and_detail(monkeypatch):
     glued = {}
-    monkeypatch.setattr(report, "_glue", lambda name, obj: glued.__setitem__(name, obj))
+    monkeypatch.setattr(glue, "_glue", lambda name, obj: glued.__setitem__(name, obj))
     report.glue_claims([_claim((1.5, 2.0), key="d_rmse"), _claim()])
     assert glued == {"d_rmse": "not reproduced",
                      "d_rmse_detail": "not reproduced: ours 1.75 [1.5, 2] deg, boundary < 1 deg"}

@@ -8,7 +8,7 @@ import sys
 import nbformat
 import pytest
 
-from navbook.booktools import execute
+from navbook.execute import execute
 from navlib.paths import NOTEBOOK_DIR
 
 CELLS = [

@@ -9,9 +9,9 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
-from navbook import report  # noqa: E402
+from navbook import report, tables  # noqa: E402
 from navlib import plotstyle as rs  # noqa: E402
-from navbook.booktools import shrunk_figures  # noqa: E402
+from navbook.screenshots import shrunk_figures  # noqa: E402
 from navlib.errors import InputError  # noqa: E402
 from navlib.workbench.fit import fit_model, simulate  # noqa: E402
 from navlib.workbench.loop import LoopResult, loop, loop_figure, noise_band, staircase_figure, step_labels  # noqa: E402
@@ -40,7 +40,7 @@ def test_panel_grid_rejects_bad_input_naming_the_parameter():
 
 
 def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
-    monkeypatch.setattr(report, "READABLE_TABLES", False)          # restored after the test
+    monkeypatch.setattr(tables, "READABLE_TABLES", False)          # restored after the test
     with plt.rc_context():
         report.use_style()
         assert plt.rcParams["font.size"] >= 11 and plt.rcParams["figure.figsize"][0] <= rs.MAX_WIDTH_IN
@@ -57,7 +57,7 @@ def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
         label = axes[0].xaxis.label.get_window_extent(r)
         assert box.y1 < axes[0].get_window_extent(r).y0 and box.y1 <= label.y0   # under the x label
         assert fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN and ticks.y0 >= 0
-    assert report.READABLE_TABLES                                  # use_style turned readable tables on
+    assert tables.READABLE_TABLES                                  # use_style turned readable tables on
 
 
 @pytest.fixture(scope="module")

@@ -6,8 +6,7 @@ import nbformat
 import pandas as pd
 import pytest
 
-from navbook import booktools as bt
-from navbook import report
+from navbook import api_pages, claim_boxes, html_checks, landing, report, results_check
 from navlib import verdicts
 from navlib.errors import InputError
 
@@ -62,26 +61,26 @@ def test_each_case_of_cannot_be_judged_gets_its_own_label():
     assert set(verdicts.VERDICT_DEFINITIONS) >= {f"cannot be judged: {v[0]}" for v in verdicts.REASONS.values()}
     with pytest.raises(InputError, match="basis='guess'"):
         verdicts.reason_category("guess")
-    assert all(bt.claim_problems(c.record()) == [] for c in CLAIMS)
+    assert all(results_check.claim_problems(c.record()) == [] for c in CLAIMS)
     edited = dict(CLAIMS[3].record(), reason="straddles")             # a reason edited by hand
-    assert bt.claim_problems(edited) == ["reason 'straddles', the basis 'noise floor' and the why give "
+    assert results_check.claim_problems(edited) == ["reason 'straddles', the basis 'noise floor' and the why give "
                                          "'noise floor'"]
 
 
 # ------------------------------------------------------------------ landing page
 def test_reading_labels_are_readable():
-    assert bt.reading_label("2: DE + trainlm, val. stop") == "DE + trainlm, validation stop (reading 2)"
-    assert bt.reading_label("document B") == "Document B"
-    assert bt.reading_label("held-out runs") == "Held-out runs"
+    assert landing.reading_label("2: DE + trainlm, val. stop") == "DE + trainlm, validation stop (reading 2)"
+    assert landing.reading_label("document B") == "Document B"
+    assert landing.reading_label("held-out runs") == "Held-out runs"
 
 
 def test_verdict_sentence_follows_the_counts():
-    c = dict(zip(bt.COUNTED, (61, 97, 53)))
-    assert bt.verdict_sentence(c).startswith("Mixed, more not reproduced than reproduced: 61 of the paper's 211 claims")
-    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (13, 25, 7)))).startswith("Mostly not reproduced: 25 of the paper's 45 claims do not")
-    assert bt.verdict_sentence(dict(zip(bt.COUNTED, (5, 0, 2)))).startswith("Mostly reproduced: 5 of the paper's 7")
+    c = dict(zip(landing.COUNTED, (61, 97, 53)))
+    assert landing.verdict_sentence(c).startswith("Mixed, more not reproduced than reproduced: 61 of the paper's 211 claims")
+    assert landing.verdict_sentence(dict(zip(landing.COUNTED, (13, 25, 7)))).startswith("Mostly not reproduced: 25 of the paper's 45 claims do not")
+    assert landing.verdict_sentence(dict(zip(landing.COUNTED, (5, 0, 2)))).startswith("Mostly reproduced: 5 of the paper's 7")
     recs = [_claim("x", None, floor=verdicts.Floor(1.2, "noise", "less")).record()] * 3
-    s = bt.verdict_sentence(dict(zip(bt.COUNTED, (1, 0, 3))), claims=recs)
+    s = landing.verdict_sentence(dict(zip(landing.COUNTED, (1, 0, 3))), claims=recs)
     assert s.startswith("Mostly cannot be judged: 3 of the paper's 4") and "(all within our noise floor)" in s
 
 
@@ -92,10 +91,10 @@ def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_pat
     toc = tmp_path / "_toc.yml"
     toc.write_text("root: intro\nchapters:\n  - file: _generated/compass\n  - file: _generated/gyro\n"
                    "  - file: _generated/celestial\n")
-    order = bt.chapter_order([gyro, celestial, compass], toc)
+    order = landing.chapter_order([gyro, celestial, compass], toc)
     assert [p.stem for p in order] == ["compass", "gyro", "celestial"]
     sources = {"compass": ("Electronic compass", "paper A")}
-    md = bt.status_markdown(_results(), order, sources)
+    md = landing.status_markdown(_results(), order, sources)
     rows = [ln for ln in md.split("\n* - ")[1:]]                     # the list-table's rows after the header
     assert len(rows) == 2 + 1 and rows[0].startswith("chapter and source")
     rows = rows[1:]
@@ -109,7 +108,7 @@ def test_landing_page_summary_in_sidebar_order_with_bars_and_verdict_box(tmp_pat
     assert "In all, **1 of 7** of the papers' claims reproduce" in md
     assert "(what-the-verdicts-mean)=" in md and "**cannot be judged: within our noise floor**" in md
     assert "Not yet summarised (no results file): {doc}`INS/celestial </_generated/celestial>`" in md
-    by_reading = bt.readings_markdown(_results(), order, sources)
+    by_reading = landing.readings_markdown(_results(), order, sources)
     assert by_reading.index("::::{dropdown} Electronic compass: 7 rows (claims under readings), 4 readings") < by_reading.index("gyro")
     assert ("| DE + trainlm, validation stop (reading 2) | 2 | 0 | 0 | 2 (1 our interval contains the boundary, "
             "1 within our noise floor) |" in by_reading)
@@ -128,13 +127,13 @@ def test_write_status_reads_the_toc_and_the_sources(tmp_path, capsys):
         _nb(book / "_generated" / f"{chap}.ipynb", chap, title)
         (book / "_generated" / "results" / f"{chap}.json").write_text(json.dumps(_results()[chap]))
     out = book / "_generated" / "status.md"
-    assert bt.write_status(book / "_generated" / "results", book / "_generated", out) == 0
+    assert landing.write_status(book / "_generated" / "results", book / "_generated", out) == 0
     md = out.read_text()
     assert md.index("</_generated/gyro>") < md.index("{doc}`Compass </_generated/compass>`<span")
     assert (book / "_generated" / "status_readings.md").exists()
     (book / "chapters.csv").write_text("chapter,title\ncompass,Compass\n")
     with pytest.raises(InputError, match="needs the columns"):
-        bt.write_status(book / "_generated" / "results", book / "_generated", out)
+        landing.write_status(book / "_generated" / "results", book / "_generated", out)
 
 
 # ------------------------------------------------------------------ one source of counts
@@ -146,23 +145,23 @@ def _chapter_page(glance):
 
 def test_landing_and_glance_counts_come_from_one_claim_list():
     results = _results()
-    landing = bt.landing_counts(bt.status_markdown(results, []) or "")
-    assert landing == {}                                          # no notebooks: no rows
-    md = bt.status_markdown({"compass": results["compass"]}, [], None)
+    shown = html_checks.landing_counts(landing.status_markdown(results, []) or "")
+    assert shown == {}                                            # no notebooks: no rows
+    md = landing.status_markdown({"compass": results["compass"]}, [], None)
     assert "No chapter" in md
-    marks = bt.landing_counts('<span class="navbook-counts" data-chapter="compass" '
-                              'data-page="_generated/compass.html" data-paper="1 1 4" data-book="1 0 0"></span>')
+    marks = html_checks.landing_counts('<span class="navbook-counts" data-chapter="compass" '
+                                       'data-page="_generated/compass.html" data-paper="1 1 4" data-book="1 0 0"></span>')
     assert marks["_generated/compass.html"]["paper"] == (1, 1, 4, 0)
-    counts = bt.claim_counts(results)["compass"]
+    counts = landing.claim_counts(results)["compass"]
     assert tuple(counts["paper"].values()) == (1, 1, 4, 0) and tuple(counts["book"].values()) == (1, 0, 0, 0)
     full = _chapter_page(report.glance(CLAIMS))
-    assert bt.glance_counts(full) == {"paper": (1, 1, 4, 0), "book": (1, 0, 0, 0)}
-    assert bt.count_problems(marks, {"_generated/compass.html": full}) == []
+    assert html_checks.glance_counts(full) == {"paper": (1, 1, 4, 0), "book": (1, 0, 0, 0)}
+    assert html_checks.count_problems(marks, {"_generated/compass.html": full}) == []
     subset = _chapter_page(report.glance(CLAIMS[:3] + CLAIMS[-1:]))    # a glance that leaves claims out
-    problems = bt.count_problems(marks, {"_generated/compass.html": subset})
+    problems = html_checks.count_problems(marks, {"_generated/compass.html": subset})
     assert len(problems) == 1 and problems[0][1].startswith("counts differ: the glance box shows the paper's "
                                                             "claims as 1 of 3 reproduced / 1 not / 1")
-    assert bt.count_problems(marks, {})[0][1].startswith("counts differ: the landing page counts")
+    assert html_checks.count_problems(marks, {})[0][1].startswith("counts differ: the landing page counts")
 
 
 def test_the_glance_box_folds_long_lists_by_reading_and_labels_the_case():
@@ -185,54 +184,54 @@ OUT = '<div class="cell_output docutils container"><div class="output text_html"
 
 
 def test_check_page_flags_wide_code_unless_folded():
-    wide = "<pre>" + "x = 1  # " + "z" * bt.MAX_CODE_CHARS + "</pre>"
-    assert bt.check_page(page(f'<div class="highlight">{wide}</div>'))[0].startswith(
-        f"wide code line of {bt.MAX_CODE_CHARS + 9} characters")
-    assert bt.check_page(page("<pre>" + "z" * bt.MAX_CODE_CHARS + "</pre>")) == []
-    assert bt.check_page(page(f"<details class='hide above-input'><summary>Show</summary>{wide}</details>")) == []
+    wide = "<pre>" + "x = 1  # " + "z" * html_checks.MAX_CODE_CHARS + "</pre>"
+    assert html_checks.check_page(page(f'<div class="highlight">{wide}</div>'))[0].startswith(
+        f"wide code line of {html_checks.MAX_CODE_CHARS + 9} characters")
+    assert html_checks.check_page(page("<pre>" + "z" * html_checks.MAX_CODE_CHARS + "</pre>")) == []
+    assert html_checks.check_page(page(f"<details class='hide above-input'><summary>Show</summary>{wide}</details>")) == []
 
 
 def test_check_page_flags_index_name_rows_and_snake_case_headers():
     named = pd.DataFrame({"median_rms_deg": [1.0], "b": [2.0]}, index=pd.Index(["x"], name="method"))
-    problems = bt.check_page(page(OUT.format(named.to_html())))
+    problems = html_checks.check_page(page(OUT.format(named.to_html())))
     assert [p.split(" '")[0] for p in problems] == ["snake_case header", "index-name row"]
     styled = named.style.to_html()                                 # pandas' Styler: class index_name
-    assert any(p.startswith("index-name row 'method'") for p in bt.check_page(page(OUT.format(styled))))
+    assert any(p.startswith("index-name row 'method'") for p in html_checks.check_page(page(OUT.format(styled))))
     clean = report.table(named.reset_index().rename(columns={"median_rms_deg": "median RMS (deg)"}), index=False)
-    assert bt.check_page(page(OUT.format(clean._repr_html_()))) == []
+    assert html_checks.check_page(page(OUT.format(clean._repr_html_()))) == []
     # a table outside a cell output (the landing page's markdown tables, the API) is not a result table
-    assert bt.check_page(page(named.to_html())) == []
+    assert html_checks.check_page(page(named.to_html())) == []
 
 
 def test_check_html_fails_only_beyond_the_baseline(tmp_path, capsys):
     wide = "<pre>" + "z" * 100 + "</pre>"
     (tmp_path / "intro.html").write_text(page(wide + wide))
-    assert bt.check_html(tmp_path) == 1
+    assert html_checks.check_html(tmp_path) == 1
     base = tmp_path / "baseline.json"
     base.write_text(json.dumps({"pages": {"intro.html": {"wide code line": 2}}}))
-    assert bt.check_html(tmp_path, baseline=base) == 0
+    assert html_checks.check_html(tmp_path, baseline=base) == 0
     assert "known, to fix: intro.html: 2 wide code line" in capsys.readouterr().err
     base.write_text(json.dumps({"pages": {"intro.html": {"wide code line": 1}}}))
-    assert bt.check_html(tmp_path, baseline=base) == 1
+    assert html_checks.check_html(tmp_path, baseline=base) == 1
     base.write_text(json.dumps({"pages": {"intro.html": {"wide code line": 5}}}))
     (tmp_path / "intro.html").write_text(page(wide + '<script src="https://cdn.example/x.js"></script>'))
-    assert bt.check_html(tmp_path, baseline=base) == 1             # the old checks have no baseline
+    assert html_checks.check_html(tmp_path, baseline=base) == 1             # the old checks have no baseline
 
 
 def test_the_committed_baseline_names_only_known_kinds():
     from pathlib import Path
-    path = Path(__file__).resolve().parents[1] / "book" / bt.BASELINE_FILE
-    known = bt.load_baseline(path)
-    assert known and all(set(kinds) <= set(bt.LAYOUT_KINDS) for kinds in known.values())
+    path = Path(__file__).resolve().parents[2] / "book" / html_checks.BASELINE_FILE
+    known = html_checks.load_baseline(path)
+    assert known and all(set(kinds) <= set(html_checks.LAYOUT_KINDS) for kinds in known.values())
 
 
 # ------------------------------------------------------------------ API pages
 def test_api_pages_one_per_layer_build_internals_last():
-    mods = ["navlib.verdicts", "navbook.booktools", "navbook.report", "navlib.sensors.nope", "navbook.grid"]
-    pages = bt.api_pages(mods)
+    mods = ["navlib.verdicts", "navbook.landing", "navbook.report", "navlib.sensors.nope", "navbook.grid"]
+    pages = api_pages.api_pages(mods)
     assert list(pages)[-2:] == ["api_internals", "api_modules"]      # every layer, the tooling last
-    assert {f"api_{name}" for name, _, _ in bt.API_LAYERS} | {"api_modules"} == set(pages)
-    assert "navbook.booktools" in pages["api_internals"] and "navbook.booktools" not in pages["api_foundations"]
+    assert {f"api_{name}" for name, _, _ in api_pages.API_LAYERS} | {"api_modules"} == set(pages)
+    assert "navbook.landing" in pages["api_internals"] and "navbook.landing" not in pages["api_foundations"]
     assert pages["api_foundations"].count(".. automodule:: ") == 1
     assert "| {py:mod}`navlib.verdicts` | One rule for every verdict in the book. |" in pages["api_foundations"]
     assert "(not importable here" in pages["api_sensors"]
@@ -240,7 +239,7 @@ def test_api_pages_one_per_layer_build_internals_last():
     overview = pages["api_modules"]
     assert overview.index("api_sensors") < overview.index("api_foundations") < overview.index("api_internals")
     assert "api_cli" not in overview                                  # an empty layer is not listed
-    assert bt.api_layer("navlib.data.tables") == "data" and bt.api_layer("navlib.newthing") == "foundations"
+    assert api_pages.api_layer("navlib.data.tables") == "data" and api_pages.api_layer("navlib.newthing") == "foundations"
 
 
 def test_module_summary_is_the_first_sentence_as_myst(monkeypatch):
@@ -249,15 +248,15 @@ def test_module_summary_is_the_first_sentence_as_myst(monkeypatch):
     fake = types.ModuleType("navlib._fake_summary")
     fake.__doc__ = "Paper C (Yu et al. 2012) with :func:`navlib.verdicts.decide` and ``x ... y``. More text."
     monkeypatch.setitem(sys.modules, "navlib._fake_summary", fake)
-    assert bt.module_summary("navlib._fake_summary") == \
+    assert api_pages.module_summary("navlib._fake_summary") == \
         "Paper C (Yu et al. 2012) with `navlib.verdicts.decide` and `x ... y`."
     fake.__doc__ = "Run ``" + "word " * 60 + "``. Next."
-    cut = bt.module_summary("navlib._fake_summary")
+    cut = api_pages.module_summary("navlib._fake_summary")
     assert cut.endswith("` ...") and cut.count("`") == 2 and len(cut) < 210
 
 
 def test_write_results_warns_about_claims_no_glance_box_showed(tmp_path, monkeypatch):
-    monkeypatch.setattr(report, "_GLANCED", set())
+    monkeypatch.setattr(claim_boxes, "_GLANCED", set())
     report.glance(CLAIMS[:2])
     with pytest.warns(UserWarning, match="5 of the 7 claims are in no glance box"):
         report.write_results("compass", claims=CLAIMS, folder=tmp_path)

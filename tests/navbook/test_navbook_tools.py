@@ -5,7 +5,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from navbook.booktools import check_html, missing_figures, strip_metadata
+from navbook.execute import missing_figures, strip_metadata
+from navbook.html_checks import check_html
 
 
 def test_check_html_flags_remote_assets(tmp_path):
@@ -43,7 +44,7 @@ def test_missing_figures_detects_plot_cells_without_images():
 
 
 def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
-    from navbook.booktools import execute
+    from navbook.execute import execute
 
     nb = nbformat.v4.new_notebook()
     nb.cells.append(nbformat.v4.new_code_cell("x = 1"))
@@ -57,8 +58,9 @@ def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ the presentation checks of check-html
-from navbook.booktools import (MAX_PRE_CHARS, api_markdown, check_page, check_results, compare_results,  # noqa: E402
-                              navlib_modules, validate_results)
+from navbook.api_pages import api_markdown, navlib_modules  # noqa: E402
+from navbook.html_checks import MAX_PRE_CHARS, check_page  # noqa: E402
+from navbook.results_check import check_results, compare_results, validate_results  # noqa: E402
 
 OUT = '<div class="cell_output docutils container">{}</div>'
 PRE = '<div class="output stream highlight-myst-ansi notranslate"><div class="highlight"><pre>{}</pre></div></div>'
@@ -132,8 +134,8 @@ def _claim(text, reproduced, reading="as printed", source="paper"):
 
 def test_api_markdown_lists_every_navlib_module():
     mods = navlib_modules()
-    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.booktools", "navlib.studies.paper_a"} <= set(mods)
-    assert not [m for m in mods if m in ("navlib.report", "navlib.booktools", "navlib.grid")]
+    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.landing", "navlib.studies.paper_a"} <= set(mods)
+    assert not [m for m in mods if m in ("navlib.report", "navlib.booktools", "navlib.grid", "navbook.booktools")]
     assert "navlib.__main__" not in mods
     md = api_markdown(mods)
     assert md.count(".. automodule:: ") == len(mods)
@@ -233,7 +235,7 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, 
     """The kernel writes its results file where execute tells it (a temporary folder in
     $NAVBOOK_RESULTS_DIR, not a library default such as the notebook folder's ./results or the book's
     folder); execute copies it beside the notebook and restores the caller's environment."""
-    from navbook.booktools import execute
+    from navbook.execute import execute
     from navbook.report import RESULTS_ENV
 
     monkeypatch.delenv(RESULTS_ENV, raising=False)
@@ -259,16 +261,16 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, 
 
 
 def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
-    listing = tmp_path / "_modules" / "navlib"
+    listing = tmp_path / "_modules" / "navbook"
     listing.mkdir(parents=True)
-    (listing / "booktools.html").write_text('<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>')
+    (listing / "html_checks.html").write_text('<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>')
     assert check_html(tmp_path) == 0
     (listing / "cli.html").write_text('<script src="https://cdn.example/x.js"></script>')
     assert check_html(tmp_path) == 1
 
 
 def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
-    from navbook.booktools import check_chapter_opening
+    from navbook.html_checks import check_chapter_opening
 
     glance = '<div class="admonition"><p class="admonition-title">Results at a glance</p><table></table></div>'
     cell = '<div class="cell docutils container"><pre>n_seeds = 20</pre></div>'
@@ -285,7 +287,7 @@ def test_chapter_pages_must_open_with_results_at_a_glance(tmp_path, capsys):
 
 
 def test_chapter_pages_must_close_with_what_the_chapter_showed():
-    from navbook.booktools import check_chapter_closing
+    from navbook.html_checks import check_chapter_closing
 
     def box(title, paper, book=None):
         tallies = f"<p>The paper's claims: {paper[0]} of {sum(paper)} reproduced, {paper[1]} not reproduced, " \
@@ -342,7 +344,7 @@ def test_compare_results_compares_tables_of_records_exactly(tmp_path):
 
 
 def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run():
-    from navbook.booktools import check_api_page
+    from navbook.html_checks import check_api_page
     ok = ("<dl><dt>loop SYSTEM FILE.csv --model START [--json] [--report DIR]</dt>"
           "<dd><p>the whole loop</p></dd><dt>field --site LAT,LON [--date YYYY-MM-DD] [--json]</dt></dl>")
     assert check_api_page(ok, cli_page=True) == []
@@ -360,7 +362,7 @@ def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run
 def test_commands_on_the_cli_page_are_run_with_help():
     """Each command the page shows runs ``python -m navlib COMMAND --help`` in a new process: a command
     that fails, or whose help lacks an option the page shows, is a problem."""
-    from navbook.booktools import _help_problems
+    from navbook.html_checks import _help_problems
     assert _help_problems({"loop": {"--json", "--report"}, "field": {"--site"}}) == []
     assert _help_problems({"loop": {"--json", "--jsonl"}}) == [
         "'navlib loop --help' does not show --jsonl, which the page shows"]
