@@ -10,7 +10,7 @@ each other) and single-threaded (the part of the gain that is the gradient and t
 
 For each shape the chapter trains (20 or 4 nets of 1-6-1 on the 121-reading sweep; 20 nets of 1-50-1 on 8
 and 60 readings, patent B's small-sample study) it prints the time per epoch of each and the ratios, with
-``--study`` the time of ``paper_a.seed_study(..., methods=("bp_adam",))`` over 20 and 4 seeds with each
+``--study`` the time of ``compass.seed_study(..., methods=("bp_adam",))`` over 20 and 4 seeds with each
 trainer, and as its last line ``adam_speedup=<geometric mean of the per-epoch ratios against the former code>``.
 
 Run: ``.venv/bin/python benchmarks/bench_adam.py [--repeats 3] [--epochs 300] [--study]`` (best of the
@@ -32,8 +32,8 @@ from navlib.data.compass_sweeps import load_sweeps, split_sweeps
 from navlib.methods.bpnet import AdamParams, train_adam_many
 from navlib.methods.seeding import generators
 from navlib.paths import data_path
-from navlib.studies import paper_a
-from navlib.studies.paper_a import StudyParams, Sweeps
+from navlib.studies import compass
+from navlib.studies.compass import StudyParams, Sweeps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))   # the peer adapters
 from peers import autograd_adam  # noqa: E402
@@ -98,7 +98,7 @@ def main(argv=None):
             for name, fn in TRAINERS.items():
                 bpnet._adam_trajectories = fn
                 try:
-                    times[name] = best_time(lambda: paper_a.seed_study(sw, StudyParams(), seeds=seeds,
+                    times[name] = best_time(lambda: compass.seed_study(sw, StudyParams(), seeds=seeds,
                                                                        methods=("bp_adam",)), a.repeats)
                 finally:
                     bpnet._adam_trajectories = OURS

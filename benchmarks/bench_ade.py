@@ -33,7 +33,7 @@ from scipy.optimize import differential_evolution  # noqa: E402
 
 from navlib.methods.bpnet import sse_objective, n_params  # noqa: E402
 from navlib.data.compass_sweeps import load_sweeps, split_sweeps  # noqa: E402
-from navlib.studies.paper_a import Sweeps  # noqa: E402
+from navlib.studies.compass import Sweeps  # noqa: E402
 from navlib.methods.de import DEParams, evolve, evolve_many  # noqa: E402
 from navlib.methods.seeding import generators  # noqa: E402
 from navlib.paths import data_path  # noqa: E402

@@ -8,8 +8,8 @@ replaced (``tests/elm_reference.py``), in one run, on the chapter's data.
 2. ``fit``: ``fit_incremental_elm`` with the chapter's settings (elm_range 5 and 1, 5 seeds), with the
    numpy reference kernels swapped in and with the compiled ones.
 3. The chapter's ELM studies, timed with the compiled kernels and (unless ``--quick``) with the numpy
-   reference kernels swapped in: ``patent_b.glitch_study`` (glitch_prob 0.05, 15 uT, sim seed 2024),
-   ``paper_a.seed_study`` with elm_range 1.0 (ELM methods) and ``patent_b.node_count_curve`` for
+   reference kernels swapped in: ``elm_patent.glitch_study`` (glitch_prob 0.05, 15 uT, sim seed 2024),
+   ``compass.seed_study`` with elm_range 1.0 (ELM methods) and ``elm_patent.node_count_curve`` for
    elm_range 5.0 and 1.0 (all 20 seeds, 40 nodes).  The reference runs keep the rest of today's
    ``fit_incremental_elm`` (e.g. reusing a stalled stage's solve), so their times are below those of the
    code before the kernels were compiled; the ratio is that of the kernels alone.
@@ -41,8 +41,8 @@ from navlib.methods.scaling import MinMax  # noqa: E402
 from navlib.methods.seeding import generators  # noqa: E402
 from navlib.paths import data_path  # noqa: E402
 from navlib.sensors.compass import CompassErrors, SweepConfig, simulate_train_test  # noqa: E402
-from navlib.studies import paper_a, patent_b  # noqa: E402
-from navlib.studies.paper_a import StudyParams, Sweeps  # noqa: E402
+from navlib.studies import compass  # noqa: E402
+from navlib.studies.compass import StudyParams, Sweeps, elm_patent  # noqa: E402
 
 
 def best(fn, repeats: int, ref: bool = False) -> float:
@@ -101,10 +101,10 @@ def main() -> None:
     g_train, g_test = split_sweeps(simulate_train_test(
         CompassErrors(), config=SweepConfig(glitch_prob=0.05, glitch_ut=15.0), seed=2024))
     studies = {
-        "patent_b.glitch_study": lambda: patent_b.glitch_study(g_train, g_test, params, seeds=range(20)),
-        "paper_a.seed_study elm_range=1.0": lambda: paper_a.seed_study(
-            sw, replace(params, elm_range=1.0), seeds=range(20), methods=paper_a.ELM_METHODS),
-        "patent_b.node_count_curve 5.0+1.0": lambda: [patent_b.node_count_curve(
+        "elm_patent.glitch_study": lambda: elm_patent.glitch_study(g_train, g_test, params, seeds=range(20)),
+        "compass.seed_study elm_range=1.0": lambda: compass.seed_study(
+            sw, replace(params, elm_range=1.0), seeds=range(20), methods=compass.ELM_METHODS),
+        "elm_patent.node_count_curve 5.0+1.0": lambda: [elm_patent.node_count_curve(
             sw, replace(params, elm_range=r), seeds=range(20), max_nodes=40) for r in (5.0, 1.0)],
     }
     total = [0.0, 0.0]

@@ -12,7 +12,7 @@ from navlib.sensors.compass import simulate_train_test
 from navlib.methods.bpnet import AdamParams
 from navlib.methods.de import DEParams
 from navlib.methods.lm import LMParams
-from navlib.studies.paper_a import StudyParams
+from navlib.studies.compass import StudyParams
 from navlib.errors import InputError
 from navlib.data.tables import write_new_csv
 

@@ -19,6 +19,7 @@ from navlib.methods.de import DEParams
 from navlib.methods.seeding import generators, sequence
 from navlib.methods.smith import design, eight_position_indices, fit_smith, nearest_positions
 from navlib.sensors.compass import PAPER_A_EARTH, simulate_train_test
+from navlib.studies import compass
 
 
 @pytest.fixture(scope="module")
@@ -106,10 +107,10 @@ def test_family_of_one_de_stage_equals_each_method_alone(sw):
 
 
 def test_the_chapter_reexports_the_registry():
-    """paper A's study imports the registry from the methods layer: the same objects under the old names."""
-    from navlib.studies import paper_a
-    assert paper_a.METHODS is METHODS and paper_a.StudyParams is MethodParams
-    assert paper_a.fit_method is fit_method and paper_a._Eight is EightPosition
+    """The compass chapter's package imports the registry from the methods layer: the same objects, the
+    methods' settings under the chapter's name StudyParams."""
+    assert compass.METHODS is METHODS and compass.StudyParams is MethodParams
+    assert compass.fit_method is fit_method and compass.EightPosition is EightPosition
 
 
 def test_nearest_positions_within_a_tolerance():

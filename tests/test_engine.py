@@ -61,16 +61,15 @@ def test_patent_b_paper_d_and_paper_e_studies_on_two_workers_equal_one():
     from navlib.methods.anfis import AnfisOptions
     from navlib.methods.fish_swarm import FishSwarmParams
     from navlib.sensors.compass import SweepConfig, simulate_train_test
-    from navlib.studies import patent_b
-    from navlib.studies.paper_a import StudyParams, Sweeps
+    from navlib.studies.compass import StudyParams, Sweeps, elm_patent
 
     train, test = split_sweeps(simulate_train_test(config=SweepConfig(glitch_prob=0.05), seed=7))
     sw, p = Sweeps(train, test), StudyParams()
     p = replace(p, lm=replace(p.lm, epochs=10), adam=replace(p.adam, epochs=20))
-    for study in (lambda w: patent_b.node_count_curve(sw, p, seeds=range(3), max_nodes=5, workers=w),
-                  lambda w: patent_b.glitch_study(train, test, p, seeds=range(3), method="elm", workers=w),
-                  lambda w: patent_b.small_sample_study(sw, sizes=(8, 15), params=p, seeds=range(2),
-                                                        big_hidden=5, workers=w)):
+    for study in (lambda w: elm_patent.node_count_curve(sw, p, seeds=range(3), max_nodes=5, workers=w),
+                  lambda w: elm_patent.glitch_study(train, test, p, seeds=range(3), method="elm", workers=w),
+                  lambda w: elm_patent.small_sample_study(sw, sizes=(8, 15), params=p, seeds=range(2),
+                                                          big_hidden=5, workers=w)):
         pd.testing.assert_frame_equal(study(1), study(2))
     dp = paper_d.PaperDParams(seeds=(0, 1), anfis=AnfisOptions(epochs=2),
                               swarm=FishSwarmParams(n_fish=3, generations=1, try_number=1),

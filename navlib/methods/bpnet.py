@@ -22,7 +22,7 @@ Trainers (each trains several runs at once, one generator per run, :mod:`navlib.
 - :func:`train_matlab_bp_many`: MATLAB's default BP (third reading);
 - :func:`train_adam_many`: back-propagation with Adam from U(-1, 1) weights (an extra row);
 - :func:`train_least_squares`: scipy's MINPACK LM (or TRF with fewer readings than weights) to
-  convergence from U(-1, 1) weights (the ``bp_scipy_lm`` extra of :mod:`navlib.studies.paper_a`).
+  convergence from U(-1, 1) weights (the ``bp_scipy_lm`` extra of :mod:`navlib.studies.compass.turntable`).
 """
 from __future__ import annotations
 

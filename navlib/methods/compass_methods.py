@@ -1,6 +1,6 @@
 """The compass's compensation methods of paper A and document B, as one registry: stable ids, display
 labels, factories and their settings, for every study and tool that fits them (the compass chapter's
-:mod:`navlib.studies.paper_a` and :mod:`navlib.studies.patent_b`, the workbench's ``navlib compare``).
+:mod:`navlib.studies.compass`, the workbench's ``navlib compare``).
 
 Every method follows :mod:`navlib.methods.compensator`'s protocol (``fit`` or ``fit_many`` -> a fitted
 compensator with ``correct``).  Registered in :data:`METHODS` (labels are for display only):
@@ -267,7 +267,9 @@ def _eight(model: str):
     return lambda p: EightPosition(model, tol_deg=p.ls_tol_deg)
 
 
-def _rule_reading(base: str, label: str) -> str:
+def rule_reading(base: str, label: str) -> str:
+    """The name of the reading ``base`` (``R1`` or ``R4``) run with ADE's rules ``label`` (a label of
+    :data:`ADE_RULE_READINGS`)."""
     return f"{base}, ADE {label}"
 
 
@@ -316,12 +318,12 @@ RULE_READINGS: dict[str, str] = {}
 for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
     _key = (True, _f, _c)
     METHODS[f"ade_bp_pure_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}", _pure(True, (_f, _c)), True, "ADE-BP",
-                                                _rule_reading(R1, _lab), (_key, "pure"))
+                                                rule_reading(R1, _lab), (_key, "pure"))
     METHODS[f"ade_bp_full_trainlm_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}, full DE + trainlm",
                                                         _full(True, False, (_f, _c)), True, "ADE-BP",
-                                                        _rule_reading(R4, _lab), (_key, "trainlm"))
-    RULE_READINGS[_rule_reading(R1, _lab)] = f"ade_bp_pure_{_sfx}"
-    RULE_READINGS[_rule_reading(R4, _lab)] = f"ade_bp_full_trainlm_{_sfx}"
+                                                        rule_reading(R4, _lab), (_key, "trainlm"))
+    RULE_READINGS[rule_reading(R1, _lab)] = f"ade_bp_pure_{_sfx}"
+    RULE_READINGS[rule_reading(R4, _lab)] = f"ade_bp_full_trainlm_{_sfx}"
 
 #: The 8-position least squares under each model (paper A does not print its model): id -> short name.
 LS_MODELS = {"ls8": "Smith 5 terms", "ls8_planar": "planar 5 par.", "ls8_h3": "harmonic 3rd order"}

@@ -1,6 +1,7 @@
 """Document B, the ELM compass patent: ELM against node count, the patent's data preparation (median
-filter, field-gravity screen, min-max, random 90/10 split) on sweeps with glitches, and the small-sample
-claim.  The ELM rows of paper A's comparison are in :mod:`navlib.studies.paper_a`.
+filter, field-gravity screen, min-max, random 90/10 split) on sweeps with glitches, the small-sample study,
+and document B's claims.  The ELM rows of paper A's comparison are in
+:mod:`navlib.studies.compass.turntable`.
 """
 from __future__ import annotations
 
@@ -9,22 +10,22 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
-from ..angles import wrap_deg
-from ..data.compass_sweeps import unwrap_measured
-from ..errors import InputError, check_param
-from ..methods.bpnet import train_adam_many, train_matlab_bp_many
-from ..methods.compensator import NetworkCompensator
-from ..methods.elm import fit_elm, fit_incremental_elm
-from ..methods.preprocess import DotScreen, dot_product_screen, median_filter, train_test_split
-from ..methods.scaling import MinMax
-from ..methods.seeding import generators
-from ..sensors.compass import heading_from_field
-from ..sensors.planar import fit_planar_model
-from .. import engine, verdicts
-from ..claims import Claim
-from .paper_a import (ELM_METHODS, LS_MODELS, METHODS, TRAINING_ONLY, StudyParams, Sweeps, _ls_assumption,
-                      fit_method, method_id,
-                      paired_seed_difference, per_seed, rms_deg)
+from ... import engine, verdicts
+from ...angles import wrap_deg
+from ...claims import Claim
+from ...data.compass_sweeps import unwrap_measured
+from ...errors import InputError, check_param
+from ...methods.bpnet import train_adam_many, train_matlab_bp_many
+from ...methods.compass_methods import ELM_METHODS, LS_MODELS, METHODS, fit_method, method_id
+from ...methods.compensator import NetworkCompensator
+from ...methods.elm import fit_elm, fit_incremental_elm
+from ...methods.preprocess import DotScreen, dot_product_screen, median_filter, train_test_split
+from ...methods.scaling import MinMax
+from ...methods.seeding import generators
+from ...sensors.compass import heading_from_field
+from ...sensors.planar import fit_planar_model
+from .parameters import StudyParams
+from .sweeps import TRAINING_ONLY, Sweeps, ls_assumption, paired_seed_difference, per_seed, rms_deg
 
 # ----------------------------------------------------------------------------------------------------------
 # Patent B: test error against hidden-node count
@@ -235,7 +236,7 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
 
     Methods (labels from :func:`big_net_labels`):
 
-    - ``ELM back-tuned`` and ``ELM`` (as in :func:`navlib.studies.paper_a.compensate`);
+    - ``ELM back-tuned`` and ``ELM`` (as in :func:`navlib.studies.compass.turntable.compensate`);
     - ``BP 1-{big_hidden}-1 (trainlm)``: the over-sized net a MATLAB user of the patent's era gets from
       ``feedforwardnet(big_hidden)`` and ``train`` with every reading training (no validation split: the
       claim is about a net trained to convergence, and with 8 readings ``dividerand`` would leave 6):
@@ -337,7 +338,7 @@ def _series(frame: pd.DataFrame, col: str) -> pd.Series:
 
 def _paired(worse: pd.Series, better: pd.Series, name: str) -> tuple[verdicts.Estimate | None, str]:
     """The paired difference ``worse - better`` over the same seeds
-    (:func:`navlib.studies.paper_a.paired_seed_difference`), or None and the reason when there is no 95 %
+    (:func:`navlib.studies.compass.sweeps.paired_seed_difference`), or None and the reason when there is no 95 %
     interval."""
     return verdicts.attempt(paired_seed_difference, worse.rename(f"{name} (first)"),
                             better.rename(f"{name} (second)"))
@@ -394,7 +395,7 @@ def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, sm
                          why="boundary 0: document B states no amount of improvement, so any reduction of "
                              "the test RMS counts"))
     out += [beats(f"ELM back-tuned beats 8-position LS [{name}]", "implicit beats explicit models (no numbers)",
-                 "paper", ls, "b_bt_ls" if ls == "ls8" else f"b_bt_ls_{ls.split('_')[-1]}", (_ls_assumption(ls),))
+                 "paper", ls, "b_bt_ls" if ls == "ls8" else f"b_bt_ls_{ls.split('_')[-1]}", (ls_assumption(ls),))
            for ls, name in LS_MODELS.items() if ls in rms]
     out += [beats("ELM back-tuned beats ADE-BP (pure DE)", "(not in the paper)", "book", "ade_bp_pure",
                  "b_bt_ade_bp_pure", ("paper A's pure DE with its budget",))]

@@ -1,4 +1,4 @@
-"""Paper A's and document B's compensation methods on a real compass: BROAD's level sweeps (issue 36).
+"""Paper A's and document B's compensation methods on a real compass: BROAD's level sweeps.
 
 The compass chapter judges every claim on our simulated compass; where that simulator decides the answer
 (the exact planar model *is* our simulator, so nothing can beat it; the uncompensated range was set to match
@@ -45,20 +45,20 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import claims as registry
-from .. import verdicts
-from ..errors import InputError, check_param
-from ..methods.compass_methods import LS_MODELS, METHODS, MethodParams
-from ..paths import ROOT
-from ..claims import Claim
-from ..workbench.compare import CompareResult, compare
-from ..workbench.compare import report_figure as _compare_figure
-from .paper_a import ordering_rate, paired_rms_difference, per_seed
+from ... import claims as registry
+from ... import verdicts
+from ...claims import Claim
+from ...errors import InputError, check_param
+from ...methods.compass_methods import LS_MODELS, METHODS, MethodParams
+from ...paths import ROOT
+from ...plotstyle import legend_below
+from ...workbench.compare import CompareResult, compare
+from ...workbench.compare import report_figure as _compare_figure
+from .parameters import LS_TOLERANCE_MAX_DEG
+from .sweeps import ordering_rate, paired_rms_difference, per_seed
 
 #: Where BROAD's level compass sweeps live (beside the repository, never inside it).
 LEVEL_DIR = ROOT.parent / "shared" / "realdata" / "broad" / "level"
-#: The widest tolerance of the 8-position LS (half the 45-deg spacing: no reading serves two positions).
-LS_TOLERANCE_MAX_DEG = 22.5
 
 
 @dataclass(frozen=True)
@@ -204,10 +204,10 @@ def _not_run_by_reason(res: CompareResult) -> dict[str, list[str]]:
 
 
 def runs_frame(res: CompareResult) -> pd.DataFrame:
-    """A comparison as paper A's seed-study runs (:func:`navlib.studies.paper_a.seed_study`'s columns
+    """A comparison as paper A's seed-study runs (:func:`navlib.studies.compass.turntable.seed_study`'s columns
     ``method``, ``seed``, ``rms_deg``, ``min_deg``, ``max_deg``; a deterministic method has the one seed
     -1): the held-out RMS and error range of every run, so the chapter's statistics
-    (:func:`~navlib.studies.paper_a.paired_rms_difference`, :func:`~navlib.studies.paper_a.ordering_rate`)
+    (:func:`~navlib.studies.compass.sweeps.paired_rms_difference`, :func:`~navlib.studies.compass.sweeps.ordering_rate`)
     apply unchanged."""
     rows = []
     for mid in res.methods:
@@ -312,9 +312,9 @@ def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
     ``data/paper_a_error_ranges.csv``) as the paper's text.
 
     "X beats Y": RMS(Y) - RMS(X) of the held-out rows over the same seeds
-    (:func:`navlib.studies.paper_a.paired_rms_difference`), boundary 0, holds above; "one run shows LS > BP
+    (:func:`navlib.studies.compass.sweeps.paired_rms_difference`), boundary 0, holds above; "one run shows LS > BP
     > DE-BP > ADE-BP": the share of seeds whose runs show the ordering (Wilson interval, boundary 0.5, as
-    on the simulated compass, :func:`navlib.studies.paper_a.ordering_rate`).  Nothing is true by
+    on the simulated compass, :func:`navlib.studies.compass.sweeps.ordering_rate`).  Nothing is true by
     construction on real data.  A claim whose method was left out of the comparison (the 8-position LS
     without its 8 headings) has no statistic and says why (*not run*); one whose methods were not asked
     for is skipped."""
@@ -478,11 +478,10 @@ def real_figure(real: RealCompass, paper: pd.DataFrame, key: str = "trial05"):
         spare[0].legend(list(handles.values()), list(handles), loc="center",
                         title=f"{real.recording(key).label}, held out:")
     else:
-        from ..plotstyle import legend_below
         legend_below(fig.axes[-1], handles=list(handles.values()), labels=list(handles), ncol=3)
     return fig
 
 
-__all__ = ["ABSENT", "ANSWER_KEYS", "LEVEL_DIR", "LS_TOLERANCE_MAX_DEG", "RECORDINGS", "RealClaim", "RealCompass",
-           "Recording", "answer", "available", "folds_table", "method_table", "not_run", "real_claim_specs", "real_claims",
+__all__ = ["ABSENT", "ANSWER_KEYS", "LEVEL_DIR", "RECORDINGS", "RealClaim", "RealCompass", "Recording", "answer",
+           "available", "folds_table", "method_table", "not_run", "real_claim_specs", "real_claims",
            "real_compass_study", "real_figure", "runs_frame", "verdict_changes"]

@@ -1,4 +1,4 @@
-"""navlib.studies.compass_real: the papers' methods on BROAD's real level compass sweeps (issue 36).
+"""navlib.studies.compass.real: the papers' methods on BROAD's real level compass sweeps.
 
 The study runs on the real files (skipped where ``../shared/realdata`` is absent) with the cheap methods
 (uncompensated, the exact planar fit and the two ELMs; the networks of paper A cost a minute and add
@@ -13,7 +13,7 @@ from navlib import claims as registry
 from navlib import verdicts
 from navlib.errors import InputError
 from navlib.paths import DATA_DIR
-from navlib.studies import compass_real as cr
+from navlib.studies.compass import real as cr
 
 CHEAP = ("uncompensated", "physical", "elm", "elm_backtuned")
 needs_data = pytest.mark.skipif(not cr.available(), reason="BROAD's level sweeps are not in ../shared/realdata")

@@ -1,6 +1,6 @@
-"""Tests for navlib.studies.paper_a (registry, seed study, ordering probability, verdicts) and
-navlib.studies.patent_b (the ELM methods, the patent's data preparation, glitch, node-count and small-sample
-studies)."""
+"""Tests for navlib.studies.compass: paper A's runs (registry, seed study, ordering probability, verdicts,
+convergence, robustness, our choices) and document B's (:mod:`navlib.studies.compass.elm_patent`: the ELM
+methods, the patent's data preparation, glitch, node-count and small-sample studies)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -14,15 +14,20 @@ from navlib.data.compass_sweeps import split_sweeps
 from navlib.sensors.compass import PAPER_A_EARTH, SweepConfig, simulate_train_test
 from navlib.methods.de import DEParams
 from navlib import verdicts
-from navlib.studies.paper_a import (LS_MODELS, RULE_READINGS, METHODS, READINGS,
-                                    R1 as READINGS_R1, StudyParams, Sweeps,
-                                    claims, compensate, fit_method, floor_curve, implied_noise_ut, largest_noise,
-                                    noise_study, ordering_probability, ordering_rate, ordering_table,
-                                    paired_rms_difference, seed_study,
-                                    summarize, test_errors as heading_errors, verdict_table)
-from navlib.studies.patent_b import (GLITCH_VARIANTS, even_indices, glitch_run, glitch_study,
-    node_count_curve, nodes_to_goal_runs, prepare_patent_data, small_sample_study)
-from navlib.studies.patent_b import claims as patent_b_claims
+from navlib.studies.compass import (LS_MODELS, MAX_TASK_S, METHODS, R4, READINGS, ROBUST_METHODS, RULE_READINGS,
+                                    SEED_BATCH, CompassDrawRule, StudyParams, Sweeps, choices_study, claims,
+                                    compensate, convergence_claims, convergence_curves, draw_compass, draw_compasses,
+                                    fig4_panels, fit_method, floor_curve, generations_to_reach, implied_noise_ut,
+                                    largest_noise, noise_study, ordering_probability, ordering_rate, ordering_table,
+                                    paired_rms_difference, reach_summary, robustness_flips, robustness_table,
+                                    rule_reading_table, seed_study, summarize, unit_cost, verdict_table)
+from navlib.studies.compass import R1 as READINGS_R1
+from navlib.studies.compass import test_errors as heading_errors
+from navlib.studies.compass.elm_patent import (GLITCH_VARIANTS, even_indices, glitch_run, glitch_study,
+                                               node_count_curve, nodes_to_goal_runs, prepare_patent_data,
+                                               small_sample_study)
+from navlib.studies.compass.elm_patent import claims as patent_b_claims
+from navlib.studies.compass.turntable import _tasks
 from navlib.errors import InputError
 from navlib.paths import data_path
 
@@ -58,7 +63,6 @@ def test_hybrid_reaches_floor_and_pure_does_not(sw):
 
 
 def rule_reading_table_of(records):
-    from navlib.studies.paper_a import rule_reading_table
     return rule_reading_table(records, READINGS_R1)
 
 
@@ -87,7 +91,6 @@ def test_claims_and_verdict_table(sw):
     pd.testing.assert_frame_equal(verdict_table(per_claim).loc[vt.index, vt.columns], vt)
     assert len(rule_reading_table_of(per_claim)) == len(rule_reading_table_of(written))
     pd.testing.assert_frame_equal(verdict_table(written, list(RULE_READINGS)), verdict_table(cl, list(RULE_READINGS)))
-    from navlib.studies.paper_a import R4, rule_reading_table
     rt = rule_reading_table(written, READINGS_R1)
     assert list(rt.columns) == ["F by generation, CR by value", "F per individual", "F combined", "CR by rank",
                                 "F per individual, CR by rank"]
@@ -513,8 +516,6 @@ def _history_runs(first_de, first_ade, final_de, final_ade, gens=200):
 
 
 def test_generations_to_reach_and_the_convergence_claims():
-    from navlib.studies.paper_a import (convergence_claims, convergence_curves, generations_to_reach,
-                                        reach_summary)
     n = 10
     runs = _history_runs([150] * n, [60] * n, np.geomspace(10, 1000, n), np.geomspace(50, 60, n))
     reach = generations_to_reach(runs, rms_levels=(1.0,))
@@ -536,7 +537,6 @@ def test_generations_to_reach_and_the_convergence_claims():
 
 
 def test_compasses_are_drawn_by_the_stated_rule():
-    from navlib.studies.paper_a import CompassDrawRule, draw_compass, draw_compasses
     rule = CompassDrawRule(n_compasses=3)
     c = draw_compasses(rule, -16.0, 30.7, 0.04)
     assert list(c.compass) == ["C1", "C2", "C3"] and np.all(np.diff(c.draw) > 0)
@@ -561,7 +561,6 @@ def simulate_sweep_errors(e):
 
 
 def test_robustness_table_marks_verdicts_that_change_with_the_compass():
-    from navlib.studies.paper_a import robustness_flips, robustness_table
     robust = pd.DataFrame([{"compass": k, "claim": c, "reading": "r", "verdict": v}
                            for k, c, v in (("C1", "a", "reproduced"), ("C2", "a", "reproduced"),
                                            ("C1", "b", "reproduced"), ("C2", "b", "not reproduced"))])
@@ -576,19 +575,16 @@ def test_robustness_table_marks_verdicts_that_change_with_the_compass():
 
 
 def test_fig4_draws_de_bp_against_ade_bp_in_every_reading():
-    from navlib.studies.paper_a import fig4_panels
     drawn = {m for _, ids in fig4_panels() for m in ids}
     assert {ids[3] for ids in READINGS.values()} <= drawn and {ids[2] for ids in READINGS.values()} <= drawn
 
 
 def test_robustness_judges_every_reading_including_ades_rules():
-    from navlib.studies.paper_a import ROBUST_METHODS
     assert {i for ids in READINGS.values() for i in ids} <= set(ROBUST_METHODS)
     assert set(RULE_READINGS.values()) <= set(ROBUST_METHODS) and set(LS_MODELS) <= set(ROBUST_METHODS)
 
 
 def test_choices_study_reuses_the_default_runs_and_reruns_the_others(sw):
-    from navlib.studies.paper_a import choices_study
     p = StudyParams(de=DEParams(max_generations=60), adam=replace(StudyParams().adam, epochs=30))
     runs = seed_study(sw, p, seeds=range(3), methods=("de_bp_pure", "ade_bp_pure", "bp_adam"))
     out = choices_study(sw, p, runs, box_bounds=(5.0, 10.0), box_seeds=range(2), budget_factor=2,
@@ -612,11 +608,10 @@ def test_choices_study_reuses_the_default_runs_and_reruns_the_others(sw):
 
 
 def test_a_costly_unit_goes_in_smaller_batches(sw):
-    from navlib.studies.paper_a import MAX_TASK_S, SEED_BATCH, _tasks, _unit_cost
     p = StudyParams()
     long = replace(p, de=replace(p.de, max_generations=10 * p.de.max_generations))
     sizes = [len(t[3]) for t in _tasks(sw, p, list(range(6)), ("ade_bp_pure",), 0, False)[0]]
     assert sizes == [SEED_BATCH, 6 - SEED_BATCH]
     tasks, cost = _tasks(sw, long, list(range(3)), ("ade_bp_pure",), 0, False)
-    assert [len(t[3]) for t in tasks] == [1, 1, 1] and _unit_cost(("ade_bp_pure",), long) > MAX_TASK_S
-    assert cost == pytest.approx([_unit_cost(("ade_bp_pure",), long)] * 3)
+    assert [len(t[3]) for t in tasks] == [1, 1, 1] and unit_cost(("ade_bp_pure",), long) > MAX_TASK_S
+    assert cost == pytest.approx([unit_cost(("ade_bp_pure",), long)] * 3)

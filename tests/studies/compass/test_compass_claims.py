@@ -11,11 +11,11 @@ import pytest
 from navlib.claims import load_register
 from navlib.data.compass_sweeps import load_sweeps, split_sweeps
 from navlib.paths import data_path
-from navlib.studies import paper_a
-from navlib.studies.paper_a import (LS_REF_POSITIONS, R_ANY, StudyParams, Sweeps, convergence_claims,
+from navlib.studies import compass
+from navlib.studies.compass import (LS_REF_POSITIONS, R_ANY, StudyParams, Sweeps, convergence_claims,
                                     convergence_generations, generations_to_reach, ls_positions_rms, seed_study,
                                     sweep_claims)
-from navlib.studies.patent_b import claims as patent_b_claims
+from navlib.studies.compass.elm_patent import claims as patent_b_claims
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +47,7 @@ def test_uncompensated_range_row_is_by_construction_on_simulated_sweeps(sw, runs
     want = max(abs(u.min_deg - unc.error_min_deg), abs(u.max_deg - unc.error_max_deg))
     c = next(c for c in sweep_claims(runs, paper, sw) if c.key == "a_uncomp_range")
     assert c.reading == R_ANY and c.rule == "exact" and c.estimate.value == pytest.approx(want)
-    assert c.boundary == paper_a.CompassDrawRule().tolerance_deg and c.holds_when == "below"
+    assert c.boundary == compass.CompassDrawRule().tolerance_deg and c.holds_when == "below"
     assert c.by_construction and c.verdict == "cannot be judged" and c.basis == "by construction"
     assert f"{unc.error_min_deg:+.2f}" in c.why                  # the paper's range, from the data file
     # on a real sweep file the same statistic is judged: within 2 deg of both ends, or not
