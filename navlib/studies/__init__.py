@@ -4,5 +4,5 @@
 - :mod:`navlib.studies.patent_b` -- document B, the ELM compass patent;
 - :mod:`navlib.studies.paper_c` -- paper C, RBF identification of the axial gyro drift;
 - :mod:`navlib.studies.paper_e` -- paper E, BP-network-aided inertial/celestial navigation.
-- :mod:`navlib.studies.paper_d` -- paper D, accelerometer temperature drift by IAFSA-SCM-ANFIS.
+- :mod:`navlib.studies.accelerometer` -- paper D, accelerometer temperature drift by IAFSA-SCM-ANFIS.
 """

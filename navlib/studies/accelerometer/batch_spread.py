@@ -16,10 +16,11 @@ from .simulation import samples, sim_seed, unit_b_coefficients
 def unit_b_spread(runs: list, params: PaperDParams, spreads=BATCH_SPREADS, method: str = "IAFSA-SCM-ANFIS"
                   ) -> pd.DataFrame:
     """Unit B as a function of the batch spread: for every run (seed) and spread, unit B drawn by
-    :func:`unit_b_coefficients` (the same ``z`` at every spread) with the seed's unit-B noise, compensated
-    with the run's ``method`` and unit A's exact model.  Per row: largest ``|error|`` (ug) of both against
-    the measured 55 degC target, the largest error unit A's exact model leaves on unit B's noise-free
-    outputs (the units' difference alone, ug) and unit B's largest drift before compensation (mg)."""
+    :func:`~navlib.studies.accelerometer.simulation.unit_b_coefficients` (the same ``z`` at every spread) with the
+    seed's unit-B noise, compensated with the run's ``method`` and unit A's exact model.  Per row: largest
+    ``|error|`` (ug) of both against the measured 55 degC target, the largest error unit A's exact model leaves on
+    unit B's noise-free outputs (the units' difference alone, ug) and unit B's largest drift before compensation
+    (mg)."""
     rows = []
     ref = params.experiment.reference_c
     for r in runs:
@@ -58,11 +59,12 @@ def _units_difference(params: PaperDParams, draw: int, spreads) -> tuple:
 
 def spread_needed(params: PaperDParams, paper: pd.DataFrame, spreads=BATCH_SPREADS, n_draws: int = 200
                   ) -> pd.DataFrame:
-    """Per draw of unit B (draw ``k`` uses :func:`sim_seed` ``(k, "batch_b")``; no draw is picked): its
-    largest drift before compensation at every spread (mg), and the spread at which the units' difference
-    alone (unit A's exact model on unit B's noise-free outputs) first reaches the paper's 9.3 ug (linear
-    interpolation over 0 and ``spreads``; at spread 0 the exact model leaves only the cross-coupling and
-    misalignment terms it ignores, a few ug; NaN when 9.3 ug is not reached within ``spreads``)."""
+    """Per draw of unit B (draw ``k`` uses :func:`~navlib.studies.accelerometer.simulation.sim_seed` ``(k,
+    "batch_b")``; no draw is picked): its largest drift before compensation at every spread (mg), and the spread at
+    which the units' difference alone (unit A's exact model on unit B's noise-free outputs) first reaches the
+    paper's 9.3 ug (linear interpolation over 0 and ``spreads``; at spread 0 the exact model leaves only the
+    cross-coupling and misalignment terms it ignores, a few ug; NaN when 9.3 ug is not reached within
+    ``spreads``)."""
     check_param("n_draws", n_draws, lo=1, hi=100000, integer=True)
     b = _paper_value(paper, "unit_b_after") * 1000
     sp = np.asarray(spreads, float)

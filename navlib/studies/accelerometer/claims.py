@@ -21,10 +21,11 @@ from .tables import per_seed
 
 
 def drift_claims(params: PaperDParams, paper: pd.DataFrame, seeds) -> list:
-    """The drifts our simulator was set to (sections 2 and 2.1.1, Figs 2-3): per seed the largest output
-    drift and the largest 0/180 deg bias drift of unit A (:func:`drift_by_seed`), median over the seeds
-    against the paper's 5 mg and 1.7 mg ("reached": holds above).  True by construction: the simulator's
-    default coefficients were chosen to approach them, so the verdict checks our simulator, not the paper."""
+    """The drifts our simulator was set to (sections 2 and 2.1.1, Figs 2-3): per seed the largest output drift and
+    the largest 0/180 deg bias drift of unit A (:func:`~navlib.studies.accelerometer.figures.drift_by_seed`), median
+    over the seeds against the paper's 5 mg and 1.7 mg ("reached": holds above).  True by construction: the
+    simulator's default coefficients were chosen to approach them, so the verdict checks our simulator, not the
+    paper."""
     d = drift_by_seed(params, seeds)
     c = params.coefficients
     setting = (f"navlib.sensors.accelerometer.AccelCoefficients defaults were chosen to approach the paper's "
@@ -197,10 +198,10 @@ def _ratio_claim(test: pd.DataFrame, base: str, k: float, floor_ug: float, sigma
 
 def two_orders_claims(err: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, reading: str,
                       key_prefix: str = "", boundaries=NEARLY_TWO_ORDERS, s: str = "test") -> list:
-    """"Compared with the single models the accuracy rose by nearly two orders of magnitude" (section 5.2,
-    after ANN 0.138, FIS 0.101, ANFIS 0.034 mg): one claim per single model (ANN, FIS, ANFIS) and per
-    boundary of "nearly two orders" (:data:`NEARLY_TWO_ORDERS`), each the paired RMSE ratio over the seeds
-    on set ``s``.  Keys ``<key_prefix>_two_orders_<model>_<boundary>`` when ``key_prefix`` is given."""
+    """"Compared with the single models the accuracy rose by nearly two orders of magnitude" (section 5.2, after ANN
+    0.138, FIS 0.101, ANFIS 0.034 mg): one claim per single model (ANN, FIS, ANFIS) and per boundary of "nearly two
+    orders" (:data:`~navlib.studies.accelerometer.parameters.NEARLY_TWO_ORDERS`), each the paired RMSE ratio over
+    the seeds on set ``s``.  Keys ``<key_prefix>_two_orders_<model>_<boundary>`` when ``key_prefix`` is given."""
     test = per_seed(err, (*METHODS, "oracle"), s)
     sigma = params.experiment.noise_ug
     p = _paper_rmse_ug(paper)
@@ -300,10 +301,12 @@ def tuner_claims(err: pd.DataFrame, params: PaperDParams) -> list:
 
 def unit_b_spread_claims(ub: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, need: pd.DataFrame,
                          method: str = "IAFSA-SCM-ANFIS") -> list:
-    """Unit B's 9.3 ug judged at every batch spread of :func:`unit_b_spread` except ``params``'s own (that is
-    the claim ``accel_unit_b``): median over seeds of the largest error against 9.3 ug, with the noise
-    floor of a perfect model's largest error; and the spread 9.3 ug needs (median over the draws of
-    :func:`spread_needed`, a statistic of our simulator, judged against the assumed spread)."""
+    """Unit B's 9.3 ug judged at every batch spread of
+    :func:`~navlib.studies.accelerometer.batch_spread.unit_b_spread` except ``params``'s own (that is the claim
+    ``accel_unit_b``): median over seeds of the largest error against 9.3 ug, with the noise floor of a perfect
+    model's largest error; and the spread 9.3 ug needs (median over the draws of
+    :func:`~navlib.studies.accelerometer.batch_spread.spread_needed`, a statistic of our simulator, judged against
+    the assumed spread)."""
     p_after = _paper_value(paper, "unit_b_after") * 1000
     sigma = params.experiment.noise_ug
     exp = params.experiment

@@ -81,10 +81,10 @@ def drift_summary(df: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, s
 
 
 def drift_by_seed(params: PaperDParams, seeds) -> pd.DataFrame:
-    """Figs 2-3 per seed (unit A, measured, against 55 degC): the largest ``|bias drift|`` of the 0/180 deg
-    bias test (:func:`fig3_bias`, noise :func:`sim_seed` ``(seed, "bias_test")``) and the largest
-    ``|N(T, q) - N(55, q)|`` of the tumble (:func:`fig2_output_drift`, unit A's noise ``(seed,
-    "noise_a")``), in mg; one row per seed."""
+    """Figs 2-3 per seed (unit A, measured, against 55 degC): the largest ``|bias drift|`` of the 0/180 deg bias
+    test (:func:`fig3_bias`, noise :func:`~navlib.studies.accelerometer.simulation.sim_seed` ``(seed,
+    "bias_test")``) and the largest ``|N(T, q) - N(55, q)|`` of the tumble (:func:`fig2_output_drift`, unit A's
+    noise ``(seed, "noise_a")``), in mg; one row per seed."""
     rows = []
     for s in seeds:
         s = int(s)

@@ -77,8 +77,8 @@ def max_error_floor_ug(noise_ug: float, n_temperatures: int, n_positions: int) -
 
 
 def _floors(params: PaperDParams) -> dict:
-    """The floors of :func:`noise_floor` from the experiment's shape: held-out, training (the reference
-    temperature is one of the training temperatures) and unit B's largest error."""
+    """The floors of :func:`~navlib.studies.accelerometer.tables.noise_floor` from the experiment's shape: held-out,
+    training (the reference temperature is one of the training temperatures) and unit B's largest error."""
     exp = params.experiment
     sigma = exp.noise_ug
     n_sp = exp.set_points_c.size

@@ -103,12 +103,12 @@ def _chapter_task(kind: str, params: PaperDParams, seed: int):
 
 def run_chapter(params: PaperDParams = PaperDParams(), noise_levels=(), random_reading: bool = True,
                 workers: int = 1, scheduler: str | None = None) -> Chapter:
-    """The chapter's runs as one batch of engine tasks (:mod:`navlib.engine`; one task per seed and
-    variant, the most expensive first): the main study at ``params`` with the other tuners
-    (``tuners=True``), the same seeds at every noise level of ``noise_levels`` (ug per reading; the
-    ``params`` level is taken from the main runs) and, if ``random_reading``, under the random split.
-    Every task draws its data from its seed alone (:func:`sim_seed`), so the noise levels and the two
-    splits are paired over the same seeds and nothing depends on where a task ran."""
+    """The chapter's runs as one batch of engine tasks (:mod:`navlib.engine`; one task per seed and variant, the
+    most expensive first): the main study at ``params`` with the other tuners (``tuners=True``), the same seeds at
+    every noise level of ``noise_levels`` (ug per reading; the ``params`` level is taken from the main runs) and, if
+    ``random_reading``, under the random split. Every task draws its data from its seed alone
+    (:func:`~navlib.studies.accelerometer.simulation.sim_seed`), so the noise levels and the two splits are paired
+    over the same seeds and nothing depends on where a task ran."""
     levels = [float(v) for v in noise_levels]
     for v in levels:
         check_param("noise_levels", v, lo=0, lo_open=True, hi=10000)

@@ -13,8 +13,8 @@ from .parameters import SIM_ENTROPY, SIM_PARTS, PaperDParams
 
 
 def sim_seed(seed: int, part: str) -> np.random.SeedSequence:
-    """The draw of one part (:data:`SIM_PARTS`) of seed ``seed``: ``SeedSequence(SIM_ENTROPY,
-    spawn_key=(seed, part))``."""
+    """The draw of one part (:data:`~navlib.studies.accelerometer.parameters.SIM_PARTS`) of seed ``seed``:
+    ``SeedSequence(SIM_ENTROPY, spawn_key=(seed, part))``."""
     check_param("seed", seed, lo=0, integer=True)
     return sequence(SIM_ENTROPY, seed, SIM_PARTS[part])
 

@@ -37,10 +37,10 @@ def table2(err: pd.DataFrame, paper: pd.DataFrame, sets=("train", "test")) -> pd
 
 
 def noise_floor(err: pd.DataFrame, params: PaperDParams) -> pd.DataFrame:
-    """The noise floors of the chapter's statistics (ug): the RMSE on held-out temperatures
-    (``sqrt(2) noise``) and on the training readings (:func:`rmse_floor_ug`), the largest error on unit B
-    (:func:`max_error_floor_ug`), with the exact model's (oracle's) held-out and training RMSE (median over
-    seeds) beside."""
+    """The noise floors of the chapter's statistics (ug): the RMSE on held-out temperatures (``sqrt(2) noise``) and
+    on the training readings (:func:`~navlib.studies.accelerometer.floors.rmse_floor_ug`), the largest error on unit
+    B (:func:`~navlib.studies.accelerometer.floors.max_error_floor_ug`), with the exact model's (oracle's) held-out
+    and training RMSE (median over seeds) beside."""
     def orc(s):
         return 1000 * float(err[(err["method"] == "oracle") & (err["set"] == s)]["RMSE_mg"].median())
 
@@ -64,7 +64,7 @@ def per_seed(err: pd.DataFrame, methods, s: str, col: str = "RMSE_mg") -> pd.Dat
 
 
 def method_summary(err: pd.DataFrame, s: str = "test") -> dict:
-    """Per method :func:`navlib.method_stats` of the RMSE (ug) over seeds on set ``s``."""
+    """Per method ``navlib.claims.method_stats`` of the RMSE (ug) over seeds on set ``s``."""
     out = {}
     for m in METHODS:
         g = err[(err["method"] == m) & (err["set"] == s)]
@@ -145,9 +145,9 @@ def tuner_table(runs: list, err: pd.DataFrame) -> pd.DataFrame:
 
 
 def spread_summary(need: pd.DataFrame, paper: pd.DataFrame, spreads=BATCH_SPREADS) -> pd.DataFrame:
-    """Over the draws of :func:`spread_needed`, per spread: unit B's largest drift (median, 5th and 95th
-    percentile, mg) and the units' difference alone (median, ug); and the share of draws whose drift
-    reaches the paper's 7.21 mg."""
+    """Over the draws of :func:`~navlib.studies.accelerometer.batch_spread.spread_needed`, per spread: unit B's
+    largest drift (median, 5th and 95th percentile, mg) and the units' difference alone (median, ug); and the share
+    of draws whose drift reaches the paper's 7.21 mg."""
     before = _paper_value(paper, "unit_b_before")
     rows = []
     for s in spreads:
