@@ -299,6 +299,7 @@ def tuner_claims(err: pd.DataFrame, params: PaperDParams) -> list:
     return out
 
 
+# ------------------------------------------------------------------------------ unit B by batch spread
 def unit_b_spread_claims(ub: pd.DataFrame, params: PaperDParams, paper: pd.DataFrame, need: pd.DataFrame,
                          method: str = "IAFSA-SCM-ANFIS") -> list:
     """Unit B's 9.3 ug judged at every batch spread of
