@@ -31,7 +31,7 @@ from sko.AFSA import AFSA  # noqa: E402
 from navlib.methods.anfis import AnfisOptions, anfis  # noqa: E402
 from navlib.methods.fish_swarm import FishSwarmParams, minimise  # noqa: E402
 from navlib.methods.subclust import genfis2  # noqa: E402
-from navlib.studies import paper_d as D  # noqa: E402
+from navlib.studies import accelerometer as D  # noqa: E402
 from peers import simpful_system  # noqa: E402
 
 

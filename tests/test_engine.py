@@ -20,7 +20,8 @@ import pytest
 
 from navlib import engine
 from navlib.errors import InputError
-from navlib.studies import paper_d, paper_e
+from navlib.studies import accelerometer as accel_study
+from navlib.studies import paper_e
 from navlib.workbench import accelerometer as A
 from navlib.workbench import trials as T
 
@@ -71,11 +72,11 @@ def test_patent_b_paper_d_and_paper_e_studies_on_two_workers_equal_one():
                   lambda w: elm_patent.small_sample_study(sw, sizes=(8, 15), params=p, seeds=range(2),
                                                           big_hidden=5, workers=w)):
         pd.testing.assert_frame_equal(study(1), study(2))
-    dp = paper_d.PaperDParams(seeds=(0, 1), anfis=AnfisOptions(epochs=2),
-                              swarm=FishSwarmParams(n_fish=3, generations=1, try_number=1),
-                              mlp=replace(paper_d.PaperDParams().mlp, epochs=3))
-    pd.testing.assert_frame_equal(paper_d.errors_long(paper_d.run_study(dp, workers=1)),
-                                  paper_d.errors_long(paper_d.run_study(dp, workers=2)))
+    dp = accel_study.PaperDParams(seeds=(0, 1), anfis=AnfisOptions(epochs=2),
+                                  swarm=FishSwarmParams(n_fish=3, generations=1, try_number=1),
+                                  mlp=replace(accel_study.PaperDParams().mlp, epochs=3))
+    pd.testing.assert_frame_equal(accel_study.errors_long(accel_study.run_study(dp, workers=1)),
+                                  accel_study.errors_long(accel_study.run_study(dp, workers=2)))
     spec = paper_e.StudySpec(duration_s=20.0, n_train_runs=1, n_test_runs=1, n_repeats=2, epochs=3, n_timings=1,
                              timing_epochs=1, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0), sweep_repeats=1,
                              latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=())
@@ -308,7 +309,7 @@ def test_accelerometer_and_workbench_trials_share_no_seed():
 
 
 def test_paper_d_and_e_draws_have_their_own_seeds():
-    d = [paper_d.sim_seed(s, part) for s in range(6) for part in paper_d.SIM_PARTS]
+    d = [accel_study.sim_seed(s, part) for s in range(6) for part in accel_study.SIM_PARTS]
     assert len({(x.entropy, x.spawn_key) for x in d}) == len(d)
     spec = paper_e.StudySpec()
     e = [paper_e.seed_of(spec, rep, "noise", k, i) for rep in range(spec.n_repeats) for k in range(2)

@@ -31,7 +31,8 @@ direction); noise 3 ug per reading (a 10 s average of a 10 ug/sqrt(Hz) sensor); 
 batch: every coefficient scaled by ``1 + spread N(0, 1)`` with ``batch_spread_rel`` = 0.25.  The stored data
 set (:func:`paper_units`, ``data/accel_tumble.csv``) uses batch seed 2, picked because its maximum output drift,
 6.75 mg, is the nearest to the paper's 7.21 mg among seeds 1-11; the chapter's study does not pick: it draws
-unit B afresh for every seed (:func:`navlib.studies.paper_d.simulate`) and reports the spread of the drifts.
+unit B afresh for every seed (:func:`navlib.studies.accelerometer.simulation.simulate`) and reports the spread
+of the drifts.
 
 The Fourier coefficients of one tumble (``q`` over 24 equally spaced positions) give, with ``K1 = 1 + kappa``
 (see :func:`tumble_fourier` and :func:`coefficients_from_fourier`)::

@@ -9,14 +9,14 @@ from navlib import claims as register
 from navlib import verdicts
 from navbook.results_check import claim_problems
 from navlib.sensors.accelerometer import AccelCoefficients, TumbleExperiment
-from navlib.studies import paper_d as D
+from navlib.studies import accelerometer as D
 
 BEST = "IAFSA-SCM-ANFIS"
 PHYS = "physical (poly K0, K1, K2)"
 
 
 def _err(ann, fis, n=6):
-    """Synthetic per-seed RMSEs (ug in, mg stored) on every set :func:`paper_d.claims` reads."""
+    """Synthetic per-seed RMSEs (ug in, mg stored) on every set :func:`D.claims` reads."""
     test = {"ANN": ann, "FIS": fis, "ANFIS": np.full(n, 35.7), BEST: np.full(n, 5.4), PHYS: np.full(n, 28.3),
             "oracle": np.full(n, 4.3)}
     rows = []

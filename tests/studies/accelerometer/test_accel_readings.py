@@ -1,5 +1,5 @@
-"""Paper D's other readings (issue 21): the random split of the readings, the noise study, the tuners of the
-clustering radius, "nearly two orders" at its two boundaries, and unit B as a function of the batch spread."""
+"""The accelerometer chapter's other readings: the random split of the readings, the noise study, the tuners of
+the clustering radius, "nearly two orders" at its two boundaries, and unit B as a function of the batch spread."""
 from dataclasses import replace
 
 import numpy as np
@@ -11,7 +11,7 @@ from navlib.methods.anfis import AnfisOptions
 from navlib.methods.fish_swarm import FishSwarmParams
 from navlib.methods.subclust import SubclustOptions, subclust, unit_sqdist
 from navlib.sensors.accelerometer import TumbleExperiment
-from navlib.studies import paper_d as D
+from navlib.studies import accelerometer as D
 
 BEST = "IAFSA-SCM-ANFIS"
 
