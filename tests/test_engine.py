@@ -20,7 +20,8 @@ import pytest
 
 from navlib import engine
 from navlib.errors import InputError
-from navlib.studies import paper_d, paper_e
+from navlib.studies import celestial as paper_e
+from navlib.studies import paper_d
 from navlib.workbench import accelerometer as A
 from navlib.workbench import trials as T
 

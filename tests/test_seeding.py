@@ -9,7 +9,8 @@ from navlib import seeding
 from navlib.methods import seeding as methods_seeding
 from navlib.sensors import accelerometer as acc
 from navlib.sensors import ins
-from navlib.studies import paper_d, paper_e
+from navlib.studies import celestial as paper_e
+from navlib.studies import paper_d
 from navlib.workbench import diagnose as dg
 
 SS = np.random.SeedSequence
