@@ -11,7 +11,7 @@ from filterpy.kalman import KalmanFilter
 
 from navlib.methods import kalman as km
 from navlib.methods.mlp import train_mlp
-from navlib.studies.paper_e import bp_params
+from navlib.studies.celestial import bp_params
 from navlib.sensors import ins15
 from navlib.sensors.strapdown import ImuSpec, strapdown
 from navlib.sensors.trajectory import FlightProfile, generate

@@ -21,7 +21,7 @@ import pytest
 from navlib import engine
 from navlib.errors import InputError
 from navlib.studies import accelerometer as accel_study
-from navlib.studies import paper_e
+from navlib.studies import celestial
 from navlib.workbench import accelerometer as A
 from navlib.workbench import trials as T
 
@@ -77,10 +77,10 @@ def test_patent_b_paper_d_and_paper_e_studies_on_two_workers_equal_one():
                                   mlp=replace(accel_study.PaperDParams().mlp, epochs=3))
     pd.testing.assert_frame_equal(accel_study.errors_long(accel_study.run_study(dp, workers=1)),
                                   accel_study.errors_long(accel_study.run_study(dp, workers=2)))
-    spec = paper_e.StudySpec(duration_s=20.0, n_train_runs=1, n_test_runs=1, n_repeats=2, epochs=3, n_timings=1,
+    spec = celestial.StudySpec(duration_s=20.0, n_train_runs=1, n_test_runs=1, n_repeats=2, epochs=3, n_timings=1,
                              timing_epochs=1, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0), sweep_repeats=1,
                              latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=())
-    one, two = paper_e.simulate(spec, workers=1), paper_e.simulate(spec, workers=2)
+    one, two = celestial.simulate(spec, workers=1), celestial.simulate(spec, workers=2)
     for name in ("scores", "glr", "glr_runs", "rate_corr", "traces", "sweep", "diagnosis"):
         pd.testing.assert_frame_equal(getattr(one, name), getattr(two, name))
 
@@ -311,12 +311,12 @@ def test_accelerometer_and_workbench_trials_share_no_seed():
 def test_paper_d_and_e_draws_have_their_own_seeds():
     d = [accel_study.sim_seed(s, part) for s in range(6) for part in accel_study.SIM_PARTS]
     assert len({(x.entropy, x.spawn_key) for x in d}) == len(d)
-    spec = paper_e.StudySpec()
-    e = [paper_e.seed_of(spec, rep, "noise", k, i) for rep in range(spec.n_repeats) for k in range(2)
+    spec = celestial.StudySpec()
+    e = [celestial.seed_of(spec, rep, "noise", k, i) for rep in range(spec.n_repeats) for k in range(2)
          for i in range(spec.n_train_runs + spec.n_test_runs)]
-    e += [paper_e.seed_of(spec, rep, "manoeuvre", i) for rep in range(spec.n_repeats)
+    e += [celestial.seed_of(spec, rep, "manoeuvre", i) for rep in range(spec.n_repeats)
           for i in range(spec.n_train_runs + 1)]
-    e += [paper_e.seed_of(spec, rep, "network") for rep in range(spec.n_repeats)]
+    e += [celestial.seed_of(spec, rep, "network") for rep in range(spec.n_repeats)]
     assert len(set(e)) == len(e)
 
 

@@ -10,7 +10,7 @@ from navlib.methods import seeding as methods_seeding
 from navlib.sensors import accelerometer as acc
 from navlib.sensors import ins
 from navlib.studies import accelerometer as accel_study
-from navlib.studies import paper_e
+from navlib.studies import celestial
 from navlib.workbench import diagnose as dg
 
 SS = np.random.SeedSequence
@@ -94,11 +94,11 @@ def test_paper_d_and_e_seeds_are_the_old_ones():
     for s in range(4):
         for part, k in accel_study.SIM_PARTS.items():
             assert same_stream(accel_study.sim_seed(s, part), SS(accel_study.SIM_ENTROPY, spawn_key=(s, k)))
-    spec = paper_e.StudySpec()
+    spec = celestial.StudySpec()
     for rep in range(3):
         for part, key in (("noise", (1, 4)), ("manoeuvre", (2,)), ("network", ()), ("timing", (0,))):
-            old = SS(int(spec.seed), spawn_key=(rep, paper_e.SEED_PARTS[part]) + key)
-            assert paper_e.seed_of(spec, rep, part, *key) == int(old.generate_state(1)[0])
+            old = SS(int(spec.seed), spawn_key=(rep, celestial.SEED_PARTS[part]) + key)
+            assert celestial.seed_of(spec, rep, part, *key) == int(old.generate_state(1)[0])
 
 
 def test_the_workbench_bootstrap_stream_is_the_old_one():

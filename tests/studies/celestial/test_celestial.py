@@ -1,7 +1,7 @@
-"""Paper E (INS/celestial): trajectory kinematics, strapdown, 15-state error model against closed forms,
-measurement through M against the direction-cosine route, KF against filterpy, QR gain features, GLR
-innovation test (pooled and per run), MLP, the chapter's claims under the one verdict rule (on synthetic
-scores with known answers, and on a tiny simulation), bad input."""
+"""The celestial chapter (paper E, INS/celestial): trajectory kinematics, strapdown, 15-state error model
+against closed forms, measurement through M against the direction-cosine route, KF against filterpy, QR gain
+features, GLR innovation test (pooled and per run), MLP, the chapter's claims under the one verdict rule (on
+synthetic scores with known answers, and on a tiny simulation), bad input."""
 import math
 
 import numpy as np
@@ -18,8 +18,9 @@ from navlib.sensors.strapdown import (ImuSpec, InitialError, StarSensorSpec, mis
 from navlib.sensors.trajectory import (EARTH_RATE_RAD_S, FlightProfile, dcm_to_euler, euler_rate_matrix,
                                        euler_to_dcm, generate, gravity, radii)
 from navlib import verdicts
-from navlib.studies import paper_e
-from navlib.studies.paper_e import StudySpec
+from navlib.studies import celestial
+from navlib.studies.celestial import StudySpec
+from navlib.studies.celestial.simulation import _phase_rows
 
 QUIET = ImuSpec(gyro_drift_deg_h=0, gyro_arw_deg_rt_h=0, accel_bias_ug=0, accel_noise_ug_rt_hz=0)
 
@@ -330,12 +331,12 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
 
     def add(case, mode, method, err):
         for (r, i), e in err.items():
-            for a, ax in enumerate(paper_e.AXES):
+            for a, ax in enumerate(celestial.AXES):
                 rows.append({"repeat": r, "case": case, "mode": mode, "method": method, "run": i, "axis": ax,
                              "rms_arcsec": float(e[a])})
 
     for mode in ("held-out", "same run"):
-        for case in paper_e.CASES:
+        for case in celestial.CASES:
             add(case, mode, "KF", kf)
         raw = {k: v * bp_factor[("level_raw45", mode)] * (1 + 0.1 * rng.random()) for k, v in kf.items()}
         add("level_raw45", mode, "BPKF", raw)
@@ -378,7 +379,7 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
             for method, err in (("KF", k), ("BPKF 6 QR", q6), ("BPKF 6 QR + 3 rates", np.r_[sweep_factor * k[:2],
                                                                                            sweep_rate_factor * q6[2]]),
                                 ("BPKF 45 raw", raw45_factor * q6), ("augmented KF", 0.5 * k)):
-                for a, ax in enumerate(paper_e.AXES):
+                for a, ax in enumerate(celestial.AXES):
                     sw.append({"repeat": r, "case": "s_turns", "mode": "held-out", "method": method, "run": i,
                                "axis": ax, "rms_arcsec": float(err[a]), "level_ppm": float(level),
                                "latency_ms": 0.0})
@@ -413,19 +414,19 @@ def fake_data(n_repeats=2, n_runs=4, bp_factor=None, qr_factor=0.9, rate_factor=
            "rms_arcsec": float(e[a] * (1 + level / 100) * (0.9 if m == "KF" else 1.0) * f)}
           for level in set(spec.sweep_ppm) | {float(gyro_scale_ppm)} for (r, i), e in kf.items()
           for m in ("KF", "BPKF 6 QR") for phase, f in (("turning", turn_factor), ("steady", 1.0))
-          for a, ax in enumerate(paper_e.AXES)]
+          for a, ax in enumerate(celestial.AXES)]
     empty = pd.DataFrame()
-    return paper_e.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty, {}, lm,
+    return celestial.StudyData(spec, scores, empty, empty, empty, glr_runs, timings, empty, empty, {}, lm,
                              pd.DataFrame(sw), pd.DataFrame(diag), pd.DataFrame(ph))
 
 
 def by_key(data):
-    return {c.key: c for c in paper_e.claims(data)}
+    return {c.key: c for c in celestial.claims(data)}
 
 
 def test_claims_sources_sides_boundaries_and_keys():
-    cl = paper_e.claims(fake_data())
-    paper = paper_e.paper_numbers()["value"]
+    cl = celestial.claims(fake_data())
+    paper = celestial.paper_numbers()["value"]
     keys = [c.key for c in cl]
     assert len(set(keys)) == len(keys) and all(keys)
     for c in cl:
@@ -484,10 +485,10 @@ def test_improvement_claim_lands_on_each_side(factor, verdict):
 
 def test_comparisons_refuse_scores_from_other_runs():
     with pytest.raises(InputError, match="same runs"):
-        paper_e.claims(fake_data(n_runs=4, n_repeats=2, permute=("level_raw45", "held-out", "KF")))
+        celestial.claims(fake_data(n_runs=4, n_repeats=2, permute=("level_raw45", "held-out", "KF")))
     data = fake_data()
     with pytest.raises(InputError, match="angle"):
-        paper_e.per_run(data, "level_qr6", "held-out", "BPKF", "heading")
+        celestial.per_run(data, "level_qr6", "held-out", "BPKF", "heading")
 
 
 def test_accuracy_comparisons_hold_on_the_right_side():
@@ -540,11 +541,11 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
                      timing_epochs=2, settle_s=5.0, lm_timings=1, sweep_ppm=(0.0, 100.0),
                      sweep_repeats=1, latency_ms_levels=(10.0,), smear_levels_arcsec_per_deg_s=(10.0,),
                      quiet_repeats=3)
-    data = paper_e.simulate(spec)
+    data = celestial.simulate(spec)
     n = spec.n_repeats * spec.n_test_runs
     for mode in ("held-out", "same run"):
         for method in ("KF", "BPKF"):
-            assert len(paper_e.per_run(data, "level_qr6", mode, method)) == n
+            assert len(celestial.per_run(data, "level_qr6", mode, method)) == n
     assert sorted(data.timings.groupby("timing")["n_in"].apply(sorted).map(tuple).unique()) == [(6, 45)]
     assert len(data.timings) == 2 * spec.n_timings
     assert len(data.glr_runs) == 2 * spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
@@ -557,32 +558,32 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
     assert set(zip(d["level_ppm"], d["latency_ms"], d["smear"])) == {(0, 0, 0), (0, 10, 0), (0, 0, 10), (100, 0, 0)}
     per_rep = spec.n_train_runs + spec.n_test_runs
     extra_quiet = spec.quiet_repeats - spec.sweep_repeats       # nothing missing: filters and tests only
-    assert len(paper_e.loop_runs(data)) == len(d) == (4 + extra_quiet) * per_rep + (
+    assert len(celestial.loop_runs(data)) == len(d) == (4 + extra_quiet) * per_rep + (
         spec.n_repeats - spec.sweep_repeats) * per_rep
     # the false-alarm rates run over quiet_repeats repeats, each flown once (the sweep's 0 ppm repeat not again)
     quiet = d[(d["level_ppm"] == 0) & (d["latency_ms"] == 0) & (d["smear"] == 0)]
     assert sorted(quiet.groupby("repeat").size().items()) == [(r, per_rep) for r in range(spec.quiet_repeats)]
     assert c["cel_blind_quiet"].estimate.n == c["cel_loop_quiet"].estimate.n == spec.quiet_repeats * per_rep
     assert not quiet.duplicated(["repeat", "runs", "run"]).any() and quiet["chi2"].nunique() == len(quiet)
-    assert len(paper_e.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs   # no nets
+    assert len(celestial.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs   # no nets
     assert set(d["decision"]) <= {"gyro scale factor z", km.NOT_EXPLAINED, km.NOTHING} | set(km.CANDIDATES)
     assert c["cel_loop_blind"].estimate.n == 2 * (spec.n_train_runs + spec.n_test_runs)
     # the sweep at the study's own level is the study's held-out S-turn scores (same draws, nets, filters)
     for method, case in (("KF", "sturn_qr6"), ("BPKF 6 QR + 3 rates", "sturn_qr6_rate"), ("BPKF 45 raw", "sturn_raw45")):
-        own = paper_e.per_run(data, case, "held-out", method.split(" ")[0])
+        own = celestial.per_run(data, case, "held-out", method.split(" ")[0])
         own = own[own.index.get_level_values("repeat") < spec.sweep_repeats]
-        assert paper_e.sweep_per_run(data, 100.0, method).to_numpy() == pytest.approx(own.to_numpy())
-    assert len(paper_e.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs
-    assert len(paper_e.sweep_per_run(data, 0.0, "KF", latency_ms=10.0)) == spec.sweep_repeats * spec.n_test_runs
+        assert celestial.sweep_per_run(data, 100.0, method).to_numpy() == pytest.approx(own.to_numpy())
+    assert len(celestial.sweep_per_run(data, 0.0, "KF")) == spec.sweep_repeats * spec.n_test_runs
+    assert len(celestial.sweep_per_run(data, 0.0, "KF", latency_ms=10.0)) == spec.sweep_repeats * spec.n_test_runs
 
 
 def test_the_timing_claim_is_stored_as_volatile_and_the_others_are_not():
     data = fake_data(t45_over_t6=2.0)
-    cl = paper_e.claims(data)
+    cl = celestial.claims(data)
     assert [c.key for c in cl if c.volatile] == ["cel_time_lm", "cel_time"]
     t = {c.key: c for c in cl}["cel_time"]
     assert t.verdict == "not reproduced" and t.record()["volatile"] is True
-    extra = paper_e.results_extra(data)
+    extra = celestial.results_extra(data)
     assert extra["time_ratio_45_over_6"] == pytest.approx(2.0)
 
 def test_trainlm_timing_ratio_is_paired_and_judged_against_the_papers_ratio():
@@ -590,8 +591,8 @@ def test_trainlm_timing_ratio_is_paired_and_judged_against_the_papers_ratio():
         data = fake_data(lm_ratio=ratio)
         c = by_key(data)["cel_time_lm"]
         assert c.estimate.value == pytest.approx(ratio) and c.verdict == verdict and c.volatile
-        assert paper_e.results_extra(data)["trainlm_time_ratio_45_over_6"] == pytest.approx(ratio)
-    tab = paper_e.trainlm_time(fake_data(lm_ratio=12.0)).set_index("inputs")
+        assert celestial.results_extra(data)["trainlm_time_ratio_45_over_6"] == pytest.approx(ratio)
+    tab = celestial.trainlm_time(fake_data(lm_ratio=12.0)).set_index("inputs")
     assert tab.loc[45, "ratio_to_6"] == pytest.approx(12.0) and tab.loc[9, "ratio_to_6"] == pytest.approx(1.5)
     assert tab.loc[45, "weights"] == 493 and np.isnan(tab.loc[9, "paper_s"])
 
@@ -605,7 +606,7 @@ def test_sweep_claims_land_on_each_side_at_every_level():
     for level in (0, 25, 50, 100, 200):
         assert c[f"cel_sw_imp_{level}ppm"].verdict == "not reproduced"
         assert c[f"cel_sw_rates_{level}ppm"].verdict == "not reproduced"
-    v = paper_e.sweep_verdicts(fake_data())
+    v = celestial.sweep_verdicts(fake_data())
     assert len(v) == 15 and set(v["scale_ppm"]) == {0, 25, 50, 100, 200}
     assert (v.groupby("claim").size() == 5).all() and v["claim"].str.contains("without rates").sum() == 5
 
@@ -619,7 +620,7 @@ def _scaled(data, case=None, method="BPKF", factor=1.0, level=None, sweep_method
     if level is not None:
         sel = (sw["level_ppm"] == level) & (sw["method"] == sweep_method)
         sw.loc[sel, "rms_arcsec"] *= factor
-    return paper_e.StudyData(**{**data.__dict__, "scores": s, "sweep": sw})
+    return celestial.StudyData(**{**data.__dict__, "scores": s, "sweep": sw})
 
 
 def test_turning_claim_is_the_paired_ratio_of_turning_to_steady_error_and_lands_on_each_side():
@@ -633,20 +634,20 @@ def test_turning_claim_is_the_paired_ratio_of_turning_to_steady_error_and_lands_
             assert c[k].estimate.value == pytest.approx(factor) and c[k].estimate.rule == "paired ratio"
             assert c[k].boundary == 1.0 and c[k].holds_when == "above" and c[k].verdict == verdict
     data = fake_data()
-    assert c["cel_turn"].estimate.n == len(paper_e.phase_per_run(data, "BPKF 6 QR", "turning")) == 8
-    assert len(paper_e.phase_per_run(data, "KF", "steady", level_ppm=50.0, repeats=1)) == 4
+    assert c["cel_turn"].estimate.n == len(celestial.phase_per_run(data, "BPKF 6 QR", "turning")) == 8
+    assert len(celestial.phase_per_run(data, "KF", "steady", level_ppm=50.0, repeats=1)) == 4
     # the halves of a run: split at its median |yaw rate|, RMS per angle over each half
     rate = np.zeros((1, 6, 3))
     rate[0, :, 2] = [0.0, 5.0, -6.0, 1.0, -0.5, 4.0]
     err = np.arange(18.0).reshape(1, 6, 3)
     mask = np.array([False, True, True, True, True, True])        # first epoch not scored
-    rows = pd.DataFrame(paper_e._phase_rows(50.0, 0, "KF", err, rate, mask)).set_index(["phase", "axis"])
+    rows = pd.DataFrame(_phase_rows(50.0, 0, "KF", err, rate, mask)).set_index(["phase", "axis"])
     # scored |rate| 5, 6, 1, 0.5, 4: median 4; turning epochs 1, 2, 5, steady 3, 4
     for phase, e in (("turning", err[0, [1, 2, 5]]), ("steady", err[0, [3, 4]])):
-        for a, ax in enumerate(paper_e.AXES):
+        for a, ax in enumerate(celestial.AXES):
             assert rows.loc[(phase, ax), "rms_arcsec"] == pytest.approx(np.sqrt(np.mean(e[:, a] ** 2)))
     with pytest.raises(InputError, match="phase"):
-        paper_e.phase_per_run(data, "KF", "turns")
+        celestial.phase_per_run(data, "KF", "turns")
 
 
 def test_without_rates_claim_is_the_paired_improvement_and_holds_below_the_papers_threshold():
@@ -654,14 +655,14 @@ def test_without_rates_claim_is_the_paired_improvement_and_holds_below_the_paper
     paired improvement over the same held-out runs, below the paper's 30 % (the boundary of E07, the same
     sentence with the rates), per run over the three angles and for yaw alone, and at every sweep level."""
     data = fake_data()
-    thr = paper_e.paper_numbers()["value"]["improvement_min_pct"]
+    thr = celestial.paper_numbers()["value"]["improvement_min_pct"]
     c = by_key(data)
     for k in ("cel_norate", "cel_norate_yaw") + tuple(f"cel_sw_norate_{v}ppm" for v in (0, 25, 50, 100, 200)):
         assert c[k].boundary == thr and c[k].holds_when == "below" and c[k].estimate.rule == "paired ratio"
         assert c[k].verdict == "reproduced" and c[k].source == "paper"         # fake 6 QR: 10-20 % better
     for angle, k in (("all", "cel_norate"), ("yaw", "cel_norate_yaw")):
-        bp = paper_e.per_run(data, "sturn_qr6", "held-out", "BPKF", angle).to_numpy()
-        kf = paper_e.per_run(data, "sturn_qr6", "held-out", "KF", angle).to_numpy()
+        bp = celestial.per_run(data, "sturn_qr6", "held-out", "BPKF", angle).to_numpy()
+        kf = celestial.per_run(data, "sturn_qr6", "held-out", "KF", angle).to_numpy()
         assert c[k].estimate.value == pytest.approx(100 * (1 - np.median(bp / kf)))
         assert c[k].estimate.n == bp.size == 8
     # the 6 QR BPKF at half the KF's error (50 % better): the claim fails, at the study's runs and at one level
@@ -812,11 +813,11 @@ def test_loop_claims_are_wilson_rates_and_land_on_each_side():
                          loop_quiet=[out] * 8 + [none] * 8, loop_own=[out] * 12 + ["gyro scale factor z"] * 4))
     for k in ("cel_loop_blind", "cel_loop_quiet", "cel_loop_named"):
         assert c[k].verdict == "not reproduced" and c[k].estimate.rule == "wilson rate"
-    extra = paper_e.results_extra(fake_data(loop_blind=["gyro scale factor x"] + [out] * 15))
+    extra = celestial.results_extra(fake_data(loop_blind=["gyro scale factor x"] + [out] * 15))
     assert extra["loop_false_naming_n"] == 32 and extra["loop_false_naming_rate"] == pytest.approx(1 / 32)
     assert extra["loop_false_naming_time_offset_rate"] == pytest.approx(1 / 16)
     assert extra["loop_false_naming_lo"] < 1 / 32 < extra["loop_false_naming_hi"]
-    tab = paper_e.loop_table(fake_data()).set_index("case")
+    tab = celestial.loop_table(fake_data()).set_index("case")
     assert tab.loc["time offset 10 ms", "not explained"] == 16 and tab.loc["nothing missing", "nothing missing"] == 16
     assert tab.loc["scale factor 100 ppm", "named"] == "16: gyro scale factor z"
 
