@@ -5,9 +5,9 @@ The peer (:func:`navlib.methods.ellipsoid.lm_ellipsoid`) is what magcc's LM fit 
 installed: it pulls a web stack (FastAPI, uvicorn) into the environment.  navlib is the library call the CLI
 makes; it also estimates the noise model, screens outliers, gives every parameter's uncertainty, warns
 (an accelerated sensor) and refuses data that cannot separate the parameters.  Fitted on the first 70 % of
-each recording, judged on the last 30 % (:func:`navlib.studies.workbench.calibration_beside_peer`, the
-comparison the workbench chapter shows).  Files: ``../shared/realdata/broad/3d/*.csv`` (CC BY 4.0, never
-copied here) or the files given.
+each recording, judged on the last 30 % (:func:`navlib.studies.workbench.calibrations.calibration_beside_peer`,
+the comparison the workbench chapter shows).  Files: ``../shared/realdata/broad/3d/*.csv`` (CC BY 4.0,
+never copied here) or the files given.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/calibrate_peer.py [FILE ...]
 

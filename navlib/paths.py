@@ -8,9 +8,9 @@
   compass chapter names a file in it).
 - ``ROOT`` -- the folder that holds the ``navlib`` package: the source checkout when navlib runs from one,
   site-packages when it is installed.  The library uses it in two places: :func:`data_dir` falls back to
-  ``ROOT / "data"`` in a checkout that was never installed, and :mod:`navlib.studies.workbench` looks for
-  the third-party measurements beside the checkout (``ROOT.parent / "shared" / "realdata"``; absent in an
-  install, where the workbench chapter marks its real-data claims not judged).  ``NOTEBOOK_DIR`` (``ROOT /
+  ``ROOT / "data"`` in a checkout that was never installed, and :mod:`navlib.studies.workbench.parameters`
+  looks for the third-party measurements beside the checkout (``ROOT.parent / "shared" / "realdata"``;
+  absent in an install, where the workbench chapter marks its real-data claims not judged).  ``NOTEBOOK_DIR`` (``ROOT /
   "notebooks"``) means something only in a checkout (tests).
 
 Results files go where the caller says (the book's ``navbook.report.results_dir``), never into the package.

@@ -294,25 +294,6 @@ def test_field_check_flags_an_anomaly_and_not_the_model_field(sim):
     assert far["local_anomaly"] and "local anomaly" in far["message"]
 
 
-def test_conventions_example_and_the_heading_claim():
-    """The chapter's worked example of the conventions, and the reference-free vs reference-based heading
-    claim decided by the one rule on paired trials."""
-    from navlib.studies import workbench as wb
-    t = wb.conventions_example()["value"]
-    assert t["compass heading atan2(-m_y, m_x)"] == "90.0 deg"
-    assert t["body x (forward) in NED"].startswith("+0.000, +1.000, +0.000")
-    assert t["paper E: body y (forward) in ENU"].startswith("+1.000, +0.000, +0.000")
-    assert t["paper E's yaw (rad, counter-clockwise, ENU)"] == f"{-np.pi / 2:+.4f} rad"
-    base = np.array([2.0, 2.5, 3.0, 1.8, 2.2, 2.9, 1.9, 2.4])
-
-    def heads(diff):
-        return pd.DataFrame({"reference-free calibration (deg)": base + diff,
-                             "reference-based calibration (deg)": base})
-    assert wb.free_vs_reference_claim(heads(-0.1 - 0.01 * np.arange(8))).verdict == "reproduced"
-    assert wb.free_vs_reference_claim(heads(0.1 + 0.01 * np.arange(8))).verdict == "not reproduced"
-    assert wb.free_vs_reference_claim(heads(0.1 * np.tile([-1.0, 1.0], 4))).verdict == "cannot be judged"
-
-
 def test_an_accelerated_sensor_is_warned_about(sim, tmp_path, capsys):
     """The dip constraint takes a/|a| for the vertical: a recording whose accelerometer saw more than gravity
     (fast hand motion) gets a warning in the calibration and on stderr; a still or slowly turned one none."""
