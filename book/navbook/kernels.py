@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from navlib.methods.de import DEParams
-from navlib.studies import paper_a as compass_study  # the compass chapter's study: the one line naming it
+from navlib.studies import compass as compass_study  # the compass chapter's study: the one line naming it
 
 
 def compile_kernels() -> int:

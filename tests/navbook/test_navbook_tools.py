@@ -134,7 +134,7 @@ def _claim(text, reproduced, reading="as printed", source="paper"):
 
 def test_api_markdown_lists_every_navlib_module():
     mods = navlib_modules()
-    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.landing", "navlib.studies.paper_a"} <= set(mods)
+    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.landing", "navlib.studies.compass"} <= set(mods)
     assert not [m for m in mods if m in ("navlib.report", "navlib.booktools", "navlib.grid", "navbook.booktools")]
     assert "navlib.__main__" not in mods
     md = api_markdown(mods)

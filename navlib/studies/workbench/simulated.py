@@ -11,7 +11,7 @@ from ...errors import check_param
 from ...workbench.effects import CATALOGUES
 from ...workbench.fit import effect_rms, fit_model, simulate
 from ...workbench.trials import random_params, scale_effect
-from ..paper_a import Sweeps, compensate, error_stats, test_errors
+from ..compass import Sweeps, compensate, error_stats, test_errors
 
 
 def simulated_compass(hidden_effect: str, hidden_ratio: float, noise_deg: float, seed: int) -> tuple[pd.DataFrame, float]:
