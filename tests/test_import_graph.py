@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "navlib"
 
 #: Layer of each top-level module or subpackage of navlib (lower numbers lie below).
