@@ -31,7 +31,7 @@ export ATEN_CPU_CAPABILITY := avx2
 help:
 	@echo "make book      - execute every notebook (papermill) and build the HTML book in book/_build/html"
 	@echo "make screenshots - render every built page with headless Chromium (1400 px) into book/_build/screenshots"
-	@echo "make check     - ruff lint + the library tests not marked slow (the daily tier, a few minutes)"
+	@echo "make check     - ruff lint and format check + the library tests not marked slow (the daily tier, about a minute)"
 	@echo "make test      - library tests (pytest) + nbval on the stored notebooks + their results vs notebooks/results"
 	@echo "make notebooks - re-execute notebooks/*.ipynb in place (regenerate the stored outputs and notebooks/results)"
 	@echo "make bench     - run the speed benchmarks in benchmarks/"
@@ -67,6 +67,7 @@ screenshots: $(STAMP)
 # The daily tier: lint, then the library tests not marked slow (pyproject markers), in two processes.
 check: $(STAMP)
 	@$(VENV)/bin/ruff check navlib book/navbook tests benchmarks
+	@$(VENV)/bin/ruff format --check navlib book/navbook tests benchmarks || { echo "ruff format would change the files above: run '$(VENV)/bin/ruff format navlib book/navbook tests benchmarks'" >&2; exit 1; }
 	@$(PY) -m pytest -q tests -p no:cacheprovider -m "not slow" $(if $(filter 1,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadfile --no-loadscope-reorder)
 
 # The library tests and nbval run at the same time (each is CPU-bound only part of the time: together they

@@ -16,6 +16,7 @@ trainer, and as its last line ``adam_speedup=<geometric mean of the per-epoch ra
 Run: ``.venv/bin/python benchmarks/bench_adam.py [--repeats 3] [--epochs 300] [--study]`` (best of the
 repeats).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,7 +36,7 @@ from navlib.paths import data_path
 from navlib.studies import compass
 from navlib.studies.compass import StudyParams, Sweeps
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))   # the peer adapters
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the peer adapters
 from peers import autograd_adam  # noqa: E402
 
 
@@ -52,8 +53,11 @@ def autograd_trajectories(theta0, xn, tn, n_hidden, params, threads=None):
 
 
 OURS = bpnet._adam_trajectories
-TRAINERS = {"ours": OURS, "autograd 1 thread": partial(autograd_trajectories, threads=1),
-            "autograd (former)": autograd_trajectories}
+TRAINERS = {
+    "ours": OURS,
+    "autograd 1 thread": partial(autograd_trajectories, threads=1),
+    "autograd (former)": autograd_trajectories,
+}
 
 
 def best_time(fn, repeats):
@@ -69,14 +73,19 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--epochs", type=int, default=300)
-    ap.add_argument("--study", action="store_true",
-                    help="also time the seed study (slow: the former code takes about a minute per run)")
+    ap.add_argument(
+        "--study",
+        action="store_true",
+        help="also time the seed study (slow: the former code takes about a minute per run)",
+    )
     a = ap.parse_args(argv)
     sw = Sweeps(*split_sweeps(load_sweeps(data_path("compass_sweeps.csv"))))
     params = AdamParams(epochs=a.epochs)
     ratios = []
-    print(f"ms per epoch, best of {a.repeats} runs of {a.epochs} epochs; torch default threads "
-          f"{torch.get_num_threads()}")
+    print(
+        f"ms per epoch, best of {a.repeats} runs of {a.epochs} epochs; torch default threads "
+        f"{torch.get_num_threads()}"
+    )
     for nets, m, n in ((20, 6, 121), (4, 6, 121), (20, 50, 8), (20, 50, 60)):
         idx = np.unique(np.round(np.linspace(0, sw.x_train.size - 1, n)).astype(int))
         x, t = sw.x_train[idx], sw.t_train[idx]
@@ -84,27 +93,41 @@ def main(argv=None):
         for name, fn in TRAINERS.items():
             bpnet._adam_trajectories = fn
             try:
-                train_adam_many(x, t, m, AdamParams(epochs=5), generators(range(nets)))      # warm-up
-                times[name] = best_time(lambda: train_adam_many(x, t, m, params, generators(range(nets))),
-                                        a.repeats) / a.epochs * 1e3
+                train_adam_many(x, t, m, AdamParams(epochs=5), generators(range(nets)))  # warm-up
+                times[name] = (
+                    best_time(
+                        lambda: train_adam_many(x, t, m, params, generators(range(nets))), a.repeats
+                    )
+                    / a.epochs
+                    * 1e3
+                )
             finally:
                 bpnet._adam_trajectories = OURS
         ratios.append(times["autograd (former)"] / times["ours"])
-        print(f"{nets:3d} nets 1-{m}-1 on {n:3d} readings: " + "  ".join(f"{k} {v:.3f}" for k, v in times.items())
-              + f"  ratio {ratios[-1]:.1f} (1 thread: {times['autograd 1 thread'] / times['ours']:.1f})")
+        print(
+            f"{nets:3d} nets 1-{m}-1 on {n:3d} readings: "
+            + "  ".join(f"{k} {v:.3f}" for k, v in times.items())
+            + f"  ratio {ratios[-1]:.1f} (1 thread: {times['autograd 1 thread'] / times['ours']:.1f})"
+        )
     if a.study:
         for seeds in (range(20), range(4)):
             times = {}
             for name, fn in TRAINERS.items():
                 bpnet._adam_trajectories = fn
                 try:
-                    times[name] = best_time(lambda: compass.seed_study(sw, StudyParams(), seeds=seeds,
-                                                                       methods=("bp_adam",)), a.repeats)
+                    times[name] = best_time(
+                        lambda: compass.seed_study(
+                            sw, StudyParams(), seeds=seeds, methods=("bp_adam",)
+                        ),
+                        a.repeats,
+                    )
                 finally:
                     bpnet._adam_trajectories = OURS
-            print(f"seed_study bp_adam, {len(seeds)} seeds, 3000 epochs (s): "
-                  + "  ".join(f"{k} {v:.2f}" for k, v in times.items())
-                  + f"  ratio {times['autograd (former)'] / times['ours']:.1f}")
+            print(
+                f"seed_study bp_adam, {len(seeds)} seeds, 3000 epochs (s): "
+                + "  ".join(f"{k} {v:.2f}" for k, v in times.items())
+                + f"  ratio {times['autograd (former)'] / times['ours']:.1f}"
+            )
     print(f"adam_speedup={float(np.exp(np.mean(np.log(ratios)))):.2f}")
 
 

@@ -19,6 +19,7 @@ It also times the network fitness alone and both optimisers on a trivial fitness
 output shows where the time goes. Both runs pay the same fitness cost every generation, so even an
 optimiser with no overhead at all could be at most (scipy's time) / (generations x fitness cost) faster.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -26,7 +27,7 @@ import os
 import time
 from dataclasses import replace
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")     # "on one core"
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # "on one core"
 
 import numpy as np  # noqa: E402
 from scipy.optimize import differential_evolution  # noqa: E402
@@ -49,28 +50,53 @@ def main() -> None:
     objective, _, _ = sse_objective(sw.x_train, sw.t_train, 6)
     exact, _, _ = sse_objective(sw.x_train, sw.t_train, 6, np.float64)
     dim, gens = n_params(6), args.generations
-    params = DEParams(pop_size=95, max_generations=gens, target_fitness=0.2, adaptive=True, bound=10.0,
-                      seed=0)
+    params = DEParams(
+        pop_size=95, max_generations=gens, target_fitness=0.2, adaptive=True, bound=10.0, seed=0
+    )
     ours_t, scipy_t = [], []
     for rep in range(args.repeats):
         t0 = time.perf_counter()
         res = evolve(objective, dim, params)
         ours_t.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        ref = differential_evolution(lambda x: objective(x.T), [(-10.0, 10.0)] * dim, strategy="rand1bin",
-                                     popsize=95 // dim, maxiter=gens - 1, mutation=0.5, recombination=0.6,
-                                     updating="deferred", init="random", polish=False, tol=0, atol=0,
-                                     vectorized=True, seed=0)
+        ref = differential_evolution(
+            lambda x: objective(x.T),
+            [(-10.0, 10.0)] * dim,
+            strategy="rand1bin",
+            popsize=95 // dim,
+            maxiter=gens - 1,
+            mutation=0.5,
+            recombination=0.6,
+            updating="deferred",
+            init="random",
+            polish=False,
+            tol=0,
+            atol=0,
+            vectorized=True,
+            seed=0,
+        )
         scipy_t.append(time.perf_counter() - t0)
     trivial = lambda pop: np.einsum("ij,ij->i", pop, pop)  # noqa: E731
     t0 = time.perf_counter()
     evolve(trivial, dim, replace(params, target_fitness=-1.0))
     ours_ovh = (time.perf_counter() - t0) / gens
     t0 = time.perf_counter()
-    differential_evolution(lambda x: trivial(x.T), [(-10.0, 10.0)] * dim, strategy="rand1bin",
-                           popsize=95 // dim, maxiter=gens - 1, mutation=0.5, recombination=0.6,
-                           updating="deferred", init="random", polish=False, tol=0, atol=0, vectorized=True,
-                           seed=0)
+    differential_evolution(
+        lambda x: trivial(x.T),
+        [(-10.0, 10.0)] * dim,
+        strategy="rand1bin",
+        popsize=95 // dim,
+        maxiter=gens - 1,
+        mutation=0.5,
+        recombination=0.6,
+        updating="deferred",
+        init="random",
+        polish=False,
+        tol=0,
+        atol=0,
+        vectorized=True,
+        seed=0,
+    )
     scipy_ovh = (time.perf_counter() - t0) / gens
     pop = np.random.default_rng(0).uniform(-10, 10, (95, dim))
     t0 = time.perf_counter()
@@ -93,19 +119,29 @@ def main() -> None:
     ours_fit = float(exact(res.x[None, :])[0])
     scipy_fit = float(exact(ref.x[None, :])[0])
     print(f"budget: NP 95, {gens} generations, D {dim}, 121 points; best of {args.repeats} repeats")
-    print(f"ours  ADE (navlib.methods.de.evolve):        {min(ours_t):7.3f} s   fitness J = {ours_fit:.2f} deg^2  "
-          f"({res.generations} generations, {res.n_evaluations} evaluations)")
-    print(f"scipy differential_evolution DE:    {min(scipy_t):7.3f} s   fitness J = {scipy_fit:.2f} deg^2  "
-          f"({ref.nit} iterations, nfev {ref.nfev} as scipy counts vectorised calls)")
-    print(f"per generation: fitness of 95 networks {fit_cost * 1e6:.0f} us (paid by both); optimiser overhead "
-          f"on a trivial fitness ours {ours_ovh * 1e6:.0f} us, scipy {scipy_ovh * 1e6:.0f} us")
-    print(f"bound: an optimiser with zero overhead would be {min(scipy_t) / (gens * fit_cost):.1f}x faster than "
-          f"scipy here (the fitness alone takes {gens * fit_cost:.3f} s)")
+    print(
+        f"ours  ADE (navlib.methods.de.evolve):        {min(ours_t):7.3f} s   fitness J = {ours_fit:.2f} deg^2  "
+        f"({res.generations} generations, {res.n_evaluations} evaluations)"
+    )
+    print(
+        f"scipy differential_evolution DE:    {min(scipy_t):7.3f} s   fitness J = {scipy_fit:.2f} deg^2  "
+        f"({ref.nit} iterations, nfev {ref.nfev} as scipy counts vectorised calls)"
+    )
+    print(
+        f"per generation: fitness of 95 networks {fit_cost * 1e6:.0f} us (paid by both); optimiser overhead "
+        f"on a trivial fitness ours {ours_ovh * 1e6:.0f} us, scipy {scipy_ovh * 1e6:.0f} us"
+    )
+    print(
+        f"bound: an optimiser with zero overhead would be {min(scipy_t) / (gens * fit_cost):.1f}x faster than "
+        f"scipy here (the fitness alone takes {gens * fit_cost:.3f} s)"
+    )
     print(f"equal or better fitness: {ours_fit <= scipy_fit}")
     print(f"single run: ours / fitness-only = {min(ours_t) / (gens * fit_cost):.2f}")
-    print(f"{args.seeds} seeds in one batch (evolve_many): {min(batch_t):7.3f} s = {min(batch_t) / args.seeds:.3f} s "
-          f"per run; fitness of all {95 * args.seeds} networks per generation alone: {fitness_only:.3f} s; "
-          f"per-run speedup over scipy {min(scipy_t) * args.seeds / min(batch_t):.2f}")
+    print(
+        f"{args.seeds} seeds in one batch (evolve_many): {min(batch_t):7.3f} s = {min(batch_t) / args.seeds:.3f} s "
+        f"per run; fitness of all {95 * args.seeds} networks per generation alone: {fitness_only:.3f} s; "
+        f"per-run speedup over scipy {min(scipy_t) * args.seeds / min(batch_t):.2f}"
+    )
     print(f"ade_overhead_ratio={min(batch_t) / fitness_only:.2f}")
     print(f"ade_vs_scipy_speedup={min(scipy_t) / min(ours_t):.2f}")
 

@@ -3,6 +3,7 @@
 against filterpy 2.0.0's KalmanFilter on the same sequence (predict/update per epoch, the peer).  Also the
 time per training pass of the 45-10-3 and 6-10-3 networks in one run and their ratio (paper: 7.3x).
 Prints the times and ratios; the INS simulation is not timed (it is the same for both)."""
+
 import time
 
 import numpy as np
@@ -38,11 +39,15 @@ for k in range(res.phi.shape[1]):
     kf.predict()
     kf.update(z[k], R=r[k])
 t_peer = time.perf_counter() - t0
-print(f"150 s run, 1500 epochs: numpy KF + QR + 9-10-3 net {t_ours:.3f} s; filterpy KF alone {t_peer:.3f} s; "
-      f"ratio peer/ours {t_peer / t_ours:.2f}")
+print(
+    f"150 s run, 1500 epochs: numpy KF + QR + 9-10-3 net {t_ours:.3f} s; filterpy KF alone {t_peer:.3f} s; "
+    f"ratio peer/ours {t_peer / t_ours:.2f}"
+)
 
 x45, x6 = km.gain_features(res, "raw45"), km.gain_features(res, "qr6")
 n45 = train_mlp(x45, res.att_err_arcsec, bp_params(45, epochs=300))
 n6 = train_mlp(x6, res.att_err_arcsec, bp_params(6, epochs=300))
-print(f"training pass: 45-10-3 {1e3 * n45.seconds_per_pass:.2f} ms, 6-10-3 {1e3 * n6.seconds_per_pass:.2f} ms, "
-      f"ratio {n45.seconds_per_pass / n6.seconds_per_pass:.2f} (paper 0.3038 s / 0.0418 s = 7.27)")
+print(
+    f"training pass: 45-10-3 {1e3 * n45.seconds_per_pass:.2f} ms, 6-10-3 {1e3 * n6.seconds_per_pass:.2f} ms, "
+    f"ratio {n45.seconds_per_pass / n6.seconds_per_pass:.2f} (paper 0.3038 s / 0.0418 s = 7.27)"
+)

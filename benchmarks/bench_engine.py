@@ -20,6 +20,7 @@ Prints the times and the ratios; the last lines are ``engine_speedup_2_vs_1=<rat
 Each configuration runs ``repeats`` times, interleaved with the others; the best time of each counts (the
 machine's other load only ever adds time).
 """
+
 from __future__ import annotations
 
 import os
@@ -42,7 +43,8 @@ _POOLS: dict[int, ProcessPoolExecutor] = {}
 
 
 def _peer_init_worker() -> None:
-    import torch                                  # the former module imported torch at its top
+    import torch  # the former module imported torch at its top
+
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     torch.set_num_threads(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -51,8 +53,9 @@ def _peer_init_worker() -> None:
 def peer_executor(workers: int) -> ProcessPoolExecutor:
     pool = _POOLS.get(workers)
     if pool is None:
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
-                                   initializer=_peer_init_worker)
+        pool = ProcessPoolExecutor(
+            max_workers=workers, mp_context=get_context("spawn"), initializer=_peer_init_worker
+        )
         _POOLS[workers] = pool
     return pool
 
@@ -61,7 +64,11 @@ def peer_run_tasks(fn, tasks, workers=1, cost=None) -> list:
     tasks = list(tasks)
     if workers == 1 or len(tasks) <= 1:
         return [fn(*t) for t in tasks]
-    order = sorted(range(len(tasks)), key=lambda i: -cost[i]) if cost is not None else list(range(len(tasks)))
+    order = (
+        sorted(range(len(tasks)), key=lambda i: -cost[i])
+        if cost is not None
+        else list(range(len(tasks)))
+    )
     queue = iter(order)
     lock = threading.Lock()
     pool = peer_executor(workers - 1)
@@ -117,8 +124,13 @@ def study_args(per_case: int) -> list:
     real = T.run_trials
     T.run_trials = lambda fn, args, *a, **k: seen.extend(args) or []
     try:
-        T.hidden_effect_study("compass", ratios=(3.0, 10.0), noises=(0.05, 0.2), seeds=range(per_case),
-                              none_seeds=range(2 * per_case))
+        T.hidden_effect_study(
+            "compass",
+            ratios=(3.0, 10.0),
+            noises=(0.05, 0.2),
+            seeds=range(per_case),
+            none_seeds=range(2 * per_case),
+        )
     finally:
         T.run_trials = real
     return seen
@@ -139,30 +151,38 @@ def main() -> None:
     # start-up, from nothing to the first task's result
     t_ours_start, _ = timed(lambda: engine.run(_ready, [()] * 2, workers=2))
     t_peer_start, _ = timed(lambda: peer_executor(1).submit(_ready).result())
-    print(f"start-up: local dask cluster of 2 workers {t_ours_start:.2f} s; former pool "
-          f"(1 spawned worker + this process) {t_peer_start:.2f} s")
+    print(
+        f"start-up: local dask cluster of 2 workers {t_ours_start:.2f} s; former pool "
+        f"(1 spawned worker + this process) {t_peer_start:.2f} s"
+    )
 
     fn = T.hidden_effect_trial
-    T.hidden_effect_trial(*args[0])                            # warm this process (numba caches, imports),
-    engine.client(2).run(T.hidden_effect_trial, *args[0])      # every cluster worker
-    peer_executor(1).submit(T.hidden_effect_trial, *args[0]).result()   # and the pool's worker
+    T.hidden_effect_trial(*args[0])  # warm this process (numba caches, imports),
+    engine.client(2).run(T.hidden_effect_trial, *args[0])  # every cluster worker
+    peer_executor(1).submit(T.hidden_effect_trial, *args[0]).result()  # and the pool's worker
 
-    runs = {"ours_1": lambda: engine.run_batches(fn, args, T.TRIAL_BATCH, workers=1),
-            "peer_1": lambda: peer_run_trials(fn, args, workers=1),
-            "ours_2": lambda: engine.run_batches(fn, args, T.TRIAL_BATCH, workers=2),
-            "peer_2": lambda: peer_run_trials(fn, args, workers=2)}
+    runs = {
+        "ours_1": lambda: engine.run_batches(fn, args, T.TRIAL_BATCH, workers=1),
+        "peer_1": lambda: peer_run_trials(fn, args, workers=1),
+        "ours_2": lambda: engine.run_batches(fn, args, T.TRIAL_BATCH, workers=2),
+        "peer_2": lambda: peer_run_trials(fn, args, workers=2),
+    }
     best, out = {}, {}
-    for _ in range(repeats):                                   # interleaved; the best of each
+    for _ in range(repeats):  # interleaved; the best of each
         for name, f in runs.items():
             t, out[name] = timed(f)
             best[name] = min(best.get(name, np.inf), t)
-    t_ours_1, t_peer_1, t_ours_2, t_peer_2 = (best[k] for k in ("ours_1", "peer_1", "ours_2", "peer_2"))
+    t_ours_1, t_peer_1, t_ours_2, t_peer_2 = (
+        best[k] for k in ("ours_1", "peer_1", "ours_2", "peer_2")
+    )
     frames = [pd.DataFrame(out[k]) for k in runs]
     for f in frames[1:]:
         pd.testing.assert_frame_equal(frames[0], f)
     print("results identical in all four runs")
-    print(f"engine: 1 worker {t_ours_1:.1f} s, 2 workers {t_ours_2:.1f} s "
-          f"({t_ours_start + t_ours_2:.1f} s with the cluster's start-up)")
+    print(
+        f"engine: 1 worker {t_ours_1:.1f} s, 2 workers {t_ours_2:.1f} s "
+        f"({t_ours_start + t_ours_2:.1f} s with the cluster's start-up)"
+    )
     print(f"former pool: 1 worker {t_peer_1:.1f} s, 2 workers {t_peer_2:.1f} s")
     print(f"peer_speedup_2_vs_1={t_peer_1 / t_peer_2:.2f}")
     print(f"startup_peer_vs_engine={t_peer_start / t_ours_start:.2f}")

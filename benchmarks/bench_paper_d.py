@@ -12,6 +12,7 @@
 Prints a ratio line per comparison: ``<what>_speedup=<peer time / our time>``.
 Run: ``.venv/bin/python benchmarks/bench_paper_d.py``.
 """
+
 from __future__ import annotations
 
 import os
@@ -20,7 +21,7 @@ import time
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))   # the peer adapters
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))  # the peer adapters
 
 import numpy as np  # noqa: E402
 from anfis_toolbox.membership import GaussianMF  # noqa: E402
@@ -57,8 +58,10 @@ def main():
             fs.set_variable(nm, float(v))
         peer.append(fs.Sugeno_inference(["y"], verbose=False)["y"])
     t_peer = time.perf_counter() - t
-    print(f"inference: max |ours - simpful| = {np.max(np.abs(ours - np.array(peer))):.2e} mg; "
-          f"per 1000 points ours {1000 * t_ours / len(Xq) * 1000:.2f} ms, simpful {1000 * t_peer / len(Xq) * 1000:.0f} ms")
+    print(
+        f"inference: max |ours - simpful| = {np.max(np.abs(ours - np.array(peer))):.2e} mg; "
+        f"per 1000 points ours {1000 * t_ours / len(Xq) * 1000:.2f} ms, simpful {1000 * t_peer / len(Xq) * 1000:.0f} ms"
+    )
     print(f"inference_speedup={t_peer / t_ours:.0f}")
 
     # 2. ANFIS on identical rules
@@ -66,25 +69,43 @@ def main():
     t = time.perf_counter()
     res = anfis(X[tr], y[tr], fis, AnfisOptions(epochs=epochs))
     t_ours = time.perf_counter() - t
-    mfs = {f"x{i}": [GaussianMF(float(fis.centers[r, i]), float(fis.sigmas[r, i])) for r in range(fis.n_rules)]
-           for i in range(2)}
+    mfs = {
+        f"x{i}": [
+            GaussianMF(float(fis.centers[r, i]), float(fis.sigmas[r, i]))
+            for r in range(fis.n_rules)
+        ]
+        for i in range(2)
+    }
     model = TSKANFIS(mfs, rules=[(r, r) for r in range(fis.n_rules)])
     trainer = HybridTrainer(learning_rate=0.01, epochs=1)
     trainer.fit(model, X[tr], y[tr])
     first = np.asarray(model.consequent_layer.parameters)
     ls_diff = np.max(np.abs(model.predict(X[tr]).ravel() - fis(X[tr])))
-    model = TSKANFIS({k: [GaussianMF(m.parameters["mean"], m.parameters["sigma"]) for m in v]
-                      for k, v in {f"x{i}": [GaussianMF(float(fis.centers[r, i]), float(fis.sigmas[r, i]))
-                                             for r in range(fis.n_rules)] for i in range(2)}.items()},
-                     rules=[(r, r) for r in range(fis.n_rules)])
+    model = TSKANFIS(
+        {
+            k: [GaussianMF(m.parameters["mean"], m.parameters["sigma"]) for m in v]
+            for k, v in {
+                f"x{i}": [
+                    GaussianMF(float(fis.centers[r, i]), float(fis.sigmas[r, i]))
+                    for r in range(fis.n_rules)
+                ]
+                for i in range(2)
+            }.items()
+        },
+        rules=[(r, r) for r in range(fis.n_rules)],
+    )
     t = time.perf_counter()
     HybridTrainer(learning_rate=0.01, epochs=epochs).fit(model, X[tr], y[tr])
     t_peer = time.perf_counter() - t
     rmse_peer = float(np.sqrt(np.mean((model.predict(X[tr]).ravel() - y[tr]) ** 2)))
-    print(f"anfis: consequent matrix {first.shape}; first-epoch FIS outputs differ from ours by {ls_diff:.2e} mg "
-          f"(the peer's premises already took one step, and it adds a 1e-6 ridge)")
-    print(f"anfis: training RMSE after {epochs} epochs ours {1000 * res.train_rmse.min():.2f} ug (best epoch "
-          f"{res.best_epoch}), anfis-toolbox {1000 * rmse_peer:.2f} ug; time ours {t_ours:.2f} s, peer {t_peer:.2f} s")
+    print(
+        f"anfis: consequent matrix {first.shape}; first-epoch FIS outputs differ from ours by {ls_diff:.2e} mg "
+        f"(the peer's premises already took one step, and it adds a 1e-6 ridge)"
+    )
+    print(
+        f"anfis: training RMSE after {epochs} epochs ours {1000 * res.train_rmse.min():.2f} ug (best epoch "
+        f"{res.best_epoch}), anfis-toolbox {1000 * rmse_peer:.2f} ug; time ours {t_ours:.2f} s, peer {t_peer:.2f} s"
+    )
     print(f"anfis_speedup={t_peer / t_ours:.2f}")
 
     # 3. fish swarm
@@ -101,16 +122,30 @@ def main():
     def one(z):
         n_peer[0] += 1
         return float(obj((lo + np.clip(z, 0, 1) * (hi - lo))[None])[0])
+
     np.random.seed(1)
     t = time.perf_counter()
-    af = AFSA(one, n_dim=2, size_pop=sp.n_fish, max_iter=sp.generations, max_try_num=sp.try_number,
-              step=sp.step, visual=sp.visual, q=0.98, delta=sp.delta)
+    af = AFSA(
+        one,
+        n_dim=2,
+        size_pop=sp.n_fish,
+        max_iter=sp.generations,
+        max_try_num=sp.try_number,
+        step=sp.step,
+        visual=sp.visual,
+        q=0.98,
+        delta=sp.delta,
+    )
     bx, by = af.run()
     t_peer = time.perf_counter() - t
-    print(f"swarm: ours best {1000 * r.fun:.2f} ug at ra={r.x[0]:.3f}, rb/ra={r.x[1]:.3f} with {r.n_evaluations} "
-          f"evaluations in {r.n_calls} calls, {t_ours:.1f} s")
-    print(f"swarm: scikit-opt AFSA best {1000 * float(np.ravel(by)[0]):.2f} ug with {n_peer[0]} evaluations "
-          f"(one per call), {t_peer:.1f} s")
+    print(
+        f"swarm: ours best {1000 * r.fun:.2f} ug at ra={r.x[0]:.3f}, rb/ra={r.x[1]:.3f} with {r.n_evaluations} "
+        f"evaluations in {r.n_calls} calls, {t_ours:.1f} s"
+    )
+    print(
+        f"swarm: scikit-opt AFSA best {1000 * float(np.ravel(by)[0]):.2f} ug with {n_peer[0]} evaluations "
+        f"(one per call), {t_peer:.1f} s"
+    )
     print(f"swarm_speedup={t_peer / t_ours:.2f}")
 
 

@@ -9,6 +9,7 @@ of the true heading; magnetometer: the algebraic ellipsoid fit, 9 quadric coeffi
 what the loop's diagnosis costs over one fit.  Files are simulated here (no real data copied) in a
 temporary folder; prints both times per file and their ratio.
 """
+
 import subprocess
 import sys
 import tempfile
@@ -41,16 +42,24 @@ def compass_file(path: Path, n: int = 100_000) -> None:
     rng = np.random.default_rng(np.random.SeedSequence(18, spawn_key=(1,)))
     t = rng.uniform(0, 360, n)
     h = np.radians(t)
-    meas = (t + 1.0 + 0.8 * np.sin(h) + 0.3 * np.cos(h) + 0.2 * np.sin(2 * h) + rng.normal(0, 0.1, n)) % 360
-    pd.DataFrame({"true_heading_deg": t, "measured_heading_deg": meas,
-                  "sweep": np.r_[np.ones(n // 2, int), np.full(n - n // 2, 2)],
-                  "time_s": 0.1 * np.arange(n)}).to_csv(path, index=False)
+    meas = (
+        t + 1.0 + 0.8 * np.sin(h) + 0.3 * np.cos(h) + 0.2 * np.sin(2 * h) + rng.normal(0, 0.1, n)
+    ) % 360
+    pd.DataFrame(
+        {
+            "true_heading_deg": t,
+            "measured_heading_deg": meas,
+            "sweep": np.r_[np.ones(n // 2, int), np.full(n - n // 2, 2)],
+            "time_s": 0.1 * np.arange(n),
+        }
+    ).to_csv(path, index=False)
 
 
 def magnetometer_file(path: Path, n: int = 20_000) -> None:
     params = {"hard_x_ut": 3.0, "hard_y_ut": -2.0, "hard_z_ut": 1.5}
-    simulate_hand_turned(params, duration_s=n / 10.0, noise_ut=0.1,
-                         seed=np.random.SeedSequence(18, spawn_key=(2,))).to_csv(path, index=False)
+    simulate_hand_turned(
+        params, duration_s=n / 10.0, noise_ut=0.1, seed=np.random.SeedSequence(18, spawn_key=(2,))
+    ).to_csv(path, index=False)
 
 
 def timed(cmd: list[str]) -> float:
@@ -61,8 +70,10 @@ def timed(cmd: list[str]) -> float:
 
 def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
-        cases = [("compass", Path(tmp) / "compass_100k.csv", compass_file, PEER_COMPASS, "misalignment"),
-                 ("magnetometer", Path(tmp) / "magnetometer_20k.csv", magnetometer_file, PEER_MAG, "")]
+        cases = [
+            ("compass", Path(tmp) / "compass_100k.csv", compass_file, PEER_COMPASS, "misalignment"),
+            ("magnetometer", Path(tmp) / "magnetometer_20k.csv", magnetometer_file, PEER_MAG, ""),
+        ]
         for system, path, make, peer, model in cases:
             make(path)
             rows = sum(1 for _ in open(path)) - 1

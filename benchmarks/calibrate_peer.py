@@ -19,6 +19,7 @@ magcc's LM fit at 13-29 ms per file: against that navlib is 5-20 x.  Held-out di
 worse than the raw field on 12 of 17 recordings and warned on all 12 (fast rotation, magnets: the
 accelerometer saw more than gravity); the peer made it worse on 11 and failed on 2.
 """
+
 from __future__ import annotations
 
 import sys
@@ -36,7 +37,9 @@ def warm_up() -> None:
     """numba kernels and imports, not timed."""
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "warm.csv"
-        simulate_free({"hard_x_ut": 5.0}, duration_s=20.0, seed=1).drop(columns=list(DERIVED)).to_csv(p, index=False)
+        simulate_free({"hard_x_ut": 5.0}, duration_s=20.0, seed=1).drop(
+            columns=list(DERIVED)
+        ).to_csv(p, index=False)
         calibrate(load_free(p))
 
 
@@ -50,11 +53,15 @@ def main(argv: list[str]) -> int:
     pd.set_option("display.width", 250)
     print(r.accuracy.join(r.times).to_string(float_format=lambda x: f"{x:.3g}"))
     s = r.summary()
-    print(f"\nnavlib: {s['calibrated']} of {s['trials']} calibrated ({s['warned']} with a warning), {s['refused']} "
-          f"refused; made the held-out direction worse on {s['navlib_worse']}, warned on {s['navlib_worse_warned']} "
-          f"of those.  Peer: failed on {s['peer_failed']}, made it worse on {s['peer_worse']}.")
-    print(f"time per fit: navlib median {r.times['navlib (s)'].median():.2f} s, peer median "
-          f"{1000 * r.times['peer (s)'].median():.1f} ms; ratio {s['time_ratio']:.0f}x (median over files)")
+    print(
+        f"\nnavlib: {s['calibrated']} of {s['trials']} calibrated ({s['warned']} with a warning), {s['refused']} "
+        f"refused; made the held-out direction worse on {s['navlib_worse']}, warned on {s['navlib_worse_warned']} "
+        f"of those.  Peer: failed on {s['peer_failed']}, made it worse on {s['peer_worse']}."
+    )
+    print(
+        f"time per fit: navlib median {r.times['navlib (s)'].median():.2f} s, peer median "
+        f"{1000 * r.times['peer (s)'].median():.1f} ms; ratio {s['time_ratio']:.0f}x (median over files)"
+    )
     return 0
 
 

@@ -18,6 +18,7 @@ The last line is ``compare_compass_s=<command, 2 workers, simulated file>``.
 
 Run: ``.venv/bin/python benchmarks/compare_compass.py [--repeats 2]``.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -51,11 +52,27 @@ def best(fn, repeats: int) -> float:
 
 
 def command(path, workers: int) -> None:
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", ""))
-                                                      if p))
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p),
+    )
     env.pop("NAVLIB_SCHEDULER", None)
-    p = subprocess.run([sys.executable, "-m", "navlib", "compare", "compass", str(path), "--workers", str(workers),
-                        "--json"], capture_output=True, text=True, env=env)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "navlib",
+            "compare",
+            "compass",
+            str(path),
+            "--workers",
+            str(workers),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+    )
     if p.returncode != 0:
         raise SystemExit(f"navlib compare failed: {p.stderr.strip()}")
 
@@ -74,29 +91,40 @@ def main() -> None:
     R = args.repeats
     with tempfile.TemporaryDirectory() as tmp:
         sim = Path(tmp) / "sim_152.csv"
-        simulate_train_test(CompassErrors(), PAPER_A_EARTH, SweepConfig(n_points=76, step_deg=4.8),
-                            seed=2024).to_csv(sim, index=False)
-        files = [("simulated, 2 x 76 readings", sim)] + ([("BROAD trial 05 (real)", BROAD05)]
-                                                           if BROAD05.exists() else [])
-        command(sim, 1)                                   # numba's cache and the OS's file cache warm
+        simulate_train_test(
+            CompassErrors(), PAPER_A_EARTH, SweepConfig(n_points=76, step_deg=4.8), seed=2024
+        ).to_csv(sim, index=False)
+        files = [("simulated, 2 x 76 readings", sim)] + (
+            [("BROAD trial 05 (real)", BROAD05)] if BROAD05.exists() else []
+        )
+        command(sim, 1)  # numba's cache and the OS's file cache warm
         ours2 = None
-        print(f"navlib compare compass FILE (default methods, 10 seeds), end to end, best of {R}; "
-              f"the peer: one plain 8-position LS fit + correction in this process")
+        print(
+            f"navlib compare compass FILE (default methods, 10 seeds), end to end, best of {R}; "
+            f"the peer: one plain 8-position LS fit + correction in this process"
+        )
         for name, path in files:
             n = len(load_sweeps(path))
             t2 = best(lambda: command(path, 2), R)
             t1 = best(lambda: command(path, 1), R)
             ours2 = t2 if ours2 is None else ours2
-            line = (f"  {name} ({n} rows): 2 workers {t2:.1f} s ({'within' if t2 <= TARGET_S else 'OVER'} the "
-                    f"{TARGET_S:.0f} s target), 1 worker {t1:.1f} s; ")
+            line = (
+                f"  {name} ({n} rows): 2 workers {t2:.1f} s ({'within' if t2 <= TARGET_S else 'OVER'} the "
+                f"{TARGET_S:.0f} s target), 1 worker {t1:.1f} s; "
+            )
             try:
                 peer = best(lambda: plain_ls(path), max(R, 20))
-            except InputError as err:                   # BROAD 05's sweep 1 has no reading near 135 deg
+            except InputError as err:  # BROAD 05's sweep 1 has no reading near 135 deg
                 print(line + f"plain LS fit: not possible ({err})")
                 continue
-            print(line + f"plain LS fit {1e3 * peer:.2f} ms; ratio ours (2 workers) / LS fit {t2 / peer:.3g}")
-    print(f"cores here: {len(os.sched_getaffinity(0))}; load average at the end {os.getloadavg()[0]:.1f} "
-          f"(other work on the machine slows both columns)")
+            print(
+                line
+                + f"plain LS fit {1e3 * peer:.2f} ms; ratio ours (2 workers) / LS fit {t2 / peer:.3g}"
+            )
+    print(
+        f"cores here: {len(os.sched_getaffinity(0))}; load average at the end {os.getloadavg()[0]:.1f} "
+        f"(other work on the machine slows both columns)"
+    )
     print(f"compare_compass_s={ours2:.2f}")
 
 

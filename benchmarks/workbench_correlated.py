@@ -5,6 +5,7 @@ intervals.  Also the cost: process time per trial.
 
     .venv/bin/python benchmarks/workbench_correlated.py [trials per case] [correlations, e.g. 0,0.9] [workers]
 """
+
 import sys
 import time
 
@@ -20,15 +21,22 @@ def main() -> None:
     pd.set_option("display.width", 200)
     for system in ("magnetometer", "compass"):
         t = time.perf_counter()
-        study = correlated_noise_study(system, correlations=rhos, seeds=range(trials), workers=workers)
+        study = correlated_noise_study(
+            system, correlations=rhos, seeds=range(trials), workers=workers
+        )
         wall = time.perf_counter() - t
-        print(f"--- {system}: {len(study)} trials in {wall:.0f} s wall ({workers} processes, "
-              f"{workers * wall / len(study):.2f} process-s per trial)")
+        print(
+            f"--- {system}: {len(study)} trials in {wall:.0f} s wall ({workers} processes, "
+            f"{workers * wall / len(study):.2f} process-s per trial)"
+        )
         print(correlated_noise_rates(study).round(3).to_string(), flush=True)
         wrong = study[~study.correct.astype(bool)]
         if len(wrong):
-            print(wrong[["correlation", "hidden", "named", "ar_order", "lag1", "seed"]].to_string(), flush=True)
+            print(
+                wrong[["correlation", "hidden", "named", "ar_order", "lag1", "seed"]].to_string(),
+                flush=True,
+            )
 
 
-if __name__ == "__main__":          # worker processes are spawned: they import this file
+if __name__ == "__main__":  # worker processes are spawned: they import this file
     main()

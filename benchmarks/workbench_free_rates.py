@@ -13,6 +13,7 @@ the system's noise_directions hook), AR(0.9): quiet 98/100 (Wilson 0.930-0.994);
 (the study's trial_seed of each trial's coordinates), run in parts on a loaded machine -- see the
 closing note of issue 23 for the detection rates measured.
 """
+
 import sys
 import time
 
@@ -30,21 +31,39 @@ def main():
     rhos = [float(v) for v in sys.argv[4].split(",")] if len(sys.argv) > 4 else [0.0, 0.9]
     for rho in rhos:
         t = time.time()
-        st = hidden_effect_study(ratios=(3.0,), noises=(0.3,), seeds=range(trials), none_seeds=range(trials),
-                                 correlation=rho, duration_s=duration, workers=workers)
+        st = hidden_effect_study(
+            ratios=(3.0,),
+            noises=(0.3,),
+            seeds=range(trials),
+            none_seeds=range(trials),
+            correlation=rho,
+            duration_s=duration,
+            workers=workers,
+        )
         rows = []
         for h, g in st.groupby("hidden", sort=False):
             k = int(g.correct.astype(bool).sum())
             e = wilson(k, len(g))
-            rows.append({"hidden": h, "rate": "quiet" if h == "(none)" else "named", "trials": len(g), "k": k,
-                         "value": e.value, "95% low": e.lo, "95% high": e.hi})
-        print(f"--- AR(1) correlation {rho}, {duration:g} s at 10 Hz, noise 0.3 uT, effects at 3x noise "
-              f"({time.time() - t:.0f} s wall, {workers} workers)")
+            rows.append(
+                {
+                    "hidden": h,
+                    "rate": "quiet" if h == "(none)" else "named",
+                    "trials": len(g),
+                    "k": k,
+                    "value": e.value,
+                    "95% low": e.lo,
+                    "95% high": e.hi,
+                }
+            )
+        print(
+            f"--- AR(1) correlation {rho}, {duration:g} s at 10 Hz, noise 0.3 uT, effects at 3x noise "
+            f"({time.time() - t:.0f} s wall, {workers} workers)"
+        )
         print(pd.DataFrame(rows).round(3).to_string(index=False), flush=True)
         wrong = st[~st.correct.astype(bool)]
         if len(wrong):
             print(wrong[["hidden", "named", "seed"]].to_string(index=False), flush=True)
 
 
-if __name__ == "__main__":                          # the engine's worker processes import this file
+if __name__ == "__main__":  # the engine's worker processes import this file
     main()

@@ -6,6 +6,7 @@ costs more than it gives (the 100k-row compass loop of ``benchmarks/bench_workbe
 OpenBLAS's two threads, 9.1 s with one, on 2 cores), and the Monte Carlo commands get their parallelism from
 worker processes.  The variables must be set before numpy loads, hence here and not in :mod:`navlib.cli`.
 """
+
 import os
 import sys
 
@@ -17,6 +18,7 @@ def run() -> int:
     for name, value in ONE_THREAD.items():
         os.environ.setdefault(name, value)
     from .cli import main  # noqa: PLC0415  # lazy: the thread variables must be set before numpy loads
+
     return main()
 
 

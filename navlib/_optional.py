@@ -5,6 +5,7 @@ brings it (``navlib.methods.mlp needs torch, which is not installed: pip install
 checks that it is installed, without importing it (the engine checks for dask.distributed before it starts a
 cluster in the background).  Both raise :class:`MissingExtra`.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -75,6 +76,6 @@ def require(module: str, needed_by: str, alternative: str | None = None) -> Modu
         return importlib.import_module(module)
     except ModuleNotFoundError as err:
         top = module.partition(".")[0]
-        if err.name != top:                  # the module is there but something it imports is broken
+        if err.name != top:  # the module is there but something it imports is broken
             raise
         raise _missing(top, needed_by, alternative) from None

@@ -19,6 +19,7 @@ may not run an entry's primary reading (or any of its rows: other parameters, or
 the entry is then kept as *cannot be judged: its primary reading was not run*, with the rows that were
 run as its sensitivity, and the run finishes.
 """
+
 from __future__ import annotations
 
 import csv
@@ -34,6 +35,7 @@ from . import verdicts
 from .errors import InputError
 from .formatting import fmt, plain
 from .paths import data_path
+
 
 # ------------------------------------------------------------------------------------- one results row
 @dataclass(frozen=True)
@@ -87,24 +89,33 @@ class Claim:
             raise InputError(f"Claim.source={self.source!r}: must be 'paper' or 'book'")
         if self.data not in verdicts.DATA:
             raise InputError(f"Claim.data={self.data!r}: must be 'simulated' or 'real'")
-        if not isinstance(self.decided_by, tuple) or not all(isinstance(d, str) and d.strip()
-                                                               for d in self.decided_by):
-            raise InputError(f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts")
+        if not isinstance(self.decided_by, tuple) or not all(
+            isinstance(d, str) and d.strip() for d in self.decided_by
+        ):
+            raise InputError(
+                f"Claim.decided_by={self.decided_by!r}: must be a tuple of non-empty texts"
+            )
         if self.estimate is not None:
             if not isinstance(self.estimate, verdicts.Estimate):
-                raise InputError(f"Claim.estimate: a navlib.verdicts.Estimate, got "
-                                 f"{type(self.estimate).__name__}")
+                raise InputError(
+                    f"Claim.estimate: a navlib.verdicts.Estimate, got "
+                    f"{type(self.estimate).__name__}"
+                )
             if not str(self.statistic).strip():
                 raise InputError(f"Claim {self.claim!r}: say what the statistic is (with its unit)")
             if self.boundary is None or not math.isfinite(float(self.boundary)):
                 raise InputError(f"Claim {self.claim!r}: a statistic needs a finite boundary")
             if self.holds_when not in verdicts.SIDES:
-                raise InputError(f"Claim {self.claim!r}: holds_when={self.holds_when!r}: must be 'above' "
-                                 f"or 'below'")
+                raise InputError(
+                    f"Claim {self.claim!r}: holds_when={self.holds_when!r}: must be 'above' "
+                    f"or 'below'"
+                )
         elif not self.why.strip():
             raise InputError(f"Claim {self.claim!r}: without a statistic, 'why' must say why")
         if self.by_construction and not self.why.strip():
-            raise InputError(f"Claim {self.claim!r}: true by construction: 'why' must say which setting")
+            raise InputError(
+                f"Claim {self.claim!r}: true by construction: 'why' must say which setting"
+            )
         if self.floor is not None and not isinstance(self.floor, verdicts.Floor):
             raise InputError("Claim.floor: a navlib.verdicts.Floor")
         if self.key and not self.key.isidentifier():
@@ -120,8 +131,14 @@ class Claim:
         return "no statistic" if self.estimate is None else self.estimate.rule
 
     def _decision(self) -> tuple[bool | None, str]:
-        return verdicts.decide(self.interval, self.boundary, self.holds_when, self.floor,
-                               self.by_construction, self.margin)
+        return verdicts.decide(
+            self.interval,
+            self.boundary,
+            self.holds_when,
+            self.floor,
+            self.by_construction,
+            self.margin,
+        )
 
     @property
     def reproduced(self) -> bool | None:
@@ -167,8 +184,11 @@ class Claim:
 
     @property
     def ours_text(self) -> str:
-        return f"{self.ours}; {self.interval_text}" if self.ours and self.estimate is not None else (
-            self.ours or self.interval_text)
+        return (
+            f"{self.ours}; {self.interval_text}"
+            if self.ours and self.estimate is not None
+            else (self.ours or self.interval_text)
+        )
 
     @property
     def reason(self) -> str:
@@ -176,21 +196,28 @@ class Claim:
         basis, extra = self.basis, self.why.strip()
         if basis == "straddles":
             lo, hi = self.interval
-            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
-                    f"{self._bound()}")
+            text = (
+                f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] contains the boundary "
+                f"{self._bound()}"
+            )
         elif basis == "noise floor":
             f = self.floor
             flo, fhi = f.interval
-            ftext = self._num(f.value) + ("" if flo == fhi else
-                                          f" [{fmt(flo, self.spec)}, {fmt(fhi, self.spec)}]")
+            ftext = self._num(f.value) + (
+                "" if flo == fhi else f" [{fmt(flo, self.spec)}, {fmt(fhi, self.spec)}]"
+            )
             lo, hi = self.interval
-            text = (f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
-                    f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
-                    f"(set by {f.assumption}); it would need {f.needs}")
+            text = (
+                f"our interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] does not lie beyond our "
+                f"noise floor {ftext}, which is not {self.holds_when} the boundary {self._bound()} "
+                f"(set by {f.assumption}); it would need {f.needs}"
+            )
         elif basis == "equivalent":
             lo, hi = self.interval
-            text = (f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] lies within the "
-                    f"equivalence margin {self._bound()} +- {fmt(self.margin, '{:.4g}')}")
+            text = (
+                f"the 95 % interval [{fmt(lo, self.spec)}, {fmt(hi, self.spec)}] lies within the "
+                f"equivalence margin {self._bound()} +- {fmt(self.margin, '{:.4g}')}"
+            )
         else:
             text = ""
         return "; ".join(t for t in (text, extra) if t)
@@ -198,30 +225,52 @@ class Claim:
     def record(self) -> dict:
         """The claim as stored in a results file (the book's ``write_results``)."""
         e = self.estimate
-        return {"claim": self.claim, "reading": self.reading, "source": self.source, "paper": self.paper,
-                "ours": self.ours_text, "statistic": self.statistic or None, "unit": self.unit,
-                "rule": self.rule, "estimate": None if e is None else plain(e.value),
-                "interval": None if e is None else [plain(e.lo), plain(e.hi)],
-                "n": None if e is None else int(e.n),
-                "boundary": None if self.boundary is None else plain(self.boundary),
-                "holds_when": self.holds_when,
-                "floor": None if self.floor is None else {"value": plain(self.floor.value),
-                                                          "interval": [plain(v) for v in self.floor.interval],
-                                                          "assumption": self.floor.assumption,
-                                                          "needs": self.floor.needs},
-                "by_construction": bool(self.by_construction), "decided_by": list(self.decided_by),
-                "reproduced": self.reproduced, "verdict": self.verdict, "basis": self.basis,
-                "reason": verdicts.reason_category(self.basis, self.reason),
-                "why": self.reason, "key": self.key or None, "volatile": bool(self.volatile),
-                "margin": None if self.margin is None else plain(self.margin), "data": self.data}
+        return {
+            "claim": self.claim,
+            "reading": self.reading,
+            "source": self.source,
+            "paper": self.paper,
+            "ours": self.ours_text,
+            "statistic": self.statistic or None,
+            "unit": self.unit,
+            "rule": self.rule,
+            "estimate": None if e is None else plain(e.value),
+            "interval": None if e is None else [plain(e.lo), plain(e.hi)],
+            "n": None if e is None else int(e.n),
+            "boundary": None if self.boundary is None else plain(self.boundary),
+            "holds_when": self.holds_when,
+            "floor": None
+            if self.floor is None
+            else {
+                "value": plain(self.floor.value),
+                "interval": [plain(v) for v in self.floor.interval],
+                "assumption": self.floor.assumption,
+                "needs": self.floor.needs,
+            },
+            "by_construction": bool(self.by_construction),
+            "decided_by": list(self.decided_by),
+            "reproduced": self.reproduced,
+            "verdict": self.verdict,
+            "basis": self.basis,
+            "reason": verdicts.reason_category(self.basis, self.reason),
+            "why": self.reason,
+            "key": self.key or None,
+            "volatile": bool(self.volatile),
+            "margin": None if self.margin is None else plain(self.margin),
+            "data": self.data,
+        }
 
 
 def method_stats(rms, min_err=None, max_err=None) -> dict:
     """Headline statistics of one method over seeds: median, 10th and 90th percentile of the RMS error,
     median of the per-run minimum and maximum error, and the number of seeds (runs)."""
     r = np.asarray(rms, float)
-    out = {"median_rms": float(np.median(r)), "p10_rms": float(np.quantile(r, 0.1)),
-           "p90_rms": float(np.quantile(r, 0.9)), "n_seeds": int(r.size)}
+    out = {
+        "median_rms": float(np.median(r)),
+        "p10_rms": float(np.quantile(r, 0.1)),
+        "p90_rms": float(np.quantile(r, 0.9)),
+        "n_seeds": int(r.size),
+    }
     if min_err is not None:
         out["median_min"] = float(np.median(np.asarray(min_err, float)))
     if max_err is not None:
@@ -231,16 +280,47 @@ def method_stats(rms, min_err=None, max_err=None) -> dict:
 
 # ------------------------------------------------------------------------------------------- registers
 #: The registers each chapter's rows are judged against (file ``data/claims_<name>.csv``).
-REGISTERS = {"compass": ("paper_a", "patent_b"), "gyro": ("paper_c",), "accelerometer": ("paper_d",),
-             "celestial": ("paper_e",), "workbench": ("workbench",)}
+REGISTERS = {
+    "compass": ("paper_a", "patent_b"),
+    "gyro": ("paper_c",),
+    "accelerometer": ("paper_d",),
+    "celestial": ("paper_e",),
+    "workbench": ("workbench",),
+}
 #: How the book names each register's source.
-SOURCE_NAMES = {"paper_a": "Paper A", "patent_b": "Document B", "paper_c": "Paper C", "paper_d": "Paper D",
-                "paper_e": "Paper E", "workbench": "The workbench"}
+SOURCE_NAMES = {
+    "paper_a": "Paper A",
+    "patent_b": "Document B",
+    "paper_c": "Paper C",
+    "paper_d": "Paper D",
+    "paper_e": "Paper E",
+    "workbench": "The workbench",
+}
 KINDS = ("value", "comparison", "order", "rate", "qualitative", "inconsistency")
 STATUSES = ("judged", "open", "not checkable", "noted")
-COLUMNS = ("id", "origin", "headline", "kind", "status", "claim", "quote", "quote_zh", "where", "statistic",
-           "boundary", "holds_when", "unit", "rows", "primary_claim", "primary_reading", "why_primary",
-           "sensitivity", "needs", "margin", "margin_why")
+COLUMNS = (
+    "id",
+    "origin",
+    "headline",
+    "kind",
+    "status",
+    "claim",
+    "quote",
+    "quote_zh",
+    "where",
+    "statistic",
+    "boundary",
+    "holds_when",
+    "unit",
+    "rows",
+    "primary_claim",
+    "primary_reading",
+    "why_primary",
+    "sensitivity",
+    "needs",
+    "margin",
+    "margin_why",
+)
 _ID = re.compile(r"^[A-Z]\d{2,3}$")
 
 
@@ -289,7 +369,9 @@ def parse_register(lines: Iterable[str], name: str) -> tuple[Entry, ...]:
     cols = tuple(reader.fieldnames or ())
     if set(cols) != set(COLUMNS):
         missing, extra = sorted(set(COLUMNS) - set(cols)), sorted(set(cols) - set(COLUMNS))
-        raise InputError(f"{name}: columns differ from data/claims.md (missing {missing}, unknown {extra})")
+        raise InputError(
+            f"{name}: columns differ from data/claims.md (missing {missing}, unknown {extra})"
+        )
     out, seen = [], set()
     for i, raw in enumerate(reader, start=2):
         r = {k: (v or "").strip() for k, v in raw.items() if k is not None}
@@ -332,24 +414,47 @@ def parse_register(lines: Iterable[str], name: str) -> tuple[Entry, ...]:
             if rows:
                 bad("rows", f"a {r['status']!r} entry has no results rows")
             if not r["needs"]:
-                bad("needs", f"a {r['status']!r} entry says what would decide it or why it cannot be")
+                bad(
+                    "needs",
+                    f"a {r['status']!r} entry says what would decide it or why it cannot be",
+                )
         if r["margin"] and not r["margin_why"]:
             bad("margin_why", "say where the equivalence margin comes from")
         if (r["kind"] == "inconsistency") != (r["status"] == "noted"):
             bad("status", "an inconsistency is 'noted', and only an inconsistency is")
-        out.append(Entry(
-            id=r["id"], origin=r["origin"], headline=r["headline"] == "yes", kind=r["kind"], status=r["status"],
-            claim=r["claim"], quote=r["quote"], quote_zh=r["quote_zh"], where=r["where"],
-            statistic=r["statistic"], boundary=_number(r["boundary"], f"{at}, column 'boundary'"),
-            holds_when=r["holds_when"] or None, unit=r["unit"], rows=rows, primary_claim=r["primary_claim"],
-            primary_reading=r["primary_reading"], why_primary=r["why_primary"], sensitivity=r["sensitivity"],
-            needs=r["needs"], margin=_number(r["margin"], f"{at}, column 'margin'"), margin_why=r["margin_why"],
-            register=name.removeprefix("claims_").removesuffix(".csv")))
+        out.append(
+            Entry(
+                id=r["id"],
+                origin=r["origin"],
+                headline=r["headline"] == "yes",
+                kind=r["kind"],
+                status=r["status"],
+                claim=r["claim"],
+                quote=r["quote"],
+                quote_zh=r["quote_zh"],
+                where=r["where"],
+                statistic=r["statistic"],
+                boundary=_number(r["boundary"], f"{at}, column 'boundary'"),
+                holds_when=r["holds_when"] or None,
+                unit=r["unit"],
+                rows=rows,
+                primary_claim=r["primary_claim"],
+                primary_reading=r["primary_reading"],
+                why_primary=r["why_primary"],
+                sensitivity=r["sensitivity"],
+                needs=r["needs"],
+                margin=_number(r["margin"], f"{at}, column 'margin'"),
+                margin_why=r["margin_why"],
+                register=name.removeprefix("claims_").removesuffix(".csv"),
+            )
+        )
     heads = [e.id for e in out if e.headline]
     if any(e.headline and e.origin != "paper" for e in out):
         raise InputError(f"{name}: a headline is the source's own claim (origin 'paper')")
     if any(e.origin == "paper" for e in out) and len(heads) != 1:
-        raise InputError(f"{name}: exactly one headline entry (headline = yes) is needed, found {heads}")
+        raise InputError(
+            f"{name}: exactly one headline entry (headline = yes) is needed, found {heads}"
+        )
     return tuple(out)
 
 
@@ -378,11 +483,19 @@ def _across(primary: Mapping, others: list[Mapping], worlds: list[Mapping] | Non
     """How the primary verdict moves: across the other rows (readings, noise levels, splits) and across
     drawn worlds (records ``{"compass"|"world", "claim", "reading", "verdict"}`` of the primary row)."""
     v = primary["verdict"]
-    out = {"rows": 1 + len(others), "same": 1 + sum(o["verdict"] == v for o in others),
-           "verdicts": {k: sum(o["verdict"] == k for o in [primary, *others]) for k in verdicts.VERDICTS}}
+    out = {
+        "rows": 1 + len(others),
+        "same": 1 + sum(o["verdict"] == v for o in others),
+        "verdicts": {
+            k: sum(o["verdict"] == k for o in [primary, *others]) for k in verdicts.VERDICTS
+        },
+    }
     if worlds:
-        mine = [w for w in worlds if w.get("claim") == primary["row_claim"]
-                and w.get("reading") == primary["reading"]]
+        mine = [
+            w
+            for w in worlds
+            if w.get("claim") == primary["row_claim"] and w.get("reading") == primary["reading"]
+        ]
         if mine:
             out["worlds"] = len(mine)
             out["worlds_same"] = sum(w.get("verdict") == v for w in mine)
@@ -390,16 +503,26 @@ def _across(primary: Mapping, others: list[Mapping], worlds: list[Mapping] | Non
 
 
 def across_text(record: Mapping) -> str:
-    """"same in 4 of 5 readings; flips on 2 of 5 drawn compasses" (or "one reading") from a record's
+    """ "same in 4 of 5 readings; flips on 2 of 5 drawn compasses" (or "one reading") from a record's
     ``across`` summary."""
     a = record.get("across") or {}
     n = int(a.get("rows", 1))
-    parts = ["one reading" if n == 1 else
-             (f"same in all {n} readings" if a.get("same") == n else f"same in {a.get('same')} of {n} readings")]
+    parts = [
+        "one reading"
+        if n == 1
+        else (
+            f"same in all {n} readings"
+            if a.get("same") == n
+            else f"same in {a.get('same')} of {n} readings"
+        )
+    ]
     if "worlds" in a:
         flips = a["worlds"] - a["worlds_same"]
-        parts.append(f"same on all {a['worlds']} drawn compasses" if flips == 0 else
-                     f"differs on {flips} of {a['worlds']} drawn compasses")
+        parts.append(
+            f"same on all {a['worlds']} drawn compasses"
+            if flips == 0
+            else f"differs on {flips} of {a['worlds']} drawn compasses"
+        )
     return "; ".join(parts)
 
 
@@ -410,27 +533,53 @@ def _with_margin(r: dict, e: Entry) -> dict:
         return r
     f = r.get("floor")
     floor = None if f is None else tuple(f.get("interval") or (f["value"], f["value"]))
-    rep, basis = verdicts.decide(r["interval"], r["boundary"], r["holds_when"], floor, r["by_construction"],
-                                 e.margin)
+    rep, basis = verdicts.decide(
+        r["interval"], r["boundary"], r["holds_when"], floor, r["by_construction"], e.margin
+    )
     out = {**r, "margin": e.margin}
     if basis == "equivalent":
         lo, hi = r["interval"]
-        out.update(reproduced=rep, basis=basis, verdict=verdicts.verdict_name(rep, basis), reason=None,
-                   why=f"the 95 % interval [{lo:.4g}, {hi:.4g}] lies within the equivalence margin "
-                       f"{r['boundary']:.4g} +- {e.margin:g} {e.unit}".rstrip() + f" ({e.margin_why})")
+        out.update(
+            reproduced=rep,
+            basis=basis,
+            verdict=verdicts.verdict_name(rep, basis),
+            reason=None,
+            why=f"the 95 % interval [{lo:.4g}, {hi:.4g}] lies within the equivalence margin "
+            f"{r['boundary']:.4g} +- {e.margin:g} {e.unit}".rstrip()
+            + f" ({e.margin_why})",
+        )
     return out
 
 
 def _unjudged(e: Entry, cat: str | None = None) -> dict:
     cat = cat or ("not yet computed" if e.status == "open" else "not checkable")
-    return {"claim": e.claim, "reading": "as printed", "source": e.origin, "paper": e.quote or e.claim,
-            "ours": "–", "statistic": e.statistic or None, "unit": e.unit, "rule": "no statistic",
-            "estimate": None, "interval": None, "n": None, "boundary": None, "holds_when": None,
-            "floor": None, "by_construction": False, "decided_by": [], "reproduced": None,
-            "verdict": "cannot be judged", "basis": "no statistic", "reason": cat,
-            "why": verdicts.REGISTER_REASONS[cat] + e.needs, "key": None, "volatile": False,
-            "row_claim": None,
-            "primary_reading": e.primary_reading if cat == "not run" else f"none ({cat})"}
+    return {
+        "claim": e.claim,
+        "reading": "as printed",
+        "source": e.origin,
+        "paper": e.quote or e.claim,
+        "ours": "–",
+        "statistic": e.statistic or None,
+        "unit": e.unit,
+        "rule": "no statistic",
+        "estimate": None,
+        "interval": None,
+        "n": None,
+        "boundary": None,
+        "holds_when": None,
+        "floor": None,
+        "by_construction": False,
+        "decided_by": [],
+        "reproduced": None,
+        "verdict": "cannot be judged",
+        "basis": "no statistic",
+        "reason": cat,
+        "why": verdicts.REGISTER_REASONS[cat] + e.needs,
+        "key": None,
+        "volatile": False,
+        "row_claim": None,
+        "primary_reading": e.primary_reading if cat == "not run" else f"none ({cat})",
+    }
 
 
 def data_of(record: Mapping) -> str:
@@ -442,32 +591,51 @@ def data_of(record: Mapping) -> str:
 def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None) -> dict:
     """The record of a judged entry from its rows ``mine`` (all on one kind of data): the primary row's
     fields, the other rows as ``sensitivity``; "not run" when the primary row (or every row) is missing."""
-    if not mine:                  # none of its rows run: other parameters, or no real measurements
+    if not mine:  # none of its rows run: other parameters, or no real measurements
         rec = _unjudged(e, "not run")
-        rec["why"] = ("not run: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): with these "
-                      "parameters, or without the real measurements they need (../shared/realdata), they "
-                      "are not computed")
+        rec["why"] = (
+            "not run: the chapter wrote none of its rows (" + "; ".join(e.rows) + "): with these "
+            "parameters, or without the real measurements they need (../shared/realdata), they "
+            "are not computed"
+        )
         return {**rec, **base, "sensitivity": [], "across": {"rows": 0, "same": 0, "verdicts": {}}}
     prim = [r for r in mine if r["claim"] == e.primary_claim and r["reading"] == e.primary_reading]
     if len(prim) > 1:
-        raise InputError(f"claims_{e.register}.csv, {e.id}: two results rows {e.primary_claim!r} under the "
-                         f"primary reading {e.primary_reading!r}" + (" on real data" if base.get("data") == "real"
-                                                                      else ""))
-    if not prim:                  # a rerun with other parameters: the primary reading was not run
+        raise InputError(
+            f"claims_{e.register}.csv, {e.id}: two results rows {e.primary_claim!r} under the "
+            f"primary reading {e.primary_reading!r}"
+            + (" on real data" if base.get("data") == "real" else "")
+        )
+    if not prim:  # a rerun with other parameters: the primary reading was not run
         rec = _unjudged(e, "not run")
-        rec["why"] = (f"not run: the primary reading {e.primary_reading!r} of {e.primary_claim!r} was not "
-                      f"run with these parameters; the {len(mine)} row(s) that were are its sensitivity")
-        return {**rec, **base, "sensitivity": [{**r, "source": e.origin} for r in mine],
-                "across": {"rows": 0, "same": 0, "verdicts": {}}}
+        rec["why"] = (
+            f"not run: the primary reading {e.primary_reading!r} of {e.primary_claim!r} was not "
+            f"run with these parameters; the {len(mine)} row(s) that were are its sensitivity"
+        )
+        return {
+            **rec,
+            **base,
+            "sensitivity": [{**r, "source": e.origin} for r in mine],
+            "across": {"rows": 0, "same": 0, "verdicts": {}},
+        }
     p = prim[0]
     others = [{**r, "source": e.origin} for r in mine if r is not p]
-    rec = {**p, **base, "claim": e.claim, "row_claim": p["claim"], "source": e.origin,
-           "primary_reading": p["reading"], "sensitivity": others}
+    rec = {
+        **p,
+        **base,
+        "claim": e.claim,
+        "row_claim": p["claim"],
+        "source": e.origin,
+        "primary_reading": p["reading"],
+        "sensitivity": others,
+    }
     rec["across"] = _across(rec, others, worlds)
     return rec
 
 
-def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None = None) -> list[dict]:
+def evaluate(
+    chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None = None
+) -> list[dict]:
     """One record per register entry of ``chapter`` (except inconsistencies): for a judged entry its
     primary row's fields (``claim`` is the register's wording, ``row_claim`` the row's), the register's
     ``id``, ``quote``, ``quote_zh``, ``where``, ``kind``, ``status``, ``headline``, ``primary_reading``,
@@ -485,8 +653,10 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
     rows = [dict(r) for r in rows]
     for r in rows:
         if data_of(r) not in verdicts.DATA:
-            raise InputError(f"chapter {chapter!r}: results row {r.get('claim')!r}: data={r.get('data')!r} "
-                             f"must be 'simulated' or 'real'")
+            raise InputError(
+                f"chapter {chapter!r}: results row {r.get('claim')!r}: data={r.get('data')!r} "
+                f"must be 'simulated' or 'real'"
+            )
     es = entries(chapter)
     if not es:
         raise InputError(f"chapter {chapter!r} has no claims register (navlib.claims.REGISTERS)")
@@ -494,27 +664,48 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
     for e in es:
         for text in e.rows:
             if text in owner:
-                raise InputError(f"claims_{e.register}.csv, {e.id}: row {text!r} already belongs to "
-                                 f"{owner[text].id}")
+                raise InputError(
+                    f"claims_{e.register}.csv, {e.id}: row {text!r} already belongs to "
+                    f"{owner[text].id}"
+                )
             owner[text] = e
     files = ", ".join(f"data/claims_{n}.csv" for n in registers(chapter))
     by_entry: dict[tuple[str, str], list[dict]] = {}
     for r in rows:
         e = owner.get(r["claim"])
         if e is None:
-            raise InputError(f"chapter {chapter!r}: results row {r['claim']!r} ({r['reading']}) belongs to no "
-                             f"entry of {files}: add it to an entry's rows")
+            raise InputError(
+                f"chapter {chapter!r}: results row {r['claim']!r} ({r['reading']}) belongs to no "
+                f"entry of {files}: add it to an entry's rows"
+            )
         by_entry.setdefault((e.id, data_of(r)), []).append(_with_margin(r, e))
     out, real = [], []
     for e in es:
         if e.status == "noted":
             continue
-        base = {"id": e.id, "register": e.register, "kind": e.kind, "status": e.status, "headline": e.headline,
-                "quote": e.quote, "quote_zh": e.quote_zh, "where": e.where, "why_primary": e.why_primary,
-                "dimensions": e.sensitivity, "needs": e.needs, "data": "simulated"}
+        base = {
+            "id": e.id,
+            "register": e.register,
+            "kind": e.kind,
+            "status": e.status,
+            "headline": e.headline,
+            "quote": e.quote,
+            "quote_zh": e.quote_zh,
+            "where": e.where,
+            "why_primary": e.why_primary,
+            "dimensions": e.sensitivity,
+            "needs": e.needs,
+            "data": "simulated",
+        }
         if e.status != "judged":
-            out.append({**_unjudged(e), **base, "sensitivity": [],
-                        "across": {"rows": 0, "same": 0, "verdicts": {}}})
+            out.append(
+                {
+                    **_unjudged(e),
+                    **base,
+                    "sensitivity": [],
+                    "across": {"rows": 0, "same": 0, "verdicts": {}},
+                }
+            )
             continue
         out.append(_judged(e, by_entry.get((e.id, "simulated"), []), base, worlds))
         if (e.id, "real") in by_entry:
@@ -524,8 +715,18 @@ def evaluate(chapter: str, rows: Iterable[Mapping], worlds: list[Mapping] | None
 
 def inconsistencies(chapter: str) -> list[dict]:
     """The register's ``noted`` entries of a chapter: where a paper contradicts itself."""
-    return [{"id": e.id, "register": e.register, "claim": e.claim, "quote": e.quote, "where": e.where,
-             "numbers": e.needs} for e in entries(chapter) if e.status == "noted"]
+    return [
+        {
+            "id": e.id,
+            "register": e.register,
+            "claim": e.claim,
+            "quote": e.quote,
+            "where": e.where,
+            "numbers": e.needs,
+        }
+        for e in entries(chapter)
+        if e.status == "noted"
+    ]
 
 
 def headlines(records: Iterable[Mapping]) -> list[dict]:
@@ -536,10 +737,28 @@ def headlines(records: Iterable[Mapping]) -> list[dict]:
 def tally(records: Iterable[Mapping]) -> dict[str, int]:
     """Counts of register records by status and, for judged ones, by primary verdict."""
     recs = list(records)
-    out = {k: sum(r["verdict"] == k and r.get("status") == "judged" for r in recs) for k in verdicts.VERDICTS}
-    out.update({s: sum(r.get("status") == s for r in recs) for s in ("judged", "open", "not checkable")})
+    out = {
+        k: sum(r["verdict"] == k and r.get("status") == "judged" for r in recs)
+        for k in verdicts.VERDICTS
+    }
+    out.update(
+        {s: sum(r.get("status") == s for r in recs) for s in ("judged", "open", "not checkable")}
+    )
     return out
 
 
-__all__ = ["Entry", "REGISTERS", "SOURCE_NAMES", "across_text", "data_of", "entries", "evaluate", "headlines",
-           "inconsistencies", "load_register", "parse_register", "registers", "tally"]
+__all__ = [
+    "Entry",
+    "REGISTERS",
+    "SOURCE_NAMES",
+    "across_text",
+    "data_of",
+    "entries",
+    "evaluate",
+    "headlines",
+    "inconsistencies",
+    "load_register",
+    "parse_register",
+    "registers",
+    "tally",
+]

@@ -31,6 +31,7 @@ Progress: a tqdm bar on stderr for studies that run longer than :data:`PROGRESS_
 is a terminal (never in a notebook's stored outputs) unless ``NAVLIB_PROGRESS=1`` asks for it (``0``
 turns it off everywhere); no bar, and no error, when tqdm is not installed (it is not a core dependency).
 """
+
 from __future__ import annotations
 
 import atexit
@@ -68,15 +69,17 @@ WORKER_ENV = dict(ONE_THREAD)
 #: dask settings of the local cluster (its scheduler, nannies and workers): no statistical profiler (it
 #: samples every worker's stack every 10 ms) and slower housekeeping loops (dask's defaults cost an idle
 #: 2-worker cluster about 12 % of a core, these 1 %); glibc's malloc as in this process.
-LOCAL_CONFIG = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
-                "distributed.worker.profile.enabled": False,
-                "distributed.admin.tick.interval": "1s",
-                "distributed.admin.system-monitor.interval": "2s",
-                "distributed.worker.memory.monitor-interval": "1s",
-                # dask's workers start with MALLOC_TRIM_THRESHOLD_=65536, which also fixes glibc's mmap threshold
-                # at 128 kB: every numpy temporary above it is mmap'ed and zeroed afresh (paper E's filter ran 1.4x
-                # slower in a worker than in this process); the workers keep glibc's adaptive defaults
-                "distributed.nanny.pre-spawn-environ": dict(WORKER_ENV)}
+LOCAL_CONFIG = {
+    "distributed.scheduler.allowed-failures": ALLOWED_FAILURES,
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+    # dask's workers start with MALLOC_TRIM_THRESHOLD_=65536, which also fixes glibc's mmap threshold
+    # at 128 kB: every numpy temporary above it is mmap'ed and zeroed afresh (paper E's filter ran 1.4x
+    # slower in a worker than in this process); the workers keep glibc's adaptive defaults
+    "distributed.nanny.pre-spawn-environ": dict(WORKER_ENV),
+}
 #: Seconds to wait for a scheduler at an address before giving up.
 CONNECT_TIMEOUT_S = 10.0
 #: Seconds an address has to accept a TCP connection, and then again to send the first message of dask's
@@ -93,15 +96,15 @@ PROBE_MAX_BYTES = 1 << 16
 PROBE_MAX_FRAMES = 64
 
 _ADDRESS = re.compile(r"^(tcp|tls|ws|wss|inproc|ucx)://\S+$")
-_CLIENTS: dict[tuple, Any] = {}          # ("local", n) or ("remote", address) -> Client
-_CLUSTERS: dict[tuple, Any] = {}         # ("local", n) -> LocalCluster
-_PRELOADS: list = []                     # futures of start()'s imports (a released future is cancelled)
-_STARTING: dict[tuple, Any] = {}         # key -> concurrent.futures.Future of a start() in the background
+_CLIENTS: dict[tuple, Any] = {}  # ("local", n) or ("remote", address) -> Client
+_CLUSTERS: dict[tuple, Any] = {}  # ("local", n) -> LocalCluster
+_PRELOADS: list = []  # futures of start()'s imports (a released future is cancelled)
+_STARTING: dict[tuple, Any] = {}  # key -> concurrent.futures.Future of a start() in the background
 _LOCK = threading.RLock()
-_TIER = threading.local()                # .tier of the study this thread runs (background(); 0 otherwise)
+_TIER = threading.local()  # .tier of the study this thread runs (background(); 0 otherwise)
 #: Priority distance between tiers of :func:`background` studies: every task of a higher tier outranks every
 #: task of a lower one (a study's own priorities are at most its number of tasks).
-TIER_STEP = 10 ** 6
+TIER_STEP = 10**6
 
 
 # ------------------------------------------------------------------------------------------ where
@@ -116,7 +119,9 @@ def scheduler_address(scheduler: str | None = None) -> str | None:
     given = addr.strip()
     addr = given if "://" in given else "tcp://" + given
     if not _ADDRESS.match(addr) or (addr.startswith("tcp://") and not re.search(r":\d+$", addr)):
-        raise InputError(f"scheduler {given!r}: give an address such as tcp://127.0.0.1:8786 (host and port)")
+        raise InputError(
+            f"scheduler {given!r}: give an address such as tcp://127.0.0.1:8786 (host and port)"
+        )
     return addr
 
 
@@ -127,16 +132,20 @@ def _recv(sock, n: int, deadline: float, addr: str, timeout: float) -> bytes:
     while len(buf) < n:
         left = deadline - time.monotonic()
         if left <= 0:
-            raise InputError(f"scheduler {addr}: accepts connections but sent no dask handshake within {timeout:g} s "
-                             f"(not a dask scheduler, or a stuck one)")
+            raise InputError(
+                f"scheduler {addr}: accepts connections but sent no dask handshake within {timeout:g} s "
+                f"(not a dask scheduler, or a stuck one)"
+            )
         sock.settimeout(left)
         try:
             chunk = sock.recv(n - len(buf))
         except socket.timeout:
-            continue                                    # the deadline check above says it
+            continue  # the deadline check above says it
         if not chunk:
-            raise InputError(f"scheduler {addr}: closed the connection without a dask handshake (not a dask "
-                             f"scheduler?)")
+            raise InputError(
+                f"scheduler {addr}: closed the connection without a dask handshake (not a dask "
+                f"scheduler?)"
+            )
         buf += chunk
     return buf
 
@@ -156,28 +165,37 @@ def probe_scheduler(addr: str, timeout: float | None = None) -> None:
     if not addr.startswith("tcp://"):
         return
     timeout = PROBE_TIMEOUT_S if timeout is None else float(timeout)
-    host, _, port = addr[len("tcp://"):].rpartition(":")
-    host = host.strip("[]")                             # an IPv6 address in brackets
+    host, _, port = addr[len("tcp://") :].rpartition(":")
+    host = host.strip("[]")  # an IPv6 address in brackets
     try:
         sock = socket.create_connection((host, int(port)), timeout=timeout)
     except socket.timeout:
         raise InputError(f"scheduler {addr}: no connection within {timeout:g} s") from None
     except OSError as err:
-        raise InputError(f"scheduler {addr}: cannot connect ({err.strerror or type(err).__name__})") from None
+        raise InputError(
+            f"scheduler {addr}: cannot connect ({err.strerror or type(err).__name__})"
+        ) from None
     with sock:
         deadline = time.monotonic() + timeout
         (total,) = struct.unpack("Q", _recv(sock, 8, deadline, addr, timeout))
         if not 16 <= total <= PROBE_MAX_BYTES:
-            raise InputError(f"scheduler {addr}: answered something that is not dask's handshake (a first message "
-                             f"of {total} bytes; a scheduler's is at most {PROBE_MAX_BYTES}): not a dask scheduler")
+            raise InputError(
+                f"scheduler {addr}: answered something that is not dask's handshake (a first message "
+                f"of {total} bytes; a scheduler's is at most {PROBE_MAX_BYTES}): not a dask scheduler"
+            )
         body = _recv(sock, total, deadline, addr, timeout)
         (n,) = struct.unpack_from("Q", body)
         head = 8 * (1 + n) if 1 <= n <= PROBE_MAX_FRAMES else None
-        ends = [] if head is None or head > total else \
-            list(itertools.accumulate(struct.unpack_from(f"{n}Q", body, 8), initial=head))
+        ends = (
+            []
+            if head is None or head > total
+            else list(itertools.accumulate(struct.unpack_from(f"{n}Q", body, 8), initial=head))
+        )
         if total not in ends:
-            raise InputError(f"scheduler {addr}: answered something that is not dask's handshake (its frames do not "
-                             f"add up): not a dask scheduler")
+            raise InputError(
+                f"scheduler {addr}: answered something that is not dask's handshake (its frames do not "
+                f"add up): not a dask scheduler"
+            )
 
 
 def dask_available() -> bool:
@@ -192,7 +210,7 @@ def default_workers() -> int:
         return 1
     try:
         return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:                       # not on Linux
+    except AttributeError:  # not on Linux
         return max(1, os.cpu_count() or 1)
 
 
@@ -215,9 +233,9 @@ def _worker_plugin():
         own setting when it is importable)."""
 
         def setup(self, worker):
-            for k, v in WORKER_ENV.items():     # read by OpenMP (torch) and BLAS when they load later
+            for k, v in WORKER_ENV.items():  # read by OpenMP (torch) and BLAS when they load later
                 os.environ.setdefault(k, v)
-            _one_thread()                      # torch already loaded: its own setting
+            _one_thread()  # torch already loaded: its own setting
 
     return OneThread()
 
@@ -238,7 +256,7 @@ def client(workers: int = 1, scheduler: str | None = None):
     key = _key(workers, addr)
     starting = _STARTING.pop(key, None)
     if starting is not None:
-        starting.result()                        # raises what the start raised
+        starting.result()  # raises what the start raised
     with _LOCK:
         c = _CLIENTS.get(key)
         if c is not None and c.status == "running":
@@ -252,19 +270,27 @@ def _new_client(key, addr, workers):
     from distributed import Client, LocalCluster  # noqa: PLC0415  # lazy: as above
 
     if addr:
-        probe_scheduler(addr)                     # a silent or foreign peer: one line, not a hang
+        probe_scheduler(addr)  # a silent or foreign peer: one line, not a hang
         try:
             c = Client(addr, timeout=f"{CONNECT_TIMEOUT_S}s", set_as_default=False)
         except (OSError, TimeoutError) as err:
-            raise InputError(f"scheduler {addr}: cannot connect ({type(err).__name__}: "
-                             f"{str(err).splitlines()[0] if str(err) else 'no answer'})") from None
+            raise InputError(
+                f"scheduler {addr}: cannot connect ({type(err).__name__}: "
+                f"{str(err).splitlines()[0] if str(err) else 'no answer'})"
+            ) from None
     else:
-        for other in [k for k in _CLUSTERS if k[0] == "local"]:       # one local cluster at a time
+        for other in [k for k in _CLUSTERS if k[0] == "local"]:  # one local cluster at a time
             _close(other)
         with dask.config.set(LOCAL_CONFIG):
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR,
-                                   scheduler_kwargs={"dashboard_address": ":0"})   # no dashboard; no fixed port
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+                scheduler_kwargs={"dashboard_address": ":0"},
+            )  # no dashboard; no fixed port
         _CLUSTERS[key] = cluster
         c = Client(cluster, set_as_default=False)
     c.register_plugin(_worker_plugin(), name="navlib-one-thread")
@@ -279,7 +305,11 @@ def _close(key) -> None:
         if obj is not None:
             try:
                 obj.close()
-            except (OSError, RuntimeError, TimeoutError):   # already gone (interpreter exit, dead loop)
+            except (
+                OSError,
+                RuntimeError,
+                TimeoutError,
+            ):  # already gone (interpreter exit, dead loop)
                 pass
 
 
@@ -288,7 +318,12 @@ def shutdown() -> None:
     for f in list(_STARTING.values()):
         try:
             f.result()
-        except (InputError, OSError, RuntimeError, TimeoutError):     # reported by client(), if ever asked
+        except (
+            InputError,
+            OSError,
+            RuntimeError,
+            TimeoutError,
+        ):  # reported by client(), if ever asked
             pass
     _STARTING.clear()
     _PRELOADS.clear()
@@ -306,7 +341,9 @@ def _import(modules: Sequence[str]) -> bool:
     return True
 
 
-def start(workers: int = 1, scheduler: str | None = None, preload: Sequence[str] = (), wait: bool = False) -> None:
+def start(
+    workers: int = 1, scheduler: str | None = None, preload: Sequence[str] = (), wait: bool = False
+) -> None:
     """Start the local cluster (or connect to the scheduler) in the background and let every worker import
     the modules ``preload`` once it is up: a chapter goes on loading its data meanwhile, and its first
     study waits for the cluster only if it is not up yet.  ``workers`` and the address are checked here;
@@ -336,8 +373,17 @@ def _start(workers: int, addr: str | None, preload: tuple) -> None:
     if preload:
         _PRELOADS[:] = [f for f in _PRELOADS if not f.done()]
         for w in c.scheduler_info(n_workers=-1)["workers"]:
-            _PRELOADS.append(c.submit(_import, preload, workers=[w], pure=False, allow_other_workers=False,
-                                      priority=10**9, key=f"navlib-preload-{uuid.uuid4().hex[:8]}"))
+            _PRELOADS.append(
+                c.submit(
+                    _import,
+                    preload,
+                    workers=[w],
+                    pure=False,
+                    allow_other_workers=False,
+                    priority=10**9,
+                    key=f"navlib-preload-{uuid.uuid4().hex[:8]}",
+                )
+            )
 
 
 # ------------------------------------------------------------------------------------------ running
@@ -351,11 +397,18 @@ def _show_progress(progress: bool | None) -> bool:
 
 
 def _bar(total: int, label: str, show: bool):
-    if not show or not installed("tqdm"):            # tqdm is not a core dependency: no bar
+    if not show or not installed("tqdm"):  # tqdm is not a core dependency: no bar
         return None
     from tqdm.auto import tqdm  # noqa: PLC0415  # lazy: optional, only for a progress bar
-    return tqdm(total=total, desc=label or "navlib", delay=PROGRESS_DELAY_S, file=sys.stderr, leave=False,
-                dynamic_ncols=True)
+
+    return tqdm(
+        total=total,
+        desc=label or "navlib",
+        delay=PROGRESS_DELAY_S,
+        file=sys.stderr,
+        leave=False,
+        dynamic_ncols=True,
+    )
 
 
 def _call(fn: Callable, args: tuple):
@@ -364,12 +417,21 @@ def _call(fn: Callable, args: tuple):
 
 
 def _batch(fn: Callable, batch: list) -> list:
-    return [fn(*a) for a in batch]                # a task of run(): _call has set the threads
+    return [fn(*a) for a in batch]  # a task of run(): _call has set the threads
 
 
-def run(fn: Callable, tasks: Iterable[tuple], *, workers: int = 1, scheduler: str | None = None,
-        cost: Sequence[float] | None = None, label: str = "", progress: bool | None = None,
-        weight: Sequence[int] | None = None, on_result: Callable[[int, Any], None] | None = None) -> list:
+def run(
+    fn: Callable,
+    tasks: Iterable[tuple],
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    cost: Sequence[float] | None = None,
+    label: str = "",
+    progress: bool | None = None,
+    weight: Sequence[int] | None = None,
+    on_result: Callable[[int, Any], None] | None = None,
+) -> list:
     """``[fn(*args) for args in tasks]`` on the engine (see the module docstring), results in task order.
 
     Parameters
@@ -428,19 +490,26 @@ def _run_dask(c, fn, tasks, cost, label, bar, weight, on_result) -> list:
 
     n = len(tasks)
     order = sorted(range(n), key=lambda i: -cost[i]) if cost is not None else list(range(n))
-    tier = getattr(_TIER, "tier", 0) * TIER_STEP                  # background studies: below the foreground
-    priority = {i: tier + n - rank for rank, i in enumerate(order)}   # higher runs first
+    tier = getattr(_TIER, "tier", 0) * TIER_STEP  # background studies: below the foreground
+    priority = {i: tier + n - rank for rank, i in enumerate(order)}  # higher runs first
     tag = re.sub(r"[^A-Za-z0-9_]+", "_", label or getattr(fn, "__name__", "task"))[:40]
     run_id = uuid.uuid4().hex[:10]
     futures = [None] * n
     for i in order:
-        futures[i] = c.submit(_call, fn, tasks[i], priority=priority[i], retries=0, pure=False,
-                              key=f"navlib-{tag}-{run_id}-{i}")
+        futures[i] = c.submit(
+            _call,
+            fn,
+            tasks[i],
+            priority=priority[i],
+            retries=0,
+            pure=False,
+            key=f"navlib-{tag}-{run_id}-{i}",
+        )
     index = {f.key: i for i, f in enumerate(futures)}
     try:
         for f in as_completed(futures, loop=c.loop):
             if f.status == "error":
-                f.result()                       # raises the task's exception here
+                f.result()  # raises the task's exception here
             if on_result is not None:
                 on_result(index[f.key], f.result())
             if bar is not None:
@@ -464,8 +533,9 @@ class Job:
         self._error: BaseException | None = None
         self._thread = None
         if threaded:
-            self._thread = threading.Thread(target=self._run, name=f"navlib-background-{fn.__name__}",
-                                            daemon=True)
+            self._thread = threading.Thread(
+                target=self._run, name=f"navlib-background-{fn.__name__}", daemon=True
+            )
             self._thread.start()
 
     def _run(self) -> None:
@@ -473,7 +543,7 @@ class Job:
         _TIER.tier = self._tier
         try:
             self._value = fn(*args, **kwargs)
-        except BaseException as err:       # handed to result(), in the caller's thread, as raised
+        except BaseException as err:  # handed to result(), in the caller's thread, as raised
             self._error = err
         finally:
             self._done.set()
@@ -502,16 +572,26 @@ def background(fn: Callable, *args, tier: int = -1, **kwargs) -> Job:
     and no scheduler (``workers``/``scheduler`` in ``kwargs``, as ``fn`` takes them) the study has nowhere
     to run beside this process: it runs when ``result()`` is first asked, as the direct call would."""
     if not isinstance(tier, int) or isinstance(tier, bool) or tier >= 0:
-        raise InputError(f"engine.background: parameter tier must be a negative integer, got {tier!r}")
+        raise InputError(
+            f"engine.background: parameter tier must be a negative integer, got {tier!r}"
+        )
     workers = kwargs.get("workers", 1)
     check_param("workers", workers, lo=1, integer=True)
     threaded = scheduler_address(kwargs.get("scheduler")) is not None or int(workers) > 1
     return Job(fn, args, kwargs, tier, threaded)
 
 
-def run_batches(fn: Callable, items: Sequence[tuple], batch_size: int, *, workers: int = 1,
-                scheduler: str | None = None, cost: Sequence[float] | None = None, label: str = "",
-                progress: bool | None = None) -> list:
+def run_batches(
+    fn: Callable,
+    items: Sequence[tuple],
+    batch_size: int,
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    cost: Sequence[float] | None = None,
+    label: str = "",
+    progress: bool | None = None,
+) -> list:
     """``[fn(*args) for args in items]``, sent in batches of ``batch_size`` consecutive items (one task
     each; the batches depend on ``batch_size`` only, never on the number of workers).  ``cost``: per
     item; a batch costs the sum of its items."""
@@ -519,9 +599,19 @@ def run_batches(fn: Callable, items: Sequence[tuple], batch_size: int, *, worker
     items = [tuple(a) for a in items]
     if cost is not None and len(cost) != len(items):
         raise InputError(f"engine.run_batches: {len(cost)} costs for {len(items)} items")
-    bounds = [(s, min(s + int(batch_size), len(items))) for s in range(0, len(items), int(batch_size))]
+    bounds = [
+        (s, min(s + int(batch_size), len(items))) for s in range(0, len(items), int(batch_size))
+    ]
     batches = [(fn, items[a:b]) for a, b in bounds]
     bcost = None if cost is None else [float(sum(cost[a:b])) for a, b in bounds]
-    parts = run(_batch, batches, workers=workers, scheduler=scheduler, cost=bcost, label=label or
-                getattr(fn, "__name__", ""), progress=progress, weight=[b - a for a, b in bounds])
+    parts = run(
+        _batch,
+        batches,
+        workers=workers,
+        scheduler=scheduler,
+        cost=bcost,
+        label=label or getattr(fn, "__name__", ""),
+        progress=progress,
+        weight=[b - a for a, b in bounds],
+    )
     return [r for part in parts for r in part]

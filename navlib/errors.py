@@ -3,6 +3,7 @@
 Every message names what is wrong precisely: the file, the column and the row for a table; the parameter
 and the value for a parameter.  No traceback reaches a user of the command line.
 """
+
 from __future__ import annotations
 
 import math
@@ -26,8 +27,16 @@ class UserCodeError(Exception):
         super().__init__(" ".join(str(message).split()))
 
 
-def check_param(name: str, value: Any, *, lo: float | None = None, hi: float | None = None,
-                lo_open: bool = False, hi_open: bool = False, integer: bool = False) -> None:
+def check_param(
+    name: str,
+    value: Any,
+    *,
+    lo: float | None = None,
+    hi: float | None = None,
+    lo_open: bool = False,
+    hi_open: bool = False,
+    integer: bool = False,
+) -> None:
     """Raise :class:`InputError` unless ``lo <= value <= hi`` (open ends when asked), finite, and whole
     if ``integer``. ``name`` is the parameter's name as the user wrote it."""
     try:
@@ -49,4 +58,6 @@ def check_param(name: str, value: Any, *, lo: float | None = None, hi: float | N
 def check_choice(name: str, value: Any, options) -> None:
     """Raise :class:`InputError` unless ``value`` is one of ``options`` (a ``typing.Literal``'s values)."""
     if value not in tuple(options):
-        raise InputError(f"parameter {name}={value!r}: must be one of {', '.join(map(repr, options))}")
+        raise InputError(
+            f"parameter {name}={value!r}: must be one of {', '.join(map(repr, options))}"
+        )

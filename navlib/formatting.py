@@ -4,6 +4,7 @@
 digits, so stored results compare within tolerance; :func:`fmt` formats a number for a sentence or a table
 cell (NaN and None become an en dash).
 """
+
 from __future__ import annotations
 
 import math
@@ -33,7 +34,9 @@ def plain(value: Any, digits: int = 6) -> Any:
 
 def fmt(value: Any, spec: str = "{:.3g}") -> str:
     """Format a number for prose or a table cell; NaN/None become an en dash."""
-    if value is None or (isinstance(value, (float, np.floating)) and not math.isfinite(float(value))):
+    if value is None or (
+        isinstance(value, (float, np.floating)) and not math.isfinite(float(value))
+    ):
         return "–"
     if isinstance(value, (np.floating, np.integer)):
         value = value.item()

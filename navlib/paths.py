@@ -15,6 +15,7 @@
 
 Results files go where the caller says (the book's ``navbook.report.results_dir``), never into the package.
 """
+
 from __future__ import annotations
 
 import importlib.resources
@@ -37,7 +38,9 @@ def data_dir() -> Path:
         if err.name not in (DATA_PACKAGE, "navlib"):
             raise
         return ROOT / "data"
-    return Path(os.fspath(folder))      # a folder on disk: navlib is installed unzipped (zip-safe = false)
+    return Path(
+        os.fspath(folder)
+    )  # a folder on disk: navlib is installed unzipped (zip-safe = false)
 
 
 # the folder data_path reads from, found once (notebooks/compass.ipynb names a file in it)

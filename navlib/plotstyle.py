@@ -21,6 +21,7 @@ its natural size when it is at most that wide, so figures are at most :data:`MAX
 
 Matplotlib only: nothing here is imported by the CLI's loop unless a figure is asked for.
 """
+
 from __future__ import annotations
 
 import math
@@ -43,11 +44,24 @@ MIN_PANEL_IN = 3.4
 PANEL_HEIGHT_IN = 3.2
 
 #: The matplotlib settings of the style (rcParams).
-RC = {"figure.dpi": DPI, "savefig.dpi": DPI, "figure.figsize": (MAX_WIDTH_IN, 3.6),
-      "font.size": 11, "axes.titlesize": 12, "axes.labelsize": 11, "legend.fontsize": 11,
-      "legend.title_fontsize": 11, "xtick.labelsize": 11, "ytick.labelsize": 11,
-      "figure.titlesize": 12, "axes.grid": True, "grid.alpha": 0.3, "legend.frameon": False,
-      "figure.autolayout": False, "savefig.pad_inches": 0.02}
+RC = {
+    "figure.dpi": DPI,
+    "savefig.dpi": DPI,
+    "figure.figsize": (MAX_WIDTH_IN, 3.6),
+    "font.size": 11,
+    "axes.titlesize": 12,
+    "axes.labelsize": 11,
+    "legend.fontsize": 11,
+    "legend.title_fontsize": 11,
+    "xtick.labelsize": 11,
+    "ytick.labelsize": 11,
+    "figure.titlesize": 12,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "legend.frameon": False,
+    "figure.autolayout": False,
+    "savefig.pad_inches": 0.02,
+}
 
 
 def use_style() -> None:
@@ -57,8 +71,9 @@ def use_style() -> None:
     mpl.rcParams.update(RC)
 
 
-def panel_grid(n_panels: int, width_in: float = MAX_WIDTH_IN, min_panel_in: float = MIN_PANEL_IN
-               ) -> tuple[int, int]:
+def panel_grid(
+    n_panels: int, width_in: float = MAX_WIDTH_IN, min_panel_in: float = MIN_PANEL_IN
+) -> tuple[int, int]:
     """``(rows, cols)`` for ``n_panels`` panels in a figure ``width_in`` wide: one row when every panel is
     at least ``min_panel_in`` wide side by side (``n * min_panel_in <= width_in``); else two columns when
     the panels pair up evenly and two fit; else one column (the panels stacked)."""
@@ -72,8 +87,15 @@ def panel_grid(n_panels: int, width_in: float = MAX_WIDTH_IN, min_panel_in: floa
     return int(n_panels), 1
 
 
-def panels(n_panels: int = 1, *, width_in: float = MAX_WIDTH_IN, panel_height_in: float = PANEL_HEIGHT_IN,
-           stack: bool = False, sharex: bool = False, sharey: bool = False):
+def panels(
+    n_panels: int = 1,
+    *,
+    width_in: float = MAX_WIDTH_IN,
+    panel_height_in: float = PANEL_HEIGHT_IN,
+    stack: bool = False,
+    sharex: bool = False,
+    sharey: bool = False,
+):
     """A figure of ``n_panels`` axes laid out by :func:`panel_grid` (``stack=True``: one column whatever
     the width, e.g. curves over a shared time axis), ``width_in`` wide (at most :data:`MAX_WIDTH_IN`), each
     row ``panel_height_in`` high, with a constrained layout (room is kept for legends placed by
@@ -84,14 +106,28 @@ def panels(n_panels: int = 1, *, width_in: float = MAX_WIDTH_IN, panel_height_in
     check_param("width_in", width_in, lo=0, lo_open=True, hi=MAX_WIDTH_IN)
     check_param("panel_height_in", panel_height_in, lo=0, lo_open=True, hi=12)
     rows, cols = (int(n_panels), 1) if stack else panel_grid(n_panels, width_in)
-    fig, axes = plt.subplots(rows, cols, figsize=(width_in, panel_height_in * rows), layout="constrained",
-                             sharex=sharex, sharey=sharey, squeeze=False)
+    fig, axes = plt.subplots(
+        rows,
+        cols,
+        figsize=(width_in, panel_height_in * rows),
+        layout="constrained",
+        sharex=sharex,
+        sharey=sharey,
+        squeeze=False,
+    )
     flat = list(axes.ravel())
     return fig, (flat[0] if n_panels == 1 else flat)
 
 
-def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handles=None, labels=None,
-                 markerscale: float = 1.0):
+def legend_below(
+    ax,
+    *,
+    ncol: int | None = None,
+    title: str | None = None,
+    handles=None,
+    labels=None,
+    markerscale: float = 1.0,
+):
     """Place ``ax``'s legend below the axes and their x tick labels and x label (outside the data),
     centred, in as many columns as fit the axes' width (at most four); with a constrained layout the
     figure keeps room for it.  Returns the Legend (None when nothing is labelled)."""
@@ -105,7 +141,7 @@ def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handl
     if ncol is None:
         fig_w = fig.get_size_inches()[0] * ax.get_position().width
         longest = max(len(str(t)) for t in labels)
-        per_col = 0.5 + 0.075 * longest                   # marker + text at 11 pt, in inches
+        per_col = 0.5 + 0.075 * longest  # marker + text at 11 pt, in inches
         ncol = max(1, min(4, len(labels), int(fig_w // per_col)))
     # below what hangs under the axes (tick labels, however many lines or slanted, and the x label),
     # measured on a draw without rendering
@@ -113,8 +149,17 @@ def legend_below(ax, *, ncol: int | None = None, title: str | None = None, handl
     below = ax.get_tightbbox()
     drop = max(0.0, (ax.bbox.y0 - below.y0) / fig.dpi * 72.0) + 6.0 if below is not None else 30.0
     anchor = ax.transAxes + ScaledTranslation(0, -drop / 72.0, fig.dpi_scale_trans)
-    return ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=anchor,
-                     ncol=ncol, title=title, borderaxespad=0.0, markerscale=markerscale)
+    return ax.legend(
+        handles,
+        labels,
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        bbox_transform=anchor,
+        ncol=ncol,
+        title=title,
+        borderaxespad=0.0,
+        markerscale=markerscale,
+    )
 
 
 def legend_right(ax, *, title: str | None = None):
@@ -123,8 +168,14 @@ def legend_right(ax, *, title: str | None = None):
     handles, labels = ax.get_legend_handles_labels()
     if not handles:
         return None
-    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), title=title,
-                     borderaxespad=0.0)
+    return ax.legend(
+        handles,
+        labels,
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+        title=title,
+        borderaxespad=0.0,
+    )
 
 
 # ------------------------------------------------------------------------------------- the loop staircase
@@ -144,16 +195,26 @@ def wrap_label(text: str, width: int) -> str:
     return "\n".join(lines)
 
 
-def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequence[float] | None = None, *,
-              floor: tuple[float, float] | None = None, floor_label: str = "noise floor", unit: str = "",
-              title: str | None = None):
+def staircase(
+    ax,
+    labels: Sequence[str],
+    rms: Sequence[float],
+    held_out: Sequence[float] | None = None,
+    *,
+    floor: tuple[float, float] | None = None,
+    floor_label: str = "noise floor",
+    unit: str = "",
+    title: str | None = None,
+):
     """Draw one workbench loop on ``ax`` as a staircase: step ``i`` (x from i to i + 1) at the error
     ``rms[i]`` of the model after adding the effect ``labels[i]`` (written on the step), log error axis,
     the held-out error of each step as a marker, and the noise ``floor`` ``(low, high)`` as a band."""
     rms = np.asarray(rms, float)
     n = rms.size
     if n == 0 or len(labels) != n:
-        raise InputError(f"staircase: labels ({len(labels)}) and rms ({n}) must be as many, at least one")
+        raise InputError(
+            f"staircase: labels ({len(labels)}) and rms ({n}) must be as many, at least one"
+        )
     if np.any(~np.isfinite(rms)) or np.any(rms <= 0):
         raise InputError("staircase: rms must be finite and positive (log axis)")
     x = np.arange(n + 1)
@@ -163,7 +224,9 @@ def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequenc
         if ho.size != n:
             raise InputError(f"staircase: held_out ({ho.size}) and rms ({n}) must be as many")
         ok = np.isfinite(ho) & (ho > 0)
-        ax.plot(x[:-1][ok] + 0.5, ho[ok], "o", mfc="white", mec="C0", mew=2, ms=8, label="held-out rms")
+        ax.plot(
+            x[:-1][ok] + 0.5, ho[ok], "o", mfc="white", mec="C0", mew=2, ms=8, label="held-out rms"
+        )
     if floor is not None:
         lo, hi = (float(v) for v in floor)
         if not (0 < lo <= hi and math.isfinite(hi)):
@@ -179,17 +242,24 @@ def staircase(ax, labels: Sequence[str], rms: Sequence[float], held_out: Sequenc
     if max(len(line) for t in texts for line in t.split("\n")) <= width:
         ax.set_xticks(x[:-1] + 0.5, texts)
     else:
-        ax.set_xticks(x[:-1] + 0.5, [str(t) for t in labels], rotation=30, ha="right",
-                      rotation_mode="anchor")
+        ax.set_xticks(
+            x[:-1] + 0.5, [str(t) for t in labels], rotation=30, ha="right", rotation_mode="anchor"
+        )
     ax.tick_params(axis="x", length=0)
     ax.grid(axis="x", visible=False)
     for i, (v, t) in enumerate(zip(rms, labels)):
-        ax.annotate(f"{v:.3g}", (i + 0.5, v), xytext=(0, 4), textcoords="offset points", ha="center",
-                    va="bottom")
+        ax.annotate(
+            f"{v:.3g}",
+            (i + 0.5, v),
+            xytext=(0, 4),
+            textcoords="offset points",
+            ha="center",
+            va="bottom",
+        )
     ax.set_ylabel(f"error ({unit})" if unit else "error")
     ax.set_xlabel("model after each step")
     if title:
         ax.set_title(title)
     lo_y, hi_y = ax.get_ylim()
-    ax.set_ylim(lo_y, hi_y * 1.6)                    # room for the value written above the first step
+    ax.set_ylim(lo_y, hi_y * 1.6)  # room for the value written above the first step
     return ax

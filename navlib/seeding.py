@@ -17,6 +17,7 @@ some studies).  Rewriting them through :func:`sequence` would give the same stre
 agree, and the book's stored numbers depend on them, so they are left as they are and documented where
 they are drawn.
 """
+
 from __future__ import annotations
 
 from typing import Iterable

@@ -13,6 +13,7 @@ A caller who set a thread count in the environment (``OPENBLAS_NUM_THREADS``, ``
 ``MKL_NUM_THREADS``) keeps it: the limit applies only where none is set.  Calls nested inside one entry point
 pay for the limit once.
 """
+
 from __future__ import annotations
 
 import contextvars
@@ -24,8 +25,9 @@ from threadpoolctl import threadpool_limits
 from . import ONE_THREAD
 
 #: The variables that, set by the caller, mean "use this many threads" (then navlib sets no limit).
-THREAD_VARIABLES = tuple(k for k in ONE_THREAD if k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS",
-                                                        "MKL_NUM_THREADS"))
+THREAD_VARIABLES = tuple(
+    k for k in ONE_THREAD if k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+)
 _INSIDE = contextvars.ContextVar("navlib_one_blas_thread", default=False)
 
 
@@ -37,6 +39,7 @@ def caller_chose_threads() -> bool:
 def one_blas_thread(func):
     """Decorator: run ``func`` with one BLAS thread (module docstring), unless the caller chose a count or an
     enclosing call already set the limit."""
+
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
         if _INSIDE.get() or caller_chose_threads():
@@ -47,4 +50,5 @@ def one_blas_thread(func):
                 return func(*args, **kwargs)
         finally:
             _INSIDE.reset(token)
+
     return wrapper

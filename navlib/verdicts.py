@@ -35,6 +35,7 @@ deterministic computation on real data (no randomness anywhere) has a zero-width
 :func:`decide` is the rule; the book's ``check-results`` calls it again on every stored claim, so a verdict
 that does not follow from its interval, boundary, side and floor fails the test.
 """
+
 from __future__ import annotations
 
 import math
@@ -112,16 +113,18 @@ def _order_ranks(n: int, q: float, level: float) -> tuple[int, int] | None:
     """0-based ranks ``(i, j)`` of the order statistics that bracket the ``q`` quantile with coverage of at
     least ``level`` (equal tails, :math:`B \\sim \\mathrm{Bin}(n, q)`), or None when ``n`` is too small."""
     a = (1 - level) / 2
-    cdf = special.bdtr(np.arange(n + 1), n, q)     # the binomial cdf (scipy.stats.binom.cdf)
-    low = np.flatnonzero(cdf <= a)           # P(x_(r) > quantile) = P(B <= r - 1) <= a
-    high = np.flatnonzero(cdf >= 1 - a)      # P(x_(s) < quantile) = 1 - P(B <= s - 1) <= a
+    cdf = special.bdtr(np.arange(n + 1), n, q)  # the binomial cdf (scipy.stats.binom.cdf)
+    low = np.flatnonzero(cdf <= a)  # P(x_(r) > quantile) = P(B <= r - 1) <= a
+    high = np.flatnonzero(cdf >= 1 - a)  # P(x_(s) < quantile) = 1 - P(B <= s - 1) <= a
     if low.size == 0 or high.size == 0 or high[0] + 1 > n:
         return None
-    r, s = int(low[-1]) + 1, int(high[0]) + 1   # 1-based ranks
+    r, s = int(low[-1]) + 1, int(high[0]) + 1  # 1-based ranks
     return r - 1, s - 1
 
 
-def quantile_ci(x, q: float = 0.5, level: float = LEVEL, rule: str = "quantile over runs") -> Estimate:
+def quantile_ci(
+    x, q: float = 0.5, level: float = LEVEL, rule: str = "quantile over runs"
+) -> Estimate:
     """The ``q`` quantile of ``x`` with a distribution-free interval from its order statistics
     (:math:`x_{(r)} \\le \\xi_q \\le x_{(s)}` with :math:`P(B \\le r-1) \\le \\alpha/2` and
     :math:`P(B \\ge s) \\le \\alpha/2`, :math:`B \\sim \\mathrm{Bin}(n, q)`).  Too few runs for that coverage
@@ -131,9 +134,13 @@ def quantile_ci(x, q: float = 0.5, level: float = LEVEL, rule: str = "quantile o
     ranks = _order_ranks(a.size, q, level)
     if ranks is None:
         need = next(n for n in range(a.size + 1, 100000) if _order_ranks(n, q, level) is not None)
-        raise InputError(f"quantile_ci: a {level:.0%} interval of the {q:g} quantile needs at least {need} "
-                         f"runs, got {a.size}")
-    return Estimate(float(np.quantile(a, q)), float(a[ranks[0]]), float(a[ranks[1]]), rule, int(a.size))
+        raise InputError(
+            f"quantile_ci: a {level:.0%} interval of the {q:g} quantile needs at least {need} "
+            f"runs, got {a.size}"
+        )
+    return Estimate(
+        float(np.quantile(a, q)), float(a[ranks[0]]), float(a[ranks[1]]), rule, int(a.size)
+    )
 
 
 def median_ci(x, level: float = LEVEL) -> Estimate:
@@ -154,7 +161,9 @@ def paired_difference(a, b, level: float = LEVEL) -> Estimate:
     interval. ``a[i]`` and ``b[i]`` must come from the same seed or run."""
     x, y = _sample(a, "paired_difference a"), _sample(b, "paired_difference b")
     if x.size != y.size:
-        raise InputError(f"paired_difference: {x.size} values against {y.size}: pairs need the same runs")
+        raise InputError(
+            f"paired_difference: {x.size} values against {y.size}: pairs need the same runs"
+        )
     e = quantile_ci(x - y, 0.5, level)
     return Estimate(e.value, e.lo, e.hi, "paired difference", e.n)
 
@@ -164,7 +173,9 @@ def paired_ratio(a, b, level: float = LEVEL) -> Estimate:
     interval (``b`` must be positive)."""
     x, y = _sample(a, "paired_ratio a"), _sample(b, "paired_ratio b")
     if x.size != y.size:
-        raise InputError(f"paired_ratio: {x.size} values against {y.size}: pairs need the same runs")
+        raise InputError(
+            f"paired_ratio: {x.size} values against {y.size}: pairs need the same runs"
+        )
     if np.any(y <= 0):
         raise InputError("paired_ratio: the denominators must be positive")
     e = quantile_ci(x / y, 0.5, level)
@@ -173,16 +184,29 @@ def paired_ratio(a, b, level: float = LEVEL) -> Estimate:
 
 def wilson(k: int, n: int, level: float = LEVEL) -> Estimate:
     """A rate ``k / n`` over independent trials with its Wilson score interval."""
-    if not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer))) or n < 1 or not 0 <= k <= n:
-        raise InputError(f"wilson: k={k!r}, n={n!r}: need whole numbers with 0 <= k <= n and n >= 1")
+    if (
+        not (isinstance(k, (int, np.integer)) and isinstance(n, (int, np.integer)))
+        or n < 1
+        or not 0 <= k <= n
+    ):
+        raise InputError(
+            f"wilson: k={k!r}, n={n!r}: need whole numbers with 0 <= k <= n and n >= 1"
+        )
     from scipy import stats  # noqa: PLC0415  # lazy: importing scipy.stats costs every command-line start 0.3 s
 
     ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="wilson")
     return Estimate(k / n, float(ci.low), float(ci.high), "wilson rate", int(n))
 
 
-def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequence | int,
-              n_resamples: int = 2000, level: float = LEVEL, paired: bool = True) -> Estimate:
+def bootstrap(
+    data,
+    statistic: Callable[..., float],
+    *,
+    seed: np.random.SeedSequence | int,
+    n_resamples: int = 2000,
+    level: float = LEVEL,
+    paired: bool = True,
+) -> Estimate:
     """A statistic of a real table with a percentile bootstrap interval over its rows.
 
     ``data`` is a sequence of equal-length arrays (columns; rows are resampled together when ``paired``),
@@ -194,12 +218,21 @@ def bootstrap(data, statistic: Callable[..., float], *, seed: np.random.SeedSequ
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     from scipy import stats  # noqa: PLC0415  # lazy: as in wilson
 
-    res = stats.bootstrap(tuple(cols), statistic, n_resamples=n_resamples, confidence_level=level,
-                          method="percentile", paired=paired, vectorized=False,
-                          rng=np.random.default_rng(ss))
+    res = stats.bootstrap(
+        tuple(cols),
+        statistic,
+        n_resamples=n_resamples,
+        confidence_level=level,
+        method="percentile",
+        paired=paired,
+        vectorized=False,
+        rng=np.random.default_rng(ss),
+    )
     value = float(statistic(*cols))
     lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
-    return Estimate(value, min(lo, value), max(hi, value), "bootstrap over rows", int(cols[0].shape[0]))
+    return Estimate(
+        value, min(lo, value), max(hi, value), "bootstrap over rows", int(cols[0].shape[0])
+    )
 
 
 def exact(value: float) -> Estimate:
@@ -241,20 +274,26 @@ class Floor:
             raise InputError(f"Floor.value={self.value!r}: must be a finite number")
         for f in ("assumption", "needs"):
             if not str(getattr(self, f)).strip():
-                raise InputError(f"Floor.{f} is empty: say what decides the floor and what it would need")
+                raise InputError(
+                    f"Floor.{f} is empty: say what decides the floor and what it would need"
+                )
         for f in ("lo", "hi"):
             v = getattr(self, f)
             if v is not None and (not isinstance(v, (int, float)) or not math.isfinite(v)):
                 raise InputError(f"Floor.{f}={v!r}: must be a finite number or None")
         if not self.interval[0] <= self.value <= self.interval[1]:
-            raise InputError(f"Floor interval [{self.interval[0]}, {self.interval[1]}] must contain its "
-                             f"value {self.value}")
+            raise InputError(
+                f"Floor interval [{self.interval[0]}, {self.interval[1]}] must contain its "
+                f"value {self.value}"
+            )
 
     @property
     def interval(self) -> tuple[float, float]:
         """``(lo, hi)``; the value itself for a floor measured once."""
-        return (float(self.value if self.lo is None else self.lo),
-                float(self.value if self.hi is None else self.hi))
+        return (
+            float(self.value if self.lo is None else self.lo),
+            float(self.value if self.hi is None else self.hi),
+        )
 
 
 def on_side(value: float, boundary: float, holds_when: str) -> bool:
@@ -285,8 +324,14 @@ def worse_bound(boundary: float, holds_when: str, floor=None) -> float:
     return f[1] if holds_when == "below" else f[0]
 
 
-def decide(interval: Sequence[float] | None, boundary: float | None, holds_when: str | None,
-           floor=None, by_construction: bool = False, margin: float | None = None) -> tuple[bool | None, str]:
+def decide(
+    interval: Sequence[float] | None,
+    boundary: float | None,
+    holds_when: str | None,
+    floor=None,
+    by_construction: bool = False,
+    margin: float | None = None,
+) -> tuple[bool | None, str]:
     """The verdict (True = reproduced, False = not reproduced, None = cannot be judged) and its basis
     (one of :data:`BASES`) from a 95 % interval, the boundary, the claim's side and the noise floor
     (``floor``: a number, an interval ``(lo, hi)`` or a :class:`Floor`).
@@ -321,7 +366,9 @@ def decide(interval: Sequence[float] | None, boundary: float | None, holds_when:
     lo, hi = float(interval[0]), float(interval[1])
     b = float(boundary)
     if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(b)) or lo > hi:
-        raise InputError(f"interval [{lo}, {hi}] and boundary {b}: need finite numbers with lo <= hi")
+        raise InputError(
+            f"interval [{lo}, {hi}] and boundary {b}: need finite numbers with lo <= hi"
+        )
     if margin is not None:
         m = float(margin)
         if not math.isfinite(m) or m <= 0:
@@ -349,45 +396,63 @@ def verdict_name(reproduced: bool | None, basis: str | None = None) -> str:
 #: without a statistic, what its reason says) -> (short label shown beside the verdict, definition).
 #: The book defines them once (the landing page's verdict box, the glossary) from this table.
 REASONS = {
-    "straddles": ("our interval contains the boundary",
-                  "the 95 % interval of our statistic contains (or touches) the claim's boundary: more runs "
-                  "or a less noisy experiment could decide it"),
-    "noise floor": ("within our noise floor",
-                    "our interval lies beyond the claim's boundary (or touches it), but not beyond the noise "
-                    "floor of our experiment (the best value sensor noise and the exact physical model allow), "
-                    "whose whole interval lies beyond the boundary: no method could show the claim in our "
-                    "experiment; the reason names the assumption that sets the floor and the value it would "
-                    "need"),
-    "by construction": ("by construction of our simulator",
-                        "the statistic is true because we set it in our simulator, so our runs cannot test "
-                        "it"),
-    "no statistic": ("the paper gives no number",
-                     "the paper prints nothing we can compare our statistic with"),
-    "too few runs": ("too few runs for an interval",
-                     "our runs are too few for a 95 % interval of the statistic"),
-    "not yet computed": ("not yet computed",
-                         "the claim is checkable but the book does not compute its statistic yet; the claims "
-                         "register says which statistic and how many runs would decide it"),
-    "not checkable": ("not checkable",
-                      "no experiment of ours can test the claim (the register says why)"),
-    "not run": ("its primary reading was not run",
-                "the chapter ran with parameters under which the claim's primary reading does not exist, or "
-                "without the real measurements it needs (../shared/realdata); the readings that were run are "
-                "shown as its sensitivity"),
+    "straddles": (
+        "our interval contains the boundary",
+        "the 95 % interval of our statistic contains (or touches) the claim's boundary: more runs "
+        "or a less noisy experiment could decide it",
+    ),
+    "noise floor": (
+        "within our noise floor",
+        "our interval lies beyond the claim's boundary (or touches it), but not beyond the noise "
+        "floor of our experiment (the best value sensor noise and the exact physical model allow), "
+        "whose whole interval lies beyond the boundary: no method could show the claim in our "
+        "experiment; the reason names the assumption that sets the floor and the value it would "
+        "need",
+    ),
+    "by construction": (
+        "by construction of our simulator",
+        "the statistic is true because we set it in our simulator, so our runs cannot test it",
+    ),
+    "no statistic": (
+        "the paper gives no number",
+        "the paper prints nothing we can compare our statistic with",
+    ),
+    "too few runs": (
+        "too few runs for an interval",
+        "our runs are too few for a 95 % interval of the statistic",
+    ),
+    "not yet computed": (
+        "not yet computed",
+        "the claim is checkable but the book does not compute its statistic yet; the claims "
+        "register says which statistic and how many runs would decide it",
+    ),
+    "not checkable": (
+        "not checkable",
+        "no experiment of ours can test the claim (the register says why)",
+    ),
+    "not run": (
+        "its primary reading was not run",
+        "the chapter ran with parameters under which the claim's primary reading does not exist, or "
+        "without the real measurements it needs (../shared/realdata); the readings that were run are "
+        "shown as its sensitivity",
+    ),
 }
 #: The first words of a register entry's reason for the last two cases (written by :mod:`navlib.claims`).
-REGISTER_REASONS = {"not yet computed": "not yet computed: ", "not checkable": "not checkable: ",
-                    "not run": "not run: "}
+REGISTER_REASONS = {
+    "not yet computed": "not yet computed: ",
+    "not checkable": "not checkable: ",
+    "not run": "not run: ",
+}
 #: The verdict labels of the book in order, each with its definition (the three verdicts of
 #: ``VERDICTS``, *cannot be judged* split by :data:`REASONS`).
 VERDICT_DEFINITIONS = {
     "reproduced": "the whole 95 % interval of our statistic lies on the claim's side of its boundary",
     "not reproduced": "the whole 95 % interval lies beyond the boundary and beyond the noise floor of our "
-                      "experiment where that floor lies beyond the boundary",
+    "experiment where that floor lies beyond the boundary",
     **{f"cannot be judged: {label}": text for label, text in REASONS.values()},
     "no difference": "a comparison whose whole 95 % interval lies within its stated equivalence margin of "
-                     "the boundary (from the paper's printed precision or the sensor's resolution): the two "
-                     "do not differ by anything the paper could have shown",
+    "the boundary (from the paper's printed precision or the sensor's resolution): the two "
+    "do not differ by anything the paper could have shown",
 }
 
 

@@ -6,6 +6,7 @@ would run alone while the other process idles.  Listed here, longest first (meas
 ``--durations``), so the processes finish together; every other file follows in name order.  The order
 changes no result: every test is independent of the others.
 """
+
 import json
 import os
 import subprocess
@@ -19,9 +20,17 @@ from navlib import engine
 
 ROOT = Path(__file__).resolve().parent.parent
 
-LONGEST_FIRST = ("test_workbench_correlated.py", "test_diagnose.py", "test_engine.py",
-                 "test_workbench_screen.py", "test_celestial.py", "test_workbench_free.py",
-                 "test_workbench_loop.py", "test_compass_study.py", "test_install.py")
+LONGEST_FIRST = (
+    "test_workbench_correlated.py",
+    "test_diagnose.py",
+    "test_engine.py",
+    "test_workbench_screen.py",
+    "test_celestial.py",
+    "test_workbench_free.py",
+    "test_workbench_loop.py",
+    "test_compass_study.py",
+    "test_install.py",
+)
 
 
 def pytest_collection_modifyitems(items):
@@ -37,21 +46,57 @@ def remote(tmp_path_factory):
     sched_file = folder / "scheduler.json"
     # the workers import this checkout's navlib and navbook, and this module for its helper functions
     path = [str(ROOT), str(ROOT / "book"), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in path if p),
-               OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(p for p in path if p),
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+    )
     env.pop(engine.ENV_SCHEDULER, None)
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                               "--port", "0", "--no-dashboard", "--scheduler-file", str(sched_file)],
-                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    procs = [
+        subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "distributed.cli.dask_scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--no-dashboard",
+                "--scheduler-file",
+                str(sched_file),
+            ],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+    ]
     try:
         t0 = time.time()
         while not sched_file.exists() and time.time() - t0 < 60:
             time.sleep(0.2)
         address = json.loads(sched_file.read_text())["address"]
-        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                       "--nworkers", "2", "--nthreads", "1", "--host", "127.0.0.1",
-                                       "--no-dashboard"], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        procs.append(
+            subprocess.Popen(
+                [
+                    sys.executable,
+                    "-m",
+                    "distributed.cli.dask_worker",
+                    address,
+                    "--nworkers",
+                    "2",
+                    "--nthreads",
+                    "1",
+                    "--host",
+                    "127.0.0.1",
+                    "--no-dashboard",
+                ],
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
+        )
         c = engine.client(scheduler=address)
         c.wait_for_workers(2, timeout=60)
         yield address
@@ -59,7 +104,7 @@ def remote(tmp_path_factory):
         for key in [k for k in engine._CLIENTS if k[0] == "remote"]:
             c = engine._CLIENTS[key]
             try:
-                c.shutdown()                      # stops the scheduler and its workers
+                c.shutdown()  # stops the scheduler and its workers
             except (OSError, RuntimeError, TimeoutError):
                 pass
             engine._close(key)

@@ -1,6 +1,7 @@
 """Plain-numpy reference of the ELM back-tuning (the implementation navlib used before its loop was
 compiled with numba), for tests and benchmarks only: the compiled path must agree with it up to
 rounding, and the benchmark reports the speed ratio."""
+
 from __future__ import annotations
 
 from contextlib import contextmanager
@@ -35,8 +36,9 @@ def loss_grad(w, b, beta, X, T, name):
     return e, X.T @ d2, d2.sum(axis=0), a2.T @ d3
 
 
-def back_tune(w, b, beta, X, T, name, steps: int, step: float, max_halvings: int = 40,
-              armijo: float = 1e-4):
+def back_tune(
+    w, b, beta, X, T, name, steps: int, step: float, max_halvings: int = 40, armijo: float = 1e-4
+):
     """Returns (w, b, beta, losses, next step), as navlib's ``_back_tune``."""
     w, b, beta = w.copy(), b.copy(), beta.copy()
     e, gw, gb, gbeta = loss_grad(w, b, beta, X, T, name)
@@ -60,16 +62,22 @@ def back_tune(w, b, beta, X, T, name, steps: int, step: float, max_halvings: int
     return w, b, beta, losses, step
 
 
-def back_tune_model(model, X, T, steps: int, step: float, max_halvings: int = 40, armijo: float = 1e-4):
+def back_tune_model(
+    model, X, T, steps: int, step: float, max_halvings: int = 40, armijo: float = 1e-4
+):
     """Drop-in for ``navlib.methods.elm._back_tune`` (model in, (model, losses, step) out)."""
-    w, b, beta, losses, step = back_tune(model.w, model.b, model.beta, X, T, model.activation, steps, step,
-                                         max_halvings, armijo)
+    w, b, beta, losses, step = back_tune(
+        model.w, model.b, model.beta, X, T, model.activation, steps, step, max_halvings, armijo
+    )
     return replace(model, w=w, b=b, beta=beta), losses, step
 
 
 @contextmanager
 def numpy_reference():
     """Run navlib's ELM code with this numpy reference in place of the compiled kernels."""
-    with patch.object(elm, "_back_tune", back_tune_model), patch.object(elm, "_loss", loss), \
-            patch.object(elm, "_loss_grad", loss_grad):
+    with (
+        patch.object(elm, "_back_tune", back_tune_model),
+        patch.object(elm, "_loss", loss),
+        patch.object(elm, "_loss_grad", loss_grad),
+    ):
         yield

@@ -1,6 +1,7 @@
 """Peer libraries built from our objects, for tests and benchmarks only (the peers are not library
 dependencies): a ``simpful`` Sugeno system with the same rules as a :class:`navlib.methods.subclust.SugenoFIS`,
 and paper A's net trained by torch autograd and torch's default Adam (the reference of our Adam trainer)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -15,8 +16,13 @@ def simpful_system(fis):
     R, n = fis.centers.shape
     names = [f"x{i}" for i in range(n)]
     for i, nm in enumerate(names):
-        sets = [FuzzySet(function=Gaussian_MF(mu=float(fis.centers[r, i]), sigma=float(fis.sigmas[r, i])),
-                         term=f"m{r}") for r in range(R)]
+        sets = [
+            FuzzySet(
+                function=Gaussian_MF(mu=float(fis.centers[r, i]), sigma=float(fis.sigmas[r, i])),
+                term=f"m{r}",
+            )
+            for r in range(R)
+        ]
         fs.add_linguistic_variable(nm, LinguisticVariable(sets, universe_of_discourse=[-1e4, 1e4]))
     rules = []
     for r in range(R):
@@ -35,8 +41,8 @@ def autograd_adam(theta0, xn, tn, m, epochs, lr):
     history = np.empty((theta0.shape[0], epochs))
     for k in range(epochs):
         opt.zero_grad()
-        h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m:2 * m])
-        out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m:3 * m]) + th[:, 3 * m:3 * m + 1]
+        h = torch.sigmoid(X[None, :, None] * th[:, None, :m] + th[:, None, m : 2 * m])
+        out = torch.einsum("pnm,pm->pn", h, th[:, 2 * m : 3 * m]) + th[:, 3 * m : 3 * m + 1]
         loss = torch.mean((out - T) ** 2, dim=1)
         loss.sum().backward()
         opt.step()

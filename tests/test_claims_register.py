@@ -3,6 +3,7 @@
 Every register entry must appear in its chapter: once as a record of the chapter's results file (judged,
 not yet computed, not checkable) or in its list of the paper's contradictions, and by its id in the
 chapter's opening table as the executed notebook stores it."""
+
 import csv
 import io
 import json
@@ -21,10 +22,24 @@ HEADER = ",".join(claims.COLUMNS)
 
 def _row(**kw):
     base = dict.fromkeys(claims.COLUMNS, "")
-    base.update(id="A01", origin="paper", headline="yes", kind="comparison", status="judged", claim="X beats Y",
-                quote="X is better than Y", where="Sec. 1", statistic="rms Y - rms X, deg", boundary="0",
-                holds_when="above", unit="deg", rows="X beats Y", primary_claim="X beats Y",
-                primary_reading="r1", why_primary="the paper says r1")
+    base.update(
+        id="A01",
+        origin="paper",
+        headline="yes",
+        kind="comparison",
+        status="judged",
+        claim="X beats Y",
+        quote="X is better than Y",
+        where="Sec. 1",
+        statistic="rms Y - rms X, deg",
+        boundary="0",
+        holds_when="above",
+        unit="deg",
+        rows="X beats Y",
+        primary_claim="X beats Y",
+        primary_reading="r1",
+        why_primary="the paper says r1",
+    )
     base.update(kw)
     out = io.StringIO()
     w = csv.DictWriter(out, fieldnames=claims.COLUMNS)
@@ -47,8 +62,12 @@ def test_register_prose_types_in_none_of_our_results(name):
     interval goes stale the day a number moves, as D's did when the kernels were pinned)."""
     text = (ROOT / "data" / f"claims_{name}.csv").read_text(encoding="utf-8")
     rows = list(csv.DictReader(io.StringIO(text)))
-    found = [(r["id"], col, m.group(0)) for r in rows for col in ("why_primary", "sensitivity", "needs", "margin_why")
-             for m in OUR_INTERVAL.finditer(r.get(col) or "")]
+    found = [
+        (r["id"], col, m.group(0))
+        for r in rows
+        for col in ("why_primary", "sensitivity", "needs", "margin_why")
+        for m in OUR_INTERVAL.finditer(r.get(col) or "")
+    ]
     assert not found, found
 
 
@@ -71,21 +90,24 @@ def test_ids_are_unique_over_all_registers():
     assert len(ids) == len(set(ids))
 
 
-@pytest.mark.parametrize("row,match", [
-    (dict(status="guess"), "column 'status'"),
-    (dict(kind="vibe"), "column 'kind'"),
-    (dict(origin="blog"), "column 'origin'"),
-    (dict(primary_claim="Z beats Y"), "column 'primary_claim'"),
-    (dict(rows=""), "column 'rows'"),
-    (dict(why_primary=""), "column 'why_primary'"),
-    (dict(status="open"), "column 'rows'"),
-    (dict(status="open", rows="", needs=""), "column 'needs'"),
-    (dict(kind="inconsistency"), "column 'status'"),
-    (dict(boundary="zero"), "column 'boundary'"),
-    (dict(holds_when="left"), "column 'holds_when'"),
-    (dict(id="a1"), "column 'id'"),
-    (dict(quote=""), "column 'quote'"),
-])
+@pytest.mark.parametrize(
+    "row,match",
+    [
+        (dict(status="guess"), "column 'status'"),
+        (dict(kind="vibe"), "column 'kind'"),
+        (dict(origin="blog"), "column 'origin'"),
+        (dict(primary_claim="Z beats Y"), "column 'primary_claim'"),
+        (dict(rows=""), "column 'rows'"),
+        (dict(why_primary=""), "column 'why_primary'"),
+        (dict(status="open"), "column 'rows'"),
+        (dict(status="open", rows="", needs=""), "column 'needs'"),
+        (dict(kind="inconsistency"), "column 'status'"),
+        (dict(boundary="zero"), "column 'boundary'"),
+        (dict(holds_when="left"), "column 'holds_when'"),
+        (dict(id="a1"), "column 'id'"),
+        (dict(quote=""), "column 'quote'"),
+    ],
+)
 def test_a_bad_register_row_is_refused_in_one_line_naming_row_and_column(row, match):
     with pytest.raises(InputError, match=match) as err:
         _parse(_row(**row))
@@ -106,42 +128,93 @@ def test_a_register_needs_one_headline_and_its_columns():
 # ------------------------------------------------------------------ the evaluator
 def _rec(claim, reading, interval, boundary=0.0, side="above"):
     rep, basis = verdicts.decide(interval, boundary, side)
-    return {"claim": claim, "reading": reading, "source": "paper", "paper": "p", "ours": "o",
-            "statistic": "s", "unit": "deg", "rule": "paired difference", "estimate": sum(interval) / 2,
-            "interval": list(interval), "n": 20, "boundary": boundary, "holds_when": side, "floor": None,
-            "by_construction": False, "decided_by": [], "reproduced": rep, "verdict": verdicts.verdict_name(rep),
-            "basis": basis, "reason": verdicts.reason_category(basis, ""), "why": "" if rep is not None else "w",
-            "key": None, "volatile": False}
+    return {
+        "claim": claim,
+        "reading": reading,
+        "source": "paper",
+        "paper": "p",
+        "ours": "o",
+        "statistic": "s",
+        "unit": "deg",
+        "rule": "paired difference",
+        "estimate": sum(interval) / 2,
+        "interval": list(interval),
+        "n": 20,
+        "boundary": boundary,
+        "holds_when": side,
+        "floor": None,
+        "by_construction": False,
+        "decided_by": [],
+        "reproduced": rep,
+        "verdict": verdicts.verdict_name(rep),
+        "basis": basis,
+        "reason": verdicts.reason_category(basis, ""),
+        "why": "" if rep is not None else "w",
+        "key": None,
+        "volatile": False,
+    }
 
 
 @pytest.fixture
 def reg(monkeypatch):
-    es = _parse(_row(rows="X beats Y ; X beats Y [variant]"),
-                _row(id="A02", headline="", status="open", rows="", primary_claim="", needs="20 seeds of Z"),
-                _row(id="A03", headline="", kind="inconsistency", status="noted", rows="", primary_claim="",
-                     needs="8.5x beside 'two orders'"),
-                _row(id="A04", headline="", origin="book", rows="ours", primary_claim="ours",
-                     primary_reading="real"))
+    es = _parse(
+        _row(rows="X beats Y ; X beats Y [variant]"),
+        _row(
+            id="A02", headline="", status="open", rows="", primary_claim="", needs="20 seeds of Z"
+        ),
+        _row(
+            id="A03",
+            headline="",
+            kind="inconsistency",
+            status="noted",
+            rows="",
+            primary_claim="",
+            needs="8.5x beside 'two orders'",
+        ),
+        _row(
+            id="A04",
+            headline="",
+            origin="book",
+            rows="ours",
+            primary_claim="ours",
+            primary_reading="real",
+        ),
+    )
     monkeypatch.setitem(claims.REGISTERS, "testch", ("test",))
     monkeypatch.setattr(claims, "load_register", lambda name: es)
     return es
 
 
 def test_evaluate_folds_rows_into_one_record_per_entry(reg):
-    rows = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y", "r2", (-1, 1)),
-            _rec("X beats Y [variant]", "r1", (-3, -2)), _rec("ours", "real", (1, 3))]
-    recs = claims.evaluate("testch", rows, worlds=[
-        {"compass": "C1", "claim": "X beats Y", "reading": "r1", "verdict": "reproduced"},
-        {"compass": "C2", "claim": "X beats Y", "reading": "r1", "verdict": "not reproduced"}])
+    rows = [
+        _rec("X beats Y", "r1", (1, 2)),
+        _rec("X beats Y", "r2", (-1, 1)),
+        _rec("X beats Y [variant]", "r1", (-3, -2)),
+        _rec("ours", "real", (1, 3)),
+    ]
+    recs = claims.evaluate(
+        "testch",
+        rows,
+        worlds=[
+            {"compass": "C1", "claim": "X beats Y", "reading": "r1", "verdict": "reproduced"},
+            {"compass": "C2", "claim": "X beats Y", "reading": "r1", "verdict": "not reproduced"},
+        ],
+    )
     assert [r["id"] for r in recs] == ["A01", "A02", "A04"]
     a1, a2, a4 = recs
-    assert a1["verdict"] == "reproduced" and a1["primary_reading"] == "r1" and a1["claim"] == "X beats Y"
-    assert [(s["claim"], s["reading"]) for s in a1["sensitivity"]] == [("X beats Y", "r2"),
-                                                                       ("X beats Y [variant]", "r1")]
+    assert (
+        a1["verdict"] == "reproduced"
+        and a1["primary_reading"] == "r1"
+        and a1["claim"] == "X beats Y"
+    )
+    assert [(s["claim"], s["reading"]) for s in a1["sensitivity"]] == [
+        ("X beats Y", "r2"),
+        ("X beats Y [variant]", "r1"),
+    ]
     assert claims.across_text(a1) == "same in 1 of 3 readings; differs on 1 of 2 drawn compasses"
     assert a2["reason"] == "not yet computed" and a2["why"] == "not yet computed: 20 seeds of Z"
     assert a4["source"] == "book"
-    for r in recs:                                     # what check-results checks, including the nesting
+    for r in recs:  # what check-results checks, including the nesting
         assert claim_problems(r) == [] and register_problems(r) == []
         assert all(claim_problems(s) == [] for s in r["sensitivity"])
     assert claims.tally(recs)["open"] == 1
@@ -152,17 +225,23 @@ def test_a_register_margin_turns_a_tiny_difference_into_no_difference(monkeypatc
     es = _parse(_row(margin="0.01", margin_why="the paper prints 0.01 deg"))
     monkeypatch.setitem(claims.REGISTERS, "testch", ("test",))
     monkeypatch.setattr(claims, "load_register", lambda name: es)
-    rec, = claims.evaluate("testch", [_rec("X beats Y", "r1", (-0.004, 0.006))])
-    assert rec["verdict"] == "no difference" and rec["basis"] == "equivalent" and rec["margin"] == 0.01
+    (rec,) = claims.evaluate("testch", [_rec("X beats Y", "r1", (-0.004, 0.006))])
+    assert (
+        rec["verdict"] == "no difference" and rec["basis"] == "equivalent" and rec["margin"] == 0.01
+    )
     assert "the paper prints 0.01 deg" in rec["why"]
     assert claim_problems(rec) == []
-    assert claim_problems(dict(rec, margin=None))             # without its margin the verdict does not follow
+    assert claim_problems(dict(rec, margin=None))  # without its margin the verdict does not follow
     with pytest.raises(InputError, match="column 'margin_why'"):
         _parse(_row(margin="0.01"))
 
 
 def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(reg):
-    good = [_rec("X beats Y", "r1", (1, 2)), _rec("X beats Y [variant]", "r1", (1, 2)), _rec("ours", "real", (1, 2))]
+    good = [
+        _rec("X beats Y", "r1", (1, 2)),
+        _rec("X beats Y [variant]", "r1", (1, 2)),
+        _rec("ours", "real", (1, 2)),
+    ]
     with pytest.raises(InputError, match="belongs to no entry"):
         claims.evaluate("testch", good + [_rec("a new claim", "r1", (1, 2))])
     # a rerun with other parameters: the primary reading was not run; the run finishes and says so
@@ -170,8 +249,10 @@ def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(
     assert a1["reason"] == "not run" and a1["verdict"] == "cannot be judged" and "'r1'" in a1["why"]
     assert [s["reading"] for s in a1["sensitivity"]] == ["r2", "r1"]
     assert claim_problems(a1) == [] and register_problems(a1) == []
-    assert claims.evaluate("testch", [good[0], good[2]])[0]["verdict"] == "reproduced"   # a row not run
-    recs = claims.evaluate("testch", good[:2])         # no row of the book's entry: e.g. no real data
+    assert (
+        claims.evaluate("testch", [good[0], good[2]])[0]["verdict"] == "reproduced"
+    )  # a row not run
+    recs = claims.evaluate("testch", good[:2])  # no row of the book's entry: e.g. no real data
     a4 = recs[-1]
     assert a4["reason"] == "not run" and a4["status"] == "judged" and claim_problems(a4) == []
     assert register_problems(a4) == []
@@ -193,23 +274,37 @@ def _glance_html(chapter):
 
 @pytest.mark.parametrize("chapter", CHAPTERS)
 def test_every_register_entry_is_in_the_results_file_and_the_chapters_opening(chapter):
-    res = json.loads((ROOT / "notebooks" / "results" / f"{chapter}.json").read_text(encoding="utf-8"))
+    res = json.loads(
+        (ROOT / "notebooks" / "results" / f"{chapter}.json").read_text(encoding="utf-8")
+    )
     sim = [c for c in res["claims"] if claims.data_of(c) == "simulated"]
-    real = [c for c in res["claims"] if claims.data_of(c) == "real"]     # counted apart: one more per entry
+    real = [
+        c for c in res["claims"] if claims.data_of(c) == "real"
+    ]  # counted apart: one more per entry
     ids = [c.get("id") for c in sim]
     noted = [c["id"] for c in res.get("inconsistencies", [])]
     html = _glance_html(chapter)
     by_id = {c.get("id"): c for c in sim}
     assert len({c["id"] for c in real}) == len(real) and {c["id"] for c in real} <= set(ids)
-    assert res["claims"] == sim + real                                  # the real records after the others
+    assert res["claims"] == sim + real  # the real records after the others
     for c in real:
         assert all(claims.data_of(s) == "real" for s in c["sensitivity"])
     for e in claims.entries(chapter):
         where = noted if e.status == "noted" else ids
-        if e.status == "judged" and e.id in by_id:      # with the chapter's defaults every primary row is run
-            assert by_id[e.id].get("reason") != "not run", f"{chapter}: {e.id}'s primary reading not run"
-            written = {by_id[e.id].get("row_claim")} | {s["claim"] for s in by_id[e.id]["sensitivity"]}
+        if (
+            e.status == "judged" and e.id in by_id
+        ):  # with the chapter's defaults every primary row is run
+            assert by_id[e.id].get("reason") != "not run", (
+                f"{chapter}: {e.id}'s primary reading not run"
+            )
+            written = {by_id[e.id].get("row_claim")} | {
+                s["claim"] for s in by_id[e.id]["sensitivity"]
+            }
             assert set(e.rows) <= written, f"{chapter}: {e.id} lists rows the chapter did not write"
-        assert where.count(e.id) == 1, f"{chapter}: register entry {e.id} ({e.claim}) is not in the results file"
-        assert f">{e.id}<" in html, f"{chapter}: register entry {e.id} ({e.claim}) is not in the chapter's opening"
+        assert where.count(e.id) == 1, (
+            f"{chapter}: register entry {e.id} ({e.claim}) is not in the results file"
+        )
+        assert f">{e.id}<" in html, (
+            f"{chapter}: register entry {e.id} ({e.claim}) is not in the chapter's opening"
+        )
     assert len(ids) == len(set(ids))

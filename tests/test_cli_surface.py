@@ -1,6 +1,7 @@
 """The command line's surface (issue 34): the parser needs no workbench (``--help`` is fast), its lists of
 names equal the library's registries, every ``--json`` key is snake_case and text tables have no index
 row."""
+
 import json
 import re
 import subprocess
@@ -33,19 +34,25 @@ def test_the_parser_names_equal_the_library_registries():
 
 def test_help_loads_no_workbench():
     """``--help`` of every command in a fresh interpreter imports neither the workbench, pandas nor scipy."""
-    code = ("import sys, contextlib, io\n"
-            "from navlib import cli\n"
-            "names = ['--help'] + [[c, '--help'] for c in ('simulate-compass', 'diagnose', 'loop', 'field', "
-            "'calibrate', 'apply', 'rates', 'grid')]\n"
-            "for a in names:\n"
-            "    with contextlib.redirect_stdout(io.StringIO()):\n"
-            "        try: cli.main(a if isinstance(a, list) else [a])\n"
-            "        except SystemExit: pass\n"
-            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('pandas', 'scipy', 'numba', 'matplotlib')"
-            " or m.startswith('navlib.workbench'))\n"
-            "print(','.join(heavy))\n")
-    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                       env={"PYTHONPATH": ENV_PATH, "PATH": "/usr/bin:/bin"})
+    code = (
+        "import sys, contextlib, io\n"
+        "from navlib import cli\n"
+        "names = ['--help'] + [[c, '--help'] for c in ('simulate-compass', 'diagnose', 'loop', 'field', "
+        "'calibrate', 'apply', 'rates', 'grid')]\n"
+        "for a in names:\n"
+        "    with contextlib.redirect_stdout(io.StringIO()):\n"
+        "        try: cli.main(a if isinstance(a, list) else [a])\n"
+        "        except SystemExit: pass\n"
+        "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('pandas', 'scipy', 'numba', 'matplotlib')"
+        " or m.startswith('navlib.workbench'))\n"
+        "print(','.join(heavy))\n"
+    )
+    p = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env={"PYTHONPATH": ENV_PATH, "PATH": "/usr/bin:/bin"},
+    )
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip() == "", p.stdout
 
@@ -67,13 +74,29 @@ def compass_file(tmp_path_factory):
     return out
 
 
-@pytest.mark.parametrize("args", [
-    ["field", "--site", "50,10", "--json"],
-    ["diagnose", "compass", "{f}", "--json"],
-    ["loop", "compass", "{f}", "--json"],
-    ["rates", "compass", "--trials", "1", "--null-trials", "1", "--noise", "0.1", "--ratio", "10", "--workers", "1",
-     "--json"],
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["field", "--site", "50,10", "--json"],
+        ["diagnose", "compass", "{f}", "--json"],
+        ["loop", "compass", "{f}", "--json"],
+        [
+            "rates",
+            "compass",
+            "--trials",
+            "1",
+            "--null-trials",
+            "1",
+            "--noise",
+            "0.1",
+            "--ratio",
+            "10",
+            "--workers",
+            "1",
+            "--json",
+        ],
+    ],
+)
 def test_every_json_key_is_snake_case(args, compass_file, capsys):
     capsys.readouterr()
     assert cli.main([a.format(f=compass_file) for a in args]) == 0
@@ -87,7 +110,7 @@ def test_the_loop_table_has_no_index_row(compass_file, capsys):
     assert cli.main(["loop", "compass", str(compass_file)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split()[0] == "step" and "model" in lines[0]
-    assert lines[1].split()[0] == "0"                    # the first step, not a lone 'step' index header
+    assert lines[1].split()[0] == "0"  # the first step, not a lone 'step' index header
 
 
 def test_every_shipped_example_runs_from_any_folder(tmp_path, monkeypatch, capsys):
@@ -102,13 +125,16 @@ def test_every_shipped_example_runs_from_any_folder(tmp_path, monkeypatch, capsy
         capsys.readouterr()
 
 
-@pytest.mark.parametrize("args, says", [
-    (["loop", "compass", "compass_sweeps.csv"], "--example compass_sweeps"),
-    (["loop", "compass", "nothing_here.csv"], "navlib examples"),
-    (["loop", "drift", "--example", "compass_sweeps"], "a compass file, not drift"),
-    (["loop", "compass", "x.csv", "--example", "compass_sweeps"], "not both"),
-    (["diagnose", "compass"], "give a measurement FILE or --example NAME"),
-])
+@pytest.mark.parametrize(
+    "args, says",
+    [
+        (["loop", "compass", "compass_sweeps.csv"], "--example compass_sweeps"),
+        (["loop", "compass", "nothing_here.csv"], "navlib examples"),
+        (["loop", "drift", "--example", "compass_sweeps"], "a compass file, not drift"),
+        (["loop", "compass", "x.csv", "--example", "compass_sweeps"], "not both"),
+        (["diagnose", "compass"], "give a measurement FILE or --example NAME"),
+    ],
+)
 def test_a_missing_file_or_a_wrong_example_is_one_line(args, says, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert cli.main(args) == 2

@@ -1,4 +1,5 @@
 """diagnose names hidden effects, stays quiet on noise, reports structure the catalogue lacks."""
+
 import json
 import subprocess
 import sys
@@ -15,12 +16,15 @@ from navlib.data.gyro_tables import drift_measurements
 from navlib.paths import data_path
 
 
-@pytest.mark.parametrize("system,noises,n", [("compass", (0.05, 0.3), None), ("drift", (1e-4, 4e-4), 16),
-                                             ("drift", (2e-4,), 40)])
+@pytest.mark.parametrize(
+    "system,noises,n",
+    [("compass", (0.05, 0.3), None), ("drift", (1e-4, 4e-4), 16), ("drift", (2e-4,), 40)],
+)
 @pytest.mark.slow
 def test_hidden_effects_are_named_and_noise_is_noise(system, noises, n):
-    study = hidden_effect_study(system, ratios=(3.0, 8.0), noises=noises, seeds=range(6), n=n,
-                                none_seeds=range(60))
+    study = hidden_effect_study(
+        system, ratios=(3.0, 8.0), noises=noises, seeds=range(6), n=n, none_seeds=range(60)
+    )
     rates = detection_rates(study)
     named = rates[rates.rate == "correctly named"]
     assert len(named) == 4
@@ -29,7 +33,9 @@ def test_hidden_effects_are_named_and_noise_is_noise(system, noises, n):
 
 
 def test_small_tables_do_not_raise_false_alarms():
-    study = hidden_effect_study("drift", ratios=(), noises=(3e-4,), seeds=range(0), n=6, none_seeds=range(120))
+    study = hidden_effect_study(
+        "drift", ratios=(), noises=(3e-4,), seeds=range(0), n=6, none_seeds=range(120)
+    )
     assert detection_rates(study).loc["(none)", "value"] <= 0.05
 
 
@@ -41,9 +47,12 @@ def test_a_trial_reports_what_it_did():
 def test_structure_outside_the_catalogue_is_reported_compass():
     """A third heading harmonic (e.g. sensor nonlinearity) is in no catalogued effect."""
     data = simulate("compass", {"yaw_deg": 1.0, "hard_x": 0.2}, noise=0.05, seed=0)
-    data["measured_heading_deg"] = np.mod(data.measured_heading_deg
-                                          + 0.4 * np.sin(np.radians(3 * data.true_heading_deg)), 360)
-    d = diagnose(fit_model("compass", data, ["misalignment", "hard_iron", "soft_iron", "temperature"]))
+    data["measured_heading_deg"] = np.mod(
+        data.measured_heading_deg + 0.4 * np.sin(np.radians(3 * data.true_heading_deg)), 360
+    )
+    d = diagnose(
+        fit_model("compass", data, ["misalignment", "hard_iron", "soft_iron", "temperature"])
+    )
     assert d.missing is None and not d.consistent_with_noise
     found = [s.what for s in d.structure if s.significant]
     assert any("heading harmonic 3" in w for w in found)
@@ -53,19 +62,28 @@ def test_structure_outside_the_catalogue_is_reported_compass():
 def test_structure_outside_the_catalogue_is_reported_drift():
     data = simulate("drift", {"earth_rate_gain": 1.0}, n=30, noise=1e-4, seed=1)
     x = data.latitude_error_deg
-    data["drift_deg_h"] += 2.0 * (x ** 2 - np.mean(x ** 2))          # curvature: not in the catalogue
-    d = diagnose(fit_model("drift", data, ["earth_rate", "bias", "temperature", "temperature_change"]))
+    data["drift_deg_h"] += 2.0 * (x**2 - np.mean(x**2))  # curvature: not in the catalogue
+    d = diagnose(
+        fit_model("drift", data, ["earth_rate", "bias", "temperature", "temperature_change"])
+    )
     assert [s.what for s in d.structure if s.significant] == ["curvature in latitude_error_deg"]
 
 
 def test_permutation_test_on_six_rows_is_exact():
-    data = simulate("drift", {"earth_rate_gain": 1.0, "temperature_change_coef_deg_h_per_c": 1e-4}, n=6,
-                    noise=1e-5, seed=2)
+    data = simulate(
+        "drift",
+        {"earth_rate_gain": 1.0, "temperature_change_coef_deg_h_per_c": 1e-4},
+        n=6,
+        noise=1e-5,
+        seed=2,
+    )
     d = diagnose(fit_model("drift", data, ["earth_rate"]))
     c = {c.effect: c for c in d.candidates}
     assert c["temperature_change"].test == "permutation"
-    assert c["temperature_change"].p_value == pytest.approx(np.round(c["temperature_change"].p_value * 720) / 720)
-    assert c["bias"].test == "F"                            # a constant cannot be permuted
+    assert c["temperature_change"].p_value == pytest.approx(
+        np.round(c["temperature_change"].p_value * 720) / 720
+    )
+    assert c["bias"].test == "F"  # a constant cannot be permuted
 
 
 def test_paper_c_tables_point_to_temperature_change():
@@ -103,10 +121,13 @@ def test_cli_diagnose_drift_table_and_json():
     assert text.returncode == 0 and "add 'temperature_change'" in text.stdout
 
 
-@pytest.mark.parametrize("args,expect", [
-    (["--model", "magic"], "unknown drift effect 'magic'"),
-    (["--model", "earth_rate", "--alpha", "2"], "alpha"),
-])
+@pytest.mark.parametrize(
+    "args,expect",
+    [
+        (["--model", "magic"], "unknown drift effect 'magic'"),
+        (["--model", "earth_rate", "--alpha", "2"], "alpha"),
+    ],
+)
 def test_cli_bad_arguments_exit_2(args, expect):
     r = run_cli("diagnose", "drift", str(data_path("gyro_drift_measurements.csv")), *args)
     assert r.returncode == 2 and expect in r.stderr
@@ -115,12 +136,19 @@ def test_cli_bad_arguments_exit_2(args, expect):
 
 def test_cli_bad_files_exit_2(tmp_path):
     bad = tmp_path / "bad.csv"
-    pd.DataFrame({"latitude_error_deg": [0.01, "x"], "drift_deg_h": [0.001, 0.002]}).to_csv(bad, index=False)
+    pd.DataFrame({"latitude_error_deg": [0.01, "x"], "drift_deg_h": [0.001, 0.002]}).to_csv(
+        bad, index=False
+    )
     r = run_cli("diagnose", "drift", str(bad))
     assert r.returncode == 2 and "column 'latitude_error_deg', row 2" in r.stderr
     few = tmp_path / "few.csv"
-    pd.DataFrame({"latitude_error_deg": [0.01, 0.02], "drift_deg_h": [0.001, 0.002],
-                  "temperature_c": [20, 30]}).to_csv(few, index=False)
+    pd.DataFrame(
+        {
+            "latitude_error_deg": [0.01, 0.02],
+            "drift_deg_h": [0.001, 0.002],
+            "temperature_c": [20, 30],
+        }
+    ).to_csv(few, index=False)
     r = run_cli("diagnose", "drift", str(few), "--model", "earth_rate,bias,temperature")
     assert r.returncode == 2 and "rows cannot determine" in r.stderr
     r = run_cli("diagnose", "compass", str(few))

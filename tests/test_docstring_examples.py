@@ -1,4 +1,5 @@
 """The examples in the user-facing docstrings (issue 24) run and print what they say."""
+
 import doctest
 
 import pytest
@@ -12,7 +13,9 @@ EXAMPLES = [loop_module.loop, diagnose_module.diagnose, calibration_module.calib
 
 @pytest.mark.parametrize("fn", EXAMPLES, ids=lambda f: f.__qualname__)
 def test_docstring_example_runs_as_written(fn):
-    tests = doctest.DocTestFinder().find(fn, globs=vars(__import__(fn.__module__, fromlist=["x"])).copy())
+    tests = doctest.DocTestFinder().find(
+        fn, globs=vars(__import__(fn.__module__, fromlist=["x"])).copy()
+    )
     examples = [t for t in tests if t.examples]
     assert examples, f"{fn.__qualname__} has no example"
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)

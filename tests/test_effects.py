@@ -1,4 +1,5 @@
 """Named-effect models: catalogue, exact fits, identifiability, one-call add, comparison."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -31,6 +32,7 @@ def test_each_effect_alone_is_recovered_by_its_own_parameters(system):
 def test_needed_columns_are_enforced():
     """An effect that needs a column is untestable without it and cannot be put in a model."""
     from navlib.workbench.effects import testable
+
     data = simulate("compass", {"yaw_deg": 1.0}, noise=0.1).drop(columns=["temperature_c"])
     ok, why = testable(CATALOGUES["compass"], data)
     assert "temperature" not in ok and why["temperature"] == "no column 'temperature_c'"
@@ -70,8 +72,11 @@ def test_adding_an_effect_is_one_call_and_lowers_the_residual():
     assert f1.effects == ("misalignment", "hard_iron", "soft_iron")
     assert f1.rms < f0.rms / 2 and f1.loo_rms < f0.loo_rms
     table = compare(f0, f1, f1.add("temperature"))
-    assert list(table.index) == ["misalignment + hard_iron", "misalignment + hard_iron + soft_iron",
-                                 "misalignment + hard_iron + soft_iron + temperature"]
+    assert list(table.index) == [
+        "misalignment + hard_iron",
+        "misalignment + hard_iron + soft_iron",
+        "misalignment + hard_iron + soft_iron + temperature",
+    ]
     assert table["rms (deg)"].is_monotonic_decreasing
     with pytest.raises(InputError, match="already in the model"):
         f1.add("soft_iron")
@@ -88,16 +93,19 @@ def test_misalignment_and_soft_iron_never_explain_the_same_residual():
 
 
 def test_earth_rate_adds_no_constant():
-    frame = pd.DataFrame({"latitude_error_deg": [0.01, 0.02, 0.03, 0.04], "drift_deg_h": [1e-3] * 4})
+    frame = pd.DataFrame(
+        {"latitude_error_deg": [0.01, 0.02, 0.03, 0.04], "drift_deg_h": [1e-3] * 4}
+    )
     fit = fit_model("drift", frame, ["earth_rate"])
-    assert fit.rms > 1e-4                                  # a pure bias is not explained...
-    assert fit_model("drift", frame, ["earth_rate", "bias"]).rms < 1e-15   # ...until bias is added
+    assert fit.rms > 1e-4  # a pure bias is not explained...
+    assert fit_model("drift", frame, ["earth_rate", "bias"]).rms < 1e-15  # ...until bias is added
     zero = pd.DataFrame({"latitude_error_deg": [0.0] * 3, "drift_deg_h": [1.0, 2.0, 3.0]})
     assert np.allclose(fit_model("drift", zero, ["earth_rate"]).predict(zero), 0.0)
 
 
 def test_earth_rate_gain_one_is_table1():
     from navlib.sensors.ins import drift_from_latitude_error
+
     frame = pd.DataFrame({"latitude_error_deg": [0.005, -0.02, 0.013]})
     frame["drift_deg_h"] = drift_from_latitude_error(frame.latitude_error_deg)
     assert fit_model("drift", frame, ["earth_rate"]).params["earth_rate_gain"] == pytest.approx(1.0)
@@ -121,7 +129,9 @@ def test_effect_validation():
     with pytest.raises(InputError, match="constant"):
         fit_model("drift", data.assign(temperature_c=20.0), ["temperature"])
     with pytest.raises(InputError, match="5 rows cannot determine 5|at least"):
-        fit_model("drift", data.iloc[:4], ["earth_rate", "bias", "temperature", "temperature_change"])
+        fit_model(
+            "drift", data.iloc[:4], ["earth_rate", "bias", "temperature", "temperature_change"]
+        )
     with pytest.raises(InputError, match="unknown system"):
         fit_model("gravity", data, [])
 

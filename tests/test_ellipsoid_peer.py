@@ -1,5 +1,6 @@
 """The dedicated calibrator's fit (navlib.methods.ellipsoid); the workbench chapter's comparison with it is
 tested in tests/studies/workbench/test_wbstudy_peer.py."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -38,10 +39,10 @@ def test_the_lm_fit_is_no_worse_than_its_algebraic_start_on_noisy_data():
     b, S = algebraic_ellipsoid(m)
     F0 = np.mean(np.linalg.norm(m - b, axis=1))
     b2, S2, F = lm_ellipsoid(m)
-    assert F == pytest.approx(F0)                     # the LM fit keeps its start's radius
+    assert F == pytest.approx(F0)  # the LM fit keeps its start's radius
     geo0 = np.sqrt(np.mean((np.linalg.norm((m - b) @ (S * F0), axis=1) - F0) ** 2))
     geo = np.sqrt(np.mean((np.linalg.norm((m - b2) @ S2, axis=1) - F) ** 2))
-    assert geo <= geo0 + 1e-12 and geo < 1.5            # the geometric error, near the 1 uT noise
+    assert geo <= geo0 + 1e-12 and geo < 1.5  # the geometric error, near the 1 uT noise
 
 
 def test_the_workbench_fit_is_the_algebraic_fit_scaled():
@@ -49,14 +50,19 @@ def test_the_workbench_fit_is_the_algebraic_fit_scaled():
     frame = pd.DataFrame(m, columns=["mag_x_ut", "mag_y_ut", "mag_z_ut"])
     W, c = ellipsoid_fit(frame)
     b, S = algebraic_ellipsoid(m)
-    assert np.array_equal(c, b) and np.allclose(W, np.mean(np.linalg.norm(m - b, axis=1)) * S, rtol=0, atol=0)
+    assert np.array_equal(c, b) and np.allclose(
+        W, np.mean(np.linalg.norm(m - b, axis=1)) * S, rtol=0, atol=0
+    )
 
 
-@pytest.mark.parametrize("m, says", [
-    (np.ones((5, 3)), "n >= 9"),
-    (np.c_[raw_field()[:, :2], np.full(600, np.nan)], "finite"),
-    (np.c_[raw_field()[:, :2], np.zeros(600)], "3-D"),
-])
+@pytest.mark.parametrize(
+    "m, says",
+    [
+        (np.ones((5, 3)), "n >= 9"),
+        (np.c_[raw_field()[:, :2], np.full(600, np.nan)], "finite"),
+        (np.c_[raw_field()[:, :2], np.zeros(600)], "3-D"),
+    ],
+)
 def test_bad_fields_are_refused_in_one_line(m, says):
     with pytest.raises(InputError, match=says):
         lm_ellipsoid(m)

@@ -1,4 +1,5 @@
 """Tests for navlib.methods.elm: plain ELM, back-tuning, pruning and the point-incremental scheme (patent B)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -6,8 +7,18 @@ import pytest
 
 from navlib.methods.seeding import generator
 
-from navlib.methods.elm import (ACTIVATIONS, ELMModel, ELMParams, IncrementalELMParams, _back_tune, back_tune,
-                               fit_elm, fit_incremental_elm, loss_and_gradients, prune_nodes)
+from navlib.methods.elm import (
+    ACTIVATIONS,
+    ELMModel,
+    ELMParams,
+    IncrementalELMParams,
+    _back_tune,
+    back_tune,
+    fit_elm,
+    fit_incremental_elm,
+    loss_and_gradients,
+    prune_nodes,
+)
 from navlib.errors import InputError
 from navlib.methods.jit import column_sums, pairwise_sum
 
@@ -30,7 +41,7 @@ def test_elm_interpolates_exactly_with_as_many_nodes_as_samples(seed):
     # Huang 2006, Thm 2.1: N distinct samples, N random sigmoid nodes -> H invertible, zero error.
     # Sigmoid H is ill-conditioned (cond ~1e9 here), so "exact" means to about 1e-6 of the target.
     x = np.linspace(0.0, 1.0, 10)
-    t = np.sin(2 * np.pi * x) + 0.3 * x ** 2
+    t = np.sin(2 * np.pi * x) + 0.3 * x**2
     p = ELMParams(n_hidden=10, weight_range=10.0, bias_range=10.0, seed=seed)
     model = fit_elm(x, t, p)
     assert model.n_hidden == 10
@@ -55,7 +66,7 @@ def test_shapes_1d_and_2d():
     x, t = compass_like(30)
     m1 = fit_elm(x, t, ELMParams(n_hidden=4))
     assert m1.predict(x).shape == (30,)
-    X2 = np.column_stack([x, x ** 2])
+    X2 = np.column_stack([x, x**2])
     T2 = np.column_stack([t, 1 - t])
     m2 = fit_elm(X2, T2, ELMParams(n_hidden=4))
     assert (m2.n_inputs, m2.n_hidden, m2.n_outputs) == (2, 4, 2)
@@ -68,8 +79,13 @@ def test_gradients_match_finite_differences():
     X = rng.uniform(0, 1, (12, 2))
     T = rng.normal(size=(12, 2))
     for act in ("sigmoid", "tanh"):
-        m = ELMModel(w=rng.normal(size=(2, 3)), b=rng.normal(size=3), beta=rng.normal(size=(3, 2)),
-                     activation=act, squeeze_output=False)
+        m = ELMModel(
+            w=rng.normal(size=(2, 3)),
+            b=rng.normal(size=3),
+            beta=rng.normal(size=(3, 2)),
+            activation=act,
+            squeeze_output=False,
+        )
         loss, gw, gb, gbeta = loss_and_gradients(m, X, T)
         assert loss == pytest.approx(m.loss(X, T))
         for name, grad in (("w", gw), ("b", gb), ("beta", gbeta)):
@@ -107,14 +123,21 @@ def test_compiled_loss_and_gradients_match_numpy(activation):
     # several inputs and outputs: every matrix product and sum of the compiled kernel is exercised
     rng = np.random.default_rng(8)
     X, T = rng.uniform(0, 1, (37, 3)), rng.normal(size=(37, 2))
-    m = ELMModel(w=rng.normal(size=(3, 5)), b=rng.normal(size=5), beta=rng.normal(size=(5, 2)),
-                 activation=activation, squeeze_output=False)
+    m = ELMModel(
+        w=rng.normal(size=(3, 5)),
+        b=rng.normal(size=5),
+        beta=rng.normal(size=(5, 2)),
+        activation=activation,
+        squeeze_output=False,
+    )
     ours = loss_and_gradients(m, X, T)
     ref = reference.loss_grad(m.w, m.b, m.beta, X, T, activation)
     assert ours[0] == pytest.approx(ref[0], rel=1e-13)
     for name, a, r in zip(("W", "b", "beta"), ours[1:], ref[1:]):
         assert a.shape == r.shape, name
-        np.testing.assert_allclose(a, r, rtol=1e-12, atol=1e-15 * np.abs(r).max(), err_msg=f"dE/d{name}")
+        np.testing.assert_allclose(
+            a, r, rtol=1e-12, atol=1e-15 * np.abs(r).max(), err_msg=f"dE/d{name}"
+        )
 
 
 @pytest.mark.parametrize("activation", ACTIVATIONS)
@@ -122,19 +145,25 @@ def test_compiled_loss_and_gradients_match_numpy(activation):
 def test_compiled_back_tuning_matches_numpy_reference(activation, lr):
     # the same accepted steps, halvings and doublings as the plain-numpy loop, up to rounding
     x, t = compass_like(121, noise=0.05, seed=3)
-    model = fit_elm(x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=3, activation=activation))
-    model.beta *= 0.8                        # off the least-squares optimum, so that tuning has work to do
+    model = fit_elm(
+        x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=3, activation=activation)
+    )
+    model.beta *= 0.8  # off the least-squares optimum, so that tuning has work to do
     X, T = x[:, None], t[:, None]
-    w, b, beta, ref_losses, ref_step = reference.back_tune(model.w, model.b, model.beta, X, T, activation,
-                                                           40, lr)
+    w, b, beta, ref_losses, ref_step = reference.back_tune(
+        model.w, model.b, model.beta, X, T, activation, 40, lr
+    )
     tuned, losses, step = _back_tune(model, X, T, 40, lr)
-    assert len(ref_losses) == 41 and ref_losses[-1] < 0.5 * ref_losses[0]   # the comparison has teeth
+    assert (
+        len(ref_losses) == 41 and ref_losses[-1] < 0.5 * ref_losses[0]
+    )  # the comparison has teeth
     assert len(losses) == len(ref_losses)
     np.testing.assert_allclose(losses, ref_losses, rtol=1e-10, atol=0)
-    assert step == ref_step                                                   # a power of two times lr
+    assert step == ref_step  # a power of two times lr
     for name, ref in (("w", w), ("b", b), ("beta", beta)):
-        np.testing.assert_allclose(getattr(tuned, name), ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max(),
-                                   err_msg=name)
+        np.testing.assert_allclose(
+            getattr(tuned, name), ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max(), err_msg=name
+        )
 
 
 @pytest.mark.parametrize("lr", [1e-300, 1e-16, 1e-15])
@@ -145,31 +174,44 @@ def test_stalled_line_search_matches_numpy_reference(lr):
     model = fit_elm(x, t, ELMParams(n_hidden=4, weight_range=5.0, bias_range=5.0, seed=2))
     model.beta *= 0.8
     X, T = x[:, None], t[:, None]
-    *_, ref_losses, ref_step = reference.back_tune(model.w, model.b, model.beta, X, T, "sigmoid", 10, lr)
+    *_, ref_losses, ref_step = reference.back_tune(
+        model.w, model.b, model.beta, X, T, "sigmoid", 10, lr
+    )
     tuned, losses, step = _back_tune(model, X, T, 10, lr)
     assert step == ref_step and len(losses) == len(ref_losses)
     np.testing.assert_allclose(losses, ref_losses, rtol=1e-10, atol=0)
-    if lr == 1e-300:                         # nothing can move: 40 halvings (into subnormals), then stop
+    if lr == 1e-300:  # nothing can move: 40 halvings (into subnormals), then stop
         assert len(losses) == 1 and 0 < step < lr * 1e-12
         np.testing.assert_array_equal(tuned.w, model.w)
-    if lr == 1e-15:                          # steps of about one ulp of the weights are still taken
+    if lr == 1e-15:  # steps of about one ulp of the weights are still taken
         assert len(losses) == 11
 
 
 def test_incremental_elm_matches_numpy_reference():
     # the whole scheme (ELM, prune and tune stages, validation loss) with the numpy reference swapped in
     x, t = compass_like(121, noise=0.05, seed=5)
-    p = IncrementalELMParams(max_nodes=6, loss_goal=0.0, max_iter=12, weight_range=5.0, bias_range=5.0,
-                             prune_tol=1e-2, seed=4)
+    p = IncrementalELMParams(
+        max_nodes=6,
+        loss_goal=0.0,
+        max_iter=12,
+        weight_range=5.0,
+        bias_range=5.0,
+        prune_tol=1e-2,
+        seed=4,
+    )
     # contiguous copies: numpy's own products round differently on strided views
     args = (x[::2].copy(), t[::2].copy(), p)
     kw = dict(x_val=x[1::2].copy(), t_val=t[1::2].copy())
     model, hist = fit_incremental_elm(*args, **kw)
     with reference.numpy_reference():
         ref_model, ref_hist = fit_incremental_elm(*args, **kw)
-    assert hist[["iteration", "stage", "n_nodes"]].equals(ref_hist[["iteration", "stage", "n_nodes"]])
+    assert hist[["iteration", "stage", "n_nodes"]].equals(
+        ref_hist[["iteration", "stage", "n_nodes"]]
+    )
     assert (hist.stage == "tune").sum() == 6 and hist.loss.iloc[-1] < 0.1 * hist.loss.iloc[1]
-    np.testing.assert_allclose(hist[["loss", "val_loss"]], ref_hist[["loss", "val_loss"]], rtol=1e-10, atol=0)
+    np.testing.assert_allclose(
+        hist[["loss", "val_loss"]], ref_hist[["loss", "val_loss"]], rtol=1e-10, atol=0
+    )
     np.testing.assert_allclose(model.predict(x), ref_model.predict(x), rtol=1e-10, atol=1e-12)
 
 
@@ -181,10 +223,10 @@ def test_back_tuning_never_increases_training_loss(seed, lr):
     before = model.loss(x, t)
     tuned, losses = back_tune(model, x, t, steps=40, lr=lr)
     assert losses[0] == pytest.approx(before, rel=1e-12)
-    assert np.all(np.diff(losses) < 0)          # every accepted step lowers the loss
+    assert np.all(np.diff(losses) < 0)  # every accepted step lowers the loss
     assert tuned.loss(x, t) == pytest.approx(losses[-1], rel=1e-12)
-    assert tuned.loss(x, t) < before            # and tuning does something on a 4-node net
-    assert model.loss(x, t) == before           # the input model is not modified
+    assert tuned.loss(x, t) < before  # and tuning does something on a 4-node net
+    assert model.loss(x, t) == before  # the input model is not modified
 
 
 def test_back_tuning_moves_all_weights():
@@ -215,8 +257,15 @@ def test_pruning_removes_node_with_zero_output_weight():
 def test_incremental_history_and_monotone_stages():
     x, t = compass_like(121, noise=0.05)
     # 12 nodes at most keeps cond(H) < 1e12, where least squares is accurate to rounding
-    p = IncrementalELMParams(max_nodes=12, loss_goal=0.0, max_iter=40, weight_range=5.0,
-                             bias_range=5.0, tune_steps=30, seed=7)
+    p = IncrementalELMParams(
+        max_nodes=12,
+        loss_goal=0.0,
+        max_iter=40,
+        weight_range=5.0,
+        bias_range=5.0,
+        tune_steps=30,
+        seed=7,
+    )
     model, hist = fit_incremental_elm(x, t, p)
     assert list(hist.columns) == ["iteration", "stage", "n_nodes", "loss", "val_loss"]
     assert hist.iteration.iloc[-1] == 40 and hist.iteration.is_monotonic_increasing
@@ -238,20 +287,21 @@ def test_incremental_history_and_monotone_stages():
 def test_incremental_stops_at_loss_goal_and_fits():
     x, t = compass_like(121, noise=0.0)
     goal = 1e-7
-    p = IncrementalELMParams(max_nodes=40, loss_goal=goal, max_iter=400, weight_range=5.0,
-                             bias_range=5.0, seed=0)
+    p = IncrementalELMParams(
+        max_nodes=40, loss_goal=goal, max_iter=400, weight_range=5.0, bias_range=5.0, seed=0
+    )
     model, hist = fit_incremental_elm(x, t, p)
     assert hist.loss.iloc[-1] <= goal
     assert (hist.loss.iloc[:-1].groupby(hist.iteration.iloc[:-1]).last() > goal).all()
     assert hist.iteration.iloc[-1] < 400
-    assert np.sqrt(model.loss(x, t)) * 360 < 0.2   # deg, over the sweep
+    assert np.sqrt(model.loss(x, t)) * 360 < 0.2  # deg, over the sweep
 
 
 def test_incremental_prunes_negligible_nodes():
     x, t = compass_like(40)
     p = IncrementalELMParams(max_nodes=10, loss_goal=0.0, max_iter=9, prune_tol=1e9, seed=1)
     model, hist = fit_incremental_elm(x, t, p)
-    assert (hist.stage == "prune").sum() == 4   # iterations 3, 5, 7, 9 add a node, then drop one
+    assert (hist.stage == "prune").sum() == 4  # iterations 3, 5, 7, 9 add a node, then drop one
     assert model.n_hidden == 1 and hist.n_nodes[hist.stage == "prune"].eq(1).all()
 
 
@@ -284,19 +334,24 @@ def test_determinism_with_seed():
     m3, _ = fit_incremental_elm(x, t, p, rng=12)
     assert not np.array_equal(m1.w[:, :3], m3.w[:, :3])
     e1 = fit_elm(x, t, ELMParams(n_hidden=8, seed=5))
-    e2 = fit_elm(x, t, ELMParams(n_hidden=8), rng=generator(5))      # seed = run index (navlib.methods.seeding)
+    e2 = fit_elm(
+        x, t, ELMParams(n_hidden=8), rng=generator(5)
+    )  # seed = run index (navlib.methods.seeding)
     np.testing.assert_array_equal(e1.w, e2.w)
     np.testing.assert_array_equal(e1.beta, e2.beta)
 
 
-@pytest.mark.parametrize("kwargs, word", [
-    (dict(n_hidden=0), "n_hidden"),
-    (dict(n_hidden=2.5), "n_hidden"),
-    (dict(activation="relu"), "activation"),
-    (dict(weight_range=0.0), "weight_range"),
-    (dict(bias_range=-1.0), "bias_range"),
-    (dict(seed=-1), "seed"),
-])
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        (dict(n_hidden=0), "n_hidden"),
+        (dict(n_hidden=2.5), "n_hidden"),
+        (dict(activation="relu"), "activation"),
+        (dict(weight_range=0.0), "weight_range"),
+        (dict(bias_range=-1.0), "bias_range"),
+        (dict(seed=-1), "seed"),
+    ],
+)
 def test_bad_elm_params(kwargs, word):
     x, t = compass_like(20)
     with pytest.raises(InputError, match=word) as err:
@@ -304,16 +359,19 @@ def test_bad_elm_params(kwargs, word):
     assert "\n" not in str(err.value)
 
 
-@pytest.mark.parametrize("kwargs, word", [
-    (dict(max_nodes=0), "max_nodes"),
-    (dict(lr=0.0), "lr"),
-    (dict(lr=float("nan")), "lr"),
-    (dict(loss_goal=-1e-3), "loss_goal"),
-    (dict(max_iter=0), "max_iter"),
-    (dict(tune_steps=-1), "tune_steps"),
-    (dict(prune_tol=-1.0), "prune_tol"),
-    (dict(schedule="even"), "schedule"),
-])
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        (dict(max_nodes=0), "max_nodes"),
+        (dict(lr=0.0), "lr"),
+        (dict(lr=float("nan")), "lr"),
+        (dict(loss_goal=-1e-3), "loss_goal"),
+        (dict(max_iter=0), "max_iter"),
+        (dict(tune_steps=-1), "tune_steps"),
+        (dict(prune_tol=-1.0), "prune_tol"),
+        (dict(schedule="even"), "schedule"),
+    ],
+)
 def test_bad_incremental_params(kwargs, word):
     x, t = compass_like(20)
     with pytest.raises(InputError, match=word):

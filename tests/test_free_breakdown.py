@@ -1,5 +1,6 @@
 """The reference-free loop's breakdown of what remains (issue 34): each factor finds the structure built
 into it, the sentence names the one that holds the most, and the loop's outputs carry it."""
+
 import json
 
 import numpy as np
@@ -13,13 +14,18 @@ RNG = np.random.default_rng(5)
 N = 2000
 T = np.arange(N) * 0.05
 U = RNG.normal(size=(N, 3)) * 30
-ACC = np.column_stack([np.zeros(N), np.zeros(N), 9.81 + np.abs(RNG.normal(size=N)) * np.r_[np.zeros(N // 2),
-                                                                                         np.ones(N // 2) * 3]])
+ACC = np.column_stack(
+    [
+        np.zeros(N),
+        np.zeros(N),
+        9.81 + np.abs(RNG.normal(size=N)) * np.r_[np.zeros(N // 2), np.ones(N // 2) * 3],
+    ]
+)
 RATE = np.abs(RNG.normal(size=N)) * 40
 
 
 def _table(resid):
-    return fb.breakdown(resid, ["magnitude", "dip"][:resid.shape[1]], fb.factors(T, RATE, U, ACC))
+    return fb.breakdown(resid, ["magnitude", "dip"][: resid.shape[1]], fb.factors(T, RATE, U, ACC))
 
 
 def test_shares_are_between_cell_variance():
@@ -34,12 +40,15 @@ def test_shares_are_between_cell_variance():
     assert t["amplitude_ut"] == pytest.approx(np.sqrt(between / N))
 
 
-@pytest.mark.parametrize("factor, make, invariant", [
-    ("time", lambda: np.where(T > T[-1] * 0.7, 1.0, 0.0), "magnitude"),
-    ("orientation", lambda: np.where(np.argmax(np.abs(U), axis=1) == 2, 1.0, 0.0), "magnitude"),
-    ("acceleration", lambda: np.abs(np.linalg.norm(ACC, axis=1) - 9.81), "dip"),
-    ("turn rate", lambda: RATE / 40, "dip"),
-])
+@pytest.mark.parametrize(
+    "factor, make, invariant",
+    [
+        ("time", lambda: np.where(T > T[-1] * 0.7, 1.0, 0.0), "magnitude"),
+        ("orientation", lambda: np.where(np.argmax(np.abs(U), axis=1) == 2, 1.0, 0.0), "magnitude"),
+        ("acceleration", lambda: np.abs(np.linalg.norm(ACC, axis=1) - 9.81), "dip"),
+        ("turn rate", lambda: RATE / 40, "dip"),
+    ],
+)
 def test_the_factor_built_in_is_named(factor, make, invariant):
     r = RNG.normal(size=(N, 2)) * 0.2
     r[:, ["magnitude", "dip"].index(invariant)] += make()
@@ -59,14 +68,16 @@ def test_noise_alone_names_no_factor():
 
 def test_rate_from_the_field_when_no_gyro():
     """Without gyro columns the turn rate is the corrected field's turn between samples over the time step."""
-    ang = np.radians(np.cumsum(np.r_[0.0, np.full(N - 1, 2.0)]))        # 2 deg per 0.05 s: 40 deg/s
+    ang = np.radians(np.cumsum(np.r_[0.0, np.full(N - 1, 2.0)]))  # 2 deg per 0.05 s: 40 deg/s
     u = np.column_stack([np.cos(ang), np.sin(ang), np.zeros(N)]) * 40
     cell, labels = fb.factors(T, None, u)["turn rate"]
     assert all(lab.startswith("40-40") or lab.startswith("40 ") for lab in labels.values())
 
 
 def test_no_columns_no_factors():
-    assert fb.reading(fb.breakdown(RNG.normal(size=(N, 1)), ["magnitude"], {})).startswith("no factor")
+    assert fb.reading(fb.breakdown(RNG.normal(size=(N, 1)), ["magnitude"], {})).startswith(
+        "no factor"
+    )
 
 
 def test_loop_report_and_json_carry_the_breakdown(tmp_path):
@@ -90,5 +101,6 @@ def test_loop_report_and_json_carry_the_breakdown(tmp_path):
 
 def test_other_systems_have_no_breakdown():
     from navlib.workbench.fit import simulate
+
     res = loop("compass", simulate("compass", {"hard_x": 0.05}, noise=0.05, seed=1))
     assert res.remaining() is None and "remaining" not in res.to_dict()

@@ -1,5 +1,6 @@
 """The reference-free invariants' analytic Jacobian against finite differences, and the kernel against
 the frame-based residuals it replaced (issue 34)."""
+
 import numpy as np
 import pytest
 from scipy.optimize._numdiff import approx_derivative
@@ -7,9 +8,27 @@ from scipy.spatial.transform import Rotation
 
 from navlib.workbench.free_kernel import FreeKernel, rotation_deg
 
-ALL = ["field_ut", "field_down_ut", "hard_x_ut", "hard_y_ut", "hard_z_ut", "scale_x", "scale_y", "soft_xy",
-       "soft_xz", "soft_yz", "temp_x_ut_c", "temp_y_ut_c", "temp_z_ut_c", "mis_x_deg", "mis_y_deg", "mis_z_deg"]
-X = dict(zip(ALL, [45, 30, 3, -2, 1, .02, -.01, .01, .005, -.007, .1, -.05, .02, 1., -.5, .3]))
+ALL = [
+    "field_ut",
+    "field_down_ut",
+    "hard_x_ut",
+    "hard_y_ut",
+    "hard_z_ut",
+    "scale_x",
+    "scale_y",
+    "soft_xy",
+    "soft_xz",
+    "soft_yz",
+    "temp_x_ut_c",
+    "temp_y_ut_c",
+    "temp_z_ut_c",
+    "mis_x_deg",
+    "mis_y_deg",
+    "mis_z_deg",
+]
+X = dict(
+    zip(ALL, [45, 30, 3, -2, 1, 0.02, -0.01, 0.01, 0.005, -0.007, 0.1, -0.05, 0.02, 1.0, -0.5, 0.3])
+)
 
 
 def _data(seed=1, n=60):
@@ -18,8 +37,14 @@ def _data(seed=1, n=60):
 
 
 @pytest.mark.parametrize("acc", [True, False])
-@pytest.mark.parametrize("names", [ALL, ["field_ut", "field_down_ut", "hard_x_ut", "hard_y_ut", "hard_z_ut"],
-                                   ["field_ut", "field_down_ut", "scale_x", "mis_z_deg"]])
+@pytest.mark.parametrize(
+    "names",
+    [
+        ALL,
+        ["field_ut", "field_down_ut", "hard_x_ut", "hard_y_ut", "hard_z_ut"],
+        ["field_ut", "field_down_ut", "scale_x", "mis_z_deg"],
+    ],
+)
 def test_jacobian_matches_finite_differences(acc, names):
     names = [q for q in names if acc or (q != "field_down_ut" and not q.startswith("mis"))]
     m, a, dt = _data()
@@ -45,20 +70,32 @@ def test_residuals_follow_the_definition():
     """e0 = |M (m - b - k dT)| - F and e1 = (g - c e0)/sqrt(1 - c^2), written out without the kernel."""
     m, a, dt = _data(3)
     p = X
-    K = np.array([[p["scale_x"], p["soft_xy"], p["soft_xz"]], [p["soft_xy"], p["scale_y"], p["soft_yz"]],
-                  [p["soft_xz"], p["soft_yz"], -p["scale_x"] - p["scale_y"]]])
+    K = np.array(
+        [
+            [p["scale_x"], p["soft_xy"], p["soft_xz"]],
+            [p["soft_xy"], p["scale_y"], p["soft_yz"]],
+            [p["soft_xz"], p["soft_yz"], -p["scale_x"] - p["scale_y"]],
+        ]
+    )
     b = np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
     kt = np.array([p["temp_x_ut_c"], p["temp_y_ut_c"], p["temp_z_ut_c"]])
     u = (m - b - dt[:, None] * kt) @ (np.eye(3) + K).T
     e0 = np.linalg.norm(u, axis=1) - p["field_ut"]
-    R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
-    g = np.sum(a / np.linalg.norm(a, axis=1, keepdims=True) * (u @ R.T), axis=1) - p["field_down_ut"]
+    R = Rotation.from_rotvec(
+        np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])
+    ).as_matrix()
+    g = (
+        np.sum(a / np.linalg.norm(a, axis=1, keepdims=True) * (u @ R.T), axis=1)
+        - p["field_down_ut"]
+    )
     c = p["field_down_ut"] / p["field_ut"]
     want = np.column_stack([e0, (g - c * e0) / np.sqrt(1 - c * c)])
     got = FreeKernel(ALL, m, a, dt).residuals(np.array([p[q] for q in ALL], float))
     assert np.allclose(got, want, rtol=1e-12, atol=1e-10)
 
 
-@pytest.mark.parametrize("v", [[0, 0, 0], [1, -0.5, 0.3], [170, 20, -40], [1e-9, 0, 0], [0, 0, -180]])
+@pytest.mark.parametrize(
+    "v", [[0, 0, 0], [1, -0.5, 0.3], [170, 20, -40], [1e-9, 0, 0], [0, 0, -180]]
+)
 def test_rotation_deg_is_scipys(v):
     assert np.allclose(rotation_deg(v), Rotation.from_rotvec(np.radians(v)).as_matrix(), atol=1e-14)

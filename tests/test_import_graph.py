@@ -6,6 +6,7 @@ foundations, then data, sensors, methods, workbench, studies, and the command li
 import its own layer or a lower one.  The book's tooling (``book/navbook``) is not part of navlib: navlib
 never imports it.
 """
+
 from __future__ import annotations
 
 import ast
@@ -18,11 +19,27 @@ PKG = ROOT / "navlib"
 
 #: Layer of each top-level module or subpackage of navlib (lower numbers lie below).
 LAYERS = {
-    "navlib": 0, "errors": 0, "angles": 0, "names": 0, "paths": 0, "threads": 0, "_optional": 0,
-    "formatting": 0, "seeding": 0,
-    "verdicts": 1, "plotstyle": 1, "engine": 1, "claims": 1,
-    "data": 2, "sensors": 3, "methods": 4, "workbench": 5, "studies": 6,
-    "commands": 7, "cli": 7, "__main__": 8,
+    "navlib": 0,
+    "errors": 0,
+    "angles": 0,
+    "names": 0,
+    "paths": 0,
+    "threads": 0,
+    "_optional": 0,
+    "formatting": 0,
+    "seeding": 0,
+    "verdicts": 1,
+    "plotstyle": 1,
+    "engine": 1,
+    "claims": 1,
+    "data": 2,
+    "sensors": 3,
+    "methods": 4,
+    "workbench": 5,
+    "studies": 6,
+    "commands": 7,
+    "cli": 7,
+    "__main__": 8,
 }
 
 
@@ -45,16 +62,20 @@ def imports_of(path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
-                base = base[:len(base) - (node.level - 1)]
+                base = base[: len(base) - (node.level - 1)]
                 mod = ".".join(base + ([node.module] if node.module else []))
             else:
                 mod = node.module or ""
             if mod.split(".")[0] not in ("navlib", "navbook"):
                 continue
-            for a in node.names:                  # `from . import x` imports the module x
+            for a in node.names:  # `from . import x` imports the module x
                 sub = f"{mod}.{a.name}"
-                out.add(sub if (ROOT / Path(*sub.split("."))).with_suffix(".py").exists()
-                        or (ROOT / Path(*sub.split(".")) / "__init__.py").exists() else mod)
+                out.add(
+                    sub
+                    if (ROOT / Path(*sub.split("."))).with_suffix(".py").exists()
+                    or (ROOT / Path(*sub.split(".")) / "__init__.py").exists()
+                    else mod
+                )
     out.discard(name)
     return out
 
@@ -108,7 +129,7 @@ def cycles(g: dict[str, set[str]]) -> list[list[str]]:
 def test_the_graph_is_read_from_the_code():
     g = graph()
     assert len(g) > 60 and "navlib.workbench.loop" in g
-    assert "navlib.workbench.fit" in g["navlib.workbench.loop"]              # a real edge is found
+    assert "navlib.workbench.fit" in g["navlib.workbench.loop"]  # a real edge is found
 
 
 def test_navlib_has_no_import_circle():
@@ -116,8 +137,12 @@ def test_navlib_has_no_import_circle():
 
 
 def test_no_import_runs_up_a_layer():
-    up = [f"{a} (layer {layer(a)}) -> {b} (layer {layer(b)})" for a, deps in graph().items() for b in deps
-          if b.startswith("navlib") and layer(b) > layer(a)]
+    up = [
+        f"{a} (layer {layer(a)}) -> {b} (layer {layer(b)})"
+        for a, deps in graph().items()
+        for b in deps
+        if b.startswith("navlib") and layer(b) > layer(a)
+    ]
     assert up == []
 
 
@@ -125,10 +150,13 @@ def test_navlib_never_imports_the_books_tooling():
     assert [(a, b) for a, deps in graph().items() for b in deps if b.startswith("navbook")] == []
 
 
-@pytest.mark.parametrize("g, expected", [
-    ({"a": {"b"}, "b": {"a"}, "c": set()}, [["a", "b"]]),
-    ({"a": {"b"}, "b": {"c"}, "c": {"a"}}, [["a", "b", "c"]]),
-    ({"a": {"b"}, "b": set()}, []),
-])
+@pytest.mark.parametrize(
+    "g, expected",
+    [
+        ({"a": {"b"}, "b": {"a"}, "c": set()}, [["a", "b"]]),
+        ({"a": {"b"}, "b": {"c"}, "c": {"a"}}, [["a", "b", "c"]]),
+        ({"a": {"b"}, "b": set()}, []),
+    ],
+)
 def test_the_circle_finder_finds_circles(g, expected):
     assert cycles(g) == expected

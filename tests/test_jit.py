@@ -1,4 +1,5 @@
 """navlib.methods.jit: the compiled kernels give the same numbers whatever instruction set they are compiled for."""
+
 import json
 import os
 import subprocess
@@ -31,16 +32,20 @@ print(json.dumps(out))
 
 
 #: LLVM's 'haswell' and its features (numba takes the host's features unless told): AVX2 and FMA, no AVX-512.
-_HASWELL = {"NUMBA_CPU_NAME": "haswell",
-            "NUMBA_CPU_FEATURES": "+64bit,+avx,+avx2,+bmi,+bmi2,+cmov,+cx16,+f16c,+fma,+fsgsbase,+lzcnt,+mmx,"
-                                  "+movbe,+pclmul,+popcnt,+rdrnd,+sahf,+sse,+sse2,+sse3,+sse4.1,+sse4.2,+ssse3,"
-                                  "+xsave,+xsaveopt"}
+_HASWELL = {
+    "NUMBA_CPU_NAME": "haswell",
+    "NUMBA_CPU_FEATURES": "+64bit,+avx,+avx2,+bmi,+bmi2,+cmov,+cx16,+f16c,+fma,+fsgsbase,+lzcnt,+mmx,"
+    "+movbe,+pclmul,+popcnt,+rdrnd,+sahf,+sse,+sse2,+sse3,+sse4.1,+sse4.2,+ssse3,"
+    "+xsave,+xsaveopt",
+}
 
 
 def _run(env_extra):
     env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CPU_")}
     env.update(env_extra)
-    res = subprocess.run([sys.executable, "-c", _SCRIPT], env=env, capture_output=True, text=True, timeout=300)
+    res = subprocess.run(
+        [sys.executable, "-c", _SCRIPT], env=env, capture_output=True, text=True, timeout=300
+    )
     assert res.returncode == 0, res.stderr[-2000:]
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -60,7 +65,9 @@ def test_kernels_compiled_for_avx2_and_for_the_host_give_the_same_bits():
     from llvmlite import binding
 
     host = binding.get_host_cpu_features()
-    if not (binding.get_process_triple().startswith("x86_64") and host.get("avx2") and host.get("fma")):
+    if not (
+        binding.get_process_triple().startswith("x86_64") and host.get("avx2") and host.get("fma")
+    ):
         pytest.skip("needs an x86-64 processor with AVX2 and FMA")
     avx2 = _run(_HASWELL)
     here = _run({})

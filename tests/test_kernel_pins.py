@@ -3,6 +3,7 @@ notebook outputs bit for bit (Makefile, "The same floating-point kernels").  A p
 honours (a renamed numpy feature group, a new variable name) would fail silently, CI would compute other
 numbers, and nbval would fail on the other machine only: this checks, in a fresh interpreter started with the
 Makefile's variables, that each library reports the pinned path."""
+
 from __future__ import annotations
 
 import json
@@ -44,23 +45,39 @@ def makefile_pins() -> dict[str, str]:
 def test_each_library_takes_the_pinned_kernels():
     pins = makefile_pins()
     env = {k: v for k, v in os.environ.items() if k not in PINS} | pins
-    run = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True, timeout=120,
-                         check=False)
+    run = subprocess.run(
+        [sys.executable, "-c", PROBE],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
     assert run.returncode == 0, run.stderr
-    assert "cannot" not in run.stderr.lower(), run.stderr        # numpy's warning for a pin it refuses
+    assert "cannot" not in run.stderr.lower(), run.stderr  # numpy's warning for a pin it refuses
     got = json.loads(run.stdout)
-    assert got["x86_v4"] is False                                  # numpy's AVX-512 loops are off
-    assert got["openblas"] == [pins["OPENBLAS_CORETYPE"]]          # both OpenBLAS copies (numpy's, scipy's)
+    assert got["x86_v4"] is False  # numpy's AVX-512 loops are off
+    assert got["openblas"] == [pins["OPENBLAS_CORETYPE"]]  # both OpenBLAS copies (numpy's, scipy's)
     if got["aten"] is not None:
-        assert got["aten"] in ("AVX2", "DEFAULT"), got["aten"]    # DEFAULT only on a machine without AVX2
+        assert got["aten"] in ("AVX2", "DEFAULT"), got[
+            "aten"
+        ]  # DEFAULT only on a machine without AVX2
 
 
 def test_the_probe_sees_the_native_kernels_without_the_pins():
     """The control: without the variables, a machine with AVX-512 reports it (so the check above can fail)."""
     env = {k: v for k, v in os.environ.items() if k not in PINS}
-    run = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True, timeout=120,
-                         check=False)
+    run = subprocess.run(
+        [sys.executable, "-c", PROBE],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
     got = json.loads(run.stdout)
     if not got["avx512f"]:
-        pytest.skip("this processor has no AVX-512: the pinned and native kernels are the same here")
+        pytest.skip(
+            "this processor has no AVX-512: the pinned and native kernels are the same here"
+        )
     assert got["x86_v4"] is True

@@ -1,5 +1,6 @@
 """The generic MLP (:mod:`navlib.methods.mlp`): it fits a smooth map, is seeded, and checks its parameters
 and shapes."""
+
 import numpy as np
 import pytest
 import torch
@@ -23,8 +24,15 @@ def test_mlp_fits_a_smooth_map_and_is_seeded(hidden):
     assert a.loss_history[-1] < a.loss_history[0]
 
 
-@pytest.mark.parametrize("kw, word", [(dict(n_hidden=0), "n_hidden"), (dict(hidden="relu"), "hidden"),
-                                      (dict(trainer="sgd"), "trainer"), (dict(epochs=0), "epochs")])
+@pytest.mark.parametrize(
+    "kw, word",
+    [
+        (dict(n_hidden=0), "n_hidden"),
+        (dict(hidden="relu"), "hidden"),
+        (dict(trainer="sgd"), "trainer"),
+        (dict(epochs=0), "epochs"),
+    ],
+)
 def test_mlp_bad_params(kw, word):
     with pytest.raises(InputError, match=word):
         MLPParams(**kw)

@@ -1,5 +1,6 @@
 """The size check of "consistent with noise" (issue 35): the sample-to-sample noise the data show, the ratio
 of the residual to it, and the largest effect a candidate would take out."""
+
 from types import SimpleNamespace
 
 import numpy as np
@@ -14,7 +15,7 @@ def _fit(r, time=True):
     r = np.asarray(r, float)
     n = r.shape[0]
     data = pd.DataFrame({"time_s": np.arange(n) * 0.1} if time else {"x": np.zeros(n)})
-    return SimpleNamespace(data=data, residuals=r.ravel(), rss=float(np.sum(r ** 2)), n=r.size)
+    return SimpleNamespace(data=data, residuals=r.ravel(), rss=float(np.sum(r**2)), n=r.size)
 
 
 @pytest.mark.parametrize("phi", [0.0, 0.5, 0.9])
@@ -47,7 +48,7 @@ def test_a_candidate_that_takes_out_much_is_named():
     rng = np.random.default_rng(4)
     r = rng.normal(size=(500, 1))
     f = _fit(r)
-    big = SimpleNamespace(rss=f.rss - 500 * 25.0)         # takes out 5 rms, 5 times s_short (about 1)
+    big = SimpleNamespace(rss=f.rss - 500 * 25.0)  # takes out 5 rms, 5 times s_short (about 1)
     small = SimpleNamespace(rss=f.rss - 500 * 0.01)
     got = ns.noise_size(f, {"small": small, "big": big}, "deg")
     assert got.biggest == "big" and got.explained == pytest.approx(5.0)
@@ -57,7 +58,7 @@ def test_a_candidate_that_takes_out_much_is_named():
 
 def test_short_tables_are_not_checked():
     assert ns.noise_size(_fit(np.ones((ns.MIN_ROWS - 1, 1))), {}, "uT") is None
-    assert ns.noise_size(_fit(np.ones((100, 1))), {}, "uT") is None        # no short-lag spread
+    assert ns.noise_size(_fit(np.ones((100, 1))), {}, "uT") is None  # no short-lag spread
 
 
 def _corrupted(seed: int, deg: float):
@@ -65,14 +66,22 @@ def _corrupted(seed: int, deg: float):
     ``deg`` in six 15-s segments (a smooth bump about a random axis each)."""
     from scipy.spatial.transform import Rotation
     from navlib.workbench.magnetometer import QUAT, simulate_hand_turned
+
     d = simulate_hand_turned({"hard_x_ut": 3.0}, duration_s=150.0, noise_ut=0.3, seed=seed)
     rng = np.random.default_rng([seed, 7])
     n = len(d)
     err = np.zeros((n, 3))
     for start in rng.choice(n - 200, 6, replace=False):
         axis = rng.normal(size=3)
-        err[start:start + 150] += np.radians(deg) * np.sin(np.linspace(0, np.pi, 150))[:, None] * axis / np.linalg.norm(axis)
-    q = (Rotation.from_quat(d[list(QUAT)].to_numpy()[:, [1, 2, 3, 0]]) * Rotation.from_rotvec(err)).as_quat()
+        err[start : start + 150] += (
+            np.radians(deg)
+            * np.sin(np.linspace(0, np.pi, 150))[:, None]
+            * axis
+            / np.linalg.norm(axis)
+        )
+    q = (
+        Rotation.from_quat(d[list(QUAT)].to_numpy()[:, [1, 2, 3, 0]]) * Rotation.from_rotvec(err)
+    ).as_quat()
     q = q[:, [3, 0, 1, 2]] * np.where(q[:, 3:4] < 0, -1.0, 1.0)
     d[list(QUAT)] = q
     return d
@@ -85,6 +94,7 @@ def test_a_reference_corrupted_in_segments_is_not_called_noise(seed):
     noise".  Up to 20 deg of attitude error (15 uT of field) in 60 % of the recording; the same recording
     with a good reference ends consistent with noise."""
     from navlib.workbench.loop import loop
+
     bad = loop("magnetometer", _corrupted(seed, 20.0))
     assert not bad.consistent_with_noise
     good = loop("magnetometer", _corrupted(seed, 0.0))

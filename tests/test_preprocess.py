@@ -1,12 +1,18 @@
 """Tests for navlib.methods.preprocess (patent B data preparation) and navlib.methods.scaling (min-max normalisation)."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from navlib.errors import InputError
-from navlib.methods.preprocess import (dot_product_screen, field_gravity_dot, median_filter,
-    reject_dot_product_outliers, train_test_split)
+from navlib.methods.preprocess import (
+    dot_product_screen,
+    field_gravity_dot,
+    median_filter,
+    reject_dot_product_outliers,
+    train_test_split,
+)
 from navlib.methods.scaling import MinMax
 
 
@@ -16,8 +22,8 @@ def sweep_readings(n: int = 121, seed: int = 0):
     rng = np.random.default_rng(seed)
     h = np.deg2rad(np.linspace(0.0, 360.0, n))
     dip = np.deg2rad(60.0)
-    f = 50.0 * np.array([np.cos(dip), 0.0, np.sin(dip)])           # NED field, uT
-    rot = np.zeros((n, 3, 3))                                       # sensor <- NED, yaw only
+    f = 50.0 * np.array([np.cos(dip), 0.0, np.sin(dip)])  # NED field, uT
+    rot = np.zeros((n, 3, 3))  # sensor <- NED, yaw only
     rot[:, 0, 0], rot[:, 0, 1] = np.cos(h), np.sin(h)
     rot[:, 1, 0], rot[:, 1, 1] = -np.sin(h), np.cos(h)
     rot[:, 2, 2] = 1.0
@@ -30,10 +36,10 @@ def sweep_readings(n: int = 121, seed: int = 0):
 def test_glitch_filter_rejects_injected_glitches_and_keeps_clean_readings():
     mag, grav = sweep_readings()
     clean = reject_dot_product_outliers(mag, grav)
-    assert clean.all()                                  # the soft-iron variation is not "abnormal"
-    mag[37, 2] += 15.0                                  # magnetometer spike
-    grav[80] = [4.0, 0.0, 8.96]                         # accelerometer shock (same |g|, tilted)
-    mag[100] *= 0.6                                     # field magnitude dropout
+    assert clean.all()  # the soft-iron variation is not "abnormal"
+    mag[37, 2] += 15.0  # magnetometer spike
+    grav[80] = [4.0, 0.0, 8.96]  # accelerometer shock (same |g|, tilted)
+    mag[100] *= 0.6  # field magnitude dropout
     keep = reject_dot_product_outliers(mag, grav)
     assert np.flatnonzero(~keep).tolist() == [37, 80, 100]
     keep_cos = reject_dot_product_outliers(mag, grav, normalize=True)
@@ -89,31 +95,34 @@ def test_median_filter_columns_and_edges():
     # nearest: sample 0 sees [v0, v0, v0, v1, v2]
     v = np.array([10.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
     assert median_filter(v, 5)[0] == 10.0
-    assert median_filter(v, 5, mode="wrap")[0] == 5.0           # sees [5, 6, 10, 1, 2]
+    assert median_filter(v, 5, mode="wrap")[0] == 5.0  # sees [5, 6, 10, 1, 2]
 
 
 def test_median_filter_closed_sweep():
     # a full revolution sampled at both 0 and 360 deg: the ring has period n - 1
     h = np.linspace(0.0, 2 * np.pi, 121)
     v = np.cos(h)
-    v[0] += 5.0                                                 # glitch on the 0 deg reading
+    v[0] += 5.0  # glitch on the 0 deg reading
     out = median_filter(v, 5, mode="closed")
     ring = np.cos(h[:-1])
     ring[0] += 5.0
     ref = median_filter(ring, 5, mode="wrap")
     np.testing.assert_allclose(out[:-1], ref, atol=1e-15)
-    assert abs(out[0] - 1.0) < 0.01                             # glitch removed
+    assert abs(out[0] - 1.0) < 0.01  # glitch removed
     # the 360 deg reading's window is [v118, v119, v120, v1, v2]: it never sees its own glitch twin
     assert out[-1] == np.median(v[[118, 119, 120, 1, 2]])
 
 
-@pytest.mark.parametrize("kwargs, word", [
-    (dict(window=4), "window"),
-    (dict(window=0), "window"),
-    (dict(window=2.5), "window"),
-    (dict(window=3, mode="circular"), "mode"),
-    (dict(window=121, mode="closed"), "window"),
-])
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [
+        (dict(window=4), "window"),
+        (dict(window=0), "window"),
+        (dict(window=2.5), "window"),
+        (dict(window=3, mode="circular"), "mode"),
+        (dict(window=121, mode="closed"), "window"),
+    ],
+)
 def test_median_filter_bad_params(kwargs, word):
     with pytest.raises(InputError, match=word):
         median_filter(np.arange(121.0), **kwargs)
@@ -140,8 +149,12 @@ def test_train_test_split():
     np.testing.assert_array_equal(te, te2)
     assert not np.array_equal(te, train_test_split(121, 0.9, rng=4)[1])
     assert [a.size for a in train_test_split(2, 0.99, rng=0)] == [1, 1]
-    for kwargs, word in ((dict(n=1), "n"), (dict(n=10, frac=1.0), "frac"),
-                         (dict(n=10, frac=0.0), "frac"), (dict(n=10, rng=-2), "seed")):
+    for kwargs, word in (
+        (dict(n=1), "n"),
+        (dict(n=10, frac=1.0), "frac"),
+        (dict(n=10, frac=0.0), "frac"),
+        (dict(n=10, rng=-2), "seed"),
+    ):
         with pytest.raises(InputError, match=word):
             train_test_split(**kwargs)
 
@@ -156,7 +169,7 @@ def test_minmax_roundtrip_and_errors():
     one = MinMax.fit(v[:, 0])
     assert one.transform(v[:, 0]).shape == (50,)
     np.testing.assert_allclose(one.transform(v[:, 0]), z[:, 0])
-    assert one.transform(one.hi[0] + one.span[0]) == pytest.approx(2.0)   # no clipping
+    assert one.transform(one.hi[0] + one.span[0]) == pytest.approx(2.0)  # no clipping
     np.testing.assert_allclose(one.inverse_scale(np.array([0.5])), 0.5 * one.span)
     with pytest.raises(InputError, match="column 1 is constant"):
         MinMax.fit(np.column_stack([v[:, 0], np.ones(50)]))

@@ -1,4 +1,5 @@
 """navlib.methods.rbf: MATLAB newrb / newrbe semantics."""
+
 import math
 
 import numpy as np
@@ -21,8 +22,8 @@ def test_spread_to_width_relation():
 
 def test_newrb_reproduces_known_target_exactly_with_enough_neurons():
     x = np.linspace(-2, 2, 9)
-    t = np.sin(1.3 * x) + 0.2 * x ** 2
-    net = newrb(x, t, goal=0.0, spread=1.0)          # goal 0 is never met strictly: all 9 neurons
+    t = np.sin(1.3 * x) + 0.2 * x**2
+    net = newrb(x, t, goal=0.0, spread=1.0)  # goal 0 is never met strictly: all 9 neurons
     assert net.n_neurons == 9
     assert np.max(np.abs(net.predict(x) - t)) < 1e-9
     assert net.perf_mse[-1] < 1e-18
@@ -113,10 +114,17 @@ def test_multi_input_and_multi_output():
     assert np.max(np.abs(net.predict(x) - t)) < 1e-6
 
 
-@pytest.mark.parametrize("kwargs, fragment", [
-    (dict(spread=0.0), "SPREAD"), (dict(spread=-1.0), "SPREAD"), (dict(spread=float("nan")), "SPREAD"),
-    (dict(goal=-1e-9), "goal"), (dict(goal_kind="rms"), "goal_kind"), (dict(max_neurons=0), "max_neurons"),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragment",
+    [
+        (dict(spread=0.0), "SPREAD"),
+        (dict(spread=-1.0), "SPREAD"),
+        (dict(spread=float("nan")), "SPREAD"),
+        (dict(goal=-1e-9), "goal"),
+        (dict(goal_kind="rms"), "goal_kind"),
+        (dict(max_neurons=0), "max_neurons"),
+    ],
+)
 def test_bad_parameters(kwargs, fragment):
     with pytest.raises(InputError, match=fragment):
         newrb([0.0, 1.0, 2.0], [0.0, 1.0, 0.0], **kwargs)
@@ -141,14 +149,17 @@ def test_radbas():
 
 def test_gaussian_width_conversion_matches_matlab_radbas():
     from navlib.methods.rbf import LN2_SQRT, radbas, spread_from_gaussian_width, width_from_spread
+
     delta = 2.0
     sp = spread_from_gaussian_width(delta)
     assert sp == pytest.approx(0.8326 * delta, rel=1e-4)
-    b = width_from_spread(sp)                 # newrb's bias 0.8326 / SPREAD
+    b = width_from_spread(sp)  # newrb's bias 0.8326 / SPREAD
     assert b == pytest.approx(1.0 / delta)
     u = np.linspace(-5, 5, 11)
-    assert np.allclose(radbas(b * u), np.exp(-u ** 2 / delta ** 2))
-    assert radbas(np.array(1.0)) == pytest.approx(math.exp(-1.0))           # radbas(n) = exp(-n^2)
-    assert radbas(LN2_SQRT / 3.0 * np.array(3.0)) == pytest.approx(0.5)      # MATLAB: 0.5 at distance SPREAD
+    assert np.allclose(radbas(b * u), np.exp(-(u**2) / delta**2))
+    assert radbas(np.array(1.0)) == pytest.approx(math.exp(-1.0))  # radbas(n) = exp(-n^2)
+    assert radbas(LN2_SQRT / 3.0 * np.array(3.0)) == pytest.approx(
+        0.5
+    )  # MATLAB: 0.5 at distance SPREAD
     with pytest.raises(InputError, match="delta"):
         spread_from_gaussian_width(0.0)

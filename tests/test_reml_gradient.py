@@ -1,5 +1,6 @@
 """Issue 34: the vectorised REML likelihood of the AR noise model and its analytic gradient
 (navlib.workbench.reml), against the direct likelihood and finite differences."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -12,11 +13,17 @@ def _series(seed=4, rows=200, axes=3, drop=0.03):
     rng = np.random.default_rng(seed)
     t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], rows))
     n = rows * axes
-    return serial.series_of(pd.DataFrame({"time_s": t}), n, "magnetometer").without(rng.random(n) < drop), n
+    return serial.series_of(pd.DataFrame({"time_s": t}), n, "magnetometer").without(
+        rng.random(n) < drop
+    ), n
 
 
 def _basis(ser, n, k, seed=5):
-    return serial.basis_on(np.random.default_rng(seed).standard_normal((n, k)), ser, n) if k else np.zeros((n, 0))
+    return (
+        serial.basis_on(np.random.default_rng(seed).standard_normal((n, k)), ser, n)
+        if k
+        else np.zeros((n, 0))
+    )
 
 
 KAPPAS = [(0.6,), (0.8, -0.3), (0.2, 0.3, -0.4), (-0.7,), (0.95, 0.5, 0.1)]
@@ -25,11 +32,15 @@ KAPPAS = [(0.6,), (0.8, -0.3), (0.2, 0.3, -0.4), (-0.7,), (0.95, 0.5, 0.1)]
 @pytest.mark.parametrize("kappa", [(0.5,), (0.5, -0.3), (0.5, -0.3, 0.7), (0.9, 0.8, -0.9, 0.4)])
 def test_levinson_derivatives_are_those_of_the_recursion(kappa):
     phi, v, dphi, dv = reml.levinson_derivatives(kappa)
-    assert np.array_equal(phi, reml.levinson(kappa)[0]) and np.array_equal(v, reml.levinson(kappa)[1])
+    assert np.array_equal(phi, reml.levinson(kappa)[0]) and np.array_equal(
+        v, reml.levinson(kappa)[1]
+    )
     h = 1e-6
     for j in range(len(kappa)):
-        up, down = reml.levinson(np.add(kappa, h * np.eye(len(kappa))[j])), \
-            reml.levinson(np.subtract(kappa, h * np.eye(len(kappa))[j]))
+        up, down = (
+            reml.levinson(np.add(kappa, h * np.eye(len(kappa))[j])),
+            reml.levinson(np.subtract(kappa, h * np.eye(len(kappa))[j])),
+        )
         assert np.allclose(dphi[j], (up[0] - down[0]) / (2 * h), atol=1e-8)
         assert np.allclose(dv[j], (up[1] - down[1]) / (2 * h), atol=1e-8)
 
@@ -55,21 +66,31 @@ def test_the_gradient_equals_finite_differences_of_the_likelihood(k, order):
     the parts' too (a bootstrap's parts serve every order up to theirs)."""
     ser, n = _series(seed=8)
     Q = _basis(ser, n, k, seed=9)
-    r = serial.colour(np.random.default_rng(10).standard_normal(len(ser.order)), (0.6, 0.3), ser, n) \
-        + Q @ np.ones(k)
+    r = serial.colour(
+        np.random.default_rng(10).standard_normal(len(ser.order)), (0.6, 0.3), ser, n
+    ) + Q @ np.ones(k)
     lik = reml._Restricted(r, Q, ser, 3)
     h = 1e-6
     for kappa in [kp for kp in KAPPAS if len(kp) == order]:
         _, grad = lik.value_and_gradient(kappa)
-        fd = [(lik(np.add(kappa, h * e)) - lik(np.subtract(kappa, h * e))) / (2 * h) for e in np.eye(order)]
-        assert np.allclose(grad, fd, rtol=1e-5, atol=1e-4 * max(1.0, np.max(np.abs(fd)))), (kappa, grad, fd)
+        fd = [
+            (lik(np.add(kappa, h * e)) - lik(np.subtract(kappa, h * e))) / (2 * h)
+            for e in np.eye(order)
+        ]
+        assert np.allclose(grad, fd, rtol=1e-5, atol=1e-4 * max(1.0, np.max(np.abs(fd)))), (
+            kappa,
+            grad,
+            fd,
+        )
 
 
 def test_the_optimisers_objective_is_in_atanh_kappa():
     """What L-BFGS-B minimises: ``-l_R(tanh a)`` and its gradient in ``a``."""
     ser, n = _series(seed=11)
     Q = _basis(ser, n, 5, seed=12)
-    r = serial.colour(np.random.default_rng(13).standard_normal(len(ser.order)), (0.8, -0.2, 0.1), ser, n)
+    r = serial.colour(
+        np.random.default_rng(13).standard_normal(len(ser.order)), (0.8, -0.2, 0.1), ser, n
+    )
     fun, jac = serial._objective(reml._Restricted(r, Q, ser, 3))
     assert jac is True
     a = np.arctanh([0.7, -0.1, 0.2])
@@ -85,7 +106,9 @@ def test_the_estimate_with_the_analytic_gradient_is_the_maximum():
     no direction of ``kappa`` raises it by more than the optimiser's tolerance."""
     ser, n = _series(seed=14, rows=400)
     X = np.random.default_rng(15).standard_normal((n, 4))
-    r = serial.colour(np.random.default_rng(16).standard_normal(len(ser.order)), (0.6, 0.3, 0.2), ser, n)
+    r = serial.colour(
+        np.random.default_rng(16).standard_normal(len(ser.order)), (0.6, 0.3, 0.2), ser, n
+    )
     nm = serial.estimate(r, X, ser, order=3, interval=False, start_at=(0.5, 0.2, 0.1))
     lik = reml._Restricted(r, serial.basis_on(X, ser, n), ser, 3)
     best = lik(nm.kappa)

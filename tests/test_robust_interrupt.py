@@ -1,6 +1,7 @@
 """Ctrl-C (issue 35, item 5): the command line prints one line ("interrupted") and exits 130 instead of a
 traceback; an output folder it stopped half-written keeps its marker saying it is incomplete (and the line
 names it), a folder nothing was written into yet is removed again.  ``--debug`` lets the traceback through."""
+
 import os
 import signal
 import subprocess
@@ -23,7 +24,9 @@ def _ctrl_c_as_at_a_terminal():
     test &``, CI runners) with SIGINT ignored, the ignoring is inherited, and Python then installs no
     KeyboardInterrupt handler: the command would rightly sleep through the signal.  Likewise a blocked signal."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})     # and not blocked either (also inherited)
+    signal.pthread_sigmask(
+        signal.SIG_UNBLOCK, {signal.SIGINT}
+    )  # and not blocked either (also inherited)
 
 
 def _wait_for(path, proc, timeout_s=120.0):
@@ -37,21 +40,46 @@ def _wait_for(path, proc, timeout_s=120.0):
         time.sleep(0.05)
 
 
-@pytest.mark.parametrize("values, wait_for, left", [
-    ("60", grid.MARKER, None),                                      # interrupted in the first run: no folder
-    ("0.1,60", "slow_001.ipynb", [grid.MARKER, "slow_001.ipynb"]),  # after one run: marked incomplete
-])
+@pytest.mark.parametrize(
+    "values, wait_for, left",
+    [
+        ("60", grid.MARKER, None),  # interrupted in the first run: no folder
+        (
+            "0.1,60",
+            "slow_001.ipynb",
+            [grid.MARKER, "slow_001.ipynb"],
+        ),  # after one run: marked incomplete
+    ],
+)
 @pytest.mark.slow
 def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, wait_for, left):
     pytest.importorskip("papermill")
     nb = tiny_notebook(tmp_path / "slow.ipynb", parameters="n = 1.0", body=SLOW)
     out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-m", "navbook", "grid", str(nb), "--param", f"n={values}", "--out", str(out),
-                          "--workers", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV,
-                         start_new_session=True, preexec_fn=_ctrl_c_as_at_a_terminal)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "navbook",
+            "grid",
+            str(nb),
+            "--param",
+            f"n={values}",
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=ENV,
+        start_new_session=True,
+        preexec_fn=_ctrl_c_as_at_a_terminal,
+    )
     try:
         _wait_for(out / wait_for, p)
-        os.killpg(p.pid, signal.SIGINT)                  # as a terminal's Ctrl-C: the kernel gets it too
+        os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the kernel gets it too
         _, err = p.communicate(timeout=120)
     finally:
         if p.poll() is None:
@@ -60,7 +88,9 @@ def test_sigint_to_a_running_grid_is_one_line_and_status_130(tmp_path, values, w
     if left is None:
         assert err.strip() == "navbook grid: interrupted" and not out.exists()
     else:
-        assert err.strip() == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)"
+        assert (
+            err.strip() == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)"
+        )
         assert sorted(x.name for x in out.iterdir()) == left and not (out / "grid.csv").exists()
         assert "interrupted (Ctrl-C)" in (out / grid.MARKER).read_text()
 
@@ -80,11 +110,26 @@ def test_keyboard_interrupt_in_process(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(grid, "run_point", second_interrupted)
     args = ["grid", str(nb), "--param", "n=1,2", "--out", str(out), "--workers", "1"]
     assert book_cli.main(args) == 130
-    assert capsys.readouterr().err == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)\n"
+    assert (
+        capsys.readouterr().err
+        == f"navbook grid: interrupted; {out} is incomplete ({grid.MARKER} says so)\n"
+    )
     # --debug: the traceback shows where it was
     calls.clear()
     with pytest.raises(KeyboardInterrupt):
-        book_cli.main(["--debug", "grid", str(nb), "--param", "n=1,2", "--out", str(tmp_path / "debug"), "--workers", "1"])
+        book_cli.main(
+            [
+                "--debug",
+                "grid",
+                str(nb),
+                "--param",
+                "n=1,2",
+                "--out",
+                str(tmp_path / "debug"),
+                "--workers",
+                "1",
+            ]
+        )
 
 
 def test_an_interrupted_loop_leaves_no_report_folder(tmp_path, monkeypatch, capsys):
@@ -97,7 +142,9 @@ def test_an_interrupted_loop_leaves_no_report_folder(tmp_path, monkeypatch, caps
     monkeypatch.setattr(commands, "loop", interrupted)
     capsys.readouterr()
     assert cli.main(["loop", "compass", str(src), "--report", str(tmp_path / "rep")]) == 130
-    assert capsys.readouterr().err == "navlib loop: interrupted\n" and not (tmp_path / "rep").exists()
+    assert (
+        capsys.readouterr().err == "navlib loop: interrupted\n" and not (tmp_path / "rep").exists()
+    )
 
 
 def test_the_broad_converter_interrupted_is_one_line(tmp_path, monkeypatch, capsys):
@@ -121,7 +168,7 @@ def test_a_file_interrupted_while_written_is_removed(tmp_path, stop):
     with pytest.raises(stop):
         write_new(tmp_path / "out.csv", half)
     assert not (tmp_path / "out.csv").exists()
-    (tmp_path / "mine.csv").write_text("mine")                       # an existing file is still refused, kept
+    (tmp_path / "mine.csv").write_text("mine")  # an existing file is still refused, kept
     with pytest.raises(Exception, match="already exists"):
         write_new(tmp_path / "mine.csv", half)
     assert (tmp_path / "mine.csv").read_text() == "mine"

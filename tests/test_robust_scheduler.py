@@ -2,6 +2,7 @@
 item 2): a port that accepts and never answers, one that answers random bytes or another protocol, one that
 hangs up.  The servers are started here on 127.0.0.1 and stopped after each test; the probe's timeout is set
 small (``engine.PROBE_TIMEOUT_S``), so the bound checked is generous."""
+
 import json
 import os
 import socket
@@ -18,7 +19,7 @@ from navlib import cli, engine
 from navlib.errors import InputError
 
 SMALL_TIMEOUT_S = 0.5
-BOUND_S = 15.0                       # the brief's bound for the default timeouts; the small one is far below
+BOUND_S = 15.0  # the brief's bound for the default timeouts; the small one is far below
 
 
 class Server:
@@ -54,7 +55,7 @@ class Server:
 
 
 def _silent(conn):
-    pass                                             # keeps the connection open, says nothing
+    pass  # keeps the connection open, says nothing
 
 
 def _bytes(data):
@@ -67,10 +68,19 @@ def _hang_up(conn):
 
 ANSWERS = {
     "silent": (_silent, "sent no dask handshake within 0.5 s"),
-    "random bytes": (_bytes(np.random.default_rng(35).bytes(64)), "not dask's handshake (a first message of"),
-    "http": (_bytes(b"HTTP/1.1 400 Bad Request\r\n\r\n"), "not dask's handshake (a first message of"),
-    "frames that do not add up": (_bytes(struct.pack("QQQ", 40, 1, 1000) + bytes(24)), "do not add up"),
-    "too many frames": (_bytes(struct.pack("QQ", 40, 10 ** 9) + bytes(32)), "do not add up"),
+    "random bytes": (
+        _bytes(np.random.default_rng(35).bytes(64)),
+        "not dask's handshake (a first message of",
+    ),
+    "http": (
+        _bytes(b"HTTP/1.1 400 Bad Request\r\n\r\n"),
+        "not dask's handshake (a first message of",
+    ),
+    "frames that do not add up": (
+        _bytes(struct.pack("QQQ", 40, 1, 1000) + bytes(24)),
+        "do not add up",
+    ),
+    "too many frames": (_bytes(struct.pack("QQ", 40, 10**9) + bytes(32)), "do not add up"),
     "a few bytes, then silence": (_bytes(b"\x01\x02"), "sent no dask handshake within 0.5 s"),
     "hangs up": (_hang_up, "closed the connection without a dask handshake"),
 }
@@ -94,13 +104,15 @@ def small_timeout(monkeypatch):
 def test_a_peer_that_is_not_a_scheduler_is_one_line(server, small_timeout, capsys):
     says = server.says
     t0 = time.monotonic()
-    rc = cli.main(["rates", "drift", "--trials", "1", "--null-trials", "1", "--scheduler", server.address])
+    rc = cli.main(
+        ["rates", "drift", "--trials", "1", "--null-trials", "1", "--scheduler", server.address]
+    )
     took = time.monotonic() - t0
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1, err
     assert err.startswith(f"navlib rates: error: scheduler {server.address}: ") and says in err, err
     assert took < BOUND_S and server.accepted >= 1
-    assert not any(k[0] == "remote" for k in engine._CLIENTS)         # no client was left behind
+    assert not any(k[0] == "remote" for k in engine._CLIENTS)  # no client was left behind
 
 
 @pytest.mark.parametrize("server", ["silent"], indirect=True)
@@ -113,7 +125,7 @@ def test_the_default_timeouts_are_within_the_bound(server, monkeypatch):
 
 def test_a_closed_port_is_one_line(small_timeout, capsys):
     with socket.create_server(("127.0.0.1", 0)) as s:
-        port = s.getsockname()[1]                   # bound, then closed: nobody listens there
+        port = s.getsockname()[1]  # bound, then closed: nobody listens there
     rc = cli.main(["rates", "drift", "--trials", "1", "--scheduler", f"127.0.0.1:{port}"])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and "cannot connect" in err, err
@@ -122,15 +134,29 @@ def test_a_closed_port_is_one_line(small_timeout, capsys):
 def test_a_real_scheduler_passes_the_probe(tmp_path):
     sched_file = tmp_path / "scheduler.json"
     env = {k: v for k, v in os.environ.items() if k != engine.ENV_SCHEDULER}
-    p = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                          "--no-dashboard", "--scheduler-file", str(sched_file)], env=env,
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "distributed.cli.dask_scheduler",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            "0",
+            "--no-dashboard",
+            "--scheduler-file",
+            str(sched_file),
+        ],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         t0 = time.time()
         while not sched_file.exists() and time.time() - t0 < 60:
             time.sleep(0.1)
         address = json.loads(sched_file.read_text())["address"]
-        for _ in range(50):                          # the file is written as the scheduler starts listening
+        for _ in range(50):  # the file is written as the scheduler starts listening
             try:
                 engine.probe_scheduler(address)
                 break

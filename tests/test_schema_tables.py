@@ -1,6 +1,7 @@
 """The data dictionary of every workbench system (``columns_table``) lists exactly what its loader requires:
 each required column, dropped from a valid file, is refused by name; a file holding only the required columns
 loads."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -44,7 +45,7 @@ def test_table_lists_exactly_what_the_loader_requires(system, tmp_path):
     load = get_system(system).load
     path = tmp_path / "ok.csv"
     frame.to_csv(path, index=False)
-    load(path)                                            # the valid file loads
+    load(path)  # the valid file loads
     for col in required:
         p = tmp_path / f"without_{col}.csv"
         frame.drop(columns=[col]).to_csv(p, index=False)
@@ -52,17 +53,19 @@ def test_table_lists_exactly_what_the_loader_requires(system, tmp_path):
             load(p)
         assert f"'{col}'" in str(err.value) and "missing column" in str(err.value)
     only = tmp_path / "required_only.csv"
-    one = frame[frame["sweep"] == 1] if "sweep" in frame else frame       # without 'sweep': one sweep
+    one = frame[frame["sweep"] == 1] if "sweep" in frame else frame  # without 'sweep': one sweep
     one[required].to_csv(only, index=False)
-    load(only)                                            # nothing else is required
+    load(only)  # nothing else is required
 
 
 def test_the_table_is_the_loaders_own_schema():
     """Derived from the Column list, not typed twice: a new column shows up in the table."""
-    cols = (Column("a_deg", "deg", lo=0, hi=360, meaning="an angle"),
-            Column("n", "", required=False, lo=0, integer=True, meaning="a count"),
-            Column("who", required=True, text=True, meaning="a name"),
-            Column("x", "uT", required=False, checked=False, meaning="information"))
+    cols = (
+        Column("a_deg", "deg", lo=0, hi=360, meaning="an angle"),
+        Column("n", "", required=False, lo=0, integer=True, meaning="a count"),
+        Column("who", required=True, text=True, meaning="a name"),
+        Column("x", "uT", required=False, checked=False, meaning="information"),
+    )
     t = schema_table(cols)
     assert t["column"].tolist() == ["a_deg", "n", "who", "x"]
     assert t["required"].tolist() == ["yes", "no", "yes", "no"]
@@ -85,6 +88,7 @@ def test_text_column_kept_as_text_and_required(tmp_path):
 def test_system_without_schema_is_named():
     from dataclasses import replace
     from navlib.workbench.effects import register_system, SYSTEMS as REG
+
     s = replace(get_system("drift"), name="drift_noschema", columns=())
     register_system(s)
     try:
@@ -100,37 +104,54 @@ def test_a_table_over_the_row_limit_is_refused_before_it_is_parsed(tmp_path, mon
     a file over MAX_ROWS is refused by name, its line count and the limit, before any parsing."""
     import navlib.data.tables as T
     from navlib.errors import InputError
+
     cols = [T.Column("x", "-", "a number")]
     ok, big = tmp_path / "ok.csv", tmp_path / "big.csv"
     ok.write_text("x\n" + "1\n" * 50)
     big.write_text("x\n" + "1\n" * 51)
     monkeypatch.setattr(T, "_parse", lambda *a: (_ for _ in ()).throw(AssertionError("parsed")))
-    with pytest.raises(InputError, match=r"big.csv: 51 lines after the header; navlib reads at most 50 rows"):
+    with pytest.raises(
+        InputError, match=r"big.csv: 51 lines after the header; navlib reads at most 50 rows"
+    ):
         T.read_table(big, cols, max_rows=50)
     monkeypatch.undo()
     assert len(T.read_table(ok, cols, max_rows=50)) == 50
     assert len(T.read_table(big, cols, max_rows=None)) == 51
     no_newline = tmp_path / "last.csv"
-    no_newline.write_text("x\n" + "1\n" * 49 + "1")            # 50 rows, no final newline
+    no_newline.write_text("x\n" + "1\n" * 49 + "1")  # 50 rows, no final newline
     assert len(T.read_table(no_newline, cols, max_rows=50)) == 50
     utf16 = tmp_path / "u16.csv"
     utf16.write_bytes(("x\n" + "1\n" * 51).encode("utf-16"))
     with pytest.raises(InputError, match="51 lines"):
         T.read_table(utf16, cols, max_rows=50)
-    assert T.MAX_ROWS >= 100_000                                 # the 100k-row compass benchmark still loads
+    assert T.MAX_ROWS >= 100_000  # the 100k-row compass benchmark still loads
 
 
 def test_the_cli_refuses_a_two_million_row_file_in_one_line(tmp_path):
     import subprocess
     import sys
     from navlib.paths import ROOT
+
     p = tmp_path / "huge.csv"
     with open(p, "w") as fh:
         fh.write("mag_x_ut,mag_y_ut,mag_z_ut\n")
         fh.write("20.0,1.0,40.0\n" * 2_000_000)
-    r = subprocess.run([sys.executable, "-m", "navlib", "calibrate", "magnetometer", str(p), "--out",
-                        str(tmp_path / "cal.json")], capture_output=True, text=True, timeout=120,
-                       env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin", "OPENBLAS_NUM_THREADS": "1"})
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "navlib",
+            "calibrate",
+            "magnetometer",
+            str(p),
+            "--out",
+            str(tmp_path / "cal.json"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin", "OPENBLAS_NUM_THREADS": "1"},
+    )
     assert r.returncode == 2 and r.stderr.count("\n") == 1
     assert "huge.csv: 2,000,000 lines after the header; navlib reads at most" in r.stderr
     assert not (tmp_path / "cal.json").exists()

@@ -12,8 +12,8 @@ def smith_curve(h, coef):
 
 def test_smith_exact_on_noiseless_smith_data():
     coef = [1.2, 8.0, -3.0, 1.5, -0.7]
-    m = np.arange(0, 360, 45.0)                 # the 8 positions, in compass (measured) heading
-    t = m - smith_curve(m, coef)                # deviation = measured - true
+    m = np.arange(0, 360, 45.0)  # the 8 positions, in compass (measured) heading
+    t = m - smith_curve(m, coef)  # deviation = measured - true
     model = fit_smith(m, t)
     assert np.allclose(model.coef, coef, atol=1e-10)
     assert np.allclose(wrap_deg(model.correct(m) - t), 0, atol=1e-10)

@@ -1,5 +1,6 @@
 """Subtractive clustering (MATLAB subclust) on hand-traced cases, genfis2, Sugeno inference against simpful,
 and ANFIS's gradient and step-size rule."""
+
 import math
 
 import numpy as np
@@ -37,7 +38,7 @@ def test_grey_zone_rejected_then_exhausted():
     C, _, trace = subclust(X, 0.5, bounds=[[0.0], [1.0]], return_trace=True)
     p0 = 4 + 2 * math.exp(-1.44)
     p3 = 2 + 4 * math.exp(-1.44) - p0 * math.exp(-4 * (0.3 / 0.625) ** 2)
-    assert 0.15 < p3 / p0 < 0.5 and p3 / p0 + 0.6 < 1          # the hand trace itself
+    assert 0.15 < p3 / p0 < 0.5 and p3 / p0 + 0.6 < 1  # the hand trace itself
     assert trace == ["accept", "grey-reject", "grey-reject", "exhausted"]
     np.testing.assert_allclose(C[:, 0], [0.0])
 
@@ -57,8 +58,10 @@ def test_radius_per_dimension_and_data_units():
     np.testing.assert_allclose(np.sort(C[:, 0]), [10.0, 20.0])
 
 
-@pytest.mark.parametrize("kwargs, word", [(dict(radii=0.0), "radii"), (dict(radii=[0.5, 0.5, 0.5]), "radii"),
-                                          (dict(radii=-1), "radii")])
+@pytest.mark.parametrize(
+    "kwargs, word",
+    [(dict(radii=0.0), "radii"), (dict(radii=[0.5, 0.5, 0.5]), "radii"), (dict(radii=-1), "radii")],
+)
 def test_subclust_bad_radii(kwargs, word):
     with pytest.raises(InputError, match=word):
         subclust(np.random.default_rng(0).random((5, 2)), **kwargs)
@@ -96,7 +99,7 @@ def test_genfis2_inference_equals_simpful():
 def test_genfis2_consequents_are_the_least_squares_solution():
     rng = np.random.default_rng(4)
     X = rng.uniform(0, 1, (40, 2))
-    y = 3 * X[:, 0] - 2 * X[:, 1] + 0.5       # linear: any rule base reproduces it exactly
+    y = 3 * X[:, 0] - 2 * X[:, 1] + 0.5  # linear: any rule base reproduces it exactly
     fis = genfis2(X, y, 0.6)
     np.testing.assert_allclose(fis(X), y, atol=1e-9)
 
@@ -110,8 +113,9 @@ def test_premise_gradient_matches_finite_differences():
 
     def sse(c, s):
         return float(np.sum((SugenoFIS(c, s, fis.consequents)(X) - t) ** 2))
+
     h = 1e-6
-    for (r, i) in [(0, 0), (fis.n_rules - 1, 1)]:
+    for r, i in [(0, 0), (fis.n_rules - 1, 1)]:
         dc = np.zeros_like(fis.centers)
         dc[r, i] = h
         num_c = (sse(fis.centers + dc, fis.sigmas) - sse(fis.centers - dc, fis.sigmas)) / (2 * h)
@@ -120,14 +124,17 @@ def test_premise_gradient_matches_finite_differences():
         assert gs[r, i] == pytest.approx(num_s, rel=1e-5, abs=1e-9)
 
 
-@pytest.mark.parametrize("errors, factor", [
-    ([5, 4, 3, 2, 1], 1.1),            # four consecutive decreases
-    ([9, 5, 4, 3, 2, 1], 1.1),         # the window slides
-    ([1, 2, 1, 2, 1], 0.9),            # up-down-up-down: two oscillations
-    ([5, 4, 3, 2, 2.5], 1.0),          # neither
-    ([2, 1, 2, 1, 0.5], 1.0),          # down-up-down-down: neither
-    ([4, 3, 2, 1], 1.0),               # too short
-])
+@pytest.mark.parametrize(
+    "errors, factor",
+    [
+        ([5, 4, 3, 2, 1], 1.1),  # four consecutive decreases
+        ([9, 5, 4, 3, 2, 1], 1.1),  # the window slides
+        ([1, 2, 1, 2, 1], 0.9),  # up-down-up-down: two oscillations
+        ([5, 4, 3, 2, 2.5], 1.0),  # neither
+        ([2, 1, 2, 1, 0.5], 1.0),  # down-up-down-down: neither
+        ([4, 3, 2, 1], 1.0),  # too short
+    ],
+)
 def test_step_size_rule(errors, factor):
     assert update_step(errors, 0.01) == pytest.approx(0.01 * factor)
 
@@ -142,15 +149,22 @@ def test_anfis_applies_the_rule_and_returns_the_best_checking_epoch():
     ss = 0.01
     for k in range(len(res.train_rmse)):
         assert res.step_sizes[k] == pytest.approx(ss)
-        ss = update_step(res.train_rmse[:k + 1], ss)
+        ss = update_step(res.train_rmse[: k + 1], ss)
     assert res.best_epoch == int(np.argmin(res.check_rmse))
     best = np.sqrt(np.mean((res.fis(Xc) - tc) ** 2))
     assert best == pytest.approx(res.check_rmse.min(), rel=1e-9)
     assert res.train_rmse[-1] < res.train_rmse[0]
 
 
-@pytest.mark.parametrize("kw, word", [(dict(epochs=0), "epochs"), (dict(epochs=2.5), "epochs"),
-                                      (dict(initial_step=0), "initial_step"), (dict(step_decrease=1.5), "step_decrease")])
+@pytest.mark.parametrize(
+    "kw, word",
+    [
+        (dict(epochs=0), "epochs"),
+        (dict(epochs=2.5), "epochs"),
+        (dict(initial_step=0), "initial_step"),
+        (dict(step_decrease=1.5), "step_decrease"),
+    ],
+)
 def test_anfis_bad_options(kw, word):
     with pytest.raises(InputError, match=word):
         AnfisOptions(**kw)

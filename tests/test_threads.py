@@ -1,4 +1,5 @@
 """One BLAS thread inside the workbench's entry points for library calls (navlib.threads, issue 34)."""
+
 import contextlib
 
 import numpy as np
@@ -26,7 +27,7 @@ def test_the_limit_applies_inside_and_is_lifted_after(no_thread_variables):
     if not blas_threads():
         pytest.skip("no BLAS library loaded that threadpoolctl controls")
     np.ones((2, 2)) @ np.ones((2, 2))
-    with threadpool_limits(limits=2, user_api="blas"):      # a caller's session with two BLAS threads
+    with threadpool_limits(limits=2, user_api="blas"):  # a caller's session with two BLAS threads
         outside = blas_threads()
         seen = threads.one_blas_thread(blas_threads)()
         assert seen == {1}
@@ -35,7 +36,9 @@ def test_the_limit_applies_inside_and_is_lifted_after(no_thread_variables):
 
 def test_a_thread_count_the_caller_chose_is_kept(monkeypatch):
     calls = []
-    monkeypatch.setattr(threads, "threadpool_limits", lambda **kw: calls.append(kw) or contextlib.nullcontext())
+    monkeypatch.setattr(
+        threads, "threadpool_limits", lambda **kw: calls.append(kw) or contextlib.nullcontext()
+    )
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")
     assert threads.one_blas_thread(lambda: 7)() == 7
     assert calls == []
@@ -44,7 +47,7 @@ def test_a_thread_count_the_caller_chose_is_kept(monkeypatch):
         monkeypatch.delenv(k, raising=False)
     nested = threads.one_blas_thread(threads.one_blas_thread(lambda: 8))
     assert nested() == 8
-    assert calls == [{"limits": 1, "user_api": "blas"}]       # nested calls set the limit once
+    assert calls == [{"limits": 1, "user_api": "blas"}]  # nested calls set the limit once
 
 
 @pytest.mark.parametrize("entry", [calibrate, diagnose, fit_model, loop])

@@ -4,6 +4,7 @@ covariance on small problems (irregular clocks with repeated times and gaps, a n
 regular clock, the bound KAPPA_MAX, several observations per time); the compiled kernels equal their
 plain-Python selves; the series is time-major; and on 50,000 observations the memory stays far below an
 n x n matrix's."""
+
 import json
 import subprocess
 import sys
@@ -42,9 +43,19 @@ def _dense_factor(kappa, ser):
 rng0 = np.random.default_rng(34)
 CASES = {
     # irregular clock: steps of 0.1 s with jitter, repeated times (one observation per row) and gaps
-    "irregular, repeated times, gaps": (0.8, np.cumsum(rng0.choice([0.0, 0.1, 0.13, 0.1, 0.9], 70)), 1, 0.0),
+    "irregular, repeated times, gaps": (
+        0.8,
+        np.cumsum(rng0.choice([0.0, 0.1, 0.13, 0.1, 0.9], 70)),
+        1,
+        0.0,
+    ),
     "irregular, two per row, left out": (0.9, np.cumsum(rng0.choice([0.1, 0.12, 0.5], 50)), 2, 0.1),
-    "negative kappa, regular clock": (-0.6, 0.1 * np.cumsum(rng0.choice([1, 1, 1, 2, 5], 60)), 2, 0.0),
+    "negative kappa, regular clock": (
+        -0.6,
+        0.1 * np.cumsum(rng0.choice([1, 1, 1, 2, 5], 60)),
+        2,
+        0.0,
+    ),
     "kappa at the bound": (serial.KAPPA_MAX, 0.1 * np.arange(60), 2, 0.0),
     "negative kappa at the bound": (-serial.KAPPA_MAX, 0.1 * np.arange(50), 1, 0.05),
     "three per row": (0.7, np.cumsum(rng0.choice([0.1, 0.2, 3.0], 40)), 3, 0.0),
@@ -85,28 +96,36 @@ def test_the_projected_likelihood_equals_the_dense_one(case):
     b = np.linalg.lstsq(wq, wr, rcond=None)[0]
     rss = float(np.sum((wr - wq @ b) ** 2))
     n, k = len(ser.order), 3
-    reml = -0.5 * ((n - k) * np.log(rss) + 2 * np.sum(np.log(np.diag(L))) + np.linalg.slogdet(wq.T @ wq)[1])
+    reml = -0.5 * (
+        (n - k) * np.log(rss) + 2 * np.sum(np.log(np.diag(L))) + np.linalg.slogdet(wq.T @ wq)[1]
+    )
     assert lik((kappa,)) == pytest.approx(reml, abs=1e-7)
 
 
 def test_the_compiled_kernels_equal_their_python_reference():
-    ser, n_obs = _projected(np.cumsum(np.random.default_rng(5).choice([0.0, 0.1, 0.3], 80)), 2, seed=6)
+    ser, n_obs = _projected(
+        np.cumsum(np.random.default_rng(5).choice([0.0, 0.1, 0.3], 80)), 2, seed=6
+    )
     pr = ser.projection
     phi = inn.propagation(0.93, pr.clock[ser.order])
     d = np.ascontiguousarray(pr.directions[ser.order])
     gain, sd = inn._gains(phi, d, 1e-10)
     gain_py, sd_py = inn._gains.py_func(phi, d, 1e-10)
-    assert np.allclose(gain, gain_py, rtol=1e-13, atol=0) and np.allclose(sd, sd_py, rtol=1e-13, atol=0)
+    assert np.allclose(gain, gain_py, rtol=1e-13, atol=0) and np.allclose(
+        sd, sd_py, rtol=1e-13, atol=0
+    )
     x = np.random.default_rng(7).standard_normal((len(phi), 5))
     for kernel in (inn._whiten, inn._colour):
-        assert np.allclose(kernel(phi, d, gain, sd, x), kernel.py_func(phi, d, gain, sd, x), rtol=1e-12, atol=1e-13)
+        assert np.allclose(
+            kernel(phi, d, gain, sd, x), kernel.py_func(phi, d, gain, sd, x), rtol=1e-12, atol=1e-13
+        )
 
 
 def test_a_projected_series_is_time_major():
     """Rows in time order, each row's observations together; segments start where the rows' did; leaving
     observations out keeps the time order; a series out of time order is refused by the filter."""
     t = np.r_[0.1 * np.arange(5), 5.0 + 0.1 * np.arange(4)]
-    data = pd.DataFrame({"time_s": t[::-1]})                    # file order reversed
+    data = pd.DataFrame({"time_s": t[::-1]})  # file order reversed
     ser = serial.with_projection(serial.series_of(data, 18, "magnetometer"), data, np.ones((18, 3)))
     rows = np.arange(9)[::-1]
     assert np.array_equal(ser.order, (rows[:, None] * 2 + np.arange(2)).ravel())
@@ -150,7 +169,9 @@ def test_whitening_and_the_likelihood_of_50000_observations_stay_linear_in_memor
     """50,000 observations (25,000 rows of two invariants): colouring, whitening 11 columns and the REML
     estimate together grow the process's peak memory by well under 200 MiB, where one n x n float matrix
     is 18.6 GiB (the dense factor's)."""
-    out = subprocess.run([sys.executable, "-c", _MEMORY, "25000"], capture_output=True, text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", _MEMORY, "25000"], capture_output=True, text=True, check=True
+    )
     res = json.loads(out.stdout.strip().splitlines()[-1])
     assert res["kib"] < 200 * 1024, res
     assert res["order"] == 1 and res["lag1"] == pytest.approx(0.9, abs=0.02)

@@ -1,5 +1,6 @@
 """Issue 18, statistics: outliers set aside before any test, the numerical floor, serially correlated
 samples (navlib.workbench.screen, navlib.workbench.serial)."""
+
 import json
 import subprocess
 import sys
@@ -52,7 +53,8 @@ def trial05_clean_loops(trial05):
 @REAL
 @pytest.mark.parametrize("value", [300.0, 1e10])
 def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_clean_answer(
-        trial05, trial05_clean_loops, value):
+    trial05, trial05_clean_loops, value
+):
     row = WILD_ROW
     spiked = trial05.copy()
     spiked.loc[row, "mag_x_ut"] = value
@@ -60,8 +62,10 @@ def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_
     assert diagnose(fit_model("magnetometer", spiked, []), screen=False).missing is None
     res = loop("magnetometer", spiked, [])
     assert [(o["row"], o["column"]) for o in res.outliers] == [(row + 1, "mag_x_ut")]
-    assert res.outliers[0]["residual"] == pytest.approx(value - trial05.loc[row, "mag_x_ut"], rel=0.01, abs=2.0)
-    without, clean = trial05_clean_loops          # the clean file without that row; the clean file
+    assert res.outliers[0]["residual"] == pytest.approx(
+        value - trial05.loc[row, "mag_x_ut"], rel=0.01, abs=2.0
+    )
+    without, clean = trial05_clean_loops  # the clean file without that row; the clean file
     assert steps(res) == steps(without) == steps(clean)
     assert res.final.rms == pytest.approx(without.final.rms, rel=1e-9)
     assert res.final.rms == pytest.approx(clean.final.rms, rel=0.01)
@@ -70,7 +74,9 @@ def test_one_wild_sample_in_broad_trial05_is_set_aside_and_the_loop_reaches_the_
 
 @pytest.mark.slow
 def test_one_wild_sample_in_a_simulated_recording_is_set_aside():
-    data = simulate_hand_turned({"hard_x_ut": 8.0, "soft_xy": 0.02}, duration_s=40, noise_ut=0.3, seed=5)
+    data = simulate_hand_turned(
+        {"hard_x_ut": 8.0, "soft_xy": 0.02}, duration_s=40, noise_ut=0.3, seed=5
+    )
     clean = loop("magnetometer", data, [])
     for value in (300.0, 1e10):
         bad = data.copy()
@@ -78,14 +84,18 @@ def test_one_wild_sample_in_a_simulated_recording_is_set_aside():
         res = loop("magnetometer", bad, [])
         assert [(o["row"], o["column"]) for o in res.outliers] == [(124, "mag_z_ut")]
         assert res.final.effects == clean.final.effects == ("hard_iron", "soft_iron")
-        assert res.consistent_with_noise and res.final.rms == pytest.approx(clean.final.rms, rel=0.01)
+        assert res.consistent_with_noise and res.final.rms == pytest.approx(
+            clean.final.rms, rel=0.01
+        )
 
 
 def test_compass_sweeps_with_one_reading_off_by_120_deg_reach_the_clean_answer():
     clean = load("compass", SWEEPS)
     bad = clean.copy()
     bad.loc[50, "measured_heading_deg"] = (bad.loc[50, "measured_heading_deg"] + 120.0) % 360.0
-    old = diagnose(fit_model("compass", bad, ["misalignment", "hard_iron", "soft_iron"]), screen=False)
+    old = diagnose(
+        fit_model("compass", bad, ["misalignment", "hard_iron", "soft_iron"]), screen=False
+    )
     # issue 18: 7.65 deg was once "consistent with noise"; since issue 35 the size check (noise_size) says
     # it is not, even without the screen -- but only the screen finds the reading and the clean answer
     assert old.rms > 5.0 and not old.consistent_with_noise and old.noise_size.problem
@@ -97,9 +107,13 @@ def test_compass_sweeps_with_one_reading_off_by_120_deg_reach_the_clean_answer()
     assert res.final.rms < 0.1
 
 
-@pytest.mark.parametrize("state,row,size", [(None, 3, 0.05), (None, 5, 0.01), (None, 0, 1e3), ("hot", 3, 0.05)])
+@pytest.mark.parametrize(
+    "state,row,size", [(None, 3, 0.05), (None, 5, 0.01), (None, 0, 1e3), ("hot", 3, 0.05)]
+)
 def test_one_outlying_row_of_the_drift_table_no_longer_hides_earth_rate(state, row, size):
-    table = (drift_measurements() if state is None else drift_measurements(state)).reset_index(drop=True)
+    table = (drift_measurements() if state is None else drift_measurements(state)).reset_index(
+        drop=True
+    )
     bad = table.copy()
     bad.loc[row, "drift_deg_h"] += size
     ref = loop("drift", table, [])
@@ -123,17 +137,27 @@ def test_a_file_with_too_many_outliers_is_refused_in_one_line(tmp_path):
     k = int(MAX_OUTLIER_SHARE * len(data)) + 3
     rows = np.linspace(3, len(data) - 3, k).astype(int)
     data.loc[rows, "measured_heading_deg"] = (data.loc[rows, "measured_heading_deg"] + 40.0) % 360.0
-    with pytest.raises(InputError, match=r"rows are outliers .*column 'measured_heading_deg'") as err:
+    with pytest.raises(
+        InputError, match=r"rows are outliers .*column 'measured_heading_deg'"
+    ) as err:
         loop("compass", data, ["misalignment"])
     assert "\n" not in str(err.value) and f"of {len(data)} rows" in str(err.value)
     path = tmp_path / "many.csv"
     data.to_csv(path, index=False)
     r = run_cli("loop", "compass", str(path), "--model", "misalignment")
-    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "rows are outliers" in r.stderr
+    assert (
+        r.returncode == 2
+        and len(r.stderr.strip().splitlines()) == 1
+        and "rows are outliers" in r.stderr
+    )
     # the same file with fewer outliers than the limit is fitted, the rows listed
     few = simulate("compass", {"yaw_deg": 1.0, "hard_x": 0.1}, noise=0.05, seed=2)
-    few.loc[rows[:3], "measured_heading_deg"] = (few.loc[rows[:3], "measured_heading_deg"] + 40.0) % 360.0
-    assert sorted(o["row"] for o in loop("compass", few, ["misalignment"]).outliers) == sorted(rows[:3] + 1)
+    few.loc[rows[:3], "measured_heading_deg"] = (
+        few.loc[rows[:3], "measured_heading_deg"] + 40.0
+    ) % 360.0
+    assert sorted(o["row"] for o in loop("compass", few, ["misalignment"]).outliers) == sorted(
+        rows[:3] + 1
+    )
 
 
 def test_a_burst_is_left_for_the_structure_tests_a_spike_is_set_aside():
@@ -158,11 +182,21 @@ def _clean_sets():
             rng = np.random.default_rng(trial_seed("hidden effect", 7, len(out), s))
             params = random_params(system, rng, cat)
             if system == "magnetometer":
-                data = simulate_hand_turned(params, duration_s=30, noise_ut=0.3,
-                                            noise_correlation=(0.0, 0.9)[s % 2], seed=rng)
+                data = simulate_hand_turned(
+                    params,
+                    duration_s=30,
+                    noise_ut=0.3,
+                    noise_correlation=(0.0, 0.9)[s % 2],
+                    seed=rng,
+                )
             else:
-                data = simulate(system, params, noise=(0.05, 0.3)[s % 2] if system == "compass" else 2e-4,
-                                n=16 if system == "drift" else None, seed=rng)
+                data = simulate(
+                    system,
+                    params,
+                    noise=(0.05, 0.3)[s % 2] if system == "compass" else 2e-4,
+                    n=16 if system == "drift" else None,
+                    seed=rng,
+                )
             out.append((system, data, cat))
     return out
 
@@ -188,15 +222,23 @@ def test_json_text_and_report_list_the_rows_set_aside(tmp_path):
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert [(o["row"], o["column"]) for o in out["outliers"]] == [(51, "measured_heading_deg")]
-    assert out["rows"] == len(bad) and out["rows_used"] == len(bad) - 1 and out["final"]["consistent_with_noise"]
-    d = json.loads(run_cli("diagnose", "compass", str(path), "--model", "misalignment", "--json").stdout)
+    assert (
+        out["rows"] == len(bad)
+        and out["rows_used"] == len(bad) - 1
+        and out["final"]["consistent_with_noise"]
+    )
+    d = json.loads(
+        run_cli("diagnose", "compass", str(path), "--model", "misalignment", "--json").stdout
+    )
     assert [o["row"] for o in d["outliers"]] == [51]
     text = run_cli("loop", "compass", str(path), "--model", "misalignment")
     line = [ln for ln in text.stdout.splitlines() if ln.startswith("set aside")]
     assert len(line) == 1 and "row 51 measured_heading_deg" in line[0]
     _, md = write_report(loop("compass", bad, ["misalignment"]), tmp_path / "rep")
     assert "**Outliers:** set aside 1 outlying row of 242" in md.read_text()
-    clean = json.loads(run_cli("loop", "compass", str(SWEEPS), "--model", "misalignment", "--json").stdout)
+    clean = json.loads(
+        run_cli("loop", "compass", str(SWEEPS), "--model", "misalignment", "--json").stdout
+    )
     assert clean["outliers"] == [] and clean["rows_used"] == clean["rows"]
 
 
@@ -220,7 +262,9 @@ def test_an_exact_offset_adds_misalignment_and_nothing_on_round_off(start, named
 
 
 def test_a_noiseless_magnetometer_stops_at_its_model():
-    data = simulate_hand_turned({"hard_x_ut": 3.0, "soft_xx": 0.02}, duration_s=30, noise_ut=0.0, seed=1)
+    data = simulate_hand_turned(
+        {"hard_x_ut": 3.0, "soft_xx": 0.02}, duration_s=30, noise_ut=0.0, seed=1
+    )
     res = loop("magnetometer", data, [])
     assert res.final.effects == ("hard_iron", "soft_iron") and res.consistent_with_noise
 
@@ -243,20 +287,27 @@ def test_whitening_an_ar_process_leaves_independent_samples():
     w = serial.whiten(x, kappa, ser)
     acf = [np.corrcoef(w[k:], w[:-k])[0, 1] for k in (1, 2, 3, 5)]
     assert max(abs(a) for a in acf) < 4 / np.sqrt(n), acf
-    assert abs(np.corrcoef(x[1:], x[:-1])[0, 1]) > 0.5          # the raw series is far from white
-    assert np.var(w) == pytest.approx(np.var(x), rel=0.1)        # whitened to the process variance
+    assert abs(np.corrcoef(x[1:], x[:-1])[0, 1]) > 0.5  # the raw series is far from white
+    assert np.var(w) == pytest.approx(np.var(x), rel=0.1)  # whitened to the process variance
 
 
 def test_series_are_cut_at_gaps_and_where_samples_are_left_out():
     t = np.r_[0.1 * np.arange(10), 5.0 + 0.1 * np.arange(10)]
-    ser = serial.series_of(pd.DataFrame({"time_s": t[::-1]}), 40, "magnetometer")   # 2 axes, reversed file
+    ser = serial.series_of(
+        pd.DataFrame({"time_s": t[::-1]}), 40, "magnetometer"
+    )  # 2 axes, reversed file
     assert ser.segments == 4 and ser.pos.max() == 9
-    assert np.all(np.diff(t[::-1][ser.order[:20] // 2]) > 0)      # time order
+    assert np.all(np.diff(t[::-1][ser.order[:20] // 2]) > 0)  # time order
     drop = np.zeros(40, bool)
     drop[ser.order[4]] = True
     assert ser.without(drop).segments == 5 and len(ser.without(drop).order) == 39
-    assert serial.series_of(pd.DataFrame({"x": np.ones(20)}), 20, "compass") is None   # no time: no series
-    assert serial.series_of(pd.DataFrame({"x": np.ones(20)}), 60, "magnetometer").source == "file order"
+    assert (
+        serial.series_of(pd.DataFrame({"x": np.ones(20)}), 20, "compass") is None
+    )  # no time: no series
+    assert (
+        serial.series_of(pd.DataFrame({"x": np.ones(20)}), 60, "magnetometer").source
+        == "file order"
+    )
 
 
 def test_restricted_likelihood_recovers_the_correlation_that_residuals_understate():
@@ -264,7 +315,7 @@ def test_restricted_likelihood_recovers_the_correlation_that_residuals_understat
     residuals is biased low (the regressors take out low-frequency noise); REML is not."""
     n = 300
     t = np.linspace(-1, 1, n)
-    X = np.column_stack([t ** k for k in range(8)])
+    X = np.column_stack([t**k for k in range(8)])
     ser = serial.series_of(_frame(n), n, "magnetometer")
     naive, reml = [], []
     for s in range(12):
@@ -272,19 +323,30 @@ def test_restricted_likelihood_recovers_the_correlation_that_residuals_understat
         r = e - X @ np.linalg.lstsq(X, e, rcond=None)[0]
         naive.append(np.corrcoef(r[1:], r[:-1])[0, 1])
         reml.append(serial.estimate(r, X, ser, max_order=1).lag1)
-    assert np.mean(naive) < 0.86 and abs(np.mean(reml) - 0.9) < 0.025, (np.mean(naive), np.mean(reml))
+    assert np.mean(naive) < 0.86 and abs(np.mean(reml) - 0.9) < 0.025, (
+        np.mean(naive),
+        np.mean(reml),
+    )
 
 
 @pytest.mark.slow
 def test_the_noise_model_is_reported():
-    data = simulate_hand_turned({"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=2)
+    data = simulate_hand_turned(
+        {"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=2
+    )
     res = loop("magnetometer", data, [])
     noise = res.to_dict()["noise"]
-    assert noise["series"] == "time_s" and noise["ar_order"] >= 1 and 0.8 < noise["lag1_correlation"] < 0.97
+    assert (
+        noise["series"] == "time_s"
+        and noise["ar_order"] >= 1
+        and 0.8 < noise["lag1_correlation"] < 0.97
+    )
     assert noise["lag1_interval"][0] < noise["lag1_correlation"] < noise["lag1_interval"][1]
-    assert "serially correlated" in res.final_diagnosis.message and res.final.effects == ("hard_iron",)
+    assert "serially correlated" in res.final_diagnosis.message and res.final.effects == (
+        "hard_iron",
+    )
     white = loop("compass", load("compass", SWEEPS), ["misalignment"]).to_dict()["noise"]
-    assert white["series"] is None and white["ar_order"] == 0       # heading bins: not a time series
+    assert white["series"] is None and white["ar_order"] == 0  # heading bins: not a time series
 
 
 def test_a_table_too_short_to_screen_says_so(tmp_path):
@@ -294,7 +356,11 @@ def test_a_table_too_short_to_screen_says_so(tmp_path):
         r = run_cli(cmd, "drift", str(path), "--model", "earth_rate", "--json")
         assert r.returncode == 0, r.stderr
         out = json.loads(r.stdout)
-        assert out["outliers"] == [] and out["screen_note"].startswith("not run") and out["outlier_cutoff"] is None
+        assert (
+            out["outliers"] == []
+            and out["screen_note"].startswith("not run")
+            and out["outlier_cutoff"] is None
+        )
 
 
 def _ar_correlation(kappa, n):
@@ -303,7 +369,7 @@ def _ar_correlation(kappa, n):
     p = len(kappa)
     rho = np.zeros(n)
     rho[0] = 1.0
-    for k in range(1, p + 1):                     # Durbin-Levinson backwards: rho from the order-k coefficients
+    for k in range(1, p + 1):  # Durbin-Levinson backwards: rho from the order-k coefficients
         rho[k] = sum(phi[k - 1, j] * rho[k - j] for j in range(1, k)) + kappa[k - 1] * v[k - 1]
     for k in range(p + 1, n):
         rho[k] = sum(phi[p, j] * rho[k - j] for j in range(1, p + 1))
@@ -313,7 +379,7 @@ def _ar_correlation(kappa, n):
 @pytest.mark.parametrize("kappa", [(0.7,), (0.9, -0.4), (0.5, 0.3, -0.2)])
 def test_whitening_is_the_inverse_cholesky_factor_on_every_segment(kappa):
     """``whiten`` against the textbook: on each segment ``W = L^-1`` with ``L L' = R`` the AR correlation."""
-    t = np.r_[0.1 * np.arange(7), 10.0 + 0.1 * np.arange(12)]               # two segments, 7 and 12 samples
+    t = np.r_[0.1 * np.arange(7), 10.0 + 0.1 * np.arange(12)]  # two segments, 7 and 12 samples
     ser = serial.series_of(pd.DataFrame({"time_s": t}), len(t), "magnetometer")
     x = np.random.default_rng(1).standard_normal((len(t), 2))
     w = serial.whiten(x, kappa, ser)
@@ -325,14 +391,20 @@ def test_whitening_is_the_inverse_cholesky_factor_on_every_segment(kappa):
 def test_the_fast_restricted_likelihood_equals_the_direct_one():
     rng = np.random.default_rng(4)
     t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], 200))
-    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(rng.random(600) < 0.03)
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(
+        rng.random(600) < 0.03
+    )
     Q = np.linalg.qr(rng.standard_normal((600, 6)))[0]
     r = rng.standard_normal(600)
     for order in (1, 2, 3):
         fast = serial._Restricted(r, Q, ser, order)
-        shared = serial._Restricted(r, Q, ser, order, serial._Prepared(Q, ser, order))   # parts shared by a bootstrap
-        for kappa in ((), (0.6,), (0.8, -0.3), (0.2, 0.3, -0.4))[:order + 1]:
-            assert fast(kappa) == pytest.approx(serial._restricted_loglik(kappa, r, Q, ser), rel=1e-10)
+        shared = serial._Restricted(
+            r, Q, ser, order, serial._Prepared(Q, ser, order)
+        )  # parts shared by a bootstrap
+        for kappa in ((), (0.6,), (0.8, -0.3), (0.2, 0.3, -0.4))[: order + 1]:
+            assert fast(kappa) == pytest.approx(
+                serial._restricted_loglik(kappa, r, Q, ser), rel=1e-10
+            )
             assert shared(kappa) == pytest.approx(fast(kappa), rel=1e-12)
 
 
@@ -362,16 +434,20 @@ def test_the_noise_model_is_chosen_around_the_regressors_the_likelihood_prefers(
     ser = serial.series_of(_frame(n), n, "magnetometer")
     J = np.column_stack([np.ones(n), np.linspace(-1, 1, n)])
     k = np.arange(n)
-    S = np.column_stack([np.cos(2 * np.pi * h * k / 120) for h in (1, 2, 3)]
-                        + [np.sin(2 * np.pi * h * k / 120) for h in (1, 2, 3)])
-    picks = [serial.select(serial.ar1_noise(np.random.default_rng(s), n, 1.0, 0.9), J, S, ser).around
-             for s in range(10)]
+    S = np.column_stack(
+        [np.cos(2 * np.pi * h * k / 120) for h in (1, 2, 3)]
+        + [np.sin(2 * np.pi * h * k / 120) for h in (1, 2, 3)]
+    )
+    picks = [
+        serial.select(serial.ar1_noise(np.random.default_rng(s), n, 1.0, 0.9), J, S, ser).around
+        for s in range(10)
+    ]
     assert picks.count("model") >= 8, picks
     rng = np.random.default_rng(7)
     y = 3.0 * np.sin(2 * np.pi * 3 * k / 120) + rng.standard_normal(n)
     m = serial.select(y, J, S, ser)
     assert m.around == "model and structure shapes" and abs(m.lag1) < 0.3, m
-    assert serial.estimate(y, J, ser).lag1 > 0.5                  # what the Jacobian alone would have said
+    assert serial.estimate(y, J, ser).lag1 > 0.5  # what the Jacobian alone would have said
 
 
 def test_the_report_counts_rows_not_observations():
@@ -381,7 +457,9 @@ def test_the_report_counts_rows_not_observations():
     d = diagnose(fit_model("magnetometer", data, ["hard_iron"]))
     first = d.report().splitlines()[0]
     assert f"rows: {len(data)} ({3 * len(data)} observations)" in first, first
-    c = diagnose(fit_model("compass", load("compass", data_path("compass_sweeps.csv")), ["misalignment"]))
+    c = diagnose(
+        fit_model("compass", load("compass", data_path("compass_sweeps.csv")), ["misalignment"])
+    )
     assert c.report().splitlines()[0].endswith(f"rows: {c.n}")
 
 
@@ -389,7 +467,9 @@ def test_the_report_counts_rows_not_observations():
 def test_the_bootstrap_level_of_correlated_noise_is_reported_and_reproducible():
     """On correlated noise the family is calibrated by the parametric bootstrap: its level is stored, the
     same seed gives the same level, and the text report states it."""
-    data = simulate_hand_turned({"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=5)
+    data = simulate_hand_turned(
+        {"hard_x_ut": 5.0}, duration_s=40, noise_ut=0.3, noise_correlation=0.9, seed=5
+    )
     f = fit_model("magnetometer", data, ["hard_iron"])
     a, b = diagnose(f), diagnose(f)
     cal = a.to_dict()["calibration"]
@@ -404,7 +484,9 @@ def test_the_vectorised_ar1_likelihoods_equal_the_fast_ones_and_pick_the_same_co
     and left-out samples; ``select_ar1_many`` against ``select`` at order 1, to the grid's resolution."""
     rng = np.random.default_rng(4)
     t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], 200))
-    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(rng.random(600) < 0.03)
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 600, "magnetometer").without(
+        rng.random(600) < 0.03
+    )
     X = rng.standard_normal((600, 4))
     S = rng.standard_normal((600, 3))
     E = serial.colour(rng.standard_normal((len(ser.order), 4)), (0.8,), ser, 600)

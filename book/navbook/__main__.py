@@ -1,4 +1,5 @@
 """``python -m navbook``: the book's command line (:mod:`navbook.cli`), with navlib's one-thread defaults."""
+
 import os
 import sys
 

@@ -5,6 +5,7 @@ page per layer.
     Write the API reference: an overview to FILE and one page per layer of ``navlib`` beside it
     (``api_<layer>.md``: a summary table of its modules, then their ``automodule`` sections).
 """
+
 from __future__ import annotations
 
 import importlib
@@ -18,13 +19,17 @@ import navbook
 
 from .landing import _md_cell
 
+
 def navlib_modules() -> list[str]:
     """Every module of the ``navlib`` package, then of the book's tooling ``navbook`` (``__main__``
     excluded), top-level modules first."""
     names = []
     for pkg in (navlib, navbook):
-        mods = [m.name for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
-                if not m.name.endswith("__main__")]
+        mods = [
+            m.name
+            for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
+            if not m.name.endswith("__main__")
+        ]
         names += sorted(mods, key=lambda n: (n.count("."), n))
     return names
 
@@ -34,7 +39,15 @@ def api_markdown(modules: list[str]) -> str:
     ``eval-rst`` block because autodoc emits reStructuredText."""
     parts = []
     for name in modules:
-        parts += [f"## `{name}`", "", "```{eval-rst}", f".. automodule:: {name}", "   :members:", "```", ""]
+        parts += [
+            f"## `{name}`",
+            "",
+            "```{eval-rst}",
+            f".. automodule:: {name}",
+            "   :members:",
+            "```",
+            "",
+        ]
     return "\n".join(parts)
 
 
@@ -47,9 +60,21 @@ API_LAYERS = (
     ("studies", "Studies: one module per source", ("navlib.studies",)),
     ("data", "Data: loaders with validation", ("navlib.data", "navlib.paths")),
     ("cli", "Command line", ("navlib.cli", "navlib.commands")),
-    ("foundations", "Shared tools: claims, verdicts, engine, seeds, figure style",
-     ("navlib.claims", "navlib.verdicts", "navlib.formatting", "navlib.plotstyle", "navlib.engine",
-      "navlib.seeding", "navlib.angles", "navlib.errors", "navlib._optional")),
+    (
+        "foundations",
+        "Shared tools: claims, verdicts, engine, seeds, figure style",
+        (
+            "navlib.claims",
+            "navlib.verdicts",
+            "navlib.formatting",
+            "navlib.plotstyle",
+            "navlib.engine",
+            "navlib.seeding",
+            "navlib.angles",
+            "navlib.errors",
+            "navlib._optional",
+        ),
+    ),
     ("internals", "The book's tooling (package navbook, not in navlib's wheel)", ("navbook",)),
 )
 
@@ -69,22 +94,24 @@ def module_summary(module: str) -> str:
     """The first sentence of a module's docstring (for the API pages' summary tables)."""
     try:
         doc = importlib.import_module(module).__doc__ or ""
-    except ImportError as err:            # an optional extra missing: say so instead of failing the page
+    except ImportError as err:  # an optional extra missing: say so instead of failing the page
         return f"(not importable here: {err})"
     text = re.sub(r"\s+", " ", doc).strip()
     first = text
     for m in re.finditer(r"[.:](?=\s|$)", text):
-        word = re.search(r"(\S+)$", text[:m.start()])
-        if (word and word.group(1).lower() in _NOT_SENTENCE_ENDS) or text[m.start() - 1:m.start()] == ".":
-            continue                       # "Yu et al. 2012", "eq. 3", "e.g. a sensor"
-        first = text[:m.start()] + "."
+        word = re.search(r"(\S+)$", text[: m.start()])
+        if (word and word.group(1).lower() in _NOT_SENTENCE_ENDS) or text[
+            m.start() - 1 : m.start()
+        ] == ".":
+            continue  # "Yu et al. 2012", "eq. 3", "e.g. a sensor"
+        first = text[: m.start()] + "."
         break
-    first = re.sub(r":\w+:`~?([^`]+)`", r"``\1``", first).replace("*", "")    # roles -> literals
-    first = first.replace("``", "`")                                           # RST -> MyST literal
-    if len(first) > 200:                   # cut at a word, closing an open literal
+    first = re.sub(r":\w+:`~?([^`]+)`", r"``\1``", first).replace("*", "")  # roles -> literals
+    first = first.replace("``", "`")  # RST -> MyST literal
+    if len(first) > 200:  # cut at a word, closing an open literal
         first = first[:200].rsplit(" ", 1)[0]
         first += ("`" if first.count("`") % 2 else "") + " ..."
-    elif first.count("`") % 2:             # the sentence ended inside a literal
+    elif first.count("`") % 2:  # the sentence ended inside a literal
         first = first[:-1] + "`."
     return first
 
@@ -101,11 +128,14 @@ def api_pages(modules: list[str]) -> dict[str, str]:
     pages = {}
     for name, title, _ in API_LAYERS:
         mods = groups[name]
-        if not mods:                      # the table of contents lists every layer's page
+        if not mods:  # the table of contents lists every layer's page
             pages[f"api_{name}"] = f"# {title}\n\nNo module of navlib belongs here yet.\n"
             continue
-        overview.append(f"| {{doc}}`{title} </_generated/api_{name}>` | "
-                        + ", ".join(f"`{m}`" for m in mods) + " |")
+        overview.append(
+            f"| {{doc}}`{title} </_generated/api_{name}>` | "
+            + ", ".join(f"`{m}`" for m in mods)
+            + " |"
+        )
         table = ["| module | what it holds |", "|---|---|"]
         table += [f"| {{py:mod}}`{m}` | {_md_cell(module_summary(m))} |" for m in mods]
         pages[f"api_{name}"] = "\n".join([f"# {title}", ""] + table + ["", api_markdown(mods)])
@@ -120,7 +150,8 @@ def write_api(out: Path) -> int:
     mods = navlib_modules()
     pages = api_pages(mods)
     for stem, text in pages.items():
-        (out if stem == "api_modules" else out.with_name(f"{stem}.md")).write_text(text, encoding="utf-8")
+        (out if stem == "api_modules" else out.with_name(f"{stem}.md")).write_text(
+            text, encoding="utf-8"
+        )
     print(f"api-modules: {len(mods)} modules on {len(pages) - 1} pages -> {out.parent}")
     return 0
-

@@ -1,5 +1,6 @@
 """A chapter's claims in boxes (the *Results at a glance* box that opens the chapter, the answers per
 claims-register entry, the *What this chapter showed* box that closes it), each verdict with its reason."""
+
 from __future__ import annotations
 
 import html
@@ -25,30 +26,46 @@ ON_REAL = "on real data"
 
 
 def _glance_frame(claims: list[Claim]) -> pd.DataFrame:
-    rows = [{"claim": c.claim, "reading": c.reading, "paper": c.paper, GLANCE_COLUMNS[3]: c.ours_text,
-             "boundary": c.boundary_text, "verdict": c.verdict + (f": {c.reason}" if c.reason else "")}
-            for c in claims]
+    rows = [
+        {
+            "claim": c.claim,
+            "reading": c.reading,
+            "paper": c.paper,
+            GLANCE_COLUMNS[3]: c.ours_text,
+            "boundary": c.boundary_text,
+            "verdict": c.verdict + (f": {c.reason}" if c.reason else ""),
+        }
+        for c in claims
+    ]
     return pd.DataFrame(rows, columns=GLANCE_COLUMNS)
 
 
 def tally_of(v: list[str]) -> str:
-    """"k of n reproduced, m not reproduced, j cannot be judged" (", e no difference" where a claim's
+    """ "k of n reproduced, m not reproduced, j cannot be judged" (", e no difference" where a claim's
     equivalence margin decided it) for a list of verdict names."""
-    text = (f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
-            f"{v.count('cannot be judged')} cannot be judged")
-    return text + (f", {v.count('no difference')} no difference" if v.count("no difference") else "")
+    text = (
+        f"{v.count('reproduced')} of {len(v)} reproduced, {v.count('not reproduced')} not reproduced, "
+        f"{v.count('cannot be judged')} cannot be judged"
+    )
+    return text + (
+        f", {v.count('no difference')} no difference" if v.count("no difference") else ""
+    )
 
 
 def tally(claims: Iterable[Claim]) -> str:
-    """"k of n reproduced, m not reproduced, j cannot be judged" (:func:`tally_of`)."""
+    """ "k of n reproduced, m not reproduced, j cannot be judged" (:func:`tally_of`)."""
     return tally_of([c.verdict for c in claims])
 
 
 #: Abbreviations of the results files' reading labels, spelled out on the landing page and in the glance
 #: boxes' folds (the glossary
 #: explains the methods' names).
-READING_WORDS = {r"\bval\. stop\b": "validation stop", r"\bsd\b": "standard deviations",
-                 r"\bKF\b": "Kalman filter", r"\bLOO\b": "leave-one-out"}
+READING_WORDS = {
+    r"\bval\. stop\b": "validation stop",
+    r"\bsd\b": "standard deviations",
+    r"\bKF\b": "Kalman filter",
+    r"\bLOO\b": "leave-one-out",
+}
 
 
 def reading_label(reading: str) -> str:
@@ -77,28 +94,45 @@ def _glance_html(claims: list[Claim], caption: str) -> str:
     """One glance table in HTML: the verdict with the case that applies (*cannot be judged: below our
     noise floor*, ...); more than :data:`GLANCE_OPEN_ROWS` claims are folded by reading, each reading a
     ``<details>`` whose summary gives its counts."""
+
     def frame(cs, with_reading=True):
-        rows = [{"claim": c.claim, "reading": c.reading, "paper": c.paper, GLANCE_COLUMNS[3]: c.ours_text,
-                 "boundary": c.boundary_text,
-                 "verdict": c.verdict_label + (f" ({c.reason})" if c.reason else "")} for c in cs]
+        rows = [
+            {
+                "claim": c.claim,
+                "reading": c.reading,
+                "paper": c.paper,
+                GLANCE_COLUMNS[3]: c.ours_text,
+                "boundary": c.boundary_text,
+                "verdict": c.verdict_label + (f" ({c.reason})" if c.reason else ""),
+            }
+            for c in cs
+        ]
         cols = GLANCE_COLUMNS if with_reading else [k for k in GLANCE_COLUMNS if k != "reading"]
         return pd.DataFrame(rows, columns=GLANCE_COLUMNS)[cols]
 
-    link = (f'<p class="navbook-glance-note">{html.escape(caption, quote=False)} (<a href="{VERDICTS_HREF}">what the '
-            f'verdicts mean</a>)</p>')
+    link = (
+        f'<p class="navbook-glance-note">{html.escape(caption, quote=False)} (<a href="{VERDICTS_HREF}">what the '
+        f"verdicts mean</a>)</p>"
+    )
     if len(claims) <= GLANCE_OPEN_ROWS:
         return link + Table(frame(claims), index=False)._repr_html_()
     readings = list(dict.fromkeys(c.reading for c in claims))
     parts = [link]
     for r in readings:
         cs = [c for c in claims if c.reading == r]
-        parts.append(f"<details><summary>{html.escape(reading_label(r))}: {html.escape(tally(cs))}</summary>"
-                     + Table(frame(cs, with_reading=False), index=False)._repr_html_() + "</details>")
+        parts.append(
+            f"<details><summary>{html.escape(reading_label(r))}: {html.escape(tally(cs))}</summary>"
+            + Table(frame(cs, with_reading=False), index=False)._repr_html_()
+            + "</details>"
+        )
     return "\n".join(parts)
 
 
-def register_records(claims: Iterable["Claim | Mapping[str, Any]"], chapter: str | None,
-                     worlds: list[Mapping[str, Any]] | None = None) -> list[dict] | None:
+def register_records(
+    claims: Iterable["Claim | Mapping[str, Any]"],
+    chapter: str | None,
+    worlds: list[Mapping[str, Any]] | None = None,
+) -> list[dict] | None:
     """The chapter's rows folded into one record per claims-register entry (:func:`navlib.claims.evaluate`),
     or None for a chapter without a register."""
     if not chapter or not registry.registers(chapter):
@@ -112,9 +146,15 @@ def record_label(r: Mapping[str, Any]) -> str:
     if r.get("reproduced") is not None:
         return str(r["verdict"])
     if r.get("basis") == "equivalent":
-        return f"no difference at margin {fmt(r.get('margin'), '{:.4g}')}" + (f" {r['unit']}" if r.get("unit") else "")
+        return f"no difference at margin {fmt(r.get('margin'), '{:.4g}')}" + (
+            f" {r['unit']}" if r.get("unit") else ""
+        )
     cat = r.get("reason")
-    return f"{r['verdict']}: {verdicts.REASONS[cat][0]}" if cat in verdicts.REASONS else str(r["verdict"])
+    return (
+        f"{r['verdict']}: {verdicts.REASONS[cat][0]}"
+        if cat in verdicts.REASONS
+        else str(r["verdict"])
+    )
 
 
 def _rec_ours(r: Mapping[str, Any]) -> str:
@@ -134,8 +174,10 @@ def headline_sentence(r: Mapping[str, Any]) -> str:
     where = str(r["where"]).split(";")[0].strip()
     text = f"{who}'s headline claim: {r['claim']} ({where}). **{record_label(r)}**"
     if r.get("status") == "judged" and r.get("row_claim"):
-        text += (f" under the primary reading ({r['primary_reading']}): ours {_rec_ours(r)}; "
-                 f"{registry.across_text(r)}.")
+        text += (
+            f" under the primary reading ({r['primary_reading']}): ours {_rec_ours(r)}; "
+            f"{registry.across_text(r)}."
+        )
     else:
         text += "."
     return text
@@ -145,41 +187,69 @@ def _rec_tally(records: list[Mapping[str, Any]]) -> str:
     return tally_of([r["verdict"] for r in records])
 
 
-ANSWER_COLUMNS = ["id", "claim", "ours: value [95 % interval]", "verdict (primary reading)", "across readings"]
+ANSWER_COLUMNS = [
+    "id",
+    "claim",
+    "ours: value [95 % interval]",
+    "verdict (primary reading)",
+    "across readings",
+]
 
 
 def _answer_frame(records: list[Mapping[str, Any]]) -> pd.DataFrame:
     """One row per claim: the register's short words for it (the paper's own words, where they are and
     why the primary reading is the most plausible are in the claim's fold below the table)."""
-    rows = [{"id": r["id"], "claim": r["claim"], ANSWER_COLUMNS[2]: _rec_ours(r),
-             ANSWER_COLUMNS[3]: record_label(r) + (f" ({r['primary_reading']})" if r.get("status") == "judged"
-                                                 and r.get("row_claim") else ""),
-             "across readings": registry.across_text(r) if r.get("status") == "judged" and r.get("row_claim")
-             else "–"}
-            for r in records]
+    rows = [
+        {
+            "id": r["id"],
+            "claim": r["claim"],
+            ANSWER_COLUMNS[2]: _rec_ours(r),
+            ANSWER_COLUMNS[3]: record_label(r)
+            + (
+                f" ({r['primary_reading']})"
+                if r.get("status") == "judged" and r.get("row_claim")
+                else ""
+            ),
+            "across readings": registry.across_text(r)
+            if r.get("status") == "judged" and r.get("row_claim")
+            else "–",
+        }
+        for r in records
+    ]
     return pd.DataFrame(rows, columns=ANSWER_COLUMNS)
 
 
 def _claim_fold(r: Mapping[str, Any]) -> str:
     """One claim's fold: the paper's words and where, the primary reading and why, the dimensions, and
     every row (the primary first) with its verdict and reason."""
-    head = (f"<p><b>{html.escape(r['id'])}</b> \u201c{html.escape(r.get('quote') or r['claim'])}\u201d "
-            f"({html.escape(r['where'])})")
+    head = (
+        f"<p><b>{html.escape(r['id'])}</b> \u201c{html.escape(r.get('quote') or r['claim'])}\u201d "
+        f"({html.escape(r['where'])})"
+    )
     if r.get("quote_zh"):
         head += f' <span lang="zh">{html.escape(r["quote_zh"])}</span>'
     head += "</p>"
     if r.get("why_primary"):
-        head += (f"<p>Primary reading: {html.escape(r['primary_reading'])}. "
-                 f"{html.escape(r['why_primary'])}</p>")
+        head += (
+            f"<p>Primary reading: {html.escape(r['primary_reading'])}. "
+            f"{html.escape(r['why_primary'])}</p>"
+        )
     if r.get("dimensions"):
         head += f"<p>Shown across: {html.escape(r['dimensions'])}.</p>"
     if r.get("status") != "judged" or not r.get("row_claim"):
         return head + f"<p>{html.escape(r.get('why') or '')}</p>"
     rows = [{**r, "claim": r["row_claim"]}] + list(r["sensitivity"])
-    frame = pd.DataFrame([{"claim": x["claim"], "reading": x["reading"] + (" (primary)" if x is rows[0] else ""),
-                           "ours: value [95 % interval]": x.get("ours") or "–",
-                           "verdict": record_label(x) + (f" ({x['why']})" if x.get("why") else "")}
-                          for x in rows])
+    frame = pd.DataFrame(
+        [
+            {
+                "claim": x["claim"],
+                "reading": x["reading"] + (" (primary)" if x is rows[0] else ""),
+                "ours: value [95 % interval]": x.get("ours") or "–",
+                "verdict": record_label(x) + (f" ({x['why']})" if x.get("why") else ""),
+            }
+            for x in rows
+        ]
+    )
     return head + Table(frame, index=False, readable=False)._repr_html_()
 
 
@@ -200,7 +270,9 @@ class Answer:
         simulated ones and counted apart."""
         for data, suffix in (("simulated", ""), ("real", f" {ON_REAL}")):
             for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims")):
-                recs = [r for r in self.records if r["source"] == src and registry.data_of(r) == data]
+                recs = [
+                    r for r in self.records if r["source"] == src and registry.data_of(r) == data
+                ]
                 if recs:
                     yield src, title + suffix, recs
 
@@ -210,13 +282,34 @@ class Answer:
             for name in registry.registers(self.chapter):
                 mine = [r for r in recs if r["register"] == name]
                 if mine:
-                    out.append(Table(_answer_frame(mine), index=False, readable=False,
-                                     caption=f"{title}: {_rec_tally(recs)}; "
-                                             f"{registry.SOURCE_NAMES[name]}: {_rec_tally(mine)}"))
+                    out.append(
+                        Table(
+                            _answer_frame(mine),
+                            index=False,
+                            readable=False,
+                            caption=f"{title}: {_rec_tally(recs)}; "
+                            f"{registry.SOURCE_NAMES[name]}: {_rec_tally(mine)}",
+                        )
+                    )
         if self.noted:
-            out.append(Table(pd.DataFrame([{"id": n["id"], "the paper says": n["claim"], "where": n["where"],
-                                            "its own numbers": n["numbers"]} for n in self.noted]),
-                             index=False, readable=False, caption="Where the paper contradicts itself"))
+            out.append(
+                Table(
+                    pd.DataFrame(
+                        [
+                            {
+                                "id": n["id"],
+                                "the paper says": n["claim"],
+                                "where": n["where"],
+                                "its own numbers": n["numbers"],
+                            }
+                            for n in self.noted
+                        ]
+                    ),
+                    index=False,
+                    readable=False,
+                    caption="Where the paper contradicts itself",
+                )
+            )
         return out
 
     def _repr_html_(self) -> str:
@@ -225,24 +318,35 @@ class Answer:
             parts.append(f'<p class="navbook-headline">{_inline_md(headline_sentence(r))}</p>')
         for src, title, recs in self._groups():
             real = registry.data_of(recs[0]) == "real"
-            note = (f'{html.escape(title)}: {_rec_tally(recs)} (one row per claim, judged under its primary '
-                    f'reading; <a href="{VERDICTS_HREF}">what the verdicts mean</a>)')
+            note = (
+                f"{html.escape(title)}: {_rec_tally(recs)} (one row per claim, judged under its primary "
+                f'reading; <a href="{VERDICTS_HREF}">what the verdicts mean</a>)'
+            )
             # the claims judged again on real data: counted apart, their tables behind a fold
-            parts.append(f'<details class="navbook-real"><summary class="navbook-glance-note">{note}</summary>'
-                         if real else f'<p class="navbook-glance-note">{note}</p>')
+            parts.append(
+                f'<details class="navbook-real"><summary class="navbook-glance-note">{note}</summary>'
+                if real
+                else f'<p class="navbook-glance-note">{note}</p>'
+            )
             for name in registry.registers(self.chapter):
                 mine = [r for r in recs if r["register"] == name]
                 if mine:
                     if len(registry.registers(self.chapter)) > 1:
-                        parts.append(f"<p><b>{html.escape(registry.SOURCE_NAMES[name])}</b>: "
-                                     f"{_rec_tally(mine)}</p>")
-                    parts.append(Table(_answer_frame(mine), index=False, readable=False)._repr_html_())
+                        parts.append(
+                            f"<p><b>{html.escape(registry.SOURCE_NAMES[name])}</b>: "
+                            f"{_rec_tally(mine)}</p>"
+                        )
+                    parts.append(
+                        Table(_answer_frame(mine), index=False, readable=False)._repr_html_()
+                    )
             if real:
                 parts.append("</details>")
         if self.noted:
-            parts.append(f"<details><summary>Where the paper contradicts itself ({len(self.noted)})</summary>"
-                         + Table(self.tables()[-1].frame, index=False, readable=False)._repr_html_()
-                         + "</details>")
+            parts.append(
+                f"<details><summary>Where the paper contradicts itself ({len(self.noted)})</summary>"
+                + Table(self.tables()[-1].frame, index=False, readable=False)._repr_html_()
+                + "</details>"
+            )
         parts.append(self._readings_html())
         return "\n".join(parts)
 
@@ -250,16 +354,24 @@ class Answer:
         """Every claim behind one fold, a dropdown per claim: the paper's words and where, the primary
         reading and why, and every row (each reading, noise level, split; the primary first)."""
         n = sum(1 + len(r["sensitivity"]) for r in self.records if r.get("row_claim"))
-        inner = [f"<details><summary>{html.escape(r['id'])} {html.escape(r['claim'])}"
-                 f"{' (' + ON_REAL + ')' if registry.data_of(r) == 'real' else ''}: "
-                 f"{html.escape(registry.across_text(r) if r.get('row_claim') else record_label(r))}</summary>"
-                 + _claim_fold(r) + "</details>" for r in self.records]
-        return (f'<details><summary>The paper\'s words, the primary reading and why, and every claim under '
-                f'every reading ({n} rows)</summary>' + "\n".join(inner) + "</details>")
+        inner = [
+            f"<details><summary>{html.escape(r['id'])} {html.escape(r['claim'])}"
+            f"{' (' + ON_REAL + ')' if registry.data_of(r) == 'real' else ''}: "
+            f"{html.escape(registry.across_text(r) if r.get('row_claim') else record_label(r))}</summary>"
+            + _claim_fold(r)
+            + "</details>"
+            for r in self.records
+        ]
+        return (
+            f"<details><summary>The paper's words, the primary reading and why, and every claim under "
+            f"every reading ({n} rows)</summary>" + "\n".join(inner) + "</details>"
+        )
 
     def __repr__(self) -> str:
-        out = ["\n".join(textwrap.wrap(headline_sentence(r).replace("**", ""), PLAIN_WIDTH))
-               for r in registry.headlines(self.records)]
+        out = [
+            "\n".join(textwrap.wrap(headline_sentence(r).replace("**", ""), PLAIN_WIDTH))
+            for r in registry.headlines(self.records)
+        ]
         out += [repr(t) for t in self.tables()]
         return "\n\n".join(out)
 
@@ -283,19 +395,27 @@ class Glance:
         sim = [c for c in claims if c.data == "simulated"]
         self.paper = [c for c in sim if c.source == "paper"]
         self.book = [c for c in sim if c.source == "book"]
-        self.real = {src: [c for c in claims if c.data == "real" and c.source == src] for src in verdicts.SOURCES}
+        self.real = {
+            src: [c for c in claims if c.data == "real" and c.source == src]
+            for src in verdicts.SOURCES
+        }
         _GLANCED.update((c.claim, c.reading, c.data) for c in claims)
 
     def _groups(self):
         """(caption, claims) per source, the claims on real data after the simulated ones, each apart."""
-        for cs, title in ((self.paper, "The paper's claims"), (self.book, "The book's own claims"),
-                          (self.real["paper"], f"The paper's claims {ON_REAL}"),
-                          (self.real["book"], f"The book's own claims {ON_REAL}")):
+        for cs, title in (
+            (self.paper, "The paper's claims"),
+            (self.book, "The book's own claims"),
+            (self.real["paper"], f"The paper's claims {ON_REAL}"),
+            (self.real["book"], f"The book's own claims {ON_REAL}"),
+        ):
             if cs:
                 yield f"{title}: {tally(cs)}", cs
 
     def tables(self) -> list[Table]:
-        return [Table(_glance_frame(cs), index=False, caption=caption) for caption, cs in self._groups()]
+        return [
+            Table(_glance_frame(cs), index=False, caption=caption) for caption, cs in self._groups()
+        ]
 
     def _repr_html_(self) -> str:
         return "\n".join(_glance_html(cs, caption) for caption, cs in self._groups())
@@ -304,8 +424,11 @@ class Glance:
         return "\n\n".join(repr(t) for t in self.tables())
 
 
-def glance(claims: Iterable[Claim], chapter: str | None = None,
-           worlds: list[Mapping[str, Any]] | None = None) -> "Glance | Answer":
+def glance(
+    claims: Iterable[Claim],
+    chapter: str | None = None,
+    worlds: list[Mapping[str, Any]] | None = None,
+) -> "Glance | Answer":
     """The Results-at-a-glance box: for a chapter with a claims register (``chapter`` given,
     :mod:`navlib.claims`) the answer first (:class:`Answer`: one row per claim under its primary
     reading, ``worlds`` the drawn-world verdicts of the rows), else one row per claim and reading
@@ -324,8 +447,8 @@ class _Outcome:
     reading: str
     source: str
     verdict: str
-    category: str | None      # the key of verdicts.REASONS of a claim that cannot be judged
-    data: str = "simulated"   # what it was judged on (Claim.data)
+    category: str | None  # the key of verdicts.REASONS of a claim that cannot be judged
+    data: str = "simulated"  # what it was judged on (Claim.data)
 
 
 def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
@@ -333,11 +456,18 @@ def _outcome(c: "Claim | Mapping[str, Any]") -> _Outcome:
     if isinstance(c, Claim):
         c = c.record()
     try:
-        return _Outcome(str(c["claim"]), str(c.get("reading", "")), str(c["source"]), str(c["verdict"]),
-                        c.get("reason") if c["verdict"] == "cannot be judged" else None,
-                        registry.data_of(c))
+        return _Outcome(
+            str(c["claim"]),
+            str(c.get("reading", "")),
+            str(c["source"]),
+            str(c["verdict"]),
+            c.get("reason") if c["verdict"] == "cannot be judged" else None,
+            registry.data_of(c),
+        )
     except (KeyError, TypeError, AttributeError):
-        raise InputError(f"a claim record without claim, source and verdict: {str(c)[:80]}") from None
+        raise InputError(
+            f"a claim record without claim, source and verdict: {str(c)[:80]}"
+        ) from None
 
 
 def _reason_counts(cs: list[_Outcome]) -> str:
@@ -366,11 +496,15 @@ class Showed:
     paper's claims, the book's own), the tally with the reasons of the claims that cannot be judged, and
     one line per claim with its verdicts over the readings."""
 
-    def __init__(self, claims: Iterable["Claim | Mapping[str, Any]"], found: Mapping[Any, str] | None = None):
+    def __init__(
+        self, claims: Iterable["Claim | Mapping[str, Any]"], found: Mapping[Any, str] | None = None
+    ):
         outs = [_outcome(c) for c in claims]
-        parts = [(title + suffix, [c for c in outs if c.source == src and c.data == data])
-                 for data, suffix in (("simulated", ""), ("real", f" {ON_REAL}"))
-                 for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims"))]
+        parts = [
+            (title + suffix, [c for c in outs if c.source == src and c.data == data])
+            for data, suffix in (("simulated", ""), ("real", f" {ON_REAL}"))
+            for src, title in (("paper", "The paper's claims"), ("book", "The book's own claims"))
+        ]
         self.parts = [(t, cs) for t, cs in parts if cs]
         self.found = dict(found or {})
 
@@ -378,9 +512,18 @@ class Showed:
         """One row per claim; ``found`` is looked up by ``(claim, data)``, then by the claim alone."""
         names = list(dict.fromkeys(c.claim for c in cs))
         data = cs[0].data if cs else "simulated"
-        return pd.DataFrame([{"claim": n, "what we found": self.found.get((n, data)) or self.found.get(n) or
-                              _claim_outcome([c for c in cs if c.claim == n])}
-                             for n in names], columns=["claim", "what we found"])
+        return pd.DataFrame(
+            [
+                {
+                    "claim": n,
+                    "what we found": self.found.get((n, data))
+                    or self.found.get(n)
+                    or _claim_outcome([c for c in cs if c.claim == n]),
+                }
+                for n in names
+            ],
+            columns=["claim", "what we found"],
+        )
 
     @staticmethod
     def _lead(title: str, cs: list[_Outcome]) -> str:
@@ -390,9 +533,14 @@ class Showed:
     def _repr_html_(self) -> str:
         out = []
         for title, cs in self.parts:
-            out.append(f'<p class="navbook-showed">{html.escape(self._lead(title, cs), quote=False)}</p>')
-            out.append("<details><summary>Claim by claim</summary>"
-                       + Table(self._rows(cs), index=False, readable=False)._repr_html_() + "</details>")
+            out.append(
+                f'<p class="navbook-showed">{html.escape(self._lead(title, cs), quote=False)}</p>'
+            )
+            out.append(
+                "<details><summary>Claim by claim</summary>"
+                + Table(self._rows(cs), index=False, readable=False)._repr_html_()
+                + "</details>"
+            )
         return "\n".join(out)
 
     def __repr__(self) -> str:
@@ -403,8 +551,11 @@ class Showed:
         return "\n".join(out)
 
 
-def showed(claims: Iterable[Claim], chapter: str | None = None,
-           worlds: list[Mapping[str, Any]] | None = None) -> Showed:
+def showed(
+    claims: Iterable[Claim],
+    chapter: str | None = None,
+    worlds: list[Mapping[str, Any]] | None = None,
+) -> Showed:
     """The *What this chapter showed* box (see :class:`Showed`); glue it into a ``:::{admonition} What
     this chapter showed`` block at the chapter's end.  With ``chapter`` (a chapter with a claims
     register) it counts claims, one per register entry, with the verdict under the primary reading."""
@@ -412,7 +563,13 @@ def showed(claims: Iterable[Claim], chapter: str | None = None,
     records = register_records(claims, chapter, worlds)
     if records is None:
         return Showed(claims)
-    found = {(r["claim"], registry.data_of(r)): record_label(r) + (
-        f" (primary reading; {registry.across_text(r)})" if r.get("status") == "judged" and r.get("row_claim")
-        else "") for r in records}
+    found = {
+        (r["claim"], registry.data_of(r)): record_label(r)
+        + (
+            f" (primary reading; {registry.across_text(r)})"
+            if r.get("status") == "judged" and r.get("row_claim")
+            else ""
+        )
+        for r in records
+    }
     return Showed([{**r, "reading": "primary"} for r in records], found)

@@ -28,6 +28,7 @@ Commands::
 Bad input is one line ``navbook COMMAND: error: ...`` and status 2, Ctrl-C one line and status 130 (the
 conventions of ``navlib``'s command line, :func:`navlib.cli.run_command`); ``--debug`` shows tracebacks.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,11 +36,13 @@ import os
 import sys
 from pathlib import Path
 
+from navlib import engine
 from navlib.cli import run_command
 from navlib.names import WORKERS_HELP
 
 from .api_pages import write_api
 from .execute import execute
+from .grid import run_grid
 from .html_checks import BASELINE_FILE, check_html
 from .landing import write_status
 from .results_check import ATOL, RTOL, check_results
@@ -47,35 +50,56 @@ from .screenshots import screenshots
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message):                       # one line, exit 2, like every other bad input
+    def error(self, message):  # one line, exit 2, like every other bad input
         print(f"{self.prog}: error: {message}", file=sys.stderr)
         raise SystemExit(2)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    ap = _Parser(prog="navbook", description="the book's tooling: execute, check, landing page, grid")
+    ap = _Parser(
+        prog="navbook", description="the book's tooling: execute, check, landing page, grid"
+    )
     ap.add_argument("--debug", action="store_true", help="show the full traceback of any error")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
     ex = sub.add_parser("execute", help="execute notebooks with papermill")
     ex.add_argument("notebooks", nargs="+", type=Path)
     g = ex.add_mutually_exclusive_group(required=True)
-    g.add_argument("--out", type=Path, help="folder for the executed copies (results go to OUT/results)")
-    g.add_argument("--in-place", action="store_true",
-                   help="re-execute the stored notebooks; store results in notebooks/results")
+    g.add_argument(
+        "--out", type=Path, help="folder for the executed copies (results go to OUT/results)"
+    )
+    g.add_argument(
+        "--in-place",
+        action="store_true",
+        help="re-execute the stored notebooks; store results in notebooks/results",
+    )
     ch = sub.add_parser("check-html", help="check the built pages")
     ch.add_argument("html_dir", type=Path)
-    ch.add_argument("--baseline", type=Path, default=None,
-                    help="known problems per page (JSON; default: check_html_baseline.json in the book "
-                         "folder, two levels above HTML_DIR, if present)")
-    st = sub.add_parser("status", help="write the landing page's status table from the results files")
+    ch.add_argument(
+        "--baseline",
+        type=Path,
+        default=None,
+        help="known problems per page (JSON; default: check_html_baseline.json in the book "
+        "folder, two levels above HTML_DIR, if present)",
+    )
+    st = sub.add_parser(
+        "status", help="write the landing page's status table from the results files"
+    )
     st.add_argument("results_dir", type=Path)
-    st.add_argument("--notebooks", type=Path, required=True, help="folder of the executed notebooks")
+    st.add_argument(
+        "--notebooks", type=Path, required=True, help="folder of the executed notebooks"
+    )
     st.add_argument("--out", type=Path, required=True)
-    st.add_argument("--toc", type=Path, default=None,
-                    help="the book's _toc.yml (chapter order; default: _toc.yml in OUT's parent folder)")
+    st.add_argument(
+        "--toc",
+        type=Path,
+        default=None,
+        help="the book's _toc.yml (chapter order; default: _toc.yml in OUT's parent folder)",
+    )
     api = sub.add_parser("api-modules", help="write the API page's automodule list")
     api.add_argument("--out", type=Path, required=True)
-    cr = sub.add_parser("check-results", help="compare fresh results files with the committed references")
+    cr = sub.add_parser(
+        "check-results", help="compare fresh results files with the committed references"
+    )
     cr.add_argument("notebooks", nargs="+", type=Path)
     cr.add_argument("--fresh", type=Path, required=True)
     cr.add_argument("--reference", type=Path, required=True)
@@ -87,24 +111,31 @@ def build_parser() -> argparse.ArgumentParser:
     sc.add_argument("out_dir", type=Path)
     sc.add_argument("--width", type=int, default=1400)
     sc.add_argument("--chromium", default=None)
-    grid = sub.add_parser("grid", help="run a chapter notebook over a grid of its parameters",
-                          description="one papermill run of NOTEBOOK per point of the grid, each with its own "
-                                      "results file; DIR gets the executed notebooks and grid.csv")
+    grid = sub.add_parser(
+        "grid",
+        help="run a chapter notebook over a grid of its parameters",
+        description="one papermill run of NOTEBOOK per point of the grid, each with its own "
+        "results file; DIR gets the executed notebooks and grid.csv",
+    )
     grid.add_argument("notebook", help="a notebook with a cell tagged 'parameters'")
-    grid.add_argument("--param", action="append", default=[], metavar="NAME=V1,V2",
-                      help="a parameter and its values (repeat for more parameters)")
+    grid.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=V1,V2",
+        help="a parameter and its values (repeat for more parameters)",
+    )
     grid.add_argument("--out", required=True, help="new or empty folder for the outputs")
     grid.add_argument("--workers", type=int, default=None, help=WORKERS_HELP)
-    grid.add_argument("--scheduler", default=None,
-                      help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)")
+    grid.add_argument(
+        "--scheduler",
+        default=None,
+        help="address of a dask scheduler, e.g. tcp://127.0.0.1:8786 (default $NAVLIB_SCHEDULER)",
+    )
     return ap
 
 
 def _grid(args) -> int:
-    from navlib import engine
-
-    from .grid import run_grid
-
     workers = engine.default_workers() if args.workers is None else args.workers
     rows = run_grid(args.notebook, args.param, args.out, workers=workers, scheduler=args.scheduler)
     failed = [r for r in rows if r["status"].startswith("failed")]
@@ -122,7 +153,9 @@ def _compile(args) -> int:
 
 def _check_html(args) -> int:
     default = Path(args.html_dir).absolute().parents[1] / BASELINE_FILE
-    return check_html(args.html_dir, baseline=args.baseline or (default if default.exists() else None))
+    return check_html(
+        args.html_dir, baseline=args.baseline or (default if default.exists() else None)
+    )
 
 
 #: Command name -> function.

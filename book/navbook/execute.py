@@ -8,6 +8,7 @@ a notebook writes its results file under.
     results file as ``notebooks/results/<chapter>.json`` (the committed reference ``make test`` compares
     with).  With ``--out DIR`` the results files go to ``DIR/results/``.
 """
+
 from __future__ import annotations
 
 import os
@@ -17,6 +18,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+import nbformat
 
 from .results import RESULTS_ENV
 
@@ -50,8 +53,6 @@ _WRITE_RESULTS = re.compile(r"""write_results\(\s*(?:chapter\s*=\s*)?["']([A-Za-
 
 def results_chapter(nb_path: Path) -> str | None:
     """The chapter name a notebook passes to ``report.write_results`` (None if it never calls it)."""
-    import nbformat
-
     nb = nbformat.read(nb_path, as_version=4)
     for cell in nb.cells:
         if cell.cell_type == "code":
@@ -61,14 +62,14 @@ def results_chapter(nb_path: Path) -> str | None:
     return None
 
 
-def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
-            parameters: dict | None = None) -> int:
+def execute(
+    notebooks: list[Path], out_dir: Path | None, in_place: bool, parameters: dict | None = None
+) -> int:
     """Execute notebooks with papermill (see the module docstring); 0 on success, 1 at the first failure.
 
     Each notebook runs with ``NAVBOOK_RESULTS_DIR`` pointing at a fresh temporary folder; the results
     files it writes are then copied to ``notebooks/results/`` (``in_place``) or ``out_dir/results/``."""
-    import nbformat
-    import papermill as pm
+    import papermill as pm  # noqa: PLC0415  # lazy: papermill costs ~1 s; only execute needs it
 
     for i, nb_path in enumerate(notebooks, 1):
         nb_path = Path(nb_path).resolve()
@@ -81,15 +82,23 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
         with tempfile.TemporaryDirectory() as tmp:
             tmp_out = Path(tmp) / nb_path.name
             tmp_results = Path(tmp) / "results"
-            os.environ[RESULTS_ENV] = str(tmp_results)   # the kernel inherits the environment
+            os.environ[RESULTS_ENV] = str(tmp_results)  # the kernel inherits the environment
             try:
-                pm.execute_notebook(str(nb_path), str(tmp_out), cwd=str(nb_path.parent),
-                                    parameters=parameters or {}, kernel_name="python3",
-                                    progress_bar=False, log_output=False)
+                pm.execute_notebook(
+                    str(nb_path),
+                    str(tmp_out),
+                    cwd=str(nb_path.parent),
+                    parameters=parameters or {},
+                    kernel_name="python3",
+                    progress_bar=False,
+                    log_output=False,
+                )
             except pm.PapermillExecutionError as err:
                 lines = [ln for ln in str(err).strip().splitlines() if ln.strip()]
-                print(f"FAILED {nb_path.name}: cell {err.exec_count}: {lines[-1] if lines else err.ename}",
-                      file=sys.stderr)
+                print(
+                    f"FAILED {nb_path.name}: cell {err.exec_count}: {lines[-1] if lines else err.ename}",
+                    file=sys.stderr,
+                )
                 return 1
             finally:
                 if old_env is None:
@@ -99,8 +108,11 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
             nb = nbformat.read(tmp_out, as_version=4)
             missing = missing_figures(nb)
             if missing:
-                print(f"FAILED {nb_path.name}: cell {missing[0]} calls plt.show() but produced no figure "
-                      f"(is MPLBACKEND set to a non-inline backend?)", file=sys.stderr)
+                print(
+                    f"FAILED {nb_path.name}: cell {missing[0]} calls plt.show() but produced no figure "
+                    f"(is MPLBACKEND set to a non-inline backend?)",
+                    file=sys.stderr,
+                )
                 return 1
             strip_metadata(nb)
             nbformat.write(nb, target)
@@ -109,6 +121,9 @@ def execute(notebooks: list[Path], out_dir: Path | None, in_place: bool,
                 results_target.mkdir(parents=True, exist_ok=True)
             for f in written:
                 shutil.copyfile(f, results_target / f.name)
-        names = ", ".join(f.name for f in written) or "none (the chapter does not call report.write_results)"
+        names = (
+            ", ".join(f.name for f in written)
+            or "none (the chapter does not call report.write_results)"
+        )
         print(f"    done in {time.perf_counter() - t0:.1f} s; results: {names}", flush=True)
     return 0

@@ -1,5 +1,6 @@
 """Glue for the prose (numbers, texts, tables, figures and the claims' verdicts), each shown where a MyST
 ``{glue:...}`` role or directive with the same name stands."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -15,7 +16,7 @@ from .tables import Table
 
 
 def _glue(name: str, obj: Any) -> None:
-    from myst_nb import glue
+    from myst_nb import glue  # noqa: PLC0415  # lazy: myst_nb loads sphinx (~1 s); only notebooks glue
 
     glue(name, obj, display=False)
 
@@ -42,7 +43,7 @@ def glue_table(name: str, tab: "Table | Glance | Answer | Showed | pd.DataFrame"
 def glue_figure(name: str, fig) -> None:
     """Glue a matplotlib figure for a MyST ``{glue:figure}`` directive (numbered, captioned, with alt text in the
     directive), then close it so it is not shown a second time."""
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only where a figure is glued
 
     _glue(name, fig)
     plt.close(fig)
@@ -51,7 +52,7 @@ def glue_figure(name: str, fig) -> None:
 def glue_png(name: str, path) -> None:
     """Glue a PNG file (e.g. the figure ``navlib loop --report`` wrote) for a MyST ``{glue:figure}``
     directive; the image is read now, so the file may be removed afterwards."""
-    from IPython.display import Image
+    from IPython.display import Image  # noqa: PLC0415  # lazy: IPython only inside a notebook
 
     _glue(name, Image(data=Path(path).read_bytes(), format="png"))
 

@@ -34,6 +34,7 @@ unset (a run does not send work back to the cluster it runs on) and, for noteboo
 parameter that the grid does not set, ``n_workers=1`` (the grid's runs are the parallel work).
 Needs papermill (the book's tooling: ``pip install 'navlib[book]'``).
 """
+
 from __future__ import annotations
 
 import ast
@@ -78,26 +79,46 @@ def notebook_parameters(path: str | os.PathLike) -> dict[str, Any]:
     if not path.is_file():
         raise InputError(f"{path}: no such notebook")
     nb = _read_notebook(path)
-    cell = next((c for c in nb["cells"] if c.get("cell_type") == "code"
-                 and "parameters" in c.get("metadata", {}).get("tags", [])), None)
+    cell = next(
+        (
+            c
+            for c in nb["cells"]
+            if c.get("cell_type") == "code"
+            and "parameters" in c.get("metadata", {}).get("tags", [])
+        ),
+        None,
+    )
     if cell is None:
-        raise InputError(f"{path}: no cell tagged 'parameters' (papermill needs one to set parameters)")
+        raise InputError(
+            f"{path}: no cell tagged 'parameters' (papermill needs one to set parameters)"
+        )
     src = "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
     try:
         tree = ast.parse(src)
     except SyntaxError as err:
-        raise InputError(f"{path}: the parameters cell does not parse (line {err.lineno})") from None
+        raise InputError(
+            f"{path}: the parameters cell does not parse (line {err.lineno})"
+        ) from None
     out: dict[str, Any] = {}
     for node in tree.body:
         if isinstance(node, ast.Assign):
             for target in node.targets:
-                names = [target] if isinstance(target, ast.Name) else list(getattr(target, "elts", []))
-                values = ([node.value] if isinstance(target, ast.Name)
-                          else list(getattr(node.value, "elts", [None] * len(names))))
+                names = (
+                    [target] if isinstance(target, ast.Name) else list(getattr(target, "elts", []))
+                )
+                values = (
+                    [node.value]
+                    if isinstance(target, ast.Name)
+                    else list(getattr(node.value, "elts", [None] * len(names)))
+                )
                 for n, v in zip(names, values):
                     if isinstance(n, ast.Name):
                         out[n.id] = _default(v, src) if v is not None else None
-        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is not None:
+        elif (
+            isinstance(node, ast.AnnAssign)
+            and isinstance(node.target, ast.Name)
+            and node.value is not None
+        ):
             out[node.target.id] = _default(node.value, src, node.annotation)
     return out
 
@@ -123,8 +144,13 @@ def _default(value: ast.expr, src: str, annotation: ast.expr | None = None) -> A
         v = ast.literal_eval(value)
     except ValueError:
         v = Expression(ast.get_source_segment(src, value) or "")
-        if (isinstance(value, ast.Call) and isinstance(value.func, ast.Name) and value.func.id in CASTS
-                and len(value.args) == 1 and not value.keywords):
+        if (
+            isinstance(value, ast.Call)
+            and isinstance(value.func, ast.Name)
+            and value.func.id in CASTS
+            and len(value.args) == 1
+            and not value.keywords
+        ):
             try:
                 v = CASTS[value.func.id](ast.literal_eval(value.args[0]))
             except (ValueError, TypeError, SyntaxError):
@@ -175,18 +201,26 @@ def convert(name: str, raw: str, default: Any) -> Any:
             if not isinstance(v, (list, tuple)):
                 raise ValueError
             return type(default)(v)
-        try:                                      # default None or an expression: a literal, else text
+        try:  # default None or an expression: a literal, else text
             return ast.literal_eval(text)
         except (ValueError, SyntaxError):
             return text
     except (ValueError, SyntaxError):
-        kind = {bool: "True or False", int: "a whole number", float: "a number",
-                list: "a Python list", tuple: "a Python tuple"}.get(type(default), "a Python literal")
-        raise InputError(f"grid: parameter {name}={raw!r}: expected {kind} (the notebook's default is "
-                         f"{shown})") from None
+        kind = {
+            bool: "True or False",
+            int: "a whole number",
+            float: "a number",
+            list: "a Python list",
+            tuple: "a Python tuple",
+        }.get(type(default), "a Python literal")
+        raise InputError(
+            f"grid: parameter {name}={raw!r}: expected {kind} (the notebook's default is {shown})"
+        ) from None
 
 
-def parse_grid(specs: list[str], parameters: dict[str, Any], notebook: str = "the notebook") -> dict[str, list]:
+def parse_grid(
+    specs: list[str], parameters: dict[str, Any], notebook: str = "the notebook"
+) -> dict[str, list]:
     """``["NAME=V1,V2", ...]`` -> ``{NAME: [v1, v2]}`` checked against ``parameters`` (a name given twice
     adds values)."""
     if not specs:
@@ -199,12 +233,14 @@ def parse_grid(specs: list[str], parameters: dict[str, Any], notebook: str = "th
             raise InputError(f"grid: --param {spec!r}: write NAME=V1,V2,...")
         if name not in parameters:
             known = ", ".join(parameters) or "none"
-            raise InputError(f"grid: parameter {name!r} is not in the parameters cell of {notebook} "
-                             f"(its parameters: {known})")
+            raise InputError(
+                f"grid: parameter {name!r} is not in the parameters cell of {notebook} "
+                f"(its parameters: {known})"
+            )
         default = parameters[name]
         if isinstance(default, (list, tuple)):
             raws = [values]
-        else:                                        # comma-separated; "a,b" in double quotes is one value
+        else:  # comma-separated; "a,b" in double quotes is one value
             raws = next(csv.reader([values], skipinitialspace=True), [])
         if not raws or any(not r.strip() for r in raws):
             raise InputError(f"grid: parameter {name}={values!r}: an empty value")
@@ -264,24 +300,36 @@ def run_point(notebook_json: str, name: str, parameters: dict, cwd: str) -> dict
     t0 = time.perf_counter()
     saved = {k: os.environ.get(k) for k in (RESULTS_ENV, engine.ENV_SCHEDULER, engine.ENV_PROGRESS)}
     with tempfile.TemporaryDirectory(prefix="navlib-grid-") as tmp:
-        src, dst, res = Path(tmp) / f"{name}_in.ipynb", Path(tmp) / f"{name}.ipynb", Path(tmp) / "results"
+        src, dst, res = (
+            Path(tmp) / f"{name}_in.ipynb",
+            Path(tmp) / f"{name}.ipynb",
+            Path(tmp) / "results",
+        )
         src.write_text(notebook_json, encoding="utf-8")
         error = None
-        os.environ[RESULTS_ENV] = str(res)            # the kernel inherits the environment
+        os.environ[RESULTS_ENV] = str(res)  # the kernel inherits the environment
         os.environ.pop(engine.ENV_SCHEDULER, None)
         os.environ[engine.ENV_PROGRESS] = "0"
         quiet = logging.getLogger("papermill")
         level = quiet.level
-        quiet.setLevel(logging.ERROR)       # "Passed unknown parameter" when it cannot parse a commented line
+        quiet.setLevel(
+            logging.ERROR
+        )  # "Passed unknown parameter" when it cannot parse a commented line
         try:
             with _stderr_to(Path(tmp) / "stderr.log"):
-                pm.execute_notebook(str(src), str(dst), parameters=parameters,
-                                    cwd=cwd if Path(cwd).is_dir() else tmp, kernel_name="python3",
-                                    progress_bar=False, log_output=False)
+                pm.execute_notebook(
+                    str(src),
+                    str(dst),
+                    parameters=parameters,
+                    cwd=cwd if Path(cwd).is_dir() else tmp,
+                    kernel_name="python3",
+                    progress_bar=False,
+                    log_output=False,
+                )
         except pm.PapermillExecutionError as err:
             lines = [ln for ln in str(err).strip().splitlines() if ln.strip()]
             error = f"cell {err.exec_count}: {lines[-1] if lines else err.ename}"
-        except (RuntimeError, OSError, TimeoutError) as err:        # kernel died, could not start ...
+        except (RuntimeError, OSError, TimeoutError) as err:  # kernel died, could not start ...
             error = f"{type(err).__name__}: {str(err).strip().splitlines()[0] if str(err).strip() else ''}"
         finally:
             quiet.setLevel(level)
@@ -291,8 +339,17 @@ def run_point(notebook_json: str, name: str, parameters: dict, cwd: str) -> dict
                 else:
                     os.environ[k] = v
         text = dst.read_text(encoding="utf-8") if dst.is_file() else None
-        results = {f.name: f.read_text(encoding="utf-8") for f in sorted(res.glob("*.json"))} if res.is_dir() else {}
-    return {"notebook": text, "results": results, "error": error, "seconds": time.perf_counter() - t0}
+        results = (
+            {f.name: f.read_text(encoding="utf-8") for f in sorted(res.glob("*.json"))}
+            if res.is_dir()
+            else {}
+        )
+    return {
+        "notebook": text,
+        "results": results,
+        "error": error,
+        "seconds": time.perf_counter() - t0,
+    }
 
 
 def _flatten(results: dict[str, str]) -> dict[str, Any]:
@@ -307,21 +364,31 @@ def _flatten(results: dict[str, str]) -> dict[str, Any]:
                 out[f"{pre}{method}: {stat}"] = v
         for c in data.get("claims") or []:
             # a claims-register record: its id (the same column in every run, whatever readings ran)
-            key = c.get("id") or c.get("key") or (f"{c['claim']} [{c['reading']}]" if c.get("reading")
-                                                  else c["claim"])
+            key = (
+                c.get("id")
+                or c.get("key")
+                or (f"{c['claim']} [{c['reading']}]" if c.get("reading") else c["claim"])
+            )
             out[f"{pre}{key}: verdict"] = c.get("verdict")
             out[f"{pre}{key}: estimate"] = c.get("estimate")
     return out
 
 
-def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLike, *, workers: int = 1,
-             scheduler: str | None = None, progress: bool | None = None) -> list[dict]:
+def run_grid(
+    notebook: str | os.PathLike,
+    specs: list[str],
+    out: str | os.PathLike,
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    progress: bool | None = None,
+) -> list[dict]:
     """Run ``notebook`` at every point of the grid ``specs`` (``["NAME=V1,V2", ...]``) and write ``out``
     (see the module docstring).  Returns grid.csv's rows."""
     nb_path, out = Path(notebook), Path(out)
     params = notebook_parameters(nb_path)
     grid = parse_grid(list(specs), params, nb_path.name)
-    engine.scheduler_address(scheduler)                      # a bad address stops here, before any run
+    engine.scheduler_address(scheduler)  # a bad address stops here, before any run
     _papermill()
     text = nb_path.read_text(encoding="utf-8")
     stem = nb_path.stem
@@ -329,10 +396,12 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
     width = max(3, len(str(len(pts))))
     names = [f"{stem}_{k:0{width}d}" for k in range(1, len(pts) + 1)]
     extra = {k: v for k, v in RUN_DEFAULTS.items() if k in params}
-    tasks = [(text, names[i], {**extra, **p}, str(nb_path.resolve().parent)) for i, p in enumerate(pts)]
+    tasks = [
+        (text, names[i], {**extra, **p}, str(nb_path.resolve().parent)) for i, p in enumerate(pts)
+    ]
     rows: list[dict | None] = [None] * len(pts)
 
-    def write(i: int, r: dict) -> None:                       # as each run finishes
+    def write(i: int, r: dict) -> None:  # as each run finishes
         if r["notebook"] is not None:
             (out / f"{names[i]}.ipynb").write_text(r["notebook"], encoding="utf-8")
         if r["results"]:
@@ -343,8 +412,14 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
         status = "ok" if r["error"] is None else f"failed: {r['error']}"
         if r["error"] is None and not r["results"]:
             status = "ok (no results file)"
-        rows[i] = {"run": i + 1, "notebook": f"{names[i]}.ipynb" if r["notebook"] is not None else "",
-                   "status": status, "seconds": round(r["seconds"], 1), **pts[i], **_flatten(r["results"])}
+        rows[i] = {
+            "run": i + 1,
+            "notebook": f"{names[i]}.ipynb" if r["notebook"] is not None else "",
+            "status": status,
+            "seconds": round(r["seconds"], 1),
+            **pts[i],
+            **_flatten(r["results"]),
+        }
 
     def table(f) -> None:
         columns: list[str] = []
@@ -353,10 +428,22 @@ def run_grid(notebook: str | os.PathLike, specs: list[str], out: str | os.PathLi
         w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
         for r in rows:
-            w.writerow({k: (json.dumps(v) if isinstance(v, (list, tuple, dict)) else v) for k, v in r.items()})
+            w.writerow(
+                {
+                    k: (json.dumps(v) if isinstance(v, (list, tuple, dict)) else v)
+                    for k, v in r.items()
+                }
+            )
 
-    with claim_out_dir(out):                                  # one grid per folder, claimed before any run
-        engine.run(run_point, tasks, workers=workers, scheduler=scheduler, label=f"grid {stem}", progress=progress,
-                   on_result=write)
-        write_new(out / "grid.csv", table, newline="")         # last: a folder with grid.csv is complete
+    with claim_out_dir(out):  # one grid per folder, claimed before any run
+        engine.run(
+            run_point,
+            tasks,
+            workers=workers,
+            scheduler=scheduler,
+            label=f"grid {stem}",
+            progress=progress,
+            on_result=write,
+        )
+        write_new(out / "grid.csv", table, newline="")  # last: a folder with grid.csv is complete
     return rows

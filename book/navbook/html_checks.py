@@ -9,6 +9,7 @@
     name in a result table, and a chapter whose glance box counts its claims differently from the landing
     page; these fail only beyond the page's count in the baseline (``book/check_html_baseline.json``).
 """
+
 from __future__ import annotations
 
 import html
@@ -20,6 +21,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 from navlib import verdicts
+from navlib.cli import build_parser
 from navlib.errors import InputError
 
 #: A preformatted output line longer than this does not fit the content column at 1400 px (measured in
@@ -37,8 +39,22 @@ LAYOUT_KINDS = ("wide code line", "index-name row", "snake_case header", "counts
 
 
 REMOTE = re.compile(r"""(?:src|href)\s*=\s*["'](?:https?:)?//(?!localhost)""", re.I)
-_VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "param", "source",
-         "track", "wbr"}
+_VOID = {
+    "area",
+    "base",
+    "br",
+    "col",
+    "embed",
+    "hr",
+    "img",
+    "input",
+    "link",
+    "meta",
+    "param",
+    "source",
+    "track",
+    "wbr",
+}
 
 
 class _PageScan(HTMLParser):
@@ -47,15 +63,15 @@ class _PageScan(HTMLParser):
     def __init__(self):
         super().__init__(convert_charrefs=True)
         self.stack: list[tuple[str, set[str]]] = []
-        self.heading = ""          # the last section heading seen (to say where a problem is)
+        self.heading = ""  # the last section heading seen (to say where a problem is)
         self._in_heading = False
         self._heading_buf: list[str] = []
-        self.pre_stack: list[list[str]] = []   # text of output <pre> blocks being read
-        self.figures: list[dict] = []          # open <figure> elements
+        self.pre_stack: list[list[str]] = []  # text of output <pre> blocks being read
+        self.figures: list[dict] = []  # open <figure> elements
         self.problems: list[str] = []
-        self._skip = 0                         # inside <script>/<style>
+        self._skip = 0  # inside <script>/<style>
         self.code_stack: list[list[str]] = []  # text of code <pre> blocks (not outputs) being read
-        self.tables: list[dict] = []           # open result tables (inside cell outputs)
+        self.tables: list[dict] = []  # open result tables (inside cell outputs)
 
     # -- helpers
     def _classes(self, attrs) -> set[str]:
@@ -81,9 +97,11 @@ class _PageScan(HTMLParser):
         if tag == "img":
             if self._in_output() and not self.figures:
                 alt = (a.get("alt") or "")[:60]
-                self.problems.append(f"figure without a caption {self._where()} (image '{alt}'): glue it "
-                                     f"with report.glue_figure and show it with a glue:figure directive "
-                                     f"that has a caption")
+                self.problems.append(
+                    f"figure without a caption {self._where()} (image '{alt}'): glue it "
+                    f"with report.glue_figure and show it with a glue:figure directive "
+                    f"that has a caption"
+                )
             for fig in self.figures:
                 fig["img"] = True
         if tag == "figure":
@@ -119,7 +137,9 @@ class _PageScan(HTMLParser):
             self._skip -= 1
         if tag in ("h1", "h2", "h3", "h4") and self._in_heading:
             self._in_heading = False
-            self.heading = re.sub(r"\s+", " ", "".join(self._heading_buf)).strip().rstrip("#").strip()
+            self.heading = (
+                re.sub(r"\s+", " ", "".join(self._heading_buf)).strip().rstrip("#").strip()
+            )
         if tag == "pre" and self.pre_stack and self._in_output():
             self._check_pre("".join(self.pre_stack.pop()))
         elif tag == "pre" and self.code_stack:
@@ -140,8 +160,10 @@ class _PageScan(HTMLParser):
             fig = self.figures.pop()
             if not fig["caption"]:
                 name = f" '{fig['id']}'" if fig["id"] else ""
-                self.problems.append(f"figure{name} without a caption {self._where()}: give the "
-                                     f"glue:figure/figure directive a caption paragraph")
+                self.problems.append(
+                    f"figure{name} without a caption {self._where()}: give the "
+                    f"glue:figure/figure directive a caption paragraph"
+                )
         # pop up to and including the matching open tag (tolerates unclosed <p> and the like)
         for k in range(len(self.stack) - 1, -1, -1):
             if self.stack[k][0] == tag:
@@ -161,39 +183,60 @@ class _PageScan(HTMLParser):
             self.tables[-1]["cell"][1].append(data)
         if "NBVAL_" in data:
             m = re.search(r"#?\s*NBVAL_\w*", data)
-            self.problems.append(f"visible nbval marker '{m.group(0).strip()}' {self._where()}: use the cell "
-                                 f"tag nbval-ignore-output (or nbval-skip) instead of the comment")
+            self.problems.append(
+                f"visible nbval marker '{m.group(0).strip()}' {self._where()}: use the cell "
+                f"tag nbval-ignore-output (or nbval-skip) instead of the comment"
+            )
 
     def _check_width(self, text: str, limit: int, what: str, shown: int, advice: str):
         """The first line of a block wider than ``limit`` characters, as one problem (one per block)."""
         for line in text.splitlines():
             if len(line.rstrip()) > limit:
-                self.problems.append(f"{what} of {len(line.rstrip())} characters (max {limit}) {self._where()}: "
-                                     f"'{line.strip()[:shown]}...': {advice}")
+                self.problems.append(
+                    f"{what} of {len(line.rstrip())} characters (max {limit}) {self._where()}: "
+                    f"'{line.strip()[:shown]}...': {advice}"
+                )
                 return
 
     def _check_pre(self, text: str):
-        self._check_width(text, MAX_PRE_CHARS, "output line", 70,
-                          "show a report.table(...) or shorten the printed text")
+        self._check_width(
+            text,
+            MAX_PRE_CHARS,
+            "output line",
+            70,
+            "show a report.table(...) or shorten the printed text",
+        )
 
     def _check_code(self, text: str):
-        self._check_width(text, MAX_CODE_CHARS, "wide code line", 60,
-                          "break the line (or fold the cell: tag hide-input)")
+        self._check_width(
+            text,
+            MAX_CODE_CHARS,
+            "wide code line",
+            60,
+            "break the line (or fold the cell: tag hide-input)",
+        )
 
     def _check_header_row(self, table: dict, row: list[tuple[bool, str]]):
         """A header row of a result table: pandas' index-name row (the index's name alone, the column
         cells blank), and snake_case column names (``median_rms_deg``: say "median RMS (deg)")."""
-        if len(row) >= 2 and "index" not in table["flagged"] and (
-                row[0][0] or (row[0][1] and not any(text for _, text in row[1:]))):
+        if (
+            len(row) >= 2
+            and "index" not in table["flagged"]
+            and (row[0][0] or (row[0][1] and not any(text for _, text in row[1:])))
+        ):
             table["flagged"].add("index")
-            self.problems.append(f"index-name row '{row[0][1]}' in a result table {self._where()}: reset the "
-                                 f"index or set its name to None (report.table(..., index=False))")
+            self.problems.append(
+                f"index-name row '{row[0][1]}' in a result table {self._where()}: reset the "
+                f"index or set its name to None (report.table(..., index=False))"
+            )
         snake = [text for _, text in row if SNAKE.fullmatch(text)]
         if snake and "snake" not in table["flagged"]:
             table["flagged"].add("snake")
-            self.problems.append(f"snake_case header '{snake[0]}' in a result table {self._where()} "
-                                 f"({len(snake)} in the row): name the column in words with its unit in "
-                                 f"parentheses")
+            self.problems.append(
+                f"snake_case header '{snake[0]}' in a result table {self._where()} "
+                f"({len(snake)} in the row): name the column in words with its unit in "
+                f"parentheses"
+            )
 
 
 #: A column name in snake_case (two or more lower-case words joined by underscores).
@@ -230,11 +273,15 @@ def check_chapter_opening(text: str) -> list[str]:
     and before the first code cell."""
     m = re.search(r'<p class="admonition-title">\s*' + GLANCE, text)
     if not m:
-        return [f"chapter without a '{GLANCE}' admonition: open the chapter with report.glance(claims) "
-                f"glued into a ':::{{admonition}} {GLANCE}' block"]
+        return [
+            f"chapter without a '{GLANCE}' admonition: open the chapter with report.glance(claims) "
+            f"glued into a ':::{{admonition}} {GLANCE}' block"
+        ]
     first_cell = text.find('<div class="cell docutils container')
     if 0 <= first_cell < m.start():
-        return [f"the '{GLANCE}' admonition comes after a code cell: move it right after the title and intro"]
+        return [
+            f"the '{GLANCE}' admonition comes after a code cell: move it right after the title and intro"
+        ]
     return []
 
 
@@ -245,20 +292,26 @@ def check_chapter_closing(text: str) -> list[str]:
     for m in re.finditer(r'<p class="admonition-title">\s*' + SHOWED, text):
         pass
     if m is None:
-        return [f"chapter without a '{SHOWED}' admonition: close the chapter with report.showed(claims) "
-                f"glued into a ':::{{admonition}} {SHOWED}' block"]
+        return [
+            f"chapter without a '{SHOWED}' admonition: close the chapter with report.showed(claims) "
+            f"glued into a ':::{{admonition}} {SHOWED}' block"
+        ]
     if text.find('<div class="cell docutils container', m.end()) >= 0:
         return [f"the '{SHOWED}' admonition is not at the chapter's end: a code cell follows it"]
-    shown = _box_counts(text[m.end():])
+    shown = _box_counts(text[m.end() :])
     glance = glance_counts(text)
     if glance is not None and shown != glance:
-        return [f"the '{SHOWED}' box counts {shown} but the glance box {glance}: build both from the same "
-                f"claims"]
+        return [
+            f"the '{SHOWED}' box counts {shown} but the glance box {glance}: build both from the same "
+            f"claims"
+        ]
     return []
 
 
-_TALLY = re.compile(r"The (paper's|book's own) claims: (\d+) of (\d+) reproduced, (\d+) not reproduced, "
-                    r"(\d+) cannot be judged(?:, (\d+) no difference)?")
+_TALLY = re.compile(
+    r"The (paper's|book's own) claims: (\d+) of (\d+) reproduced, (\d+) not reproduced, "
+    r"(\d+) cannot be judged(?:, (\d+) no difference)?"
+)
 _COUNTS_TAG = re.compile(r'<span class="navbook-counts"([^>]*)>')
 
 
@@ -269,7 +322,7 @@ def glance_counts(text: str) -> dict[str, tuple[int, int, int]] | None:
     if not m:
         return None
     end = text.find('<div class="cell docutils container', m.end())
-    return _box_counts(text[m.end(): end if end >= 0 else len(text)])
+    return _box_counts(text[m.end() : end if end >= 0 else len(text)])
 
 
 def _box_counts(fragment: str) -> dict[str, tuple[int, int, int]]:
@@ -278,8 +331,10 @@ def _box_counts(fragment: str) -> dict[str, tuple[int, int, int]]:
     box = re.sub(r"\s+", " ", html.unescape(re.sub(r"<[^>]+>", " ", fragment)))
     out = {}
     for t in _TALLY.finditer(box):
-        out.setdefault("paper" if t.group(1) == "paper's" else "book", (int(t.group(2)), int(t.group(4)),
-                                                                         int(t.group(5)), int(t.group(6) or 0)))
+        out.setdefault(
+            "paper" if t.group(1) == "paper's" else "book",
+            (int(t.group(2)), int(t.group(4)), int(t.group(5)), int(t.group(6) or 0)),
+        )
     return out
 
 
@@ -290,32 +345,49 @@ def landing_counts(text: str) -> dict[str, dict]:
     for m in _COUNTS_TAG.finditer(text):
         a = dict(re.findall(r'([\w-]+)="([^"]*)"', m.group(1)))
         if "data-page" in a:
-            out[a["data-page"]] = {"chapter": a.get("data-chapter", ""),
-                                   **{src: (tuple(int(v) for v in a.get(f"data-{src}", "").split())
-                                            + (0, 0, 0, 0))[:4]
-                                      for src in verdicts.SOURCES}}
+            out[a["data-page"]] = {
+                "chapter": a.get("data-chapter", ""),
+                **{
+                    src: (tuple(int(v) for v in a.get(f"data-{src}", "").split()) + (0, 0, 0, 0))[
+                        :4
+                    ]
+                    for src in verdicts.SOURCES
+                },
+            }
     return out
 
 
-def count_problems(landing: dict[str, dict], chapter_pages: dict[str, str]) -> list[tuple[str, str]]:
+def count_problems(
+    landing: dict[str, dict], chapter_pages: dict[str, str]
+) -> list[tuple[str, str]]:
     """``(page, problem)`` where a chapter's glance box and the landing page count its claims differently
     (both must come from the chapter's results file: every claim it writes is in its glance box)."""
     out = []
     for page, want in sorted(landing.items()):
         text = chapter_pages.get(page)
         if text is None:
-            out.append(("intro.html", f"counts differ: the landing page counts {page}, which was not built"))
+            out.append(
+                (
+                    "intro.html",
+                    f"counts differ: the landing page counts {page}, which was not built",
+                )
+            )
             continue
         got = glance_counts(text) or {}
         for src in verdicts.SOURCES:
             shown = got.get(src, (0, 0, 0, 0))
             if tuple(want[src]) != tuple(shown):
                 whose = "the paper's" if src == "paper" else "the book's own"
-                out.append((page, f"counts differ: the glance box shows {whose} claims as {shown[0]} of "
-                                  f"{sum(shown)} reproduced / {shown[1]} not / {shown[2]} cannot be judged, the "
-                                  f"landing page (the results file) {want[src][0]} of {sum(want[src])} / "
-                                  f"{want[src][1]} / {want[src][2]}: pass every claim written to "
-                                  f"report.write_results to report.glance"))
+                out.append(
+                    (
+                        page,
+                        f"counts differ: the glance box shows {whose} claims as {shown[0]} of "
+                        f"{sum(shown)} reproduced / {shown[1]} not / {shown[2]} cannot be judged, the "
+                        f"landing page (the results file) {want[src][0]} of {sum(want[src])} / "
+                        f"{want[src][1]} / {want[src][2]}: pass every claim written to "
+                        f"report.write_results to report.glance",
+                    )
+                )
     return out
 
 
@@ -326,10 +398,14 @@ def load_baseline(path: Path | None) -> dict[str, dict[str, int]]:
         return {}
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
-        return {page: {k: int(v) for k, v in kinds.items()} for page, kinds in data["pages"].items()}
+        return {
+            page: {k: int(v) for k, v in kinds.items()} for page, kinds in data["pages"].items()
+        }
     except (json.JSONDecodeError, KeyError, AttributeError, TypeError, ValueError) as err:
-        raise InputError(f"{path}: not a check-html baseline ({{\"pages\": {{page: {{kind: count}}}}}}): "
-                         f"{type(err).__name__}: {err}") from None
+        raise InputError(
+            f'{path}: not a check-html baseline ({{"pages": {{page: {{kind: count}}}}}}): '
+            f"{type(err).__name__}: {err}"
+        ) from None
 
 
 def _kind(problem: str) -> str | None:
@@ -359,9 +435,10 @@ def check_api_page(text: str, cli_page: bool = False) -> list[str]:
         out.append(f"{n} description(s) split into a 'Type:' field")
     if not cli_page:
         return out
-    from navlib.cli import build_parser
     sub = next(a for a in build_parser()._actions if a.dest == "command").choices
-    body = html.unescape(re.sub(r"<[^>]+>", "", re.sub(r"</(?:p|dt|dd|li|pre|div)>|<br\s*/?>", "\n", text)))
+    body = html.unescape(
+        re.sub(r"<[^>]+>", "", re.sub(r"</(?:p|dt|dd|li|pre|div)>|<br\s*/?>", "\n", text))
+    )
     shown: dict[str, set] = {}
     for line in body.splitlines():
         words = line.split()
@@ -385,14 +462,24 @@ def _help_problems(shown: dict) -> list[str]:
     new process); a problem when it fails or its help does not show an option the page shows."""
     out = []
     for command, options in sorted(shown.items()):
-        run = subprocess.run([sys.executable, "-m", "navlib", command, "--help"], capture_output=True,
-                             text=True, timeout=60)
+        run = subprocess.run(
+            [sys.executable, "-m", "navlib", command, "--help"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
         if run.returncode != 0:
-            out.append(f"'navlib {command} --help' failed (exit {run.returncode}): {run.stderr.strip()[-120:]}")
+            out.append(
+                f"'navlib {command} --help' failed (exit {run.returncode}): {run.stderr.strip()[-120:]}"
+            )
             continue
-        missing = sorted(o for o in options if not re.search(re.escape(o) + r"(?![\w-])", run.stdout))
+        missing = sorted(
+            o for o in options if not re.search(re.escape(o) + r"(?![\w-])", run.stdout)
+        )
         if missing:
-            out.append(f"'navlib {command} --help' does not show {', '.join(missing)}, which the page shows")
+            out.append(
+                f"'navlib {command} --help' does not show {', '.join(missing)}, which the page shows"
+            )
     return out
 
 
@@ -406,9 +493,15 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
         rel = page.relative_to(html_dir)
         found += [(rel.as_posix(), p) for p in check_page(text, content=rel.parts[0] != "_modules")]
         if rel.name.startswith("api_"):
-            found += [(rel.as_posix(), p) for p in check_api_page(text, cli_page=rel.name == "api_cli.html")]
-        if is_chapter_page(rel):                       # the chapters (executed notebooks)
-            found += [(rel.as_posix(), p) for p in check_chapter_opening(text) + check_chapter_closing(text)]
+            found += [
+                (rel.as_posix(), p)
+                for p in check_api_page(text, cli_page=rel.name == "api_cli.html")
+            ]
+        if is_chapter_page(rel):  # the chapters (executed notebooks)
+            found += [
+                (rel.as_posix(), p)
+                for p in check_chapter_opening(text) + check_chapter_closing(text)
+            ]
             chapter_pages[rel.as_posix()] = text
         landing.update(landing_counts(text))
     found += count_problems(landing, chapter_pages)
@@ -425,13 +518,19 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
         allowed = known.get(page, {}).get(kind, 0)
         if len(ps) > allowed:
             problems += [f"{page}: {p}" for p in ps]
-            problems.append(f"{page}: {len(ps)} problem(s) of the kind '{kind}', the baseline allows {allowed}"
-                            if allowed else f"{page}: {kind}: none allowed (the page had none)")
+            problems.append(
+                f"{page}: {len(ps)} problem(s) of the kind '{kind}', the baseline allows {allowed}"
+                if allowed
+                else f"{page}: {kind}: none allowed (the page had none)"
+            )
         else:
             tolerated.setdefault(page, {})[kind] = len(ps)
     for page, kinds in sorted(tolerated.items()):
-        print(f"check-html: known, to fix: {page}: " + ", ".join(f"{n} {k}" for k, n in kinds.items()),
-              file=sys.stderr)
+        print(
+            f"check-html: known, to fix: {page}: "
+            + ", ".join(f"{n} {k}" for k, n in kinds.items()),
+            file=sys.stderr,
+        )
     for p in problems[:limit]:
         print(p, file=sys.stderr)
     if len(problems) > limit:
@@ -439,8 +538,9 @@ def check_html(html_dir: Path, limit: int = 60, baseline: Path | None = None) ->
     if problems:
         print(f"check-html: {len(problems)} problem(s) in {len(pages)} pages", file=sys.stderr)
         return 1
-    print(f"check-html: {len(pages)} pages: nothing loaded from the network, no errors, no output wider than "
-          f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers, every chapter opens with "
-          f"its results at a glance; code lines, table headers and glance counts no worse than the baseline")
+    print(
+        f"check-html: {len(pages)} pages: nothing loaded from the network, no errors, no output wider than "
+        f"{MAX_PRE_CHARS} characters, every figure captioned, no nbval markers, every chapter opens with "
+        f"its results at a glance; code lines, table headers and glance counts no worse than the baseline"
+    )
     return 0
-

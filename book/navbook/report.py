@@ -37,6 +37,7 @@ The functions live in one module per job; this module is the notebooks' one name
   ``glue_claims``.
 - :mod:`navbook.results`: :func:`~navbook.results.write_results` and the readers of results files.
 """
+
 from __future__ import annotations
 
 # navlib's, for the chapters: report.Claim, report.method_stats, report.fmt, report.plain, the figure style

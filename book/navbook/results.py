@@ -1,9 +1,11 @@
 """The chapter's results file (:func:`write_results`: claims, method statistics, tables of records) and
 its readers, for the landing page and the checks."""
+
 from __future__ import annotations
 
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
@@ -34,11 +36,19 @@ def results_dir() -> Path:
     return Path(env) if env else Path.cwd() / "results"
 
 
-def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = None,
-                  methods: Mapping[str, Mapping[str, Any]] | None = None,
-                  extra: Mapping[str, Any] | None = None, folder: str | os.PathLike | None = None,
-                  overwrite: bool = False, tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None,
-                  register: bool = False, worlds: list[Mapping[str, Any]] | None = None) -> Path:
+def write_results(
+    chapter: str,
+    *,
+    claims: Iterable[Claim],
+    unit: str | None = None,
+    methods: Mapping[str, Mapping[str, Any]] | None = None,
+    extra: Mapping[str, Any] | None = None,
+    folder: str | os.PathLike | None = None,
+    overwrite: bool = False,
+    tables: Mapping[str, Iterable[Mapping[str, Any]]] | None = None,
+    register: bool = False,
+    worlds: list[Mapping[str, Any]] | None = None,
+) -> Path:
     """Write ``<folder>/<chapter>.json`` (``folder`` defaults to :func:`results_dir`)::
 
         {"chapter": ..., "unit": ..., "methods": {label: {"median_rms_<unit>", "p10_rms_<unit>",
@@ -83,24 +93,37 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     both = [(c.claim, c.reading, c.data) for c in claims]
     if len(set(both)) != len(both):
         dup = next(k for k in both if both.count(k) > 1)
-        raise InputError(f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}"
-                         + (" on real data" if dup[2] == "real" else ""))
+        raise InputError(
+            f"write_results({chapter!r}): claim {dup[0]!r} appears twice under reading {dup[1]!r}"
+            + (" on real data" if dup[2] == "real" else "")
+        )
     records = register_records(claims, chapter if register else None, worlds)
     out["claims"] = records if records is not None else [c.record() for c in claims]
     if records is not None:
         out["inconsistencies"] = registry.inconsistencies(chapter)
     unseen = [k for k in both if k not in claim_boxes._GLANCED]
-    if claim_boxes._GLANCED and unseen:                 # a chapter that shows a glance box, but not all of its claims
-        import warnings
-        warnings.warn(f"write_results({chapter!r}): {len(unseen)} of the {len(keys)} claims are in no glance "
-                      f"box (first: {unseen[0][0]!r}, {unseen[0][1]!r}); the landing page counts every claim "
-                      f"written: pass them all to report.glance", stacklevel=2)
+    if (
+        claim_boxes._GLANCED and unseen
+    ):  # a chapter that shows a glance box, but not all of its claims
+        warnings.warn(
+            f"write_results({chapter!r}): {len(unseen)} of the {len(keys)} claims are in no glance "
+            f"box (first: {unseen[0][0]!r}, {unseen[0][1]!r}); the landing page counts every claim "
+            f"written: pass them all to report.glance",
+            stacklevel=2,
+        )
     if extra:
-        out["extra"] = {str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
-                        for k, v in extra.items()}
+        out["extra"] = {
+            str(k): plain(v) if not isinstance(v, (list, tuple)) else [plain(x) for x in v]
+            for k, v in extra.items()
+        }
     for name, table_rows in (tables or {}).items():
-        if name in ("chapter", "unit", "methods", "claims", "extra", "inconsistencies") or not str(name).isidentifier():
-            raise InputError(f"write_results({chapter!r}): table name {name!r} is reserved or not an identifier")
+        if (
+            name in ("chapter", "unit", "methods", "claims", "extra", "inconsistencies")
+            or not str(name).isidentifier()
+        ):
+            raise InputError(
+                f"write_results({chapter!r}): table name {name!r} is reserved or not an identifier"
+            )
         out[str(name)] = [{str(k): plain(v) for k, v in dict(r).items()} for r in table_rows]
     d = Path(folder) if folder is not None else results_dir()
     text = json.dumps(out, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
@@ -110,9 +133,13 @@ def write_results(chapter: str, *, claims: Iterable[Claim], unit: str | None = N
     except OSError as err:
         raise InputError(f"{d}: cannot create the results folder ({err.strerror})") from None
     try:
-        write_new(path, lambda fh: fh.write(text), overwrite=overwrite,
-                  exists=f"a results file is already there (an earlier run's); remove it, write elsewhere "
-                         f"(folder=... or ${RESULTS_ENV}) or pass overwrite=True")
+        write_new(
+            path,
+            lambda fh: fh.write(text),
+            overwrite=overwrite,
+            exists=f"a results file is already there (an earlier run's); remove it, write elsewhere "
+            f"(folder=... or ${RESULTS_ENV}) or pass overwrite=True",
+        )
     except OSError as err:
         raise InputError(f"{path}: cannot write the results file ({err.strerror})") from None
     return _WrittenPath(path)
@@ -155,14 +182,34 @@ def claims_summary(results: Mapping[str, dict]) -> pd.DataFrame:
     rows = []
     for chapter, res in results.items():
         for c in res.get("claims", []):
-            rows.append({"chapter": chapter, "source": c.get("source", "paper"), "data": registry.data_of(c),
-                         "reading": c.get("reading", "as printed"), "reproduced": c.get("reproduced")})
-    cols = ["chapter", "source", "data", "reading", "claims", "reproduced", "not reproduced", "cannot be judged"]
+            rows.append(
+                {
+                    "chapter": chapter,
+                    "source": c.get("source", "paper"),
+                    "data": registry.data_of(c),
+                    "reading": c.get("reading", "as printed"),
+                    "reproduced": c.get("reproduced"),
+                }
+            )
+    cols = [
+        "chapter",
+        "source",
+        "data",
+        "reading",
+        "claims",
+        "reproduced",
+        "not reproduced",
+        "cannot be judged",
+    ]
     if not rows:
         return pd.DataFrame(columns=cols)
     df = pd.DataFrame(rows)
     g = df.groupby(["chapter", "source", "data", "reading"], sort=False)["reproduced"]
-    return pd.DataFrame({"claims": g.size(),
-                         "reproduced": g.apply(lambda s: int((s == True).sum())),  # noqa: E712
-                         "not reproduced": g.apply(lambda s: int((s == False).sum())),  # noqa: E712
-                         "cannot be judged": g.apply(lambda s: int(s.isna().sum()))}).reset_index()[cols]
+    return pd.DataFrame(
+        {
+            "claims": g.size(),
+            "reproduced": g.apply(lambda s: int((s == True).sum())),  # noqa: E712
+            "not reproduced": g.apply(lambda s: int((s == False).sum())),  # noqa: E712
+            "cannot be judged": g.apply(lambda s: int(s.isna().sum())),
+        }
+    ).reset_index()[cols]

@@ -4,6 +4,7 @@ stored verdict against the one rule, and a fresh run against the committed refer
 ``check-results --fresh DIR --reference DIR NOTEBOOK...``
     Compare the results files a fresh run wrote with the committed references, within tolerance.
 """
+
 from __future__ import annotations
 
 import json
@@ -39,7 +40,7 @@ def claim_problems(c: dict) -> list[str]:
             p.append(f"{k} missing or empty")
     if c.get("source") not in verdicts.SOURCES:
         p.append(f"source {c.get('source')!r}: must be 'paper' or 'book'")
-    if "data" in c and c["data"] not in verdicts.DATA:       # files written before the field have none
+    if "data" in c and c["data"] not in verdicts.DATA:  # files written before the field have none
         p.append(f"data {c.get('data')!r}: must be 'simulated' or 'real'")
     rule = c.get("rule")
     if rule not in verdicts.RULES:
@@ -49,8 +50,12 @@ def claim_problems(c: dict) -> list[str]:
         if interval is not None:
             p.append("rule 'no statistic' with an interval")
     else:
-        if not (isinstance(interval, list) and len(interval) == 2 and all(_is_num(v) for v in interval)
-                and interval[0] <= interval[1]):
+        if not (
+            isinstance(interval, list)
+            and len(interval) == 2
+            and all(_is_num(v) for v in interval)
+            and interval[0] <= interval[1]
+        ):
             p.append(f"interval {interval!r}: must be [lo, hi] with lo <= hi")
             interval = None
         if not _is_num(boundary):
@@ -62,8 +67,9 @@ def claim_problems(c: dict) -> list[str]:
         est = c.get("estimate")
         if not _is_num(est):
             p.append(f"estimate {est!r}: must be a number")
-        elif interval is not None and not (interval[0] - 1e-12 * abs(est) <= est <= interval[1]
-                                           + 1e-12 * abs(est)):
+        elif interval is not None and not (
+            interval[0] - 1e-12 * abs(est) <= est <= interval[1] + 1e-12 * abs(est)
+        ):
             p.append(f"estimate {est} lies outside its interval {interval}")
         if not isinstance(c.get("statistic"), str) or not c["statistic"].strip():
             p.append("statistic missing: say what the interval is of, with its unit")
@@ -71,11 +77,20 @@ def claim_problems(c: dict) -> list[str]:
     floor_value = None
     if floor is not None:
         fi = floor.get("interval") if isinstance(floor, dict) else None
-        if not (isinstance(floor, dict) and _is_num(floor.get("value"))
-                and all(isinstance(floor.get(k), str) and floor[k].strip() for k in ("assumption", "needs"))):
+        if not (
+            isinstance(floor, dict)
+            and _is_num(floor.get("value"))
+            and all(
+                isinstance(floor.get(k), str) and floor[k].strip() for k in ("assumption", "needs")
+            )
+        ):
             p.append("floor must be null or {value, interval, assumption, needs}")
-        elif fi is not None and not (isinstance(fi, list) and len(fi) == 2 and all(_is_num(v) for v in fi)
-                                     and fi[0] <= floor["value"] <= fi[1]):
+        elif fi is not None and not (
+            isinstance(fi, list)
+            and len(fi) == 2
+            and all(_is_num(v) for v in fi)
+            and fi[0] <= floor["value"] <= fi[1]
+        ):
             p.append(f"floor interval {fi!r}: must be [lo, hi] around the floor's value")
         else:
             floor_value = tuple(fi) if fi is not None else floor["value"]
@@ -93,21 +108,27 @@ def claim_problems(c: dict) -> list[str]:
             margin = c.get("margin")
             if margin is not None and not _is_num(margin):
                 return p + [f"margin {margin!r}: a number or null"]
-            want, basis = verdicts.decide(interval, boundary, side, floor_value, c["by_construction"], margin)
+            want, basis = verdicts.decide(
+                interval, boundary, side, floor_value, c["by_construction"], margin
+            )
         except InputError as err:
             return p + [str(err)]
         if c["reproduced"] is not want:
-            p.append(f"verdict {c.get('verdict')!r} does not follow from interval {interval}, boundary "
-                     f"{boundary} ({side}), floor {floor_value}, margin {margin}: the rule gives "
-                     f"{verdicts.verdict_name(want, basis)!r}")
+            p.append(
+                f"verdict {c.get('verdict')!r} does not follow from interval {interval}, boundary "
+                f"{boundary} ({side}), floor {floor_value}, margin {margin}: the rule gives "
+                f"{verdicts.verdict_name(want, basis)!r}"
+            )
         if c.get("verdict") != verdicts.verdict_name(c["reproduced"], c.get("basis")):
             p.append(f"verdict {c.get('verdict')!r} disagrees with reproduced={c['reproduced']}")
         if c.get("basis") != basis:
             p.append(f"basis {c.get('basis')!r}, the rule gives {basis!r}")
-        elif "reason" in c:               # files written before the field have none
+        elif "reason" in c:  # files written before the field have none
             want_reason = verdicts.reason_category(basis, c.get("why") or "")
             if c["reason"] != want_reason:
-                p.append(f"reason {c['reason']!r}, the basis {basis!r} and the why give {want_reason!r}")
+                p.append(
+                    f"reason {c['reason']!r}, the basis {basis!r} and the why give {want_reason!r}"
+                )
     if c.get("reproduced") is None and not (isinstance(c.get("why"), str) and c["why"].strip()):
         p.append("cannot be judged without a why")
     return p
@@ -124,15 +145,17 @@ def register_problems(c: dict) -> list[str]:
         return []
     p = []
     for k in REGISTER_KEYS:
-        if not (isinstance(c.get(k), str) and c[k].strip()) and not (k == "quote" and c.get("source") == "book"):
+        if not (isinstance(c.get(k), str) and c[k].strip()) and not (
+            k == "quote" and c.get("source") == "book"
+        ):
             p.append(f"{k} missing or empty (the claims register)")
     if not isinstance(c.get("sensitivity"), list):
         p.append("sensitivity must be a list of claim records")
     if c.get("status") not in ("judged", "open", "not checkable"):
         p.append(f"status {c.get('status')!r}: judged, open or not checkable")
-    elif (c["status"] == "judged") == (c.get("rule") == "no statistic" and c.get("reason") in
-                                       ("not yet computed", "not checkable")) or (
-            c.get("reason") == "not run" and c["status"] != "judged"):
+    elif (c["status"] == "judged") == (
+        c.get("rule") == "no statistic" and c.get("reason") in ("not yet computed", "not checkable")
+    ) or (c.get("reason") == "not run" and c["status"] != "judged"):
         p.append(f"status {c['status']!r} disagrees with its reason {c.get('reason')!r}")
     return p
 
@@ -161,11 +184,15 @@ def validate_results(res: dict, name: str) -> list[str]:
         if not isinstance(c, dict):
             p.append(f"{name}: claims[{i}] is not an object")
             continue
-        p += [f"{name}: claims[{i}] ({c.get('claim')!r}, {c.get('reading')}): {q}"
-              for q in claim_problems(c) + register_problems(c)]
+        p += [
+            f"{name}: claims[{i}] ({c.get('claim')!r}, {c.get('reading')}): {q}"
+            for q in claim_problems(c) + register_problems(c)
+        ]
         for j, s in enumerate(c.get("sensitivity") or []):
-            p += [f"{name}: claims[{i}].sensitivity[{j}] ({s.get('claim')!r}, {s.get('reading')}): {q}"
-                  for q in (claim_problems(s) if isinstance(s, dict) else ["not an object"])]
+            p += [
+                f"{name}: claims[{i}].sensitivity[{j}] ({s.get('claim')!r}, {s.get('reading')}): {q}"
+                for q in (claim_problems(s) if isinstance(s, dict) else ["not an object"])
+            ]
     methods = res.get("methods")
     if methods is not None:
         unit = res.get("unit")
@@ -187,7 +214,9 @@ def validate_results(res: dict, name: str) -> list[str]:
             for k, v in stats.items():
                 if k not in required and k not in optional:
                     p.append(f"{name}: methods[{label!r}] has an unknown key {k!r}")
-                elif k == "n_seeds" and not (isinstance(v, int) and not isinstance(v, bool) and v > 0):
+                elif k == "n_seeds" and not (
+                    isinstance(v, int) and not isinstance(v, bool) and v > 0
+                ):
                     p.append(f"{name}: methods[{label!r}].n_seeds must be a positive integer")
                 elif k != "n_seeds" and not (v is None or _is_num(v)):
                     p.append(f"{name}: methods[{label!r}].{k} must be a number or null")
@@ -202,7 +231,9 @@ def _close(a, b, rtol: float, atol: float) -> bool:
     return abs(a - b) <= atol + rtol * abs(b)
 
 
-def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol: float = ATOL) -> list[str]:
+def compare_results(
+    fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol: float = ATOL
+) -> list[str]:
     """Differences between a fresh results file and its committed reference: the same methods and
     statistics (numbers within ``atol + rtol * |reference|``, seed counts equal), the same claims (texts,
     source, rule, side) with the same verdicts, estimates, intervals and boundaries (within the same
@@ -223,12 +254,17 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
             else:
                 ok = _close(a, b, rtol, atol)
             if not ok:
-                p.append(f"{name}: methods[{label!r}].{k} = {a}, reference {b} "
-                         f"(tolerance {rtol:g} relative + {atol:g})")
+                p.append(
+                    f"{name}: methods[{label!r}].{k} = {a}, reference {b} "
+                    f"(tolerance {rtol:g} relative + {atol:g})"
+                )
     fc, rc = flat_claims(fresh), flat_claims(ref)
-    def ids_of(res):       # a record judged on real data is its entry's id marked "(real)"
-        return [c.get("id") if claims_mod.data_of(c) == "simulated" else f"{c.get('id')} (real)"
-                for c in res.get("claims") or []]
+
+    def ids_of(res):  # a record judged on real data is its entry's id marked "(real)"
+        return [
+            c.get("id") if claims_mod.data_of(c) == "simulated" else f"{c.get('id')} (real)"
+            for c in res.get("claims") or []
+        ]
 
     ids = ids_of(fresh), ids_of(ref)
     if ids[0] != ids[1]:
@@ -238,16 +274,24 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
     for i, (a, b) in enumerate(zip(fc, rc)):
         for k in ("claim", "reading", "paper", "source", "rule", "holds_when", "by_construction"):
             if a.get(k) != b.get(k):
-                p.append(f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}")
-        if claims_mod.data_of(a) != claims_mod.data_of(b):    # a missing field is "simulated"
-            p.append(f"{name}: claims[{i}].data {claims_mod.data_of(a)!r} differs from the reference "
-                     f"{claims_mod.data_of(b)!r}")
+                p.append(
+                    f"{name}: claims[{i}].{k} {a.get(k)!r} differs from the reference {b.get(k)!r}"
+                )
+        if claims_mod.data_of(a) != claims_mod.data_of(b):  # a missing field is "simulated"
+            p.append(
+                f"{name}: claims[{i}].data {claims_mod.data_of(a)!r} differs from the reference "
+                f"{claims_mod.data_of(b)!r}"
+            )
         if a.get("reproduced") != b.get("reproduced"):
-            p.append(f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
-                     f"{a.get('reproduced')}, reference {b.get('reproduced')}")
+            p.append(
+                f"{name}: claim {a.get('claim')!r} ({a.get('reading')}): verdict "
+                f"{a.get('reproduced')}, reference {b.get('reproduced')}"
+            )
         if a.get("volatile") != b.get("volatile"):
-            p.append(f"{name}: claims[{i}].volatile {a.get('volatile')!r} differs from the reference "
-                     f"{b.get('volatile')!r}")
+            p.append(
+                f"{name}: claims[{i}].volatile {a.get('volatile')!r} differs from the reference "
+                f"{b.get('volatile')!r}"
+            )
         if a.get("volatile") and b.get("volatile"):
             # a timing: its numbers follow this machine's clock; its verdict must still be the reference's
             x, y = a.get("boundary"), b.get("boundary")
@@ -256,18 +300,35 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
             continue
         for k in ("estimate", "boundary"):
             x, y = a.get(k), b.get(k)
-            if (_is_num(x) and _is_num(y) and not _close(x, y, rtol, atol)) or (_is_num(x) != _is_num(y)):
-                p.append(f"{name}: claims[{i}].{k} = {x}, reference {y} (tolerance {rtol:g} relative)")
+            if (_is_num(x) and _is_num(y) and not _close(x, y, rtol, atol)) or (
+                _is_num(x) != _is_num(y)
+            ):
+                p.append(
+                    f"{name}: claims[{i}].{k} = {x}, reference {y} (tolerance {rtol:g} relative)"
+                )
         x, y = a.get("interval"), b.get("interval")
-        if (x is None) != (y is None) or (x is not None and y is not None and not (
-                len(x) == len(y) == 2 and all(_is_num(u) and _is_num(v) and _close(u, v, rtol, atol)
-                                              for u, v in zip(x, y)))):
-            p.append(f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)")
+        if (x is None) != (y is None) or (
+            x is not None
+            and y is not None
+            and not (
+                len(x) == len(y) == 2
+                and all(
+                    _is_num(u) and _is_num(v) and _close(u, v, rtol, atol) for u, v in zip(x, y)
+                )
+            )
+        ):
+            p.append(
+                f"{name}: claims[{i}].interval = {x}, reference {y} (tolerance {rtol:g} relative)"
+            )
     base = {"chapter", "unit", "methods", "claims", "extra"}
-    for key in sorted((set(fresh) | set(ref)) - base):  # tables (write_results tables=), inconsistencies          # tables of records (write_results tables=)
+    for key in sorted(
+        (set(fresh) | set(ref)) - base
+    ):  # tables (write_results tables=), inconsistencies          # tables of records (write_results tables=)
         if fresh.get(key) != ref.get(key):
-            p.append(f"{name}: table {key!r} differs from the reference's "
-                     f"({len(fresh.get(key) or [])} records, reference {len(ref.get(key) or [])})")
+            p.append(
+                f"{name}: table {key!r} differs from the reference's "
+                f"({len(fresh.get(key) or [])} records, reference {len(ref.get(key) or [])})"
+            )
     fe, re_ = fresh.get("extra") or {}, ref.get("extra") or {}
     if set(fe) != set(re_):
         p.append(f"{name}: extra keys {sorted(fe)} differ from the reference's {sorted(re_)}")
@@ -275,8 +336,9 @@ def compare_results(fresh: dict, ref: dict, name: str, rtol: float = RTOL, atol:
     return p
 
 
-def check_results(fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: float = RTOL,
-                  atol: float = ATOL) -> int:
+def check_results(
+    fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: float = RTOL, atol: float = ATOL
+) -> int:
     """Check every chapter notebook's fresh results file (written by the nbval run) against its committed
     reference in ``ref_dir``; print each problem; 1 if any."""
     fresh_dir, ref_dir = Path(fresh_dir), Path(ref_dir)
@@ -286,19 +348,25 @@ def check_results(fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: f
         nb = Path(nb)
         chapter = results_chapter(nb)
         if chapter is None:
-            problems.append(f"{nb}: writes no results file: its last code cell must call "
-                            f"report.write_results('<chapter>', claims=...)")
+            problems.append(
+                f"{nb}: writes no results file: its last code cell must call "
+                f"report.write_results('<chapter>', claims=...)"
+            )
             continue
         chapters[chapter] = nb
         ref_path, fresh_path = ref_dir / f"{chapter}.json", fresh_dir / f"{chapter}.json"
         if not ref_path.exists():
-            problems.append(f"{ref_path}: missing reference for {nb}: regenerate it with "
-                            f"'.venv/bin/python -m navbook execute --in-place {nb}' (or make "
-                            f"notebooks) and commit it")
+            problems.append(
+                f"{ref_path}: missing reference for {nb}: regenerate it with "
+                f"'.venv/bin/python -m navbook execute --in-place {nb}' (or make "
+                f"notebooks) and commit it"
+            )
             continue
         if not fresh_path.exists():
-            problems.append(f"{fresh_path}: {nb} wrote no fresh results: run the notebooks first "
-                            f"(make test-notebooks)")
+            problems.append(
+                f"{fresh_path}: {nb} wrote no fresh results: run the notebooks first "
+                f"(make test-notebooks)"
+            )
             continue
         try:
             ref = json.loads(ref_path.read_text(encoding="utf-8"))
@@ -312,14 +380,17 @@ def check_results(fresh_dir: Path, ref_dir: Path, notebooks: list[Path], rtol: f
         checked.append(chapter)
     for stray in sorted(ref_dir.glob("*.json")) if ref_dir.is_dir() else []:
         if stray.stem not in chapters:
-            problems.append(f"{stray}: no notebook writes chapter {stray.stem!r}: delete the file or fix the "
-                            f"chapter name")
+            problems.append(
+                f"{stray}: no notebook writes chapter {stray.stem!r}: delete the file or fix the "
+                f"chapter name"
+            )
     for p in problems:
         print(p, file=sys.stderr)
     if problems:
         print(f"check-results: {len(problems)} problem(s)", file=sys.stderr)
         return 1
-    print(f"check-results: {len(checked)} chapter(s) reproduce their stored results "
-          f"({', '.join(checked)}; numbers within {rtol:g} relative + {atol:g} absolute, verdicts equal)")
+    print(
+        f"check-results: {len(checked)} chapter(s) reproduce their stored results "
+        f"({', '.join(checked)}; numbers within {rtol:g} relative + {atol:g} absolute, verdicts equal)"
+    )
     return 0
-

@@ -5,6 +5,7 @@ only a rendered page allows; Chromium is driven over the DevTools protocol on a 
     Render every page with headless Chromium (1400 px wide, full page height), record the page heights and
     list output blocks that overflow the content column.
 """
+
 from __future__ import annotations
 
 import base64
@@ -23,10 +24,19 @@ from pathlib import Path
 
 from .landing import read_chapter_sources
 
-CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                  "--disable-component-update", "--disable-sync", "--no-first-run")
-CHROMIUM_MISSING = ("chromium not found: install it with 'apt-get install -y chromium' (Debian package "
-                    "chromium) or pass --chromium /path/to/chromium")
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+)
+CHROMIUM_MISSING = (
+    "chromium not found: install it with 'apt-get install -y chromium' (Debian package "
+    "chromium) or pass --chromium /path/to/chromium"
+)
 
 #: JavaScript run on each page: output blocks and tables wider than the article (cut or scrolling).
 _OVERFLOW_JS = r"""(() => {
@@ -93,8 +103,15 @@ def shrunk_figures(figures, min_share: float | None = None) -> list[dict]:
             continue
         share = shown / natural
         if share < limit:
-            out.append({"heading": f.get("heading", ""), "src": f.get("src", ""),
-                        "natural_px": int(natural), "shown_px": int(shown), "share": round(share, 3)})
+            out.append(
+                {
+                    "heading": f.get("heading", ""),
+                    "src": f.get("src", ""),
+                    "natural_px": int(natural),
+                    "shown_px": int(shown),
+                    "share": round(share, 3),
+                }
+            )
     return out
 
 
@@ -108,17 +125,27 @@ class _Chrome:
         to_chrome_r, self._to_chrome_w = os.pipe()
         self._from_chrome_r, from_chrome_w = os.pipe()
 
-        def child_fds():            # runs in the child before exec: put the pipe ends on fds 3 and 4
+        def child_fds():  # runs in the child before exec: put the pipe ends on fds 3 and 4
             a = fcntl.fcntl(to_chrome_r, fcntl.F_DUPFD, 10)
             b = fcntl.fcntl(from_chrome_w, fcntl.F_DUPFD, 10)
             os.dup2(a, 3)
             os.dup2(b, 4)
 
         self.proc = subprocess.Popen(
-            [binary, *CHROMIUM_FLAGS, f"--user-data-dir={self.profile}", "--remote-debugging-pipe",
-             "--hide-scrollbars", "about:blank"],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            preexec_fn=child_fds, close_fds=False)
+            [
+                binary,
+                *CHROMIUM_FLAGS,
+                f"--user-data-dir={self.profile}",
+                "--remote-debugging-pipe",
+                "--hide-scrollbars",
+                "about:blank",
+            ],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            preexec_fn=child_fds,
+            close_fds=False,
+        )
         os.close(to_chrome_r)
         os.close(from_chrome_w)
         self._buf = b""
@@ -153,8 +180,10 @@ class _Chrome:
         probe = {"expression": "document.readyState + ' ' + location.href", "returnByValue": True}
         while time.monotonic() < deadline:
             try:
-                state = self.send("Runtime.evaluate", probe, session=session)["result"].get("value", "")
-            except RuntimeError:            # the context was replaced by the navigation: ask again
+                state = self.send("Runtime.evaluate", probe, session=session)["result"].get(
+                    "value", ""
+                )
+            except RuntimeError:  # the context was replaced by the navigation: ask again
                 state = ""
             if state == f"complete {url}":
                 self.events.clear()
@@ -214,26 +243,49 @@ def _capture(chrome, session, metrics: dict, height: int, png: Path) -> None:
     :data:`TILE_PX` as viewport-high tiles ``png``, ``<stem>-2.png``, ... (Chromium refuses one capture taller
     than its texture limit, "Page is too large")."""
     if height <= TILE_PX:
-        chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": height}, session=session)
+        chrome.send(
+            "Emulation.setDeviceMetricsOverride", {**metrics, "height": height}, session=session
+        )
         # let the theme's sidebar transitions (0.25 s) finish at the new size before the capture
-        chrome.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0); new Promise(r => "
-                    "setTimeout(r, 400)).then(() => 1)", "awaitPromise": True}, session=session)
+        chrome.send(
+            "Runtime.evaluate",
+            {
+                "expression": "window.scrollTo(0, 0); new Promise(r => "
+                "setTimeout(r, 400)).then(() => 1)",
+                "awaitPromise": True,
+            },
+            session=session,
+        )
         # the viewport is the whole page: no captureBeyondViewport, which lays a long chapter out again
         # without its left sidebar and shifted left (seen on every chapter page)
         shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
         png.write_bytes(base64.b64decode(shot["data"]))
         return
-    chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session)
+    chrome.send(
+        "Emulation.setDeviceMetricsOverride", {**metrics, "height": TILE_PX}, session=session
+    )
     for k, top in enumerate(range(0, height, TILE_PX)):
-        chrome.send("Runtime.evaluate", {"expression": f"window.scrollTo(0, {top}); new Promise("
-                    "r => setTimeout(r, 200)).then(() => 1)", "awaitPromise": True}, session=session)
+        chrome.send(
+            "Runtime.evaluate",
+            {
+                "expression": f"window.scrollTo(0, {top}); new Promise("
+                "r => setTimeout(r, 200)).then(() => 1)",
+                "awaitPromise": True,
+            },
+            session=session,
+        )
         shot = chrome.send("Page.captureScreenshot", {"format": "png"}, session=session)
         tile = png if k == 0 else png.with_name(f"{png.stem}-{k + 1}.png")
         tile.write_bytes(base64.b64decode(shot["data"]))
 
 
-def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str | None = None,
-                settle_s: float = 0.5) -> int:
+def screenshots(
+    html_dir: Path,
+    out_dir: Path,
+    width: int = 1400,
+    chromium: str | None = None,
+    settle_s: float = 0.5,
+) -> int:
     """Render every page under ``html_dir`` at ``width`` px, full page height, into ``out_dir`` (same
     relative names, ``.png``, folds closed as a reader first sees the page, and ``-open.png`` with every fold
     open; a page taller than :data:`TILE_PX` as tiles ``-2.png``, ``-3.png``, ...); write ``heights.csv``
@@ -250,10 +302,14 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         print(CHROMIUM_MISSING, file=sys.stderr)
         return 2
     html_dir, out_dir = Path(html_dir).resolve(), Path(out_dir)
-    pages = [p for p in sorted(html_dir.rglob("*.html"))
-             if p.relative_to(html_dir).parts[0] not in ("_modules", "_sources", "_static", "_images")
-             and p.name not in ("search.html", "genindex.html", "py-modindex.html")
-             and 'http-equiv="refresh"' not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()]
+    pages = [
+        p
+        for p in sorted(html_dir.rglob("*.html"))
+        if p.relative_to(html_dir).parts[0] not in ("_modules", "_sources", "_static", "_images")
+        and p.name not in ("search.html", "genindex.html", "py-modindex.html")
+        and 'http-equiv="refresh"'
+        not in p.read_text(encoding="utf-8", errors="replace")[:2000].lower()
+    ]
     out_dir.mkdir(parents=True, exist_ok=True)
     chrome = _Chrome(binary)
     heights, overflow, shrunk, headlines, long_pages = [], {}, {}, {}, {}
@@ -263,25 +319,44 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         for page in pages:
             rel = page.relative_to(html_dir)
             target = chrome.send("Target.createTarget", {"url": "about:blank"})["targetId"]
-            session = chrome.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+            session = chrome.send("Target.attachToTarget", {"targetId": target, "flatten": True})[
+                "sessionId"
+            ]
             chrome.send("Page.enable", session=session)
             metrics = {"width": width, "height": 900, "deviceScaleFactor": 1, "mobile": False}
             chrome.send("Emulation.setDeviceMetricsOverride", metrics, session=session)
             chrome.send("Page.navigate", {"url": page.as_uri()}, session=session)
             chrome.wait_loaded(session, page.as_uri())
-            wait = (f"new Promise(r => setTimeout(r, {int(settle_s * 1000)}))"
-                    ".then(() => (window.MathJax && MathJax.startup) ? MathJax.startup.promise : null)"
-                    ".then(() => document.fonts.ready).then(() => 1)")
-            chrome.send("Runtime.evaluate", {"expression": wait, "awaitPromise": True}, session=session)
-            js_height = ("Math.max(document.documentElement.scrollHeight, document.body.scrollHeight, "
-                         "...[...document.querySelectorAll('.bd-main, .bd-container, .bd-page-width')]"
-                         ".map(e => e.scrollHeight))")
-            closed_h = int(chrome.send("Runtime.evaluate", {"expression": js_height, "returnByValue": True},
-                                       session=session)["result"]["value"])
+            wait = (
+                f"new Promise(r => setTimeout(r, {int(settle_s * 1000)}))"
+                ".then(() => (window.MathJax && MathJax.startup) ? MathJax.startup.promise : null)"
+                ".then(() => document.fonts.ready).then(() => 1)"
+            )
+            chrome.send(
+                "Runtime.evaluate", {"expression": wait, "awaitPromise": True}, session=session
+            )
+            js_height = (
+                "Math.max(document.documentElement.scrollHeight, document.body.scrollHeight, "
+                "...[...document.querySelectorAll('.bd-main, .bd-container, .bd-page-width')]"
+                ".map(e => e.scrollHeight))"
+            )
+            closed_h = int(
+                chrome.send(
+                    "Runtime.evaluate",
+                    {"expression": js_height, "returnByValue": True},
+                    session=session,
+                )["result"]["value"]
+            )
             if rel.parts[0] == "_generated" and rel.stem in chapters and closed_h > CHAPTER_MAX_PX:
                 long_pages[str(rel)] = closed_h
-            heads = chrome.send("Runtime.evaluate", {"expression": _HEADLINES_JS, "returnByValue": True},
-                                session=session)["result"].get("value") or []
+            heads = (
+                chrome.send(
+                    "Runtime.evaluate",
+                    {"expression": _HEADLINES_JS, "returnByValue": True},
+                    session=session,
+                )["result"].get("value")
+                or []
+            )
             late = [hd for hd in heads if hd["bottom_px"] > FIRST_SCREEN_PX]
             if late:
                 headlines[str(rel)] = late
@@ -290,20 +365,45 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
             # the page as a reader first sees it (folds closed), then with every fold open: the figures and
             # tables inside the folds are checked and captured too (page-open.png)
             _capture(chrome, session, metrics, closed_h, png)
-            folds = chrome.send("Runtime.evaluate", {"expression": "document.querySelectorAll('details').length",
-                                                     "returnByValue": True}, session=session)["result"]["value"]
+            folds = chrome.send(
+                "Runtime.evaluate",
+                {
+                    "expression": "document.querySelectorAll('details').length",
+                    "returnByValue": True,
+                },
+                session=session,
+            )["result"]["value"]
             h = closed_h
             if folds:
-                h = int(chrome.send("Runtime.evaluate", {"expression": _OPEN_FOLDS_JS + js_height,
-                                                         "returnByValue": True}, session=session)["result"]["value"])
+                h = int(
+                    chrome.send(
+                        "Runtime.evaluate",
+                        {"expression": _OPEN_FOLDS_JS + js_height, "returnByValue": True},
+                        session=session,
+                    )["result"]["value"]
+                )
                 _capture(chrome, session, metrics, h, png.with_name(png.stem + "-open.png"))
-            chrome.send("Emulation.setDeviceMetricsOverride", {**metrics, "height": min(h, TILE_PX)},
-                        session=session)
-            found = chrome.send("Runtime.evaluate", {"expression": _OVERFLOW_JS, "returnByValue": True},
-                                session=session)["result"].get("value") or []
-            small = shrunk_figures(chrome.send("Runtime.evaluate", {"expression": _FIGURES_JS,
-                                                                    "returnByValue": True},
-                                               session=session)["result"].get("value") or [])
+            chrome.send(
+                "Emulation.setDeviceMetricsOverride",
+                {**metrics, "height": min(h, TILE_PX)},
+                session=session,
+            )
+            found = (
+                chrome.send(
+                    "Runtime.evaluate",
+                    {"expression": _OVERFLOW_JS, "returnByValue": True},
+                    session=session,
+                )["result"].get("value")
+                or []
+            )
+            small = shrunk_figures(
+                chrome.send(
+                    "Runtime.evaluate",
+                    {"expression": _FIGURES_JS, "returnByValue": True},
+                    session=session,
+                )["result"].get("value")
+                or []
+            )
             chrome.send("Target.closeTarget", {"targetId": target})
             heights.append((str(rel), closed_h, h))
             if found:
@@ -319,39 +419,62 @@ def screenshots(html_dir: Path, out_dir: Path, width: int = 1400, chromium: str 
         w = csv.writer(fh)
         w.writerow(["page", "height_px", "height_open_px"])
         w.writerows(heights)
-    for name, found in (("overflow.json", overflow), ("shrunk.json", shrunk), ("headlines.json", headlines)):
-        (out_dir / name).write_text(json.dumps(found, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    for name, found in (
+        ("overflow.json", overflow),
+        ("shrunk.json", shrunk),
+        ("headlines.json", headlines),
+    ):
+        (out_dir / name).write_text(
+            json.dumps(found, indent=1, ensure_ascii=False) + "\n", encoding="utf-8"
+        )
     for page, items in overflow.items():
         for it in items:
-            print(f"  wider than the column: {page}: {it['what']} by {it['overflow_px']} px under "
-                  f"'{it['heading']}': {html.unescape(it['text'])[:50]!r}", file=sys.stderr)
+            print(
+                f"  wider than the column: {page}: {it['what']} by {it['overflow_px']} px under "
+                f"'{it['heading']}': {html.unescape(it['text'])[:50]!r}",
+                file=sys.stderr,
+            )
     for page, items in shrunk.items():
         print(f"  figures shrunk on {page}: {len(items)}", file=sys.stderr)
         for it in items:
-            print(f"    {it['src']} shown at {it['shown_px']} of {it['natural_px']} px "
-                  f"({100 * it['share']:.0f} %) under '{it['heading']}'", file=sys.stderr)
+            print(
+                f"    {it['src']} shown at {it['shown_px']} of {it['natural_px']} px "
+                f"({100 * it['share']:.0f} %) under '{it['heading']}'",
+                file=sys.stderr,
+            )
     for page, items in headlines.items():
         for it in items:
-            print(f"  headline verdict below the first screen ({FIRST_SCREEN_PX} px) on {page}: ends at "
-                  f"{it['bottom_px']} px: {it['text'][:60]!r}", file=sys.stderr)
-    print(f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, long.json, overflow.json, shrunk.json, "
-          f"headlines.json)")
+            print(
+                f"  headline verdict below the first screen ({FIRST_SCREEN_PX} px) on {page}: ends at "
+                f"{it['bottom_px']} px: {it['text'][:60]!r}",
+                file=sys.stderr,
+            )
+    print(
+        f"screenshots: {len(heights)} pages -> {out_dir} (heights.csv, long.json, overflow.json, shrunk.json, "
+        f"headlines.json)"
+    )
     for page, h in long_pages.items():
-        print(f"  chapter taller than {CHAPTER_MAX_PX // FIRST_SCREEN_PX} screens with its folds closed: {page}: "
-              f"{h} px (limit {CHAPTER_MAX_PX} px): put a section's evidence behind its fold ({{evidence}})",
-              file=sys.stderr)
+        print(
+            f"  chapter taller than {CHAPTER_MAX_PX // FIRST_SCREEN_PX} screens with its folds closed: {page}: "
+            f"{h} px (limit {CHAPTER_MAX_PX} px): put a section's evidence behind its fold ({{evidence}})",
+            file=sys.stderr,
+        )
     (out_dir / "long.json").write_text(json.dumps(long_pages, indent=1) + "\n", encoding="utf-8")
     if long_pages:
         return 1
     if headlines:
-        print(f"screenshots: {sum(map(len, headlines.values()))} headline verdict(s) on {len(headlines)} "
-              f"page(s) are not on the first {FIRST_SCREEN_PX} px: shorten what comes before them",
-              file=sys.stderr)
+        print(
+            f"screenshots: {sum(map(len, headlines.values()))} headline verdict(s) on {len(headlines)} "
+            f"page(s) are not on the first {FIRST_SCREEN_PX} px: shorten what comes before them",
+            file=sys.stderr,
+        )
         return 1
     if shrunk:
-        print(f"screenshots: {sum(map(len, shrunk.values()))} figure(s) on {len(shrunk)} page(s) shown below "
-              f"75 % of their natural width (draw them at most 7.5 in wide: navbook.report.use_style, "
-              f"report.panels)", file=sys.stderr)
+        print(
+            f"screenshots: {sum(map(len, shrunk.values()))} figure(s) on {len(shrunk)} page(s) shown below "
+            f"75 % of their natural width (draw them at most 7.5 in wide: navbook.report.use_style, "
+            f"report.panels)",
+            file=sys.stderr,
+        )
         return 1
     return 0
-

@@ -6,6 +6,7 @@ draws with ``ax.plot(x, y, **style.of("ade_bp_pure"))`` instead of typing colour
 share a colour by accident (``tests`` check that no two ids of a chapter share one).  The chapters' own
 dictionaries are kept apart below and merged into :data:`METHOD_STYLE`.
 """
+
 from __future__ import annotations
 
 from typing import Any
@@ -13,28 +14,28 @@ from typing import Any
 from navlib.errors import InputError
 
 # -- the compass chapter (paper A, document B, the real compass): ids of navlib.methods.compass_methods
-COMPASS: dict[str, dict[str, Any]] = {
-}
+COMPASS: dict[str, dict[str, Any]] = {}
 
 # -- the gyro chapter (paper C)
-GYRO: dict[str, dict[str, Any]] = {
-}
+GYRO: dict[str, dict[str, Any]] = {}
 
 # -- the accelerometer chapter (paper D)
-ACCELEROMETER: dict[str, dict[str, Any]] = {
-}
+ACCELEROMETER: dict[str, dict[str, Any]] = {}
 
 # -- the celestial chapter (paper E)
-CELESTIAL: dict[str, dict[str, Any]] = {
-}
+CELESTIAL: dict[str, dict[str, Any]] = {}
 
 # -- the workbench chapter
-WORKBENCH: dict[str, dict[str, Any]] = {
-}
+WORKBENCH: dict[str, dict[str, Any]] = {}
 
 #: Every chapter's styles: method id -> matplotlib keyword arguments.
-CHAPTERS = {"compass": COMPASS, "gyro": GYRO, "accelerometer": ACCELEROMETER, "celestial": CELESTIAL,
-            "workbench": WORKBENCH}
+CHAPTERS = {
+    "compass": COMPASS,
+    "gyro": GYRO,
+    "accelerometer": ACCELEROMETER,
+    "celestial": CELESTIAL,
+    "workbench": WORKBENCH,
+}
 METHOD_STYLE: dict[str, dict[str, Any]] = {k: v for d in CHAPTERS.values() for k, v in d.items()}
 
 

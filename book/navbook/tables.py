@@ -4,14 +4,18 @@ of a chapter's parameters.
 :func:`use_style`, the chapter's first call, switches the figure style and the readable labels on
 (``READABLE_TABLES``); :func:`fold_tables` folds captioned tables behind their captions (``FOLD_TABLES``).
 """
+
 from __future__ import annotations
 
+import ast
 import hashlib
 import html
+import io
 import json
 import math
 import os
 import re
+import tokenize
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -24,8 +28,10 @@ from navlib import plotstyle
 
 #: Plain-text rendering width in characters; a stored output line longer than this would be cut on the page.
 PLAIN_WIDTH = 92
-_CSS = ("table-layout:auto;width:100%;max-width:100%;border-collapse:collapse;font-size:0.85em;"
-        "margin-bottom:0.5em")
+_CSS = (
+    "table-layout:auto;width:100%;max-width:100%;border-collapse:collapse;font-size:0.85em;"
+    "margin-bottom:0.5em"
+)
 _CELL = "padding:2px 6px;border-bottom:1px solid #ddd;vertical-align:top;overflow-wrap:break-word;"
 
 
@@ -40,10 +46,25 @@ def _breakable(text: str) -> str:
 READABLE_TABLES = False
 
 #: Unit suffixes of snake_case names and how a column header shows them.
-UNIT_SUFFIXES = {("deg", "h"): "deg/h", ("mg", "g"): "mg/g", ("m", "s"): "m/s", ("deg",): "deg",
-                 ("rad",): "rad", ("arcmin",): "arcmin", ("arcsec",): "arcsec", ("nmi",): "nmi",
-                 ("ug",): "ug", ("mg",): "mg", ("ut",): "uT", ("nt",): "nT", ("c",): "degC",
-                 ("s",): "s", ("h",): "h", ("pct",): "%", ("ppm",): "ppm"}
+UNIT_SUFFIXES = {
+    ("deg", "h"): "deg/h",
+    ("mg", "g"): "mg/g",
+    ("m", "s"): "m/s",
+    ("deg",): "deg",
+    ("rad",): "rad",
+    ("arcmin",): "arcmin",
+    ("arcsec",): "arcsec",
+    ("nmi",): "nmi",
+    ("ug",): "ug",
+    ("mg",): "mg",
+    ("ut",): "uT",
+    ("nt",): "nT",
+    ("c",): "degC",
+    ("s",): "s",
+    ("h",): "h",
+    ("pct",): "%",
+    ("ppm",): "ppm",
+}
 #: Words written in capitals in a header.
 ACRONYMS = {"rms", "rmse", "mse", "sse", "loo", "maxe", "mare", "ins", "rbf", "ann", "fis", "anfis"}
 _NEG_ZERO = re.compile(r"^[-\u2212]([+]?0(?:\.0+)?(?:e[+-]?\d+)?)$")
@@ -73,7 +94,7 @@ def label(name: Any) -> str:
         return text
     words = [w for w in text.split("_") if w]
     unit, k = _unit_suffix(words, (UNIT_SUFFIXES,))
-    words = words[:len(words) - k]
+    words = words[: len(words) - k]
     words = [w.upper() if w.lower() in ACRONYMS else w for w in words]
     return " ".join(words) + (f" ({unit})" if unit else "")
 
@@ -125,14 +146,22 @@ class Table:
     secondary table in a dropdown on the page, closed until the reader opens it (the plain text is the
     same)."""
 
-    def __init__(self, frame: pd.DataFrame, formats: Mapping[str, Any] | None = None,
-                 caption: str | None = None, index: bool = True, readable: bool | None = None,
-                 fold: bool | str | None = None):
+    def __init__(
+        self,
+        frame: pd.DataFrame,
+        formats: Mapping[str, Any] | None = None,
+        caption: str | None = None,
+        index: bool = True,
+        readable: bool | None = None,
+        fold: bool | str | None = None,
+    ):
         if not isinstance(frame, pd.DataFrame):
             frame = pd.DataFrame(frame)
         if fold is True and not caption:
-            raise InputError("report.table: fold=True needs a caption (it is the dropdown's summary)")
-        if fold is None:                    # the chapter's default (fold_tables): evidence behind its caption
+            raise InputError(
+                "report.table: fold=True needs a caption (it is the dropdown's summary)"
+            )
+        if fold is None:  # the chapter's default (fold_tables): evidence behind its caption
             fold = bool(FOLD_TABLES and caption)
         self.fold = (caption if fold is True else str(fold)) if fold else None
         self.frame = frame
@@ -153,8 +182,11 @@ class Table:
                 elif pd.api.types.is_bool_dtype(s):
                     f = lambda v: "yes" if v else "no"  # noqa: E731
                 else:
-                    out[col] = s.map(lambda v: "–" if v is None or (isinstance(v, float) and math.isnan(v))
-                                     else str(v))
+                    out[col] = s.map(
+                        lambda v: (
+                            "–" if v is None or (isinstance(v, float) and math.isnan(v)) else str(v)
+                        )
+                    )
                     continue
             fn = f if callable(f) else (lambda v, f=f: fmt(v, f))
             out[col] = s.map(fn)
@@ -173,15 +205,21 @@ class Table:
         f.index = f.index.map(_breakable)
         f.columns = [_breakable(c) for c in f.columns]
         styler = f.style if self.index else f.style.hide(axis="index")
-        styler = styler.set_uuid(f"t{digest}")      # stable across runs, distinct per table
+        styler = styler.set_uuid(f"t{digest}")  # stable across runs, distinct per table
         styler = styler.set_table_attributes(f'class="navbook-table" style="{_CSS}"')
-        styler = styler.set_table_styles([{"selector": "th", "props": _CELL + "text-align:left;"},
-                                          {"selector": "td", "props": _CELL}])
+        styler = styler.set_table_styles(
+            [
+                {"selector": "th", "props": _CELL + "text-align:left;"},
+                {"selector": "td", "props": _CELL},
+            ]
+        )
         if self.caption and not self.fold:
             styler = styler.set_caption(self.caption)
         if self.fold:
-            return (f'<details class="navbook-fold"><summary>{html.escape(self.fold, quote=False)}</summary>'
-                    f"{styler.to_html()}</details>")
+            return (
+                f'<details class="navbook-fold"><summary>{html.escape(self.fold, quote=False)}</summary>'
+                f"{styler.to_html()}</details>"
+            )
         return styler.to_html()
 
     def __repr__(self) -> str:
@@ -189,7 +227,7 @@ class Table:
         width = PLAIN_WIDTH
         clip = f.map(lambda s: s if len(s) <= 40 else s[:37] + "...")
         text = clip.to_string(index=self.index, line_width=width)
-        lines = [ln if len(ln) <= width else ln[:width - 3] + "..." for ln in text.splitlines()]
+        lines = [ln if len(ln) <= width else ln[: width - 3] + "..." for ln in text.splitlines()]
         head = [self.caption[:width]] if self.caption else []
         return "\n".join(head + lines)
 
@@ -206,8 +244,14 @@ def fold_tables(on: bool = True) -> None:
     FOLD_TABLES = bool(on)
 
 
-def table(frame: pd.DataFrame, formats: Mapping[str, Any] | None = None, caption: str | None = None,
-          index: bool = True, readable: bool | None = None, fold: bool | str | None = None) -> Table:
+def table(
+    frame: pd.DataFrame,
+    formats: Mapping[str, Any] | None = None,
+    caption: str | None = None,
+    index: bool = True,
+    readable: bool | None = None,
+    fold: bool | str | None = None,
+) -> Table:
     """Shorthand for :class:`Table`; the last expression of a cell displays it (``fold``: in a dropdown;
     None: the chapter's default, :func:`fold_tables`)."""
     return Table(frame, formats, caption, index, readable, fold)
@@ -215,8 +259,15 @@ def table(frame: pd.DataFrame, formats: Mapping[str, Any] | None = None, caption
 
 # ----------------------------------------------------------------------------------------------- parameters
 #: Unit suffixes of parameter names beyond :data:`UNIT_SUFFIXES` (which also label table columns).
-PARAMETER_UNITS = {("deg", "rt", "h"): "deg/sqrt(h)", ("hz",): "Hz", ("m",): "m", ("ms2",): "m/s^2",
-                   ("dps",): "deg/s", ("ppm",): "ppm", ("g",): "g"}
+PARAMETER_UNITS = {
+    ("deg", "rt", "h"): "deg/sqrt(h)",
+    ("hz",): "Hz",
+    ("m",): "m",
+    ("ms2",): "m/s^2",
+    ("dps",): "deg/s",
+    ("ppm",): "ppm",
+    ("g",): "g",
+}
 
 
 def unit_of(name: str) -> str:
@@ -234,7 +285,9 @@ def _parameters_cell(notebook: str | os.PathLike) -> str:
     except (UnicodeDecodeError, json.JSONDecodeError) as err:
         raise InputError(f"{path}: not a notebook ({type(err).__name__})") from None
     for cell in nb.get("cells", []):
-        if cell.get("cell_type") == "code" and "parameters" in cell.get("metadata", {}).get("tags", []):
+        if cell.get("cell_type") == "code" and "parameters" in cell.get("metadata", {}).get(
+            "tags", []
+        ):
             src = cell.get("source", "")
             return "".join(src) if isinstance(src, list) else str(src)
     raise InputError(f"{path}: no cell tagged 'parameters'")
@@ -245,9 +298,6 @@ def parameter_rows(source: str) -> list[dict]:
     assigned; a tuple assignment gives one row per name) and ``meaning`` (the comment on the
     assignment's lines, after the block of comment lines right above it; an assignment without a comment
     right under another one shares its meaning)."""
-    import ast
-    import io
-    import tokenize
 
     try:
         tree = ast.parse(source)
@@ -265,16 +315,25 @@ def parameter_rows(source: str) -> list[dict]:
         if not isinstance(node, ast.Assign) or len(node.targets) != 1:
             continue
         above, n = [], node.lineno - 1
-        while n >= 1 and n in comments and n not in code_lines and lines[n - 1].lstrip().startswith("#"):
+        while (
+            n >= 1
+            and n in comments
+            and n not in code_lines
+            and lines[n - 1].lstrip().startswith("#")
+        ):
             above.insert(0, comments[n])
             n -= 1
         beside = [comments[k] for k in range(node.lineno, node.end_lineno + 1) if k in comments]
         meaning = "; ".join(x for x in (" ".join(above), " ".join(beside)) if x)
         if not meaning and rows and prev_end == node.lineno - 1:
-            meaning = rows[-1]["meaning"]          # a pair under one comment (ade_f_min, ade_f_max)
+            meaning = rows[-1]["meaning"]  # a pair under one comment (ade_f_min, ade_f_max)
         prev_end = node.end_lineno
         target, value = node.targets[0], node.value
-        if isinstance(target, ast.Tuple) and isinstance(value, ast.Tuple) and len(target.elts) == len(value.elts):
+        if (
+            isinstance(target, ast.Tuple)
+            and isinstance(value, ast.Tuple)
+            and len(target.elts) == len(value.elts)
+        ):
             pairs = list(zip(target.elts, value.elts))
         else:
             pairs = [(target, value)]
@@ -294,8 +353,12 @@ def _show_value(v: Any) -> str:
     return repr(v)
 
 
-def parameter_table(notebook: str | os.PathLike, namespace: Mapping[str, Any], fold: bool | str = True,
-                    caption: str = "Parameters of this run") -> Table:
+def parameter_table(
+    notebook: str | os.PathLike,
+    namespace: Mapping[str, Any],
+    fold: bool | str = True,
+    caption: str = "Parameters of this run",
+) -> Table:
     """The parameters cell of ``notebook`` (the code cell tagged ``parameters``, which papermill and
     ``navlib grid`` override) as a table of name, value, unit and meaning: the value is this run's (from
     ``namespace``, the notebook's ``globals()``), with the cell's default beside it where the run changed
@@ -308,13 +371,25 @@ def parameter_table(notebook: str | os.PathLike, namespace: Mapping[str, Any], f
         shown = _show_value(value)
         if shown != _show_value(r["default"]):
             shown += f" (default {_show_value(r['default'])})"
-        rows.append({"parameter": name, "value": shown, "unit": unit_of(name) or "–", "meaning": r["meaning"]})
+        rows.append(
+            {
+                "parameter": name,
+                "value": shown,
+                "unit": unit_of(name) or "–",
+                "meaning": r["meaning"],
+            }
+        )
     changed = sum("(default " in row["value"] for row in rows)
-    summary = f"{caption}: {len(rows)} parameters" + (f", {changed} changed from the defaults" if changed else
-                                                      ", all at their defaults")
-    return Table(pd.DataFrame(rows, columns=["parameter", "value", "unit", "meaning"]), index=False,
-                 caption=summary, readable=False, fold=summary if fold is True else fold)
-
+    summary = f"{caption}: {len(rows)} parameters" + (
+        f", {changed} changed from the defaults" if changed else ", all at their defaults"
+    )
+    return Table(
+        pd.DataFrame(rows, columns=["parameter", "value", "unit", "meaning"]),
+        index=False,
+        caption=summary,
+        readable=False,
+        fold=summary if fold is True else fold,
+    )
 
 
 def use_style() -> None:

@@ -50,6 +50,7 @@ the other way); the level sweep of trial 05 has the same 144 bins (70 + 74) and 
 (``tests/test_broad_convert.py``) use small synthetic trial files in BROAD's layout; the original files are
 not part of this project.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -71,20 +72,53 @@ VARIABLES = {"imu_gyr": 3, "imu_acc": 3, "imu_mag": 3, "opt_quat": 4, "opt_pos":
 #: Length of a block (s) and the share of its samples that must have a valid optical attitude.
 BLOCK_S, MIN_VALID = 0.1, 0.75
 #: Attached-magnet trials: (t_on, t_off) in s, as the realdata README states them (not derived here).
-MAGNET_TIMES = {32: (38.2, 95.3), 33: (42.4, 98.6), 34: (45.1, 99.7), 35: (42.7, 99.5), 36: (37.0, 98.5)}
+MAGNET_TIMES = {
+    32: (38.2, 95.3),
+    33: (42.4, 98.6),
+    34: (45.1, 99.7),
+    35: (42.7, 99.5),
+    36: (37.0, 98.5),
+}
 #: Blocks flagged -1 (magnet handled): mean time within these offsets (s) of t_on and of t_off.
 ON_WINDOW_S, OFF_WINDOW_S = (-2.0, 3.0), (-1.5, 1.5)
 #: Level-sweep selection and binning (realdata README, ``broad/level``).
-LEVEL_TILT_DEG, LEVEL_RATE_DPS, LEVEL_BIN_DEG, LEVEL_MIN_SAMPLES, LEVEL_SPLIT_S = 10.0, 100.0, 3.0, 20, 100.0
+LEVEL_TILT_DEG, LEVEL_RATE_DPS, LEVEL_BIN_DEG, LEVEL_MIN_SAMPLES, LEVEL_SPLIT_S = (
+    10.0,
+    100.0,
+    3.0,
+    20,
+    100.0,
+)
 
 _FLU_FRD = np.array([1.0, -1.0, -1.0])
 _ENU_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 _TRIAL = re.compile(r"^(\d\d)_(.+)\.mat$")
 
-COLUMNS_3D = ["time_s", "mag_x_ut", "mag_y_ut", "mag_z_ut", "acc_x_ms2", "acc_y_ms2", "acc_z_ms2",
-              "gyr_x_dps", "gyr_y_dps", "gyr_z_dps", "q_w", "q_x", "q_y", "q_z", "ref_roll_deg",
-              "ref_pitch_deg", "ref_heading_deg", "moving", "pos_n_m", "pos_e_m", "pos_d_m",
-              "magnet_attached", "att_blur"]
+COLUMNS_3D = [
+    "time_s",
+    "mag_x_ut",
+    "mag_y_ut",
+    "mag_z_ut",
+    "acc_x_ms2",
+    "acc_y_ms2",
+    "acc_z_ms2",
+    "gyr_x_dps",
+    "gyr_y_dps",
+    "gyr_z_dps",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "ref_roll_deg",
+    "ref_pitch_deg",
+    "ref_heading_deg",
+    "moving",
+    "pos_n_m",
+    "pos_e_m",
+    "pos_d_m",
+    "magnet_attached",
+    "att_blur",
+]
 #: Decimals written per column (as in the shared files).
 DECIMALS = {"time_s": 3, "mag": 3, "acc": 4, "gyr": 3, "q_": 6, "ref": 3, "pos": 4, "att_blur": 4}
 
@@ -101,19 +135,25 @@ def read_trial(path) -> dict:
         raise InputError(f"{p}: no such file")
     try:
         mat = loadmat(p)
-    except Exception as err:                    # scipy raises several types for a file that is not MATLAB
-        raise InputError(f"{p.name}: not a readable MATLAB file ({type(err).__name__}: "
-                         f"{str(err).splitlines()[0] if str(err) else ''})") from None
+    except Exception as err:  # scipy raises several types for a file that is not MATLAB
+        raise InputError(
+            f"{p.name}: not a readable MATLAB file ({type(err).__name__}: "
+            f"{str(err).splitlines()[0] if str(err) else ''})"
+        ) from None
     out = {}
     n = None
     for name, cols in VARIABLES.items():
         if name not in mat:
-            raise InputError(f"{p.name}: no variable '{name}'; a BROAD trial file holds "
-                             f"{', '.join(VARIABLES)} and sampling_rate")
+            raise InputError(
+                f"{p.name}: no variable '{name}'; a BROAD trial file holds "
+                f"{', '.join(VARIABLES)} and sampling_rate"
+            )
         v = np.asarray(mat[name], dtype=float)
         v = v.reshape(-1, 1) if v.ndim == 1 else v
         if v.ndim != 2 or v.shape[1] != cols:
-            raise InputError(f"{p.name}: variable '{name}' has shape {v.shape}, expected (n, {cols})")
+            raise InputError(
+                f"{p.name}: variable '{name}' has shape {v.shape}, expected (n, {cols})"
+            )
         if n is None:
             n = v.shape[0]
         elif v.shape[0] != n:
@@ -147,7 +187,7 @@ def output_name(path) -> str:
     if not m:
         raise InputError(f"{Path(path).name}: not a BROAD trial file name (NN_name.mat)")
     name = m.group(2)
-    name = name[len("disturbed_"):] if name.startswith("disturbed_") else name
+    name = name[len("disturbed_") :] if name.startswith("disturbed_") else name
     return f"broad_{m.group(1)}_{name}.csv"
 
 
@@ -166,7 +206,9 @@ def matrix_to_quat(R: np.ndarray) -> np.ndarray:
 
 def euler_zyx_deg(R: np.ndarray) -> np.ndarray:
     """Roll, pitch, heading (deg; heading in [0, 360)) of ``C_b^n`` matrices ``(n, 3, 3)``, z-y-x order."""
-    heading, pitch, roll = Rotation.from_matrix(np.asarray(R, float)).as_euler("ZYX", degrees=True).T
+    heading, pitch, roll = (
+        Rotation.from_matrix(np.asarray(R, float)).as_euler("ZYX", degrees=True).T
+    )
     return np.column_stack([roll, pitch, np.mod(heading, 360.0)])
 
 
@@ -193,7 +235,9 @@ def trial_blocks(trial: dict, number: int | None = None) -> pd.DataFrame:
     n = len(trial["imu_mag"])
     t = np.arange(n) / fs
     block = np.floor(t / BLOCK_S + 1e-9).astype(np.int64)
-    valid = np.all(np.isfinite(trial["opt_quat"]), axis=1) & np.all(np.isfinite(trial["opt_pos"]), axis=1)
+    valid = np.all(np.isfinite(trial["opt_quat"]), axis=1) & np.all(
+        np.isfinite(trial["opt_pos"]), axis=1
+    )
     mag, acc = trial["imu_mag"] * _FLU_FRD, trial["imu_acc"] * _FLU_FRD
     gyr = np.degrees(trial["imu_gyr"]) * _FLU_FRD
     pos = trial["opt_pos"] @ _ENU_NED.T
@@ -209,11 +253,24 @@ def trial_blocks(trial: dict, number: int | None = None) -> pd.DataFrame:
             continue
         idx = np.arange(a, b)[ok]
         R, blur = chordal_mean(C[idx])
-        rows.append(np.r_[t[idx].mean(), mag[idx].mean(0), acc[idx].mean(0), gyr[idx].mean(0),
-                          matrix_to_quat(R[None])[0], euler_zyx_deg(R[None])[0],
-                          float(moving[a:b].mean() >= 0.5), pos[idx].mean(0), 0.0, blur])
+        rows.append(
+            np.r_[
+                t[idx].mean(),
+                mag[idx].mean(0),
+                acc[idx].mean(0),
+                gyr[idx].mean(0),
+                matrix_to_quat(R[None])[0],
+                euler_zyx_deg(R[None])[0],
+                float(moving[a:b].mean() >= 0.5),
+                pos[idx].mean(0),
+                0.0,
+                blur,
+            ]
+        )
     if not rows:
-        raise InputError("no 0.1 s block has a valid optical attitude in at least 75 % of its samples")
+        raise InputError(
+            "no 0.1 s block has a valid optical attitude in at least 75 % of its samples"
+        )
     out = pd.DataFrame(np.array(rows), columns=COLUMNS_3D)
     out["moving"] = out["moving"].astype(int)
     out["magnet_attached"] = magnet_flags(out["time_s"].to_numpy(), number)
@@ -227,8 +284,9 @@ def magnet_flags(time_s: np.ndarray, number: int | None) -> np.ndarray:
         return flag
     on, off = MAGNET_TIMES[number]
     flag[(time_s >= on + ON_WINDOW_S[1]) & (time_s < off + OFF_WINDOW_S[0])] = 1
-    handled = ((time_s >= on + ON_WINDOW_S[0]) & (time_s < on + ON_WINDOW_S[1])) | \
-              ((time_s >= off + OFF_WINDOW_S[0]) & (time_s < off + OFF_WINDOW_S[1]))
+    handled = ((time_s >= on + ON_WINDOW_S[0]) & (time_s < on + ON_WINDOW_S[1])) | (
+        (time_s >= off + OFF_WINDOW_S[0]) & (time_s < off + OFF_WINDOW_S[1])
+    )
     flag[handled] = -1
     return flag
 
@@ -245,7 +303,9 @@ def rounded(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 # ----------------------------------------------------------------------------------------- level sweeps
-def level_sweep(trial: dict, number: int | None = None, split_s: float = LEVEL_SPLIT_S) -> pd.DataFrame:
+def level_sweep(
+    trial: dict, number: int | None = None, split_s: float = LEVEL_SPLIT_S
+) -> pd.DataFrame:
     """A level compass sweep of one trial in the compass CSV schema (module docstring): one row per 3-deg
     bin of reference heading with at least 20 selected samples (``error_sd_deg``: the population standard
     deviation of the samples' errors about the bin's mean error; ``trials``: ``number`` as two digits),
@@ -274,10 +334,19 @@ def level_sweep(trial: dict, number: int | None = None, split_s: float = LEVEL_S
     hy = cr * mag[:, 1] - sr * mag[:, 2]
     err = wrap_deg(np.degrees(np.arctan2(-hy, hx)) - ref)
     sweep = np.where(t[sel] < split_s, 1, 2)
-    frame = pd.DataFrame({"ref": ref, "err": err, "sweep": sweep, "t": t[sel], "tilt": tilt[sel],
-                          "roll": eul[sel, 0], "pitch": eul[sel, 1],
-                          **{f"mag_{a}_ut": mag[:, i] for i, a in enumerate("xyz")},
-                          **{f"acc_{a}_ms2": acc[:, i] for i, a in enumerate("xyz")}})
+    frame = pd.DataFrame(
+        {
+            "ref": ref,
+            "err": err,
+            "sweep": sweep,
+            "t": t[sel],
+            "tilt": tilt[sel],
+            "roll": eul[sel, 0],
+            "pitch": eul[sel, 1],
+            **{f"mag_{a}_ut": mag[:, i] for i, a in enumerate("xyz")},
+            **{f"acc_{a}_ms2": acc[:, i] for i, a in enumerate("xyz")},
+        }
+    )
     frame["bin"] = np.floor(frame["ref"] / LEVEL_BIN_DEG).astype(int)
     rows = []
     for (s, _), g in frame.groupby(["sweep", "bin"], sort=True):
@@ -285,17 +354,28 @@ def level_sweep(trial: dict, number: int | None = None, split_s: float = LEVEL_S
             continue
         true = np.mod(np.degrees(np.angle(np.mean(np.exp(1j * np.radians(g["ref"]))))), 360.0)
         e = np.degrees(np.angle(np.mean(np.exp(1j * np.radians(g["err"])))))
-        rows.append({"true_heading_deg": true, "measured_heading_deg": np.mod(true + e, 360.0),
-                     "heading_error_deg": e, "error_sd_deg": float(np.std(wrap_deg(g["err"] - e))),
-                     "n_samples": len(g), "sweep": int(s), "time_median_s": float(np.median(g["t"])),
-                     "trials": "" if number is None else f"{int(number):02d}",
-                     **{c: float(g[c].mean()) for c in frame.columns if c.startswith(("mag_", "acc_"))},
-                     "ref_roll_deg": float(g["roll"].mean()), "ref_pitch_deg": float(g["pitch"].mean()),
-                     "ref_tilt_deg": float(g["tilt"].mean())})
+        rows.append(
+            {
+                "true_heading_deg": true,
+                "measured_heading_deg": np.mod(true + e, 360.0),
+                "heading_error_deg": e,
+                "error_sd_deg": float(np.std(wrap_deg(g["err"] - e))),
+                "n_samples": len(g),
+                "sweep": int(s),
+                "time_median_s": float(np.median(g["t"])),
+                "trials": "" if number is None else f"{int(number):02d}",
+                **{c: float(g[c].mean()) for c in frame.columns if c.startswith(("mag_", "acc_"))},
+                "ref_roll_deg": float(g["roll"].mean()),
+                "ref_pitch_deg": float(g["pitch"].mean()),
+                "ref_tilt_deg": float(g["tilt"].mean()),
+            }
+        )
     out = pd.DataFrame(rows)
     for col in out.columns:
         if pd.api.types.is_float_dtype(out[col]):
-            out[col] = out[col].round(2 if col == "time_median_s" else 3 if col.startswith("ref_") else 4)
+            out[col] = out[col].round(
+                2 if col == "time_median_s" else 3 if col.startswith("ref_") else 4
+            )
     return out
 
 
@@ -316,24 +396,35 @@ def convert(in_dir, out_dir, trials=None, level: bool = True) -> list[Path]:
         wanted = {int(t) for t in trials}
         missing = wanted - {trial_number(p) for p in files}
         if missing:
-            raise InputError(f"{src}: no file for trial {', '.join(f'{m:02d}' for m in sorted(missing))}")
+            raise InputError(
+                f"{src}: no file for trial {', '.join(f'{m:02d}' for m in sorted(missing))}"
+            )
         files = [p for p in files if trial_number(p) in wanted]
     if not files:
         raise InputError(f"{src}: no BROAD trial file (NN_name.mat) in this folder")
     out = Path(out_dir)
-    targets = [(p, out / "3d" / output_name(p), out / "level" / f"broad_trial{trial_number(p):02d}_level.csv")
-               for p in files]
+    targets = [
+        (
+            p,
+            out / "3d" / output_name(p),
+            out / "level" / f"broad_trial{trial_number(p):02d}_level.csv",
+        )
+        for p in files
+    ]
     for _, f3, fl in targets:
-        for f in ((f3, fl) if level else (f3,)):
+        for f in (f3, fl) if level else (f3,):
             if f.exists():
                 raise InputError(f"{f}: already exists; not overwritten (choose another --out)")
-    staging = staging_folder(out)                   # all or nothing: written here, then moved into out
+    staging = staging_folder(out)  # all or nothing: written here, then moved into out
     try:
         written = []
         for p, f3, fl in targets:
             trial = read_trial(p)
-            written.append(write_new_csv(rounded(trial_blocks(trial, trial_number(p))),
-                                         staging / f3.relative_to(out)))
+            written.append(
+                write_new_csv(
+                    rounded(trial_blocks(trial, trial_number(p))), staging / f3.relative_to(out)
+                )
+            )
             if level:
                 sweep = level_sweep(trial, trial_number(p))
                 if len(sweep):
@@ -347,11 +438,19 @@ def convert(in_dir, out_dir, trials=None, level: bool = True) -> list[Path]:
 def main(argv: list[str] | None = None) -> int:
     """``python -m navlib.data.broad --in DIR --out DIR [--trials 05,32] [--no-level]``; bad input: one
     line on stderr, exit status 2; Ctrl-C: one line, exit status 130, nothing written."""
-    ap = argparse.ArgumentParser(prog="python -m navlib.data.broad",
-                                 description="Convert BROAD's data_mat/*.mat into the workbench's CSV files.")
-    ap.add_argument("--in", dest="in_dir", required=True, help="folder holding BROAD's NN_name.mat files")
-    ap.add_argument("--out", required=True, help="folder for 3d/ and level/ (existing files are never replaced)")
-    ap.add_argument("--trials", default=None, help="comma-separated trial numbers (default: every file)")
+    ap = argparse.ArgumentParser(
+        prog="python -m navlib.data.broad",
+        description="Convert BROAD's data_mat/*.mat into the workbench's CSV files.",
+    )
+    ap.add_argument(
+        "--in", dest="in_dir", required=True, help="folder holding BROAD's NN_name.mat files"
+    )
+    ap.add_argument(
+        "--out", required=True, help="folder for 3d/ and level/ (existing files are never replaced)"
+    )
+    ap.add_argument(
+        "--trials", default=None, help="comma-separated trial numbers (default: every file)"
+    )
     ap.add_argument("--no-level", action="store_true", help="write the 3-D files only")
     args = ap.parse_args(argv)
     try:
@@ -360,17 +459,19 @@ def main(argv: list[str] | None = None) -> int:
             try:
                 trials = [int(t) for t in args.trials.split(",") if t.strip()]
             except ValueError:
-                raise InputError(f"--trials {args.trials!r}: comma-separated trial numbers, e.g. 05,32") from None
+                raise InputError(
+                    f"--trials {args.trials!r}: comma-separated trial numbers, e.g. 05,32"
+                ) from None
         for path in convert(args.in_dir, args.out, trials, level=not args.no_level):
             print(path)
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:                       # Ctrl-C: nothing was written (convert is all or nothing)
+    except KeyboardInterrupt:  # Ctrl-C: nothing was written (convert is all or nothing)
         print("interrupted; nothing written", file=sys.stderr)
         return 130
     return 0
 
 
-if __name__ == "__main__":                            # pragma: no cover
+if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

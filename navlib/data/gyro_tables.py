@@ -7,6 +7,7 @@ to max - min, the calibration window inside the alignment range).  Every loader 
 12 h latitude *output*, local latitude 28.222 deg).  Column meanings, units and provenance:
 ``data/gyro_tables.md``.
 """
+
 from __future__ import annotations
 
 import os
@@ -29,44 +30,71 @@ TABLE_FILES = {
     5: "gyro_table5_cold_test.csv",
 }
 
-_LAT = Column("latitude_deg", "deg", lo=28.0, hi=28.5)       # 12 h latitude output near the site
+_LAT = Column("latitude_deg", "deg", lo=28.0, hi=28.5)  # 12 h latitude output near the site
 _DRIFT = dict(unit="deg/h", lo=-0.1, hi=0.1)
 _TEMP = dict(unit="degC", lo=-60.0, hi=120.0)
 _NMI = dict(unit="nmi/72h", lo=0.0, hi=1000.0)
 
 COLUMNS = {
-    2: [Column("sample", "", lo=1, integer=True), _LAT,
-        Column("temperature_min_c", **_TEMP), Column("temperature_max_c", **_TEMP),
-        Column("drift_deg_h", **_DRIFT)],
-    3: [Column("test", "", lo=1, integer=True), _LAT,
-        Column("temperature_min_c", **_TEMP), Column("temperature_max_c", **_TEMP),
-        Column("paper_rbf_drift_deg_h", **_DRIFT), Column("true_drift_deg_h", **_DRIFT),
+    2: [
+        Column("sample", "", lo=1, integer=True),
+        _LAT,
+        Column("temperature_min_c", **_TEMP),
+        Column("temperature_max_c", **_TEMP),
+        Column("drift_deg_h", **_DRIFT),
+    ],
+    3: [
+        Column("test", "", lo=1, integer=True),
+        _LAT,
+        Column("temperature_min_c", **_TEMP),
+        Column("temperature_max_c", **_TEMP),
+        Column("paper_rbf_drift_deg_h", **_DRIFT),
+        Column("true_drift_deg_h", **_DRIFT),
         Column("paper_error_deg_h", **_DRIFT),
-        Column("paper_pos_error_before_nmi_72h", **_NMI), Column("paper_pos_error_after_nmi_72h", **_NMI)],
-    4: [Column("sample", "", lo=1, integer=True),
-        Column("align_temp_min_c", **_TEMP), Column("align_temp_max_c", **_TEMP),
+        Column("paper_pos_error_before_nmi_72h", **_NMI),
+        Column("paper_pos_error_after_nmi_72h", **_NMI),
+    ],
+    4: [
+        Column("sample", "", lo=1, integer=True),
+        Column("align_temp_min_c", **_TEMP),
+        Column("align_temp_max_c", **_TEMP),
         Column("align_temp_change_c", "degC", lo=0, hi=180),
-        Column("calib_temp_min_c", **_TEMP), Column("calib_temp_max_c", **_TEMP),
-        Column("calib_temp_change_c", "degC", lo=0, hi=180), _LAT,
-        Column("true_drift_deg_h", **_DRIFT), Column("paper_hot_rbf_drift_deg_h", **_DRIFT)],
-    5: [Column("test", "", lo=1, integer=True),
-        Column("align_temp_min_c", **_TEMP), Column("align_temp_max_c", **_TEMP),
-        Column("align_temp_change_c", "degC", lo=0, hi=180),
-        Column("calib_temp_min_c", **_TEMP), Column("calib_temp_max_c", **_TEMP),
+        Column("calib_temp_min_c", **_TEMP),
+        Column("calib_temp_max_c", **_TEMP),
         Column("calib_temp_change_c", "degC", lo=0, hi=180),
-        Column("paper_pos_error_hot_net_nmi_72h", **_NMI), Column("paper_pos_error_cold_net_nmi_72h", **_NMI)],
+        _LAT,
+        Column("true_drift_deg_h", **_DRIFT),
+        Column("paper_hot_rbf_drift_deg_h", **_DRIFT),
+    ],
+    5: [
+        Column("test", "", lo=1, integer=True),
+        Column("align_temp_min_c", **_TEMP),
+        Column("align_temp_max_c", **_TEMP),
+        Column("align_temp_change_c", "degC", lo=0, hi=180),
+        Column("calib_temp_min_c", **_TEMP),
+        Column("calib_temp_max_c", **_TEMP),
+        Column("calib_temp_change_c", "degC", lo=0, hi=180),
+        Column("paper_pos_error_hot_net_nmi_72h", **_NMI),
+        Column("paper_pos_error_cold_net_nmi_72h", **_NMI),
+    ],
 }
 MIN_ROWS = {2: 2, 3: 1, 4: 2, 5: 1}
-KIND = {2: "hot-state training table", 3: "hot-state test table", 4: "cold-state training table",
-        5: "cold-state test table"}
+KIND = {
+    2: "hot-state training table",
+    3: "hot-state test table",
+    4: "cold-state training table",
+    5: "cold-state test table",
+}
 
 
 def _check_range(path, df, lo_col, hi_col) -> None:
     bad = np.flatnonzero(df[lo_col].to_numpy() > df[hi_col].to_numpy())
     if bad.size:
         r = int(bad[0])
-        raise InputError(f"{where(path, lo_col, r)}: {df[lo_col].iloc[r]:g} is above "
-                         f"{hi_col} = {df[hi_col].iloc[r]:g}")
+        raise InputError(
+            f"{where(path, lo_col, r)}: {df[lo_col].iloc[r]:g} is above "
+            f"{hi_col} = {df[hi_col].iloc[r]:g}"
+        )
 
 
 def _check_change(path, df, lo_col, hi_col, change_col) -> None:
@@ -74,8 +102,10 @@ def _check_change(path, df, lo_col, hi_col, change_col) -> None:
     bad = np.flatnonzero(np.abs(df[change_col].to_numpy() - diff) > 1e-9)
     if bad.size:
         r = int(bad[0])
-        raise InputError(f"{where(path, change_col, r)}: {df[change_col].iloc[r]:g} is not "
-                         f"{hi_col} - {lo_col} = {diff[r]:g}")
+        raise InputError(
+            f"{where(path, change_col, r)}: {df[change_col].iloc[r]:g} is not "
+            f"{hi_col} - {lo_col} = {diff[r]:g}"
+        )
 
 
 def _check_unique(path, df, col) -> None:
@@ -130,18 +160,38 @@ def load_cold_test(path=None) -> pd.DataFrame:
 
 #: The columns of a user's drift table (what ``python -m navlib loop drift FILE`` reads), with their limits.
 USER_COLUMNS = [
-    Column("latitude_error_deg", "deg", lo=-1.0, hi=1.0,
-           meaning="12 h latitude error of the test, indicated - true"),
-    Column("drift_deg_h", "deg/h", lo=-1.0, hi=1.0,
-           meaning="axial gyro drift identified for the test"),
-    Column("temperature_c", "degC", required=False, lo=-60.0, hi=120.0,
-           meaning="mean temperature while the drift is identified"),
-    Column("temperature_change_c", "degC", required=False, lo=-180.0, hi=180.0,
-           meaning="temperature rise during the alignment (a cold start)"),
+    Column(
+        "latitude_error_deg",
+        "deg",
+        lo=-1.0,
+        hi=1.0,
+        meaning="12 h latitude error of the test, indicated - true",
+    ),
+    Column(
+        "drift_deg_h", "deg/h", lo=-1.0, hi=1.0, meaning="axial gyro drift identified for the test"
+    ),
+    Column(
+        "temperature_c",
+        "degC",
+        required=False,
+        lo=-60.0,
+        hi=120.0,
+        meaning="mean temperature while the drift is identified",
+    ),
+    Column(
+        "temperature_change_c",
+        "degC",
+        required=False,
+        lo=-180.0,
+        hi=180.0,
+        meaning="temperature rise during the alignment (a cold start)",
+    ),
 ]
 
 
-def load_user_drift(path: str | os.PathLike, *, require_drift: bool = True, min_rows: int = 1) -> pd.DataFrame:
+def load_user_drift(
+    path: str | os.PathLike, *, require_drift: bool = True, min_rows: int = 1
+) -> pd.DataFrame:
     """A user's drift CSV: ``latitude_error_deg`` (12 h latitude error, indicated - true, deg),
     ``drift_deg_h`` (axial drift, deg/h; optional with ``require_drift=False`` for files to identify),
     optional ``temperature_c`` and ``temperature_change_c`` (C) for a cold-state network."""
@@ -168,15 +218,32 @@ def drift_measurements(which: str = "all") -> pd.DataFrame:
     if which in ("hot", "all"):
         for number, drift_col in ((2, "drift_deg_h"), (3, "true_drift_deg_h")):
             t = load_table(number)
-            parts.append(pd.DataFrame({
-                "latitude_error_deg": t["latitude_error_deg"], "drift_deg_h": t[drift_col],
-                "temperature_c": (t["temperature_min_c"] + t["temperature_max_c"]) / 2,
-                "temperature_change_c": t["temperature_max_c"] - t["temperature_min_c"],
-                "state": "hot", "table": number, "row": t["sample" if number == 2 else "test"]}))
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "latitude_error_deg": t["latitude_error_deg"],
+                        "drift_deg_h": t[drift_col],
+                        "temperature_c": (t["temperature_min_c"] + t["temperature_max_c"]) / 2,
+                        "temperature_change_c": t["temperature_max_c"] - t["temperature_min_c"],
+                        "state": "hot",
+                        "table": number,
+                        "row": t["sample" if number == 2 else "test"],
+                    }
+                )
+            )
     if which in ("cold", "all"):
         t = load_table(4)
-        parts.append(pd.DataFrame({
-            "latitude_error_deg": t["latitude_error_deg"], "drift_deg_h": t["true_drift_deg_h"],
-            "temperature_c": (t["calib_temp_min_c"] + t["calib_temp_max_c"]) / 2,
-            "temperature_change_c": t["align_temp_change_c"], "state": "cold", "table": 4, "row": t["sample"]}))
+        parts.append(
+            pd.DataFrame(
+                {
+                    "latitude_error_deg": t["latitude_error_deg"],
+                    "drift_deg_h": t["true_drift_deg_h"],
+                    "temperature_c": (t["calib_temp_min_c"] + t["calib_temp_max_c"]) / 2,
+                    "temperature_change_c": t["align_temp_change_c"],
+                    "state": "cold",
+                    "table": 4,
+                    "row": t["sample"],
+                }
+            )
+        )
     return pd.concat(parts, ignore_index=True)

@@ -15,6 +15,7 @@ with a byte-order mark is read too); bytes that are not UTF-8 text are kept, and
 sit in a cell of a described column.  Columns the table does not describe are never checked: a NaN, text
 or a stray byte there does not stop the reading.
 """
+
 from __future__ import annotations
 
 import csv
@@ -38,7 +39,7 @@ from ..errors import InputError
 LIMIT = 1e12
 
 _FLOAT_MAX = float(np.finfo(float).max)
-_BAD_BYTES = re.compile("[\udc80-\udcff]")          # bytes that were not UTF-8 (kept by surrogateescape)
+_BAD_BYTES = re.compile("[\udc80-\udcff]")  # bytes that were not UTF-8 (kept by surrogateescape)
 
 
 @dataclass(frozen=True)
@@ -70,7 +71,7 @@ def where(path: str | os.PathLike, column: str, row: int, frame: pd.DataFrame | 
     line breaks before the row, which :func:`read_table` records in ``frame.attrs["line_jumps"]`` when a
     file has any."""
     line = row + 2
-    for start, extra in (frame.attrs.get("line_jumps", ()) if frame is not None else ()):
+    for start, extra in frame.attrs.get("line_jumps", ()) if frame is not None else ():
         if row >= start:
             line = row + 2 + extra
     return f"{Path(path).name}: column '{column}', row {row + 1} (file line {line})"
@@ -87,7 +88,9 @@ def _jumps(lines: list[int]) -> tuple[tuple[int, int], ...]:
 def show(text: str) -> str:
     """``text`` for a one-line message: bytes that are not UTF-8 as ``\\xNN``, control characters escaped."""
     text = str(text).encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
-    return "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    return "".join(
+        ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text
+    )
 
 
 #: The most data rows a table may have: every workbench step is linear in the rows (issue 34: a calibration
@@ -105,14 +108,20 @@ def _decode(p: Path, kind: str, max_rows: int | None = MAX_ROWS) -> str:
     except OSError as err:
         raise InputError(f"{p}: cannot be read ({err.strerror or type(err).__name__})") from None
     if data[:2] == b"\x1f\x8b":
-        raise InputError(f"{p.name}: is gzip-compressed; decompress it (gunzip) and give the CSV {kind}")
+        raise InputError(
+            f"{p.name}: is gzip-compressed; decompress it (gunzip) and give the CSV {kind}"
+        )
     if data[:4] == b"PK\x03\x04":
-        raise InputError(f"{p.name}: is a zip archive (an Excel workbook?); save or extract it as a CSV {kind}")
+        raise InputError(
+            f"{p.name}: is a zip archive (an Excel workbook?); save or extract it as a CSV {kind}"
+        )
     if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
         try:
             text = data.decode("utf-16")
         except UnicodeDecodeError as err:
-            raise InputError(f"{p.name}: starts as UTF-16 text but byte {err.start} is not UTF-16") from None
+            raise InputError(
+                f"{p.name}: starts as UTF-16 text but byte {err.start} is not UTF-16"
+            ) from None
         _check_size(p, text.count("\n") + (not text.endswith("\n")) - 1, max_rows)
         return text
     nul = data.find(b"\x00")
@@ -125,35 +134,41 @@ def _decode(p: Path, kind: str, max_rows: int | None = MAX_ROWS) -> str:
 def _check_size(p: Path, lines: int, max_rows: int | None) -> None:
     """Refuse a file of more than ``max_rows`` lines after its header (None: no limit)."""
     if max_rows is not None and lines > max_rows:
-        raise InputError(f"{p.name}: {lines:,} lines after the header; navlib reads at most {max_rows:,} rows (the "
-                         f"cost of every step grows with the rows: minutes and gigabytes at that size): keep "
-                         f"every k-th row or split the file")
+        raise InputError(
+            f"{p.name}: {lines:,} lines after the header; navlib reads at most {max_rows:,} rows (the "
+            f"cost of every step grows with the rows: minutes and gigabytes at that size): keep "
+            f"every k-th row or split the file"
+        )
 
 
 def _parse(p: Path, text: str, kind: str) -> tuple[list[str], list[list[str]], list[int]]:
     """Header, data rows (each padded to the header's width) and the file line each row starts on."""
     reader = csv.reader(io.StringIO(text, newline=""), skipinitialspace=True)
     header, rows, lines = None, [], []
-    last = 0                                          # the line the previous record ended on
+    last = 0  # the line the previous record ended on
     try:
         for fields in reader:
             start, last = last + 1, reader.line_num
-            if not fields or (len(fields) == 1 and not fields[0].strip()):    # a blank line
+            if not fields or (len(fields) == 1 and not fields[0].strip()):  # a blank line
                 continue
             if header is None:
                 header = [f.strip() for f in fields]
                 continue
             if len(fields) > len(header):
-                if any(f.strip() for f in fields[len(header):]):
-                    raise InputError(f"{p.name}: line {start}: {len(fields)} fields, the header has "
-                                     f"{len(header)} (a separator inside a value? quote the value)")
-                fields = fields[:len(header)]
+                if any(f.strip() for f in fields[len(header) :]):
+                    raise InputError(
+                        f"{p.name}: line {start}: {len(fields)} fields, the header has "
+                        f"{len(header)} (a separator inside a value? quote the value)"
+                    )
+                fields = fields[: len(header)]
             elif len(fields) < len(header):
                 fields = fields + [""] * (len(header) - len(fields))
             rows.append(fields)
             lines.append(start)
     except csv.Error as err:
-        raise InputError(f"{p.name}: line {reader.line_num}: not a readable CSV {kind} ({err})") from None
+        raise InputError(
+            f"{p.name}: line {reader.line_num}: not a readable CSV {kind} ({err})"
+        ) from None
     if header is None:
         raise InputError(f"{p.name}: file is empty, expected a CSV {kind} with a header line")
     return header, rows, lines
@@ -167,8 +182,10 @@ def _names(p: Path, header: list[str]) -> list[str]:
             names.append(f"Unnamed: {i}")
             continue
         if name in seen:
-            raise InputError(f"{p.name}: column '{show(name)}' appears more than once in the header "
-                             f"(columns {seen[name] + 1} and {i + 1}); remove or rename one")
+            raise InputError(
+                f"{p.name}: column '{show(name)}' appears more than once in the header "
+                f"(columns {seen[name] + 1} and {i + 1}); remove or rename one"
+            )
         seen[name] = i
         names.append(name)
     return names
@@ -199,8 +216,14 @@ def _numbers(cells: pd.Series) -> np.ndarray:
 _SEPARATORS = {";": "';'", "\t": "a tab", "|": "'|'"}
 
 
-def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int = 1,
-               kind: str = "table", max_rows: int | None = MAX_ROWS) -> pd.DataFrame:
+def read_table(
+    path: str | os.PathLike,
+    columns: list[Column],
+    *,
+    min_rows: int = 1,
+    kind: str = "table",
+    max_rows: int | None = MAX_ROWS,
+) -> pd.DataFrame:
     """Read and validate a CSV table.
 
     Checks, in order: the file exists, is a regular file and text (not compressed, archived or binary) and parses as CSV; no
@@ -220,7 +243,7 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
         raise InputError(f"{p}: no such file")
     if p.is_dir():
         raise InputError(f"{p}: is a folder, expected a CSV {kind}")
-    if not p.is_file():                               # a device or a pipe (/dev/zero would never end)
+    if not p.is_file():  # a device or a pipe (/dev/zero would never end)
         raise InputError(f"{p}: is not a regular file, expected a CSV {kind}")
     header, rows, lines = _parse(p, _decode(p, kind, max_rows), kind)
     names = _names(p, header)
@@ -230,11 +253,14 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
             hint = f"; did you mean to name '{show(near[0])}' '{col.name}'?" if near else ""
             sep = [w for s, w in _SEPARATORS.items() if len(names) == 1 and s in header[0]]
             if sep:
-                hint += f"; the file seems to use {sep[0]} as the separator, a CSV {kind} uses commas"
+                hint += (
+                    f"; the file seems to use {sep[0]} as the separator, a CSV {kind} uses commas"
+                )
             found = ", ".join(show(n) for n in names)
             found = found if len(found) <= 300 else found[:300] + " ..."
-            raise InputError(f"{p.name}: missing column '{col.name}' ({_what(col)}); "
-                             f"found {found}{hint}")
+            raise InputError(
+                f"{p.name}: missing column '{col.name}' ({_what(col)}); found {found}{hint}"
+            )
     located = pd.DataFrame(index=pd.RangeIndex(len(rows)))
     jumps = _jumps(lines)
     if jumps:
@@ -245,9 +271,11 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     for name in names:
         text = [v.strip() for v in cells[name]]
         col = described.get(name)
-        if col is None or col.text:                   # not described or names: kept as text, never checked
+        if col is None or col.text:  # not described or names: kept as text, never checked
             if any(_BAD_BYTES.search(v) for v in text):
-                text = [v.encode("utf-8", "surrogateescape").decode("utf-8", "replace") for v in text]
+                text = [
+                    v.encode("utf-8", "surrogateescape").decode("utf-8", "replace") for v in text
+                ]
             out[name] = pd.Series(text, dtype=str)
             continue
         values = _numbers(pd.Series(text, dtype=object))
@@ -257,10 +285,12 @@ def read_table(path: str | os.PathLike, columns: list[Column], *, min_rows: int 
     frame = pd.DataFrame(out, index=pd.RangeIndex(len(rows)))
     if jumps:
         frame.attrs["line_jumps"] = jumps
-    frame.attrs["source"] = p.name                  # later messages about the data name the file
+    frame.attrs["source"] = p.name  # later messages about the data name the file
     if len(frame) < min_rows:
-        raise InputError(f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
-                         f"a {kind} needs at least {min_rows}")
+        raise InputError(
+            f"{p.name}: {len(frame)} data row{'s' if len(frame) != 1 else ''}, "
+            f"a {kind} needs at least {min_rows}"
+        )
     return frame
 
 
@@ -290,12 +320,21 @@ def schema_table(columns) -> pd.DataFrame:
             limits = f"{lo}..{hi}" if (lo or hi) else "finite"
             if c.integer:
                 limits += ", whole"
-        rows.append({"column": c.name, "unit": "text" if c.text else (c.unit or "-"),
-                     "required": "yes" if c.required else "no", "limits": limits, "meaning": c.meaning})
+        rows.append(
+            {
+                "column": c.name,
+                "unit": "text" if c.text else (c.unit or "-"),
+                "required": "yes" if c.required else "no",
+                "limits": limits,
+                "meaning": c.meaning,
+            }
+        )
     return pd.DataFrame(rows, columns=["column", "unit", "required", "limits", "meaning"])
 
 
-def _check(p: Path, col: Column, text: list[str], values: np.ndarray, located: pd.DataFrame) -> None:
+def _check(
+    p: Path, col: Column, text: list[str], values: np.ndarray, located: pd.DataFrame
+) -> None:
     """A checked column's values: finite, whole if asked, within the range."""
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
@@ -305,14 +344,18 @@ def _check(p: Path, col: Column, text: list[str], values: np.ndarray, located: p
         frac = np.flatnonzero(values != np.round(values))
         if frac.size:
             r = int(frac[0])
-            raise InputError(f"{where(p, col.name, r, located)}: {show(text[r])} is not a whole number")
+            raise InputError(
+                f"{where(p, col.name, r, located)}: {show(text[r])} is not a whole number"
+            )
     lo = -LIMIT if col.lo is None else col.lo
     hi = LIMIT if col.hi is None else col.hi
     outside = np.flatnonzero((values < lo) | (values > hi))
     if outside.size:
         r = int(outside[0])
         unit = f" {col.unit}" if col.unit else ""
-        raise InputError(f"{where(p, col.name, r, located)}: {show(text[r])} is outside {lo:g}..{hi:g}{unit}")
+        raise InputError(
+            f"{where(p, col.name, r, located)}: {show(text[r])} is outside {lo:g}..{hi:g}{unit}"
+        )
 
 
 def require_variation(frame: pd.DataFrame, columns, path, what: str = "the model") -> None:
@@ -322,12 +365,20 @@ def require_variation(frame: pd.DataFrame, columns, path, what: str = "the model
         if c in frame and len(frame) > 1:
             v = frame[c].to_numpy(float)
             if np.all(v == v[0]):
-                raise InputError(f"{Path(path).name}: column '{c}' is {v[0]:g} in all {len(v)} rows; {what} "
-                                 f"needs it to vary (a stuck sensor or an unconnected channel?)")
+                raise InputError(
+                    f"{Path(path).name}: column '{c}' is {v[0]:g} in all {len(v)} rows; {what} "
+                    f"needs it to vary (a stuck sensor or an unconnected channel?)"
+                )
 
 
-def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, overwrite: bool = False,
-              exists: str = "already exists; not overwritten", newline: str | None = None) -> Path:
+def write_new(
+    path: str | os.PathLike,
+    write: Callable[[TextIO], object],
+    *,
+    overwrite: bool = False,
+    exists: str = "already exists; not overwritten",
+    newline: str | None = None,
+) -> Path:
     """The one overwrite rule of navlib: create ``path`` (and its folder) and let ``write(fh)`` fill it,
     never replacing an existing file unless ``overwrite`` is set; user data and earlier outputs are not
     overwritten by accident.  The check and the creation are one step (``open(path, "x")``), so no file
@@ -361,19 +412,28 @@ def write_new(path: str | os.PathLike, write: Callable[[TextIO], object], *, ove
     try:
         with fh:
             write(fh)
-    except BaseException:                           # an error or Ctrl-C half-way: no file that looks complete
+    except BaseException:  # an error or Ctrl-C half-way: no file that looks complete
         p.unlink(missing_ok=True)
         raise
     return p
 
 
-def write_new_csv(frame: pd.DataFrame, path: str | os.PathLike, *, overwrite: bool = False,
-                  float_format: str = "%.10g") -> Path:
+def write_new_csv(
+    frame: pd.DataFrame,
+    path: str | os.PathLike,
+    *,
+    overwrite: bool = False,
+    float_format: str = "%.10g",
+) -> Path:
     """Write ``frame`` to ``path`` but never replace an existing file unless ``overwrite`` is set
     (:func:`write_new`): user data and earlier outputs are not overwritten by accident."""
-    return write_new(path, lambda fh: frame.to_csv(fh, index=False, float_format=float_format),
-                     overwrite=overwrite, newline="",
-                     exists="already exists; not overwritten (choose another name or pass overwrite)")
+    return write_new(
+        path,
+        lambda fh: frame.to_csv(fh, index=False, float_format=float_format),
+        overwrite=overwrite,
+        newline="",
+        exists="already exists; not overwritten (choose another name or pass overwrite)",
+    )
 
 
 class FolderClaim:
@@ -386,7 +446,7 @@ class FolderClaim:
 
     def __init__(self, folder: Path, marker: Path, created: list[Path], what: str):
         self.folder, self.marker, self.created, self.what = folder, marker, created, what
-        self.before: set[str] = set()            # what the folder held when it was claimed (not ours)
+        self.before: set[str] = set()  # what the folder held when it was claimed (not ours)
 
     def __enter__(self) -> "FolderClaim":
         return self
@@ -406,35 +466,45 @@ class FolderClaim:
         for d in reversed(self.created):
             try:
                 d.rmdir()
-            except OSError:                             # not empty (someone else's files) or already gone
+            except OSError:  # not empty (someone else's files) or already gone
                 break
 
     def abandon(self, err: BaseException | None = None) -> None:
         """The work stopped: leave the folder as found if nothing was written into it since the claim, else
         mark it incomplete."""
         try:
-            written = [p for p in self.folder.iterdir() if p != self.marker and p.name not in self.before]
+            written = [
+                p for p in self.folder.iterdir() if p != self.marker and p.name not in self.before
+            ]
         except OSError:
             return
         if not written:
             self.marker.unlink(missing_ok=True)
             self._remove_created()
             return
-        why = ("interrupted (Ctrl-C)" if isinstance(err, KeyboardInterrupt)
-               else f"stopped by an error ({type(err).__name__}: {' '.join(str(err).split())[:200]})" if err is not None
-               else "stopped")
+        why = (
+            "interrupted (Ctrl-C)"
+            if isinstance(err, KeyboardInterrupt)
+            else f"stopped by an error ({type(err).__name__}: {' '.join(str(err).split())[:200]})"
+            if err is not None
+            else "stopped"
+        )
         when = pd.Timestamp.now().isoformat(timespec="seconds")
         try:
-            self.marker.write_text(f"{self.what}: {why} at {when}.  This folder is INCOMPLETE: what is here was "
-                                   f"written before it stopped, and what marks a complete run is missing.\n",
-                                   encoding="utf-8")
+            self.marker.write_text(
+                f"{self.what}: {why} at {when}.  This folder is INCOMPLETE: what is here was "
+                f"written before it stopped, and what marks a complete run is missing.\n",
+                encoding="utf-8",
+            )
         except OSError:
             return
         if err is not None:
             err.add_note(f"{self.folder} is incomplete ({self.marker.name} says so)")
 
 
-def claim_folder(folder: str | os.PathLike, marker: str, *, what: str, label: str, empty: bool) -> FolderClaim:
+def claim_folder(
+    folder: str | os.PathLike, marker: str, *, what: str, label: str, empty: bool
+) -> FolderClaim:
     """Claim the output folder ``folder`` for one writer before any work is done (the rule of
     :func:`write_new` for a folder of outputs).
 
@@ -477,33 +547,43 @@ def claim_folder(folder: str | os.PathLike, marker: str, *, what: str, label: st
         try:
             d.mkdir()
             created.append(d)
-        except FileExistsError:                     # another writer made it in between: the marker decides
+        except FileExistsError:  # another writer made it in between: the marker decides
             pass
         except OSError as err:
             claim._remove_created()
-            raise InputError(f"{label} {folder}: cannot create the folder ({err.strerror or err})") from None
+            raise InputError(
+                f"{label} {folder}: cannot create the folder ({err.strerror or err})"
+            ) from None
     if not folder.is_dir():
         claim._remove_created()
         raise InputError(f"{label} {folder}: is a file, not a folder")
     if claim.marker.exists():
-        raise InputError(f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
-                         f"folder is incomplete: choose another)")
+        raise InputError(
+            f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
+            f"folder is incomplete: choose another)"
+        )
     if empty and any(folder.iterdir()):
         claim._remove_created()
-        raise InputError(f"{label} {folder}: the folder is not empty (outputs go only into a new or empty folder, "
-                         f"never over earlier outputs)")
+        raise InputError(
+            f"{label} {folder}: the folder is not empty (outputs go only into a new or empty folder, "
+            f"never over earlier outputs)"
+        )
     try:
         fd = os.open(claim.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
     except FileExistsError:
-        raise InputError(f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
-                         f"folder is incomplete: choose another)") from None
+        raise InputError(
+            f"{label} {folder}: another run is writing there ({marker} exists; if no run is, the "
+            f"folder is incomplete: choose another)"
+        ) from None
     except OSError as err:
         claim._remove_created()
         raise InputError(f"{label} {folder}: cannot write there ({err.strerror or err})") from None
     claim.before = {p.name for p in folder.iterdir()} - {marker}
     with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write(f"{what} is writing this folder (process {os.getpid()}, started "
-                 f"{pd.Timestamp.now().isoformat(timespec='seconds')}); it is complete once this file is gone.\n")
+        fh.write(
+            f"{what} is writing this folder (process {os.getpid()}, started "
+            f"{pd.Timestamp.now().isoformat(timespec='seconds')}); it is complete once this file is gone.\n"
+        )
     return claim
 
 
@@ -525,7 +605,7 @@ def _place(src: Path, dst: Path) -> None:
         os.link(src, dst)
     except FileExistsError:
         raise
-    except OSError:                                   # no hard links here (some network file systems)
+    except OSError:  # no hard links here (some network file systems)
         with open(src, "rb") as fin, open(dst, "xb") as fout:
             shutil.copyfileobj(fin, fout)
 
@@ -543,7 +623,7 @@ def publish(staging: str | os.PathLike, target: str | os.PathLike) -> dict[Path,
         try:
             os.rename(staging, target)
             return where
-        except OSError:                               # it appeared meanwhile: placed file by file below
+        except OSError:  # it appeared meanwhile: placed file by file below
             pass
     placed: list[Path] = []
     made: list[Path] = []
@@ -568,7 +648,8 @@ def publish(staging: str | os.PathLike, target: str | os.PathLike) -> dict[Path,
             except OSError:
                 pass
         if isinstance(err, FileExistsError):
-            raise InputError(f"{dst}: already exists; not overwritten (choose another folder); "
-                             f"nothing written") from None
+            raise InputError(
+                f"{dst}: already exists; not overwritten (choose another folder); nothing written"
+            ) from None
         raise
     return where

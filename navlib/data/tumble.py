@@ -6,6 +6,7 @@ divided by the nominal scale factor: a perfect sensor reads ``1000 cos q``), ``u
 name); optional ``set_point_c`` (chamber set point) and ``true_output_mg`` (simulations only).  Every fault
 is one line naming file, column and row.
 """
+
 from __future__ import annotations
 
 import os
@@ -18,16 +19,42 @@ from ..paths import data_path
 from .tables import Column, read_table, where
 
 TUMBLE_FILE = data_path("accel_tumble.csv")
-COLUMNS = [Column("temperature_c", "degC", lo=-60.0, hi=130.0, meaning="sensor temperature at the reading"),
-           Column("position_deg", "deg", lo=0.0, hi=360.0,
-                  meaning="dividing-head angle q, on the head's 15-deg grid (input a = cos q)"),
-           Column("output_mg", "mg", lo=-5000.0, hi=5000.0,
-                  meaning="output / nominal scale factor (a perfect sensor reads 1000 cos q)"),
-           Column("unit", required=True, text=True, meaning="accelerometer name"),
-           Column("set_point_c", "degC", required=False, lo=-60.0, hi=130.0,
-                  meaning="chamber set point (the temperature rounded to 0.5 degC if absent)"),
-           Column("true_output_mg", "mg", required=False, lo=-5000.0, hi=5000.0,
-                  meaning="noise-free output (simulations only; not read by the models)")]
+COLUMNS = [
+    Column(
+        "temperature_c", "degC", lo=-60.0, hi=130.0, meaning="sensor temperature at the reading"
+    ),
+    Column(
+        "position_deg",
+        "deg",
+        lo=0.0,
+        hi=360.0,
+        meaning="dividing-head angle q, on the head's 15-deg grid (input a = cos q)",
+    ),
+    Column(
+        "output_mg",
+        "mg",
+        lo=-5000.0,
+        hi=5000.0,
+        meaning="output / nominal scale factor (a perfect sensor reads 1000 cos q)",
+    ),
+    Column("unit", required=True, text=True, meaning="accelerometer name"),
+    Column(
+        "set_point_c",
+        "degC",
+        required=False,
+        lo=-60.0,
+        hi=130.0,
+        meaning="chamber set point (the temperature rounded to 0.5 degC if absent)",
+    ),
+    Column(
+        "true_output_mg",
+        "mg",
+        required=False,
+        lo=-5000.0,
+        hi=5000.0,
+        meaning="noise-free output (simulations only; not read by the models)",
+    ),
+]
 
 
 def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -> pd.DataFrame:
@@ -49,29 +76,43 @@ def read_tumble(path: str | os.PathLike = TUMBLE_FILE, grid_deg: float = 15.0) -
     df["unit"] = unit
     q = df["position_deg"].to_numpy()
     if q.max() <= 2 * np.pi + 1e-9 and len(np.unique(q)) >= 4:
-        raise InputError(f"{name}: column 'position_deg': every value is within 0..{2 * np.pi:.4f}; these look "
-                         f"like radians, the column must be in degrees")
+        raise InputError(
+            f"{name}: column 'position_deg': every value is within 0..{2 * np.pi:.4f}; these look "
+            f"like radians, the column must be in degrees"
+        )
     off = np.abs(q / grid_deg - np.round(q / grid_deg)) * grid_deg > 1e-6
     off |= q >= 360.0
     if off.any():
         r = int(np.flatnonzero(off)[0])
-        raise InputError(f"{where(path, 'position_deg', r, df)}: {q[r]:g} is not on the dividing head's "
-                         f"{grid_deg:g} deg grid (0 <= q < 360)")
+        raise InputError(
+            f"{where(path, 'position_deg', r, df)}: {q[r]:g} is not on the dividing head's "
+            f"{grid_deg:g} deg grid (0 <= q < 360)"
+        )
     if "set_point_c" not in df.columns:
         df["set_point_c"] = np.round(df["temperature_c"].to_numpy() * 2) / 2
     return df
 
 
-def require_levels(df: pd.DataFrame, *, temperatures: int = 0, positions: int = 0, what: str = "this model",
-                   name: str = "tumble data") -> None:
+def require_levels(
+    df: pd.DataFrame,
+    *,
+    temperatures: int = 0,
+    positions: int = 0,
+    what: str = "this model",
+    name: str = "tumble data",
+) -> None:
     """Raise unless every unit in ``df`` has at least ``temperatures`` set points and ``positions``
     distinct positions (e.g. a temperature polynomial of degree 2 needs 3 temperatures)."""
     for unit, g in df.groupby("unit", sort=False):
         nt = g["set_point_c"].nunique()
         npos = g["position_deg"].nunique()
         if nt < temperatures:
-            raise InputError(f"{name}: unit {unit} has {nt} temperature{'s' if nt != 1 else ''}; "
-                             f"{what} needs at least {temperatures}")
+            raise InputError(
+                f"{name}: unit {unit} has {nt} temperature{'s' if nt != 1 else ''}; "
+                f"{what} needs at least {temperatures}"
+            )
         if npos < positions:
-            raise InputError(f"{name}: unit {unit} has {npos} position{'s' if npos != 1 else ''}; "
-                             f"{what} needs at least {positions}")
+            raise InputError(
+                f"{name}: unit {unit} has {npos} position{'s' if npos != 1 else ''}; "
+                f"{what} needs at least {positions}"
+            )

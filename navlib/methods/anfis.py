@@ -18,6 +18,7 @@ Gradients (``w_r`` firing strength, ``S = sum w``, ``f_r`` rule output, ``y`` ou
     dE/dc_ri = sum_n 2 e (f_r - y)/S w_r (x_i - c_ri)/s_ri^2
     dE/ds_ri = sum_n 2 e (f_r - y)/S w_r (x_i - c_ri)^2/s_ri^3
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -82,11 +83,11 @@ def premise_gradient(fis: SugenoFIS, X: np.ndarray, t: np.ndarray):
     f = X @ fis.consequents[:, :-1].T + fis.consequents[:, -1]
     y = np.sum(w * f, axis=1) / s
     e = y - t
-    a = 2.0 * e[:, None] * (f - y[:, None]) / s[:, None] * w                    # (N, R)
-    dx = X[:, None, :] - fis.centers[None]                                       # (N, R, n)
+    a = 2.0 * e[:, None] * (f - y[:, None]) / s[:, None] * w  # (N, R)
+    dx = X[:, None, :] - fis.centers[None]  # (N, R, n)
     sg = fis.sigmas[None]
-    gc = np.einsum("nr,nri->ri", a, dx / sg ** 2)
-    gs = np.einsum("nr,nri->ri", a, dx ** 2 / sg ** 3)
+    gc = np.einsum("nr,nri->ri", a, dx / sg**2)
+    gs = np.einsum("nr,nri->ri", a, dx**2 / sg**3)
     return gc, gs
 
 
@@ -113,7 +114,9 @@ def anfis(X, t, init: SugenoFIS, options: AnfisOptions = AnfisOptions(), check=N
     X = np.atleast_2d(np.asarray(X, float))
     t = np.asarray(t, float).ravel()
     if X.shape[1] != init.centers.shape[1] or len(t) != len(X):
-        raise InputError(f"anfis: inputs {X.shape}, targets {t.shape}, FIS for {init.centers.shape[1]} inputs")
+        raise InputError(
+            f"anfis: inputs {X.shape}, targets {t.shape}, FIS for {init.centers.shape[1]} inputs"
+        )
     c, s = init.centers.copy(), init.sigmas.copy()
     ss = options.initial_step
     trn, chk, steps = [], [], []
@@ -130,10 +133,11 @@ def anfis(X, t, init: SugenoFIS, options: AnfisOptions = AnfisOptions(), check=N
         if trn[-1] <= options.error_goal:
             break
         gc, gs = premise_gradient(fis, X, t)
-        norm = np.sqrt(np.sum(gc ** 2) + np.sum(gs ** 2))
+        norm = np.sqrt(np.sum(gc**2) + np.sum(gs**2))
         if norm > 0:
             c = c - ss * gc / norm
             s = np.maximum(s - ss * gs / norm, 1e-12)
         ss = update_step(trn, ss, options.step_increase, options.step_decrease)
-    return AnfisResult(best, np.array(trn), np.array(chk) if check is not None else None,
-                       np.array(steps), best_k)
+    return AnfisResult(
+        best, np.array(trn), np.array(chk) if check is not None else None, np.array(steps), best_k
+    )

@@ -1,4 +1,5 @@
 """Array helpers shared by the methods (one place for input checks every estimator needs)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -18,8 +19,10 @@ def as_2d(values, name: str) -> np.ndarray:
     if v.ndim == 1:
         v = v[:, None]
     if v.ndim != 2 or v.shape[0] == 0 or v.shape[1] == 0:
-        raise InputError(f"{name}: need a non-empty 1-D or 2-D array (samples along axis 0), "
-                         f"got shape {np.shape(values)}")
+        raise InputError(
+            f"{name}: need a non-empty 1-D or 2-D array (samples along axis 0), "
+            f"got shape {np.shape(values)}"
+        )
     bad = np.argwhere(~np.isfinite(v))
     if bad.size:
         r, c = bad[0]

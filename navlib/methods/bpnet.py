@@ -24,6 +24,7 @@ Trainers (each trains several runs at once, one generator per run, :mod:`navlib.
 - :func:`train_least_squares`: scipy's MINPACK LM (or TRF with fewer readings than weights) to
   convergence from U(-1, 1) weights (the ``bp_scipy_lm`` extra of :mod:`navlib.studies.compass.turntable`).
 """
+
 from __future__ import annotations
 
 import time
@@ -40,7 +41,7 @@ from .jit import LM_STOPS, hidden_accept, lm_1m1, logsig_sse, logsig_sse_keep, l
 from .lm import LMParams, LMResult, dividerand, levenberg_marquardt
 from .scaling import MinMax
 
-torch = require("torch", __name__)      # the [nets] extra
+torch = require("torch", __name__)  # the [nets] extra
 from torch.optim.adam import adam as adam_step  # noqa: E402
 
 Activation = Literal["logsig", "tansig"]
@@ -56,11 +57,16 @@ def n_params(n_hidden: int) -> int:
 def unpack(theta: np.ndarray, n_hidden: int):
     """Split ``(..., 3M+1)`` parameter arrays into ``w, b, v, c``."""
     m = n_hidden
-    return theta[..., :m], theta[..., m:2 * m], theta[..., 2 * m:3 * m], theta[..., 3 * m]
+    return theta[..., :m], theta[..., m : 2 * m], theta[..., 2 * m : 3 * m], theta[..., 3 * m]
 
 
-def forward_population(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, dtype=np.float64,
-                       activation: Activation = "logsig") -> np.ndarray:
+def forward_population(
+    thetas: np.ndarray,
+    xn: np.ndarray,
+    n_hidden: int,
+    dtype=np.float64,
+    activation: Activation = "logsig",
+) -> np.ndarray:
     """Normalised outputs of many networks at once: ``thetas (P, D)``, ``xn (N,)`` -> ``(P, N)`` (float64).
 
     ``logsig`` is computed as ``(1 + tanh(z/2))/2`` (overflow-free) with the hidden layer laid out
@@ -77,13 +83,15 @@ def forward_population(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, dtype=
     return out
 
 
-def output_jacobian(thetas: np.ndarray, xn: np.ndarray, n_hidden: int, activation: Activation = "logsig"):
+def output_jacobian(
+    thetas: np.ndarray, xn: np.ndarray, n_hidden: int, activation: Activation = "logsig"
+):
     """``(o', do'/dtheta)`` of many networks: shapes ``(P, N)`` and ``(P, N, D)`` (float64).
 
     ``do'/dw_j = v_j g'(z_j) x'``, ``do'/db_j = v_j g'(z_j)``, ``do'/dv_j = g(z_j)``, ``do'/dc = 1``, with
     ``g' = g (1 - g)`` for logsig and ``1 - g^2`` for tansig."""
     w, b, v, c = unpack(np.atleast_2d(thetas), n_hidden)
-    z = w[:, None, :] * xn[None, :, None] + b[:, None, :]                         # (P, N, M)
+    z = w[:, None, :] * xn[None, :, None] + b[:, None, :]  # (P, N, M)
     if activation == "logsig":
         g = 0.5 * (1.0 + np.tanh(0.5 * z))
         dg = g * (1.0 - g)
@@ -106,14 +114,17 @@ class BPNet:
     t_scale: MinMax
     method: str = ""
     train_time_s: float = 0.0
-    history: np.ndarray = field(default=None, repr=False)   # training loss per epoch / generation
+    history: np.ndarray = field(default=None, repr=False)  # training loss per epoch / generation
     info: dict = field(default_factory=dict)
     activation: Activation = "logsig"
 
     def predict(self, x) -> np.ndarray:
         xn = self.x_scale.transform(np.asarray(x, dtype=float))
-        return self.t_scale.inverse(forward_population(self.theta[None, :], xn, self.n_hidden,
-                                                       activation=self.activation)[0])
+        return self.t_scale.inverse(
+            forward_population(self.theta[None, :], xn, self.n_hidden, activation=self.activation)[
+                0
+            ]
+        )
 
 
 class LogsigSSE:
@@ -128,8 +139,14 @@ class LogsigSSE:
         self._hidden = self._trial_hidden = self._changed = None
 
     def __call__(self, thetas: np.ndarray) -> np.ndarray:
-        return logsig_sse(np.ascontiguousarray(np.atleast_2d(thetas), dtype=float), self.xn, self.t, self.lo,
-                          self.span, self.m)
+        return logsig_sse(
+            np.ascontiguousarray(np.atleast_2d(thetas), dtype=float),
+            self.xn,
+            self.t,
+            self.lo,
+            self.span,
+            self.m,
+        )
 
     def start(self, pop: np.ndarray) -> np.ndarray:
         """Fitness of a population ``(K, 3M+1)``, keeping its hidden layers."""
@@ -142,13 +159,24 @@ class LogsigSSE:
     def trials(self, trial: np.ndarray, pop: np.ndarray) -> np.ndarray:
         """Fitness of trial ``k`` made from individual ``k`` of the population last passed to ``start`` (as
         updated by ``accept`` and ``keep``); ``pop`` is that population."""
-        return logsig_sse_trials(np.ascontiguousarray(trial, dtype=float), np.ascontiguousarray(pop, dtype=float),
-                                 self._hidden, self.xn, self.t, self.lo, self.span, self.m, self._trial_hidden,
-                                 self._changed)
+        return logsig_sse_trials(
+            np.ascontiguousarray(trial, dtype=float),
+            np.ascontiguousarray(pop, dtype=float),
+            self._hidden,
+            self.xn,
+            self.t,
+            self.lo,
+            self.span,
+            self.m,
+            self._trial_hidden,
+            self._changed,
+        )
 
     def accept(self, accepted: np.ndarray) -> None:
         """Trials ``accepted (K,)`` replaced their parents."""
-        hidden_accept(self._hidden, self._trial_hidden, self._changed, np.asarray(accepted, dtype=np.bool_))
+        hidden_accept(
+            self._hidden, self._trial_hidden, self._changed, np.asarray(accepted, dtype=np.bool_)
+        )
 
     def keep(self, rows: np.ndarray) -> None:
         """Only the individuals ``rows (K,)`` (bool) stay in the population."""
@@ -174,16 +202,16 @@ def sse_objective(x, t, n_hidden: int, dtype=np.float32):
     m, n = int(n_hidden), len(xn)
     if dtype == np.float32:
         return LogsigSSE(xn, t, lo, span, m), xs, ts
-    X = 0.5 * np.stack([xn, np.ones_like(xn)])                            # sigmoid(z) = (1 + tanh(z/2))/2
+    X = 0.5 * np.stack([xn, np.ones_like(xn)])  # sigmoid(z) = (1 + tanh(z/2))/2
 
     def objective(thetas: np.ndarray) -> np.ndarray:
         thetas = np.atleast_2d(thetas)
         p = thetas.shape[0]
-        wb = np.stack([thetas[:, :m], thetas[:, m:2 * m]], axis=2)
+        wb = np.stack([thetas[:, :m], thetas[:, m : 2 * m]], axis=2)
         z = np.tanh(wb.reshape(p * m, 2) @ X)
-        hv = (0.5 * span) * thetas[:, 2 * m:3 * m]
+        hv = (0.5 * span) * thetas[:, 2 * m : 3 * m]
         o = np.matmul(hv[:, None, :], z.reshape(p, m, n))[:, 0, :]
-        o += (lo + span * (0.5 * thetas[:, 2 * m:3 * m].sum(axis=1) + thetas[:, 3 * m]))[:, None]
+        o += (lo + span * (0.5 * thetas[:, 2 * m : 3 * m].sum(axis=1) + thetas[:, 3 * m]))[:, None]
         o -= t
         return np.einsum("pn,pn->p", o, o)
 
@@ -194,15 +222,21 @@ def _check_xy(x, t, n_hidden):
     check_param("n_hidden", n_hidden, lo=1, integer=True)
     x, t = np.asarray(x, dtype=float), np.asarray(t, dtype=float)
     if x.ndim != 1 or x.shape != t.shape:
-        raise InputError(f"network input and target must be 1-D and of equal length, got {x.shape}, {t.shape}")
+        raise InputError(
+            f"network input and target must be 1-D and of equal length, got {x.shape}, {t.shape}"
+        )
     if len(x) < 2:
         raise InputError("a network needs at least 2 training points")
     return x, t
 
 
 # ------------------------------------------------------------------------------------------ initialisation
-def nguyen_widrow(n_hidden: int, rng: np.random.Generator, n_inputs: int = 1,
-                  active: tuple[float, float] = TANSIG_ACTIVE) -> tuple[np.ndarray, np.ndarray]:
+def nguyen_widrow(
+    n_hidden: int,
+    rng: np.random.Generator,
+    n_inputs: int = 1,
+    active: tuple[float, float] = TANSIG_ACTIVE,
+) -> tuple[np.ndarray, np.ndarray]:
     """MATLAB's ``initnw`` for a hidden layer whose inputs lie in [-1, 1] (after ``mapminmax``).
 
     Weight magnitude ``0.7 H^(1/n)`` along a random unit direction per unit, biases
@@ -215,7 +249,11 @@ def nguyen_widrow(n_hidden: int, rng: np.random.Generator, n_inputs: int = 1,
     mag = 0.7 * n_hidden ** (1.0 / n_inputs)
     d = rng.standard_normal((n_hidden, n_inputs))
     w = mag * d / np.linalg.norm(d, axis=1, keepdims=True)
-    b = np.zeros(n_hidden) if n_hidden == 1 else mag * np.linspace(-1, 1, n_hidden) * np.sign(w[:, 0])
+    b = (
+        np.zeros(n_hidden)
+        if n_hidden == 1
+        else mag * np.linspace(-1, 1, n_hidden) * np.sign(w[:, 0])
+    )
     half, mid = 0.5 * (active[1] - active[0]), 0.5 * (active[1] + active[0])
     return half * w, half * b + mid
 
@@ -252,7 +290,9 @@ def _rngs(rngs) -> list:
     return rngs
 
 
-def _adam_trajectories(theta0: np.ndarray, xn: np.ndarray, tn: np.ndarray, n_hidden: int, params: AdamParams):
+def _adam_trajectories(
+    theta0: np.ndarray, xn: np.ndarray, tn: np.ndarray, n_hidden: int, params: AdamParams
+):
     """Full-batch Adam on the normalised MSE of ``P`` logsig nets at once (:func:`train_adam_many`).
 
     The gradient is written out with torch operations, without an autograd graph (an epoch of the
@@ -278,21 +318,39 @@ def _adam_trajectories(theta0: np.ndarray, xn: np.ndarray, tn: np.ndarray, n_hid
         step = torch.zeros((), dtype=torch.float32)
         X = torch.tensor(xn, dtype=torch.float64)
         T = torch.tensor(tn, dtype=torch.float64)
-        w, b = th[:, :m, None], th[:, m:2 * m, None]                       # (P, M, 1)
-        v, c = th[:, None, 2 * m:3 * m], th[:, 3 * m:, None]               # (P, 1, M), (P, 1, 1)
+        w, b = th[:, :m, None], th[:, m : 2 * m, None]  # (P, M, 1)
+        v, c = th[:, None, 2 * m : 3 * m], th[:, 3 * m :, None]  # (P, 1, M), (P, 1, 1)
         xr, scale = X[None, None, :], 2.0 / n
-        sigmoid_backward = torch.ops.aten.sigmoid_backward                  # dy * y (1 - y), as autograd
-        history = torch.empty((params.epochs, th.shape[0], 1), dtype=torch.float64)   # rows contiguous
+        sigmoid_backward = torch.ops.aten.sigmoid_backward  # dy * y (1 - y), as autograd
+        history = torch.empty(
+            (params.epochs, th.shape[0], 1), dtype=torch.float64
+        )  # rows contiguous
         with torch.no_grad():
             for k in range(params.epochs):
-                h = torch.addcmul(b, w, xr).sigmoid_()                        # (P, M, N)
-                e = torch.baddbmm(c, v, h).sub_(T)                            # o' - t', (P, 1, N)
+                h = torch.addcmul(b, w, xr).sigmoid_()  # (P, M, N)
+                e = torch.baddbmm(c, v, h).sub_(T)  # o' - t', (P, 1, N)
                 torch.mean(e * e, dim=2, out=history[k])
                 g = e.mul_(scale)
-                dz = sigmoid_backward(v.transpose(1, 2) * g, h)               # dL/dz, (P, M, N)
-                torch.cat([dz @ X, dz.sum(dim=2), (h * g).sum(dim=2), g.sum(dim=2)], dim=1, out=grad)
-                adam_step([th], [grad], [exp_avg], [exp_avg_sq], [], [step], fused=True, amsgrad=False,
-                          beta1=0.9, beta2=0.999, lr=params.lr, weight_decay=0.0, eps=1e-8, maximize=False)
+                dz = sigmoid_backward(v.transpose(1, 2) * g, h)  # dL/dz, (P, M, N)
+                torch.cat(
+                    [dz @ X, dz.sum(dim=2), (h * g).sum(dim=2), g.sum(dim=2)], dim=1, out=grad
+                )
+                adam_step(
+                    [th],
+                    [grad],
+                    [exp_avg],
+                    [exp_avg_sq],
+                    [],
+                    [step],
+                    fused=True,
+                    amsgrad=False,
+                    beta1=0.9,
+                    beta2=0.999,
+                    lr=params.lr,
+                    weight_decay=0.0,
+                    eps=1e-8,
+                    maximize=False,
+                )
         return th.numpy().copy(), history[:, :, 0].T.numpy().copy()
     finally:
         torch.set_num_threads(threads)
@@ -309,15 +367,21 @@ def train_adam_many(x, t, n_hidden: int, params: AdamParams, rngs) -> list[BPNet
     rngs = _rngs(rngs)
     xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
     xn, tn = xs.transform(x), ts.transform(t)
-    theta0 = np.stack([g.uniform(-params.init_bound, params.init_bound, n_params(n_hidden)) for g in rngs])
+    theta0 = np.stack(
+        [g.uniform(-params.init_bound, params.init_bound, n_params(n_hidden)) for g in rngs]
+    )
     t0 = time.perf_counter()
     theta, history = _adam_trajectories(theta0, xn, tn, n_hidden, params)
     per_net = (time.perf_counter() - t0) / len(rngs)
-    return [BPNet(theta[i], n_hidden, xs, ts, "BP (Adam)", per_net, history[i]) for i in range(len(rngs))]
+    return [
+        BPNet(theta[i], n_hidden, xs, ts, "BP (Adam)", per_net, history[i])
+        for i in range(len(rngs))
+    ]
 
 
-def train_least_squares(x, t, n_hidden: int, rng: np.random.Generator, max_nfev: int = 3000,
-                        init_bound: float = 1.0) -> BPNet:
+def train_least_squares(
+    x, t, n_hidden: int, rng: np.random.Generator, max_nfev: int = 3000, init_bound: float = 1.0
+) -> BPNet:
     """Paper A's net fitted to convergence by scipy ``least_squares`` on the normalised residuals from
     U(-init_bound, init_bound) weights: MINPACK's Levenberg-Marquardt, or trust-region reflective when
     there are fewer readings than weights (MINPACK's LM cannot run then)."""
@@ -328,11 +392,17 @@ def train_least_squares(x, t, n_hidden: int, rng: np.random.Generator, max_nfev:
     theta0 = rng.uniform(-init_bound, init_bound, n_params(n_hidden))
     t0 = time.perf_counter()
     solver = "lm" if len(xn) >= n_params(n_hidden) else "trf"
-    sol = least_squares(lambda th: output_jacobian(th[None], xn, n_hidden)[0][0] - tn, theta0,
-                        jac=lambda th: output_jacobian(th[None], xn, n_hidden)[1][0], method=solver,
-                        max_nfev=max_nfev)
+    sol = least_squares(
+        lambda th: output_jacobian(th[None], xn, n_hidden)[0][0] - tn,
+        theta0,
+        jac=lambda th: output_jacobian(th[None], xn, n_hidden)[1][0],
+        method=solver,
+        max_nfev=max_nfev,
+    )
     name = "BP (LM)" if solver == "lm" else "BP (TRF)"
-    return BPNet(sol.x, n_hidden, xs, ts, name, time.perf_counter() - t0, np.array([2 * sol.cost / len(x)]))
+    return BPNet(
+        sol.x, n_hidden, xs, ts, name, time.perf_counter() - t0, np.array([2 * sol.cost / len(x)])
+    )
 
 
 def _lm_functions(x, t, n_hidden, xs: MinMax, ts: MinMax, activation: Activation):
@@ -342,7 +412,9 @@ def _lm_functions(x, t, n_hidden, xs: MinMax, ts: MinMax, activation: Activation
     gain, lo, out_lo = float(ts.gain[0]), float(ts.lo[0]), ts.out_lo
 
     def residuals(th):
-        return lo + (forward_population(th, xn, n_hidden, activation=activation) - out_lo) * gain - t
+        return (
+            lo + (forward_population(th, xn, n_hidden, activation=activation) - out_lo) * gain - t
+        )
 
     def jacobian(th):
         return gain * output_jacobian(th, xn, n_hidden, activation)[1]
@@ -350,9 +422,19 @@ def _lm_functions(x, t, n_hidden, xs: MinMax, ts: MinMax, activation: Activation
     return residuals, jacobian
 
 
-def train_lm_many(x, t, n_hidden: int, theta0: np.ndarray, xs: MinMax, ts: MinMax,
-                  activation: Activation = "logsig", lm: LMParams = LMParams(), splits=None,
-                  method: str = "BP (trainlm)", compiled: bool = True) -> list[BPNet]:
+def train_lm_many(
+    x,
+    t,
+    n_hidden: int,
+    theta0: np.ndarray,
+    xs: MinMax,
+    ts: MinMax,
+    activation: Activation = "logsig",
+    lm: LMParams = LMParams(),
+    splits=None,
+    method: str = "BP (trainlm)",
+    compiled: bool = True,
+) -> list[BPNet]:
     """``trainlm`` from ``theta0 (S, D)`` for S nets.  ``splits``: None (every reading trains, no validation
     stop) or one ``(train, val, test)`` index triple per net (MATLAB's ``dividerand``; the test part is
     held out and unused).
@@ -378,27 +460,64 @@ def train_lm_many(x, t, n_hidden: int, theta0: np.ndarray, xs: MinMax, ts: MinMa
         wt = np.ones((n_nets, n)) if tr_mask is None else tr_mask.astype(float)
         wv = np.zeros((n_nets, n)) if val_mask is None else val_mask.astype(float)
         th, ep, codes, perf, vperf, best = lm_1m1(
-            theta0, np.ascontiguousarray(xs.transform(x)), t, int(n_hidden), activation == "tansig",
-            float(ts.lo[0]), float(ts.out_lo), float(ts.gain[0]), wt, wv, val_mask is not None, int(lm.epochs),
-            float(lm.goal), float(lm.mu), float(lm.mu_dec), float(lm.mu_inc), float(lm.mu_max),
-            float(lm.min_grad), int(lm.max_fail))
-        res = LMResult(theta=th, epochs=ep, stop=[LM_STOPS[c] for c in codes], perf=perf, val_perf=vperf,
-                       best_epoch=best)
+            theta0,
+            np.ascontiguousarray(xs.transform(x)),
+            t,
+            int(n_hidden),
+            activation == "tansig",
+            float(ts.lo[0]),
+            float(ts.out_lo),
+            float(ts.gain[0]),
+            wt,
+            wv,
+            val_mask is not None,
+            int(lm.epochs),
+            float(lm.goal),
+            float(lm.mu),
+            float(lm.mu_dec),
+            float(lm.mu_inc),
+            float(lm.mu_max),
+            float(lm.min_grad),
+            int(lm.max_fail),
+        )
+        res = LMResult(
+            theta=th,
+            epochs=ep,
+            stop=[LM_STOPS[c] for c in codes],
+            perf=perf,
+            val_perf=vperf,
+            best_epoch=best,
+        )
     else:
         res = levenberg_marquardt(res_fn, jac_fn, theta0, lm, tr_mask, val_mask)
     per_net = (time.perf_counter() - t0) / theta0.shape[0]
     nets = []
     for i in range(theta0.shape[0]):
         h = res.perf[i]
-        nets.append(BPNet(res.theta[i].copy(), n_hidden, xs, ts, method, per_net, h[np.isfinite(h)],
-                          {"epochs": int(res.epochs[i]), "stop": res.stop[i],
-                           "best_epoch": int(res.best_epoch[i]),
-                           "val_history": res.val_perf[i][np.isfinite(res.val_perf[i])]}, activation))
+        nets.append(
+            BPNet(
+                res.theta[i].copy(),
+                n_hidden,
+                xs,
+                ts,
+                method,
+                per_net,
+                h[np.isfinite(h)],
+                {
+                    "epochs": int(res.epochs[i]),
+                    "stop": res.stop[i],
+                    "best_epoch": int(res.best_epoch[i]),
+                    "val_history": res.val_perf[i][np.isfinite(res.val_perf[i])],
+                },
+                activation,
+            )
+        )
     return nets
 
 
-def train_matlab_bp_many(x, t, n_hidden: int, rngs, lm: LMParams = LMParams(),
-                         validation: bool = False) -> list[BPNet]:
+def train_matlab_bp_many(
+    x, t, n_hidden: int, rngs, lm: LMParams = LMParams(), validation: bool = False
+) -> list[BPNet]:
     """MATLAB's default BP net, one per generator: ``feedforwardnet(n_hidden)`` (tansig hidden, purelin
     output, ``mapminmax`` of input and target onto [-1, 1] computed on all readings, Nguyen-Widrow
     initialisation) trained by ``trainlm``; with ``validation`` the readings are split by ``dividerand``
@@ -406,14 +525,19 @@ def train_matlab_bp_many(x, t, n_hidden: int, rngs, lm: LMParams = LMParams(),
     reading trains.  Each generator draws the initial weights, then the split."""
     x, t = _check_xy(x, t, n_hidden)
     rngs = _rngs(rngs)
-    xs, ts = MinMax.fit(x, name="network input", out=(-1, 1)), MinMax.fit(t, name="network target", out=(-1, 1))
+    xs, ts = (
+        MinMax.fit(x, name="network input", out=(-1, 1)),
+        MinMax.fit(t, name="network target", out=(-1, 1)),
+    )
     theta0 = np.stack([matlab_initial_weights(n_hidden, g) for g in rngs])
     splits = [dividerand(len(x), g) for g in rngs] if validation else None
     label = "BP MATLAB (trainlm" + (", val. stop)" if validation else ")")
     return train_lm_many(x, t, n_hidden, theta0, xs, ts, "tansig", lm, splits, label)
 
 
-def train_de_many(x, t, n_hidden: int, params: DEParams, rngs) -> tuple[list[BPNet], list[DEResult]]:
+def train_de_many(
+    x, t, n_hidden: int, params: DEParams, rngs
+) -> tuple[list[BPNet], list[DEResult]]:
     """DE-BP / ADE-BP (paper A, first reading): every weight and threshold of paper A's net evolved by
     :func:`navlib.methods.de.evolve_many` on the fitness :func:`sse_objective`, one run per generator,
     all runs' populations in one array per generation.  ``info['fitness']`` is re-scored in float64."""
@@ -423,8 +547,19 @@ def train_de_many(x, t, n_hidden: int, params: DEParams, rngs) -> tuple[list[BPN
     results = evolve_many(objective, n_params(n_hidden), params, rngs)
     exact, _, _ = sse_objective(x, t, n_hidden, np.float64)
     name = "ADE-BP" if params.adaptive else "DE-BP"
-    nets = [BPNet(r.x, n_hidden, xs, ts, name, r.elapsed_s / len(rngs), r.history,
-                  {"generations": r.generations, "fitness": float(exact(r.x[None, :])[0])}) for r in results]
+    nets = [
+        BPNet(
+            r.x,
+            n_hidden,
+            xs,
+            ts,
+            name,
+            r.elapsed_s / len(rngs),
+            r.history,
+            {"generations": r.generations, "fitness": float(exact(r.x[None, :])[0])},
+        )
+        for r in results
+    ]
     return nets, results
 
 
@@ -432,9 +567,16 @@ def train_de_many(x, t, n_hidden: int, params: DEParams, rngs) -> tuple[list[BPN
 FAMILY_VARIANTS = ("pure", "trainlm", "trainlm_val")
 
 
-def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
-                    variants=FAMILY_VARIANTS, target: Literal["deg2", "normalised"] = "deg2"
-                    ) -> dict[str, list[BPNet]]:
+def train_de_family(
+    x,
+    t,
+    n_hidden: int,
+    params: DEParams,
+    rngs,
+    lm: LMParams = LMParams(),
+    variants=FAMILY_VARIANTS,
+    target: Literal["deg2", "normalised"] = "deg2",
+) -> dict[str, list[BPNet]]:
     """One DE / ADE stage run to its own stop (``target='deg2'``: the paper's target read in deg^2, in
     practice the full ``max_generations``; ``'normalised'``: read as :func:`train_hybrid_many` reads it,
     reached early), and from it every training in ``variants``:
@@ -465,9 +607,18 @@ def train_de_family(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = 
     for v in ("trainlm", "trainlm_val"):
         if v in variants:
             validation = v == "trainlm_val"
-            out[v] = _trainlm_from_stage(x, t, n_hidden, de_nets, rngs, lm, validation,
-                                         _hybrid_name(name, validation) if target == "normalised" else
-                                         name + " full DE + trainlm" + (", val. stop" if validation else ""))
+            out[v] = _trainlm_from_stage(
+                x,
+                t,
+                n_hidden,
+                de_nets,
+                rngs,
+                lm,
+                validation,
+                _hybrid_name(name, validation)
+                if target == "normalised"
+                else name + " full DE + trainlm" + (", val. stop" if validation else ""),
+            )
     return out
 
 
@@ -482,25 +633,38 @@ def _hybrid_name(name: str, validation: bool) -> str:
     return name + " hybrid (trainlm" + (", val. stop)" if validation else ")")
 
 
-def _trainlm_from_stage(x, t, n_hidden: int, de_nets: list, rngs, lm: LMParams, validation: bool,
-                        name: str) -> list[BPNet]:
+def _trainlm_from_stage(
+    x, t, n_hidden: int, de_nets: list, rngs, lm: LMParams, validation: bool, name: str
+) -> list[BPNet]:
     """``trainlm`` (:func:`train_lm_many`) from each DE stage's best individual ``de_nets``, with a
     ``dividerand`` split drawn from each run's generator if ``validation``; ``info`` keeps the stage's
     ``de_generations``, ``de_fitness``, ``de_theta``, ``de_history`` and the time includes the stage's."""
     theta0 = np.stack([n.theta for n in de_nets])
     splits = [dividerand(len(x), g) for g in rngs] if validation else None
-    nets = train_lm_many(x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm,
-                         splits, name)
+    nets = train_lm_many(
+        x, t, n_hidden, theta0, de_nets[0].x_scale, de_nets[0].t_scale, "logsig", lm, splits, name
+    )
     for net, de in zip(nets, de_nets):
-        net.info.update(de_generations=de.info["generations"], de_fitness=de.info["fitness"],
-                        de_theta=de.theta, de_history=de.history)
+        net.info.update(
+            de_generations=de.info["generations"],
+            de_fitness=de.info["fitness"],
+            de_theta=de.theta,
+            de_history=de.history,
+        )
         net.train_time_s += de.train_time_s
     return nets
 
 
-def train_hybrid_many(x, t, n_hidden: int, params: DEParams, rngs, lm: LMParams = LMParams(),
-                      validation: bool = False, target: Literal["deg2", "normalised"] = "normalised"
-                      ) -> list[BPNet]:
+def train_hybrid_many(
+    x,
+    t,
+    n_hidden: int,
+    params: DEParams,
+    rngs,
+    lm: LMParams = LMParams(),
+    validation: bool = False,
+    target: Literal["deg2", "normalised"] = "normalised",
+) -> list[BPNet]:
     """DE / ADE-initialised BP (paper A, second reading): the DE stage of :func:`train_de_many` with the
     paper's settings, then ``trainlm`` on the same net (logsig, [0, 1] scaling) from the stage's best
     individual (:func:`train_lm_many`; with ``validation`` on a ``dividerand`` 70/15/15 split drawn from

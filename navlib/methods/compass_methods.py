@@ -29,6 +29,7 @@ document B (the ELM with back-tuning); the readings and why reading 4 is the pri
 ``data/claims_paper_a.csv``.  The measured heading handed to ``fit`` and ``correct`` may be unwrapped (the
 networks need a continuous input; the explicit models are periodic and do not mind).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -37,9 +38,22 @@ from typing import Callable, Literal
 import numpy as np
 
 from ..errors import InputError, check_choice, check_param
-from .bpnet import (AdamParams, train_adam_many, train_de_family, train_de_many, train_hybrid_many,
-                    train_least_squares, train_matlab_bp_many)
-from .compensator import HeadingTarget, MethodBase, ModelCompensator, NetworkCompensator, ScaledRegressor
+from .bpnet import (
+    AdamParams,
+    train_adam_many,
+    train_de_family,
+    train_de_many,
+    train_hybrid_many,
+    train_least_squares,
+    train_matlab_bp_many,
+)
+from .compensator import (
+    HeadingTarget,
+    MethodBase,
+    ModelCompensator,
+    NetworkCompensator,
+    ScaledRegressor,
+)
 from .de import DEParams
 from .elm import ELMParams, IncrementalELMParams, fit_elm, fit_incremental_elm
 from .lm import LMParams
@@ -69,12 +83,14 @@ class MethodParams:
     lm: LMParams = LMParams()
     adam: AdamParams = AdamParams()
     network_target: Literal["heading", "error"] = "heading"
-    elm_nodes: int = 19          # plain ELM: 19 trained output weights = the 19 weights of the 1-6-1 net
-    elm_range: float = 5.0       # input weights and biases ~ U(-elm_range, elm_range) (Huang 2006: 1)
-    elm_max_nodes: int = 30      # incremental ELM: cap on the hidden-node count
-    elm_goal_deg: float = 0.1    # incremental ELM: stop when the training RMS error (deg) is <= this
-    elm_max_iter: int = 200      # incremental ELM: the patent's k (ELM and tuning stages together)
-    ls_tol_deg: float = 1e-6     # 8-position LS: the reading used for a position lies within this of it
+    elm_nodes: int = 19  # plain ELM: 19 trained output weights = the 19 weights of the 1-6-1 net
+    elm_range: float = 5.0  # input weights and biases ~ U(-elm_range, elm_range) (Huang 2006: 1)
+    elm_max_nodes: int = 30  # incremental ELM: cap on the hidden-node count
+    elm_goal_deg: float = 0.1  # incremental ELM: stop when the training RMS error (deg) is <= this
+    elm_max_iter: int = 200  # incremental ELM: the patent's k (ELM and tuning stages together)
+    ls_tol_deg: float = (
+        1e-6  # 8-position LS: the reading used for a position lies within this of it
+    )
 
     def __post_init__(self):
         check_param("n_hidden", self.n_hidden, lo=1, integer=True)
@@ -96,17 +112,20 @@ class MethodParams:
         return HeadingTarget(self.network_target)
 
     def elm_params(self) -> ELMParams:
-        return ELMParams(n_hidden=self.elm_nodes, weight_range=self.elm_range, bias_range=self.elm_range)
+        return ELMParams(
+            n_hidden=self.elm_nodes, weight_range=self.elm_range, bias_range=self.elm_range
+        )
 
     def incremental_params(self, target_span_deg: float) -> IncrementalELMParams:
         """The incremental ELM's settings; the goal in degrees becomes a normalised MSE through the span of
         the training target (360 deg for the heading, about 47 deg for the error of the default compass)."""
-        return IncrementalELMParams(max_nodes=self.elm_max_nodes,
-                                    loss_goal=(self.elm_goal_deg / float(target_span_deg)) ** 2,
-                                    max_iter=self.elm_max_iter, weight_range=self.elm_range,
-                                    bias_range=self.elm_range)
-
-
+        return IncrementalELMParams(
+            max_nodes=self.elm_max_nodes,
+            loss_goal=(self.elm_goal_deg / float(target_span_deg)) ** 2,
+            max_iter=self.elm_max_iter,
+            weight_range=self.elm_range,
+            bias_range=self.elm_range,
+        )
 
 
 # ----------------------------------------------------------------------------------------------- methods
@@ -143,8 +162,9 @@ class EightPosition(MethodBase):
         idx = eight_position_indices(t, self.step_deg, self.tol_deg)
         if self.model == "planar":
             return ModelCompensator(fit_planar_model(t[idx], np.mod(m[idx], 360.0)))
-        return ModelCompensator(fit_smith(np.mod(m[idx], 360.0), t[idx], 3 if self.model == "harmonic3" else 2))
-
+        return ModelCompensator(
+            fit_smith(np.mod(m[idx], 360.0), t[idx], 3 if self.model == "harmonic3" else 2)
+        )
 
 
 class PlanarFit(MethodBase):
@@ -172,6 +192,7 @@ def elm_trainer(params: MethodParams, back_tuned: bool):
     """Plain ELM or the patent's back-tuned incremental ELM on min-max normalised data; ``info`` has
     ``n_nodes`` and, for the back-tuned ELM, the stage ``history`` of
     :func:`navlib.methods.elm.fit_incremental_elm`."""
+
     def train(x, t, rngs):
         out = []
         for g in rngs:
@@ -183,12 +204,15 @@ def elm_trainer(params: MethodParams, back_tuned: bool):
                     model, info["history"] = fit_incremental_elm(xn, tn, goal, rng=g)
                     return model
             else:
+
                 def fit(xn, tn):
                     return fit_elm(xn, tn, params.elm_params(), rng=g)
+
             reg = ScaledRegressor.fit(x, t, fit)
             reg.info = dict(info, n_nodes=reg.n_hidden)
             out.append(reg)
         return out
+
     return train
 
 
@@ -215,10 +239,12 @@ def _reading2_stage(family_key: tuple) -> bool:
 #: ADE's default rules (:class:`navlib.methods.de.DEParams`): F by generation, CR by value.
 ADE_DEFAULT_RULES = ("generation", "value")
 #: The other readings of ADE's rules in section 1.2, as (f_rule, cr_rule, id suffix, label part).
-ADE_RULE_READINGS = (("individual", "value", "f_ind", "F per individual"),
-                     ("combined", "value", "f_comb", "F combined"),
-                     ("generation", "rank", "cr_rank", "CR by rank"),
-                     ("individual", "rank", "f_ind_cr_rank", "F per individual, CR by rank"))
+ADE_RULE_READINGS = (
+    ("individual", "value", "f_ind", "F per individual"),
+    ("combined", "value", "f_comb", "F combined"),
+    ("generation", "rank", "cr_rank", "CR by rank"),
+    ("individual", "rank", "f_ind_cr_rank", "F per individual, CR by rank"),
+)
 
 
 def _de(p: MethodParams, adaptive: bool, rules=ADE_DEFAULT_RULES) -> DEParams:
@@ -229,32 +255,45 @@ def _pure(adaptive, rules=ADE_DEFAULT_RULES):
     def make(p):
         d = _de(p, adaptive, rules)
         if p.pure_target == "normalised":
-            return NetworkMethod(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g,
-                                                                   replace(p.lm, epochs=0)), p.target)
+            return NetworkMethod(
+                lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, replace(p.lm, epochs=0)),
+                p.target,
+            )
         return NetworkMethod(lambda x, t, g: train_de_many(x, t, p.n_hidden, d, g)[0], p.target)
+
     return make
 
 
 def _hybrid(adaptive, validation):
     def make(p):
         d = _de(p, adaptive)
-        return NetworkMethod(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation,
-                                                               p.hybrid_target), p.target)
+        return NetworkMethod(
+            lambda x, t, g: train_hybrid_many(
+                x, t, p.n_hidden, d, g, p.lm, validation, p.hybrid_target
+            ),
+            p.target,
+        )
+
     return make
 
 
 def _full(adaptive, validation, rules=ADE_DEFAULT_RULES):
     """The full DE stage (the paper's target read in deg^2, so all ``max_generations``), then trainlm."""
+
     def make(p):
         d = _de(p, adaptive, rules)
-        return NetworkMethod(lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation,
-                                                               "deg2"), p.target)
+        return NetworkMethod(
+            lambda x, t, g: train_hybrid_many(x, t, p.n_hidden, d, g, p.lm, validation, "deg2"),
+            p.target,
+        )
+
     return make
 
 
 def _matlab(validation):
-    return lambda p: NetworkMethod(lambda x, t, g: train_matlab_bp_many(x, t, p.n_hidden, g, p.lm, validation),
-                                   p.target)
+    return lambda p: NetworkMethod(
+        lambda x, t, g: train_matlab_bp_many(x, t, p.n_hidden, g, p.lm, validation), p.target
+    )
 
 
 R1, R2, R2V = "1: pure DE", "2: DE + trainlm", "2: DE + trainlm, val. stop"
@@ -277,51 +316,127 @@ def rule_reading(base: str, label: str) -> str:
 #: its reading and its DE family (:class:`MethodSpec`).
 METHODS: dict[str, MethodSpec] = {
     "uncompensated": MethodSpec("uncompensated", lambda p: Uncompensated(), False, "uncompensated"),
-    "ls8": MethodSpec("LS 8-position (Smith, 5 terms)", _eight("smith"), False,
-                      "8-position least squares"),
-    "ls8_planar": MethodSpec("LS 8-position (planar, 5 par.)", _eight("planar"), False,
-                             "8-position least squares"),
-    "ls8_h3": MethodSpec("LS 8-position (harmonic, 3rd order)", _eight("harmonic3"), False,
-                         "8-position least squares"),
+    "ls8": MethodSpec(
+        "LS 8-position (Smith, 5 terms)", _eight("smith"), False, "8-position least squares"
+    ),
+    "ls8_planar": MethodSpec(
+        "LS 8-position (planar, 5 par.)", _eight("planar"), False, "8-position least squares"
+    ),
+    "ls8_h3": MethodSpec(
+        "LS 8-position (harmonic, 3rd order)",
+        _eight("harmonic3"),
+        False,
+        "8-position least squares",
+    ),
     "physical": MethodSpec("physical model", lambda p: PlanarFit(), False),
     "bp_matlab": MethodSpec("BP MATLAB (trainlm)", _matlab(False), True, "BP network", R3),
-    "bp_matlab_val": MethodSpec("BP MATLAB (trainlm, val. stop)", _matlab(True), True, "BP network", R3V),
-    "bp_adam": MethodSpec("BP (Adam)", lambda p: NetworkMethod(
-        lambda x, t, g: train_adam_many(x, t, p.n_hidden, p.adam, g), p.target), True, "BP network", RA),
-    "bp_scipy_lm": MethodSpec("BP (scipy LM)", lambda p: NetworkMethod(
-        lambda x, t, g: [train_least_squares(x, t, p.n_hidden, r) for r in g], p.target), True),
+    "bp_matlab_val": MethodSpec(
+        "BP MATLAB (trainlm, val. stop)", _matlab(True), True, "BP network", R3V
+    ),
+    "bp_adam": MethodSpec(
+        "BP (Adam)",
+        lambda p: NetworkMethod(
+            lambda x, t, g: train_adam_many(x, t, p.n_hidden, p.adam, g), p.target
+        ),
+        True,
+        "BP network",
+        RA,
+    ),
+    "bp_scipy_lm": MethodSpec(
+        "BP (scipy LM)",
+        lambda p: NetworkMethod(
+            lambda x, t, g: [train_least_squares(x, t, p.n_hidden, r) for r in g], p.target
+        ),
+        True,
+    ),
     "de_bp_pure": MethodSpec("DE-BP pure", _pure(False), True, "DE-BP", R1, (_DE0, "pure")),
     "ade_bp_pure": MethodSpec("ADE-BP pure", _pure(True), True, "ADE-BP", R1, (_ADE0, "pure")),
-    "de_bp_hybrid_trainlm": MethodSpec("DE-BP hybrid (trainlm)", _hybrid(False, False), True, "DE-BP", R2,
-                                       (_DE0 + ("hybrid",), "trainlm")),
-    "ade_bp_hybrid_trainlm": MethodSpec("ADE-BP hybrid (trainlm)", _hybrid(True, False), True, "ADE-BP", R2,
-                                        (_ADE0 + ("hybrid",), "trainlm")),
-    "de_bp_hybrid_trainlm_val": MethodSpec("DE-BP hybrid (trainlm, val. stop)", _hybrid(False, True), True,
-                                           "DE-BP", R2V, (_DE0 + ("hybrid",), "trainlm_val")),
-    "ade_bp_hybrid_trainlm_val": MethodSpec("ADE-BP hybrid (trainlm, val. stop)", _hybrid(True, True), True,
-                                            "ADE-BP", R2V, (_ADE0 + ("hybrid",), "trainlm_val")),
-    "de_bp_full_trainlm": MethodSpec("DE-BP full DE + trainlm", _full(False, False), True, "DE-BP", R4,
-                                     (_DE0, "trainlm")),
-    "ade_bp_full_trainlm": MethodSpec("ADE-BP full DE + trainlm", _full(True, False), True, "ADE-BP", R4,
-                                      (_ADE0, "trainlm")),
-    "de_bp_full_trainlm_val": MethodSpec("DE-BP full DE + trainlm, val. stop", _full(False, True), True, "DE-BP",
-                                         R4V, (_DE0, "trainlm_val")),
-    "ade_bp_full_trainlm_val": MethodSpec("ADE-BP full DE + trainlm, val. stop", _full(True, True), True,
-                                          "ADE-BP", R4V, (_ADE0, "trainlm_val")),
-    "elm": MethodSpec("ELM", lambda p: NetworkMethod(elm_trainer(p, False), p.target), True, None, "document B"),
-    "elm_backtuned": MethodSpec("ELM back-tuned", lambda p: NetworkMethod(elm_trainer(p, True), p.target), True,
-                                None, "document B"),
+    "de_bp_hybrid_trainlm": MethodSpec(
+        "DE-BP hybrid (trainlm)",
+        _hybrid(False, False),
+        True,
+        "DE-BP",
+        R2,
+        (_DE0 + ("hybrid",), "trainlm"),
+    ),
+    "ade_bp_hybrid_trainlm": MethodSpec(
+        "ADE-BP hybrid (trainlm)",
+        _hybrid(True, False),
+        True,
+        "ADE-BP",
+        R2,
+        (_ADE0 + ("hybrid",), "trainlm"),
+    ),
+    "de_bp_hybrid_trainlm_val": MethodSpec(
+        "DE-BP hybrid (trainlm, val. stop)",
+        _hybrid(False, True),
+        True,
+        "DE-BP",
+        R2V,
+        (_DE0 + ("hybrid",), "trainlm_val"),
+    ),
+    "ade_bp_hybrid_trainlm_val": MethodSpec(
+        "ADE-BP hybrid (trainlm, val. stop)",
+        _hybrid(True, True),
+        True,
+        "ADE-BP",
+        R2V,
+        (_ADE0 + ("hybrid",), "trainlm_val"),
+    ),
+    "de_bp_full_trainlm": MethodSpec(
+        "DE-BP full DE + trainlm", _full(False, False), True, "DE-BP", R4, (_DE0, "trainlm")
+    ),
+    "ade_bp_full_trainlm": MethodSpec(
+        "ADE-BP full DE + trainlm", _full(True, False), True, "ADE-BP", R4, (_ADE0, "trainlm")
+    ),
+    "de_bp_full_trainlm_val": MethodSpec(
+        "DE-BP full DE + trainlm, val. stop",
+        _full(False, True),
+        True,
+        "DE-BP",
+        R4V,
+        (_DE0, "trainlm_val"),
+    ),
+    "ade_bp_full_trainlm_val": MethodSpec(
+        "ADE-BP full DE + trainlm, val. stop",
+        _full(True, True),
+        True,
+        "ADE-BP",
+        R4V,
+        (_ADE0, "trainlm_val"),
+    ),
+    "elm": MethodSpec(
+        "ELM", lambda p: NetworkMethod(elm_trainer(p, False), p.target), True, None, "document B"
+    ),
+    "elm_backtuned": MethodSpec(
+        "ELM back-tuned",
+        lambda p: NetworkMethod(elm_trainer(p, True), p.target),
+        True,
+        None,
+        "document B",
+    ),
 }
 #: Each reading of ADE's rules (:data:`ADE_RULE_READINGS`), in pure DE and in full DE + trainlm: the ADE-BP
 #: of that reading (DE-BP is unchanged).
 RULE_READINGS: dict[str, str] = {}
 for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
     _key = (True, _f, _c)
-    METHODS[f"ade_bp_pure_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}", _pure(True, (_f, _c)), True, "ADE-BP",
-                                                rule_reading(R1, _lab), (_key, "pure"))
-    METHODS[f"ade_bp_full_trainlm_{_sfx}"] = MethodSpec(f"ADE-BP {_lab}, full DE + trainlm",
-                                                        _full(True, False, (_f, _c)), True, "ADE-BP",
-                                                        rule_reading(R4, _lab), (_key, "trainlm"))
+    METHODS[f"ade_bp_pure_{_sfx}"] = MethodSpec(
+        f"ADE-BP {_lab}",
+        _pure(True, (_f, _c)),
+        True,
+        "ADE-BP",
+        rule_reading(R1, _lab),
+        (_key, "pure"),
+    )
+    METHODS[f"ade_bp_full_trainlm_{_sfx}"] = MethodSpec(
+        f"ADE-BP {_lab}, full DE + trainlm",
+        _full(True, False, (_f, _c)),
+        True,
+        "ADE-BP",
+        rule_reading(R4, _lab),
+        (_key, "trainlm"),
+    )
     RULE_READINGS[rule_reading(R1, _lab)] = f"ade_bp_pure_{_sfx}"
     RULE_READINGS[rule_reading(R4, _lab)] = f"ade_bp_full_trainlm_{_sfx}"
 
@@ -345,9 +460,16 @@ for _r, _ade in RULE_READINGS.items():
     READINGS[_r] = _base[:3] + (_ade,)
 
 #: The chapter's former display names, accepted by :func:`method_id` (the workbench notebook used them).
-LEGACY_NAMES = {"ADE-BP": "ade_bp_pure", "DE-BP": "de_bp_pure", "BP (Adam)": "bp_adam",
-                "BP (LM)": "bp_scipy_lm", "LS 8-position": "ls8", "physical model": "physical",
-                "ELM": "elm", "ELM back-tuned": "elm_backtuned"}
+LEGACY_NAMES = {
+    "ADE-BP": "ade_bp_pure",
+    "DE-BP": "de_bp_pure",
+    "BP (Adam)": "bp_adam",
+    "BP (LM)": "bp_scipy_lm",
+    "LS 8-position": "ls8",
+    "physical model": "physical",
+    "ELM": "elm",
+    "ELM back-tuned": "elm_backtuned",
+}
 
 
 def method_id(name: str) -> str:
@@ -364,8 +486,15 @@ def label(mid: str) -> str:
     return METHODS[method_id(mid)].label
 
 
-def fit_method(method: str, x, reference, params: MethodParams = MethodParams(), seeds=(0,), base_seed: int = 0,
-               rngs=None):
+def fit_method(
+    method: str,
+    x,
+    reference,
+    params: MethodParams = MethodParams(),
+    seeds=(0,),
+    base_seed: int = 0,
+    rngs=None,
+):
     """Fit ``method`` (an id of ``METHODS``) on measured headings ``x`` (unwrapped) and true headings,
     one run per seed (run ``k`` uses generator ``k`` of :func:`navlib.seeding.generators`), or one run per
     generator of ``rngs`` when given (a study that seeds its runs by spawn keys, :func:`navlib.seeding.sequence`).
@@ -378,8 +507,9 @@ def fit_method(method: str, x, reference, params: MethodParams = MethodParams(),
     return spec.factory(params).fit_many(x, reference, list(rngs))
 
 
-def fit_family(methods, x, reference, params: MethodParams = MethodParams(), seeds=(0,),
-               base_seed: int = 0) -> dict[str, list]:
+def fit_family(
+    methods, x, reference, params: MethodParams = MethodParams(), seeds=(0,), base_seed: int = 0
+) -> dict[str, list]:
     """Fit methods that share one DE stage (the same ``family`` key of :class:`MethodSpec`: pure DE and
     full DE + trainlm, with and without the validation stop, of one DE / ADE rule; or reading 2's DE +
     trainlm with and without the validation stop) from one stage per seed
@@ -395,20 +525,39 @@ def fit_family(methods, x, reference, params: MethodParams = MethodParams(), see
     d = replace(params.de, adaptive=adaptive, f_rule=f_rule, cr_rule=cr_rule)
     xx = np.asarray(x, dtype=float)
     tgt = params.target
-    nets = train_de_family(xx, tgt.target(xx, reference), params.n_hidden, d, generators(seeds, base_seed),
-                           params.lm, [f[1] for f in fams],
-                           params.hybrid_target if _reading2_stage(fams[0][0]) else "deg2")
-    return {m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
-            for m, f in zip(mids, fams)}
+    nets = train_de_family(
+        xx,
+        tgt.target(xx, reference),
+        params.n_hidden,
+        d,
+        generators(seeds, base_seed),
+        params.lm,
+        [f[1] for f in fams],
+        params.hybrid_target if _reading2_stage(fams[0][0]) else "deg2",
+    )
+    return {
+        m: [NetworkCompensator(n, tgt, dict(getattr(n, "info", {}))) for n in nets[f[1]]]
+        for m, f in zip(mids, fams)
+    }
 
 
 #: CPU seconds per run of each method at the chapter's defaults (measured; for ordering parallel tasks,
 #: most expensive first).  Methods not listed count as cheap; a family of methods sharing one DE stage
 #: costs the stage (``"de_stage"``) plus ``"trainlm"`` per trainlm variant.
-RUN_COST_S = {"de_bp_pure": 0.3, "ade_bp_pure": 0.3, "de_bp_hybrid_trainlm": 0.14,
-              "ade_bp_hybrid_trainlm": 0.07, "de_bp_hybrid_trainlm_val": 0.1, "ade_bp_hybrid_trainlm_val": 0.03,
-              "bp_adam": 0.05, "bp_matlab": 0.06, "bp_matlab_val": 0.02, "elm_backtuned": 0.1,
-              "de_stage": 0.3, "trainlm": 0.04}
+RUN_COST_S = {
+    "de_bp_pure": 0.3,
+    "ade_bp_pure": 0.3,
+    "de_bp_hybrid_trainlm": 0.14,
+    "ade_bp_hybrid_trainlm": 0.07,
+    "de_bp_hybrid_trainlm_val": 0.1,
+    "ade_bp_hybrid_trainlm_val": 0.03,
+    "bp_adam": 0.05,
+    "bp_matlab": 0.06,
+    "bp_matlab_val": 0.02,
+    "elm_backtuned": 0.1,
+    "de_stage": 0.3,
+    "trainlm": 0.04,
+}
 
 
 def fitting_units(params: MethodParams, methods) -> list[tuple[str, ...]]:
@@ -431,7 +580,7 @@ def fitting_units(params: MethodParams, methods) -> list[tuple[str, ...]]:
 def unit_cost(unit, params: MethodParams) -> float:
     """Estimated CPU seconds per seed of a fitting unit (:data:`RUN_COST_S`)."""
     fams = [METHODS[m].family for m in unit]
-    if len(unit) > 1 and _reading2_stage(fams[0][0]):        # reading 2's stage: the costliest member's
+    if len(unit) > 1 and _reading2_stage(fams[0][0]):  # reading 2's stage: the costliest member's
         c = max(RUN_COST_S.get(m, 0.001) for m in unit) + RUN_COST_S["trainlm"] * (len(unit) - 1)
     elif all(f is not None for f in fams) and (len(unit) > 1 or unit[0] not in RUN_COST_S):
         c = RUN_COST_S["de_stage"] + RUN_COST_S["trainlm"] * sum(f[1] != "pure" for f in fams)

@@ -16,6 +16,7 @@ The registry of the compass's concrete methods, keyed by stable ids with display
 :mod:`navlib.methods.compass_methods` (``METHODS``); the compass chapter's studies and the workbench's
 ``navlib compare`` both fit them from there.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -63,7 +64,9 @@ class HeadingTarget:
     def heading(self, measured_deg, output) -> np.ndarray:
         """Compensated heading in [0, 360) from the network output."""
         out = np.asarray(output, dtype=float)
-        return np.mod(np.asarray(measured_deg, dtype=float) + out if self.kind == "error" else out, 360.0)
+        return np.mod(
+            np.asarray(measured_deg, dtype=float) + out if self.kind == "error" else out, 360.0
+        )
 
 
 @dataclass
@@ -76,7 +79,9 @@ class ScaledRegressor:
     t_scale: MinMax
 
     @classmethod
-    def fit(cls, x, t, fit_normalised: Callable[[np.ndarray, np.ndarray], Any]) -> "ScaledRegressor":
+    def fit(
+        cls, x, t, fit_normalised: Callable[[np.ndarray, np.ndarray], Any]
+    ) -> "ScaledRegressor":
         """Fit the scalers on ``x`` and ``t``, then ``fit_normalised(x', t')`` (returns the model)."""
         xs, ts = MinMax.fit(x, name="network input"), MinMax.fit(t, name="network target")
         return cls(fit_normalised(xs.transform(x), ts.transform(t)), xs, ts)
@@ -86,7 +91,9 @@ class ScaledRegressor:
         return self.model.n_hidden
 
     def predict(self, x) -> np.ndarray:
-        return self.t_scale.inverse(self.model.predict(self.x_scale.transform(np.asarray(x, dtype=float))))
+        return self.t_scale.inverse(
+            self.model.predict(self.x_scale.transform(np.asarray(x, dtype=float)))
+        )
 
 
 @dataclass

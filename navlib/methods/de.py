@@ -54,6 +54,7 @@ seeded from the run's numpy Generator (the initial population comes from the Gen
 ``rand_ij`` are uniforms at 16-bit resolution (``k / 2^16``: a crossover probability is CR rounded up to
 the next multiple of 2^-16, within 1.6e-5 of it).
 """
+
 from __future__ import annotations
 
 import time
@@ -93,7 +94,7 @@ class DEParams:
     f_max: float = 0.9
     cr_min: float = 0.1
     cr_max: float = 0.9
-    bound: float = 10.0          # search box [-bound, bound] for every gene (initial population and trials)
+    bound: float = 10.0  # search box [-bound, bound] for every gene (initial population and trials)
     seed: int = 0
     f_rule: Literal["generation", "individual", "combined"] = "generation"
     cr_rule: Literal["value", "rank"] = "value"
@@ -137,7 +138,9 @@ def fitness_rank(fitness) -> np.ndarray:
     f = np.asarray(fitness, dtype=float)
     order = np.argsort(f, axis=-1, kind="stable")
     rank = np.empty(f.shape, dtype=float)
-    np.put_along_axis(rank, order, np.broadcast_to(np.arange(f.shape[-1], dtype=float), f.shape), axis=-1)
+    np.put_along_axis(
+        rank, order, np.broadcast_to(np.arange(f.shape[-1], dtype=float), f.shape), axis=-1
+    )
     return rank
 
 
@@ -152,7 +155,9 @@ def ade_cr(fitness, cr_min: float = 0.1, cr_max: float = 0.9, rule: str = "value
         return cr_min + (cr_max - cr_min) * fitness_rank(f) / (f.shape[-1] - 1)
     lo, hi = f.min(axis=-1, keepdims=True), f.max(axis=-1, keepdims=True)
     # the same operations, in the same order, as the former compiled rule (bit-identical numbers)
-    return np.where(hi > lo, cr_min + (cr_max - cr_min) * (f - lo) / np.where(hi > lo, hi - lo, 1.0), cr_min)
+    return np.where(
+        hi > lo, cr_min + (cr_max - cr_min) * (f - lo) / np.where(hi > lo, hi - lo, 1.0), cr_min
+    )
 
 
 def ade_f_individual(fitness, f_min: float = 0.3, f_max: float = 0.9, f_top=None) -> np.ndarray:
@@ -175,25 +180,30 @@ def ade_rates(fitness, generation: int, params: DEParams) -> tuple[np.ndarray, n
     if params.f_rule == "generation":
         big_f = np.full(f.shape, f_gen)
     else:
-        big_f = ade_f_individual(f, params.f_min, params.f_max,
-                                 params.f_max if params.f_rule == "individual" else f_gen)
+        big_f = ade_f_individual(
+            f, params.f_min, params.f_max, params.f_max if params.f_rule == "individual" else f_gen
+        )
     return big_f, ade_cr(f, params.cr_min, params.cr_max, params.cr_rule)
 
 
 @dataclass
 class DEResult:
-    x: np.ndarray                  # best individual
-    fitness: float                 # its fitness
-    generations: int               # generations run
+    x: np.ndarray  # best individual
+    fitness: float  # its fitness
+    generations: int  # generations run
     n_evaluations: int
-    history: np.ndarray            # best fitness after each generation
+    history: np.ndarray  # best fitness after each generation
     elapsed_s: float
     reached_target: bool
     population: np.ndarray = field(repr=False, default=None)
 
 
-def evolve(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams = DEParams(),
-           initial: np.ndarray | None = None) -> DEResult:
+def evolve(
+    objective: Callable[[np.ndarray], np.ndarray],
+    dim: int,
+    params: DEParams = DEParams(),
+    initial: np.ndarray | None = None,
+) -> DEResult:
     """Minimise ``objective`` over the box ``[-bound, bound]^dim`` with DE/rand/1/bin (or ADE): one run,
     seeded by ``params.seed`` (:mod:`navlib.methods.seeding`); :func:`evolve_many` with one generator.
 
@@ -202,8 +212,13 @@ def evolve(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEPa
     return evolve_many(objective, dim, params, generators([params.seed]), init)[0]
 
 
-def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params: DEParams,
-                rngs: list, initial: np.ndarray | None = None) -> list[DEResult]:
+def evolve_many(
+    objective: Callable[[np.ndarray], np.ndarray],
+    dim: int,
+    params: DEParams,
+    rngs: list,
+    initial: np.ndarray | None = None,
+) -> list[DEResult]:
     """Several independent DE runs at once, one per generator in ``rngs``: every run's population lives in
     one ``(S, NP, D)`` array and each generation makes one ``objective`` call on all ``S NP`` trials.
 
@@ -223,37 +238,55 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
     rngs = list(rngs)
     if not rngs:
         raise InputError("evolve_many: need at least one generator")
-    n_runs, n, b, gmax = len(rngs), int(params.pop_size), float(params.bound), int(params.max_generations)
+    n_runs, n, b, gmax = (
+        len(rngs),
+        int(params.pop_size),
+        float(params.bound),
+        int(params.max_generations),
+    )
     t0 = time.perf_counter()
     if initial is None:
         pop = np.stack([g.uniform(-b, b, (n, dim)) for g in rngs])
     else:
         pop = np.array(initial, dtype=float)
         if pop.shape != (n_runs, n, dim):
-            raise InputError(f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}")
-    cached = all(callable(getattr(objective, a, None)) for a in ("start", "trials", "accept", "keep"))
+            raise InputError(
+                f"initial population has shape {pop.shape}, expected {(n_runs, n, dim)}"
+            )
+    cached = all(
+        callable(getattr(objective, a, None)) for a in ("start", "trials", "accept", "keep")
+    )
     first = objective.start if cached else objective
-    fit = np.ascontiguousarray(np.asarray(first(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n))
+    fit = np.ascontiguousarray(
+        np.asarray(first(pop.reshape(-1, dim)), dtype=float).reshape(n_runs, n)
+    )
     history = np.full((n_runs, gmax), np.nan)
     results: list = [None] * n_runs
-    ids = np.arange(n_runs)                 # run index of each row still in the batch
+    ids = np.arange(n_runs)  # run index of each row still in the batch
 
     def finish(mask, g):
         for j in np.flatnonzero(mask):
             s, best = ids[j], int(np.argmin(fit[j]))
-            results[s] = DEResult(x=pop[j, best].copy(), fitness=float(fit[j, best]), generations=g,
-                                  n_evaluations=n * (g + 1), history=history[s, :g].copy(),
-                                  elapsed_s=time.perf_counter() - t0,
-                                  reached_target=bool(fit[j, best] <= params.target_fitness),
-                                  population=pop[j].copy())
+            results[s] = DEResult(
+                x=pop[j, best].copy(),
+                fitness=float(fit[j, best]),
+                generations=g,
+                n_evaluations=n * (g + 1),
+                history=history[s, :g].copy(),
+                elapsed_s=time.perf_counter() - t0,
+                reached_target=bool(fit[j, best] <= params.target_fitness),
+                population=pop[j].copy(),
+            )
 
     trial = np.empty_like(pop)
     best = np.empty(n_runs)
     accepted = np.empty((n_runs, n), np.bool_)
     # every individual's F and CR (:func:`ade_rates`, compiled as :func:`navlib.methods.jit.ade_rates_into`)
     f_all, cr_all = np.full((n_runs, n), float(params.f)), np.full((n_runs, n), float(params.cr))
-    f_schedule = ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None
-    state = xoshiro_states(rngs)        # each run's own stream for mutation, crossover and re-draws
+    f_schedule = (
+        ade_f(np.arange(gmax), gmax, params.f_min, params.f_max) if params.adaptive else None
+    )
+    state = xoshiro_states(rngs)  # each run's own stream for mutation, crossover and re-draws
     g = 0
     while True:
         done = fit.min(axis=1) <= params.target_fitness
@@ -266,21 +299,34 @@ def evolve_many(objective: Callable[[np.ndarray], np.ndarray], dim: int, params:
                 break
             if cached:
                 objective.keep(np.repeat(keep, n))
-            ids, pop, fit = ids[keep], np.ascontiguousarray(pop[keep]), np.ascontiguousarray(fit[keep])
+            ids, pop, fit = (
+                ids[keep],
+                np.ascontiguousarray(pop[keep]),
+                np.ascontiguousarray(fit[keep]),
+            )
             state = np.ascontiguousarray(state[keep])
-            trial, best, accepted = trial[:keep.sum()], best[:keep.sum()], accepted[:keep.sum()]
-        f_i, cr_i = f_all[:ids.size], cr_all[:ids.size]
+            trial, best, accepted = trial[: keep.sum()], best[: keep.sum()], accepted[: keep.sum()]
+        f_i, cr_i = f_all[: ids.size], cr_all[: ids.size]
         if params.adaptive:
-            ade_rates_into(fit, float(f_schedule[g]), float(params.f_min), float(params.f_max),
-                           float(params.cr_min), float(params.cr_max), F_RULES.index(params.f_rule),
-                           params.cr_rule == "rank", f_i, cr_i)
+            ade_rates_into(
+                fit,
+                float(f_schedule[g]),
+                float(params.f_min),
+                float(params.f_max),
+                float(params.cr_min),
+                float(params.cr_max),
+                F_RULES.index(params.f_rule),
+                params.cr_rule == "rank",
+                f_i,
+                cr_i,
+            )
         de_trials(pop, state, f_i, cr_i, b, trial)
         if cached:
             tfit = objective.trials(trial.reshape(-1, dim), pop.reshape(-1, dim))
         else:
             tfit = objective(trial.reshape(-1, dim))
         tfit = np.asarray(tfit, dtype=float).reshape(ids.size, n)
-        de_select(pop, fit, trial, tfit, best, accepted)                   # greedy selection, in place
+        de_select(pop, fit, trial, tfit, best, accepted)  # greedy selection, in place
         if cached:
             objective.accept(accepted.ravel())
         history[ids, g] = best

@@ -16,6 +16,7 @@ These are the peers the workbench's reference-free calibration (:mod:`navlib.wor
 measured against (``benchmarks/calibrate_peer.py``, the workbench chapter): they fit every file and give
 no uncertainty, no noise model and no refusal.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -27,7 +28,9 @@ from ..errors import InputError
 def _field(m) -> np.ndarray:
     m = np.asarray(m, float)
     if m.ndim != 2 or m.shape[1] != 3 or len(m) < 9:
-        raise InputError(f"an ellipsoid fit needs an (n, 3) field with n >= 9 rows, got shape {m.shape}")
+        raise InputError(
+            f"an ellipsoid fit needs an (n, 3) field with n >= 9 rows, got shape {m.shape}"
+        )
     if not np.all(np.isfinite(m)):
         raise InputError("an ellipsoid fit needs a finite field (NaN or infinity found)")
     return m
@@ -44,7 +47,9 @@ def algebraic_ellipsoid(m) -> tuple[np.ndarray, np.ndarray]:
     try:
         b = -np.linalg.solve(Q, c[6:])
     except np.linalg.LinAlgError:
-        raise InputError("the field's quadric is singular: the directions do not span 3-D") from None
+        raise InputError(
+            "the field's quadric is singular: the directions do not span 3-D"
+        ) from None
     w, V = np.linalg.eigh(Q / (1.0 + b @ Q @ b))
     if np.any(w <= 0):
         raise InputError("the fitted quadric is not an ellipsoid: the directions do not span 3-D")

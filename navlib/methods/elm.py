@@ -44,6 +44,7 @@ is negligible contribute little and are pruned; training stops when the loss is 
 iteration count exceeds k.  See :func:`fit_incremental_elm` for the choices we made where the patent is
 ambiguous.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
@@ -59,9 +60,19 @@ from .jit import elm_back_tune, elm_loss, elm_loss_grad
 from .seeding import generator
 
 __all__ = [
-    "ACTIVATIONS", "SCHEDULES", "NodeDraw", "ELMParams", "ELMModel", "IncrementalELMParams",
-    "random_nodes", "solve_output_weights", "fit_elm", "loss_and_gradients", "back_tune",
-    "prune_nodes", "fit_incremental_elm",
+    "ACTIVATIONS",
+    "SCHEDULES",
+    "NodeDraw",
+    "ELMParams",
+    "ELMModel",
+    "IncrementalELMParams",
+    "random_nodes",
+    "solve_output_weights",
+    "fit_elm",
+    "loss_and_gradients",
+    "back_tune",
+    "prune_nodes",
+    "fit_incremental_elm",
 ]
 
 ACTIVATIONS = ("sigmoid", "tanh")
@@ -105,6 +116,7 @@ def _xt(x, t) -> tuple[np.ndarray, np.ndarray, bool]:
 
 # --------------------------------------------------------------------------------------------------
 # Plain ELM
+
 
 @dataclass(frozen=True)
 class NodeDraw:
@@ -189,8 +201,9 @@ class ELMModel:
         return replace(self, w=self.w.copy(), b=self.b.copy(), beta=self.beta.copy())
 
 
-def random_nodes(n_inputs: int, n_nodes: int, rng, *, weight_range: float = 1.0,
-                 bias_range: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+def random_nodes(
+    n_inputs: int, n_nodes: int, rng, *, weight_range: float = 1.0, bias_range: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Random input weights W ~ U(-weight_range, weight_range), shape (n_inputs, n_nodes), and biases
     b ~ U(-bias_range, bias_range), shape (n_nodes,) (patent s701: "randomly initialise w_ij and b_i").
     W is drawn before b, column by column in node order."""
@@ -213,8 +226,9 @@ def solve_output_weights(h: np.ndarray, t: np.ndarray) -> np.ndarray:
     return beta
 
 
-def fit_elm(x, t, params: ELMParams | None = None, *, n_hidden: int | None = None,
-            rng=None) -> ELMModel:
+def fit_elm(
+    x, t, params: ELMParams | None = None, *, n_hidden: int | None = None, rng=None
+) -> ELMModel:
     """Fit a plain ELM: random W, b (not trained), then beta = H^+ T (:func:`solve_output_weights`).
 
     ``x``: (N,) or (N, d) normalised inputs; ``t``: (N,) or (N, m) targets.  ``n_hidden`` overrides
@@ -228,15 +242,18 @@ def fit_elm(x, t, params: ELMParams | None = None, *, n_hidden: int | None = Non
         p = replace(p, n_hidden=n_hidden)
     X, T, squeeze = _xt(x, t)
     gen = _as_rng(p.seed if rng is None else rng)
-    w, b = random_nodes(X.shape[1], int(p.n_hidden), gen, weight_range=p.weight_range,
-                        bias_range=p.bias_range)
+    w, b = random_nodes(
+        X.shape[1], int(p.n_hidden), gen, weight_range=p.weight_range, bias_range=p.bias_range
+    )
     H = _act(p.activation, X @ w + b)
-    return ELMModel(w=w, b=b, beta=solve_output_weights(H, T), activation=p.activation,
-                    squeeze_output=squeeze)
+    return ELMModel(
+        w=w, b=b, beta=solve_output_weights(H, T), activation=p.activation, squeeze_output=squeeze
+    )
 
 
 # --------------------------------------------------------------------------------------------------
 # Back-tuning (patent s702, s1001-s1104)
+
 
 def loss_and_gradients(model: ELMModel, x, t) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
     """Training loss E = mean((Y - T)^2) and its analytic gradients (dE/dW, dE/db, dE/dbeta).
@@ -261,23 +278,36 @@ def _loss(w, b, beta, X, T, act) -> float:
 def _loss_grad(w, b, beta, X, T, act):
     """Loss and gradients (dE/dW, dE/db, dE/dbeta) as :func:`loss_and_gradients` (compiled:
     :func:`navlib.methods.jit.elm_loss_grad`)."""
-    loss, gw, gb, gbeta = elm_loss_grad(_f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid")
+    loss, gw, gb, gbeta = elm_loss_grad(
+        _f64(w), _f64(b), _f64(beta), _f64(X), _f64(T), act == "sigmoid"
+    )
     return float(loss), gw, gb, gbeta
 
 
-def _back_tune(model: ELMModel, X, T, steps: int, step: float, max_halvings: int = 40,
-               armijo: float = 1e-4) -> tuple[ELMModel, list[float], float]:
+def _back_tune(
+    model: ELMModel, X, T, steps: int, step: float, max_halvings: int = 40, armijo: float = 1e-4
+) -> tuple[ELMModel, list[float], float]:
     """Gradient descent with backtracking; returns the tuned copy, the loss after each accepted step
     (the first entry is the starting loss) and the trial step for the next call.  The whole loop runs
     in one compiled call (:func:`navlib.methods.jit.elm_back_tune`)."""
-    w, b, beta, losses, step = elm_back_tune(_f64(model.w), _f64(model.b), _f64(model.beta), _f64(X),
-                                             _f64(T), model.activation == "sigmoid", int(steps),
-                                             float(step), int(max_halvings), float(armijo))
+    w, b, beta, losses, step = elm_back_tune(
+        _f64(model.w),
+        _f64(model.b),
+        _f64(model.beta),
+        _f64(X),
+        _f64(T),
+        model.activation == "sigmoid",
+        int(steps),
+        float(step),
+        int(max_halvings),
+        float(armijo),
+    )
     return replace(model, w=w, b=b, beta=beta), losses.tolist(), float(step)
 
 
-def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
-              max_halvings: int = 40) -> tuple[ELMModel, np.ndarray]:
+def back_tune(
+    model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1, max_halvings: int = 40
+) -> tuple[ELMModel, np.ndarray]:
     """Back-tune all weights (W, b, beta) of ``model`` by ``steps`` gradient-descent steps on the
     training MSE (patent s1004/s1104; gradients in :func:`loss_and_gradients`).
 
@@ -305,6 +335,7 @@ def back_tune(model: ELMModel, x, t, *, steps: int = 20, lr: float = 0.1,
 # --------------------------------------------------------------------------------------------------
 # Pruning
 
+
 def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
     """Remove hidden nodes whose output weights are negligible: ``max_k |beta_jk| <= tol``.
 
@@ -318,13 +349,15 @@ def prune_nodes(model: ELMModel, tol: float) -> tuple[ELMModel, np.ndarray]:
     if drop.all():
         drop[int(np.argmax(size))] = False
     keep = ~drop
-    pruned = replace(model, w=model.w[:, keep].copy(), b=model.b[keep].copy(),
-                     beta=model.beta[keep].copy())
+    pruned = replace(
+        model, w=model.w[:, keep].copy(), b=model.b[keep].copy(), beta=model.beta[keep].copy()
+    )
     return pruned, np.flatnonzero(drop)
 
 
 # --------------------------------------------------------------------------------------------------
 # Point-incremental ELM with autonomous back-tuning
+
 
 @dataclass(frozen=True)
 class IncrementalELMParams(NodeDraw):
@@ -379,8 +412,9 @@ class _Recorder:
         return pd.DataFrame(self.rows, columns=HISTORY_COLUMNS)
 
 
-def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng=None,
-                        x_val=None, t_val=None) -> tuple[ELMModel, pd.DataFrame]:
+def fit_incremental_elm(
+    x, t, params: IncrementalELMParams | None = None, *, rng=None, x_val=None, t_val=None
+) -> tuple[ELMModel, pd.DataFrame]:
     """Point-incremental ELM with autonomous back-tuning (patent B).
 
     Iterations n = 1, 2, ... run stages on the current network:
@@ -435,10 +469,15 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
     gen = _as_rng(p.seed if rng is None else rng)
     rec = _Recorder(Xv, Tv)
     d, m = X.shape[1], T.shape[1]
-    model = ELMModel(w=np.empty((d, 0)), b=np.empty(0), beta=np.empty((0, m)),
-                     activation=p.activation, squeeze_output=squeeze)
+    model = ELMModel(
+        w=np.empty((d, 0)),
+        b=np.empty(0),
+        beta=np.empty((0, m)),
+        activation=p.activation,
+        squeeze_output=squeeze,
+    )
     step = float(p.lr)
-    solved: list = []    # the last two (w, b, beta) of solve()
+    solved: list = []  # the last two (w, b, beta) of solve()
 
     def solve(w: np.ndarray, b: np.ndarray) -> np.ndarray:
         """beta = H^+ T for the hidden nodes (w, b).  Once tuning has stalled at the node cap, the ELM
@@ -458,7 +497,7 @@ def fit_incremental_elm(x, t, params: IncrementalELMParams | None = None, *, rng
         model = replace(model, beta=solve(model.w, model.b))
         loss = _loss(model.w, model.b, model.beta, X, T, p.activation)
         rec.add(it, "elm", model, loss)
-        if np.any(np.max(np.abs(model.beta), axis=1) <= p.prune_tol):    # some node is negligible
+        if np.any(np.max(np.abs(model.beta), axis=1) <= p.prune_tol):  # some node is negligible
             pruned, removed = prune_nodes(model, p.prune_tol)
             if removed.size:
                 model = replace(pruned, beta=solve(pruned.w, pruned.b))

@@ -14,6 +14,7 @@ errors ``e`` are the de-normalised outputs minus the targets over every sample a
 ``mse`` with ``normalization = 'none'``), so ``J`` has ``N m`` rows: the cost of one epoch grows with
 ``N m D^2`` (forming ``J'J``) and ``D^3`` (solving), which is why a net with more inputs trains slower.
 """
+
 from __future__ import annotations
 
 import time
@@ -36,8 +37,12 @@ def unpack(theta: np.ndarray, n_in: int, n_hidden: int, n_out: int):
     """Split ``(S, D)`` into ``W (S, H, n)``, ``b (S, H)``, ``V (S, m, H)``, ``c (S, m)``."""
     s, h = theta.shape[0], n_hidden
     i = h * n_in
-    return (theta[:, :i].reshape(s, h, n_in), theta[:, i:i + h], theta[:, i + h:i + h + n_out * h].reshape(s, n_out, h),
-            theta[:, i + h + n_out * h:])
+    return (
+        theta[:, :i].reshape(s, h, n_in),
+        theta[:, i : i + h],
+        theta[:, i + h : i + h + n_out * h].reshape(s, n_out, h),
+        theta[:, i + h + n_out * h :],
+    )
 
 
 def _hidden(theta, xn, n_in, n_hidden, n_out, activation):
@@ -62,14 +67,16 @@ def jacobian(theta, xn, n_in, n_hidden, n_out, activation: Activation = "logsig"
     theta = np.atleast_2d(theta)
     g, dg, v, _ = _hidden(theta, xn, n_in, n_hidden, n_out, activation)
     s, n, h = g.shape
-    vd = v[:, None, :, :] * dg[:, :, None, :]                                   # (S, N, m, H)
-    jw = vd[..., :, None] * xn[None, :, None, None, :]                          # (S, N, m, H, n)
+    vd = v[:, None, :, :] * dg[:, :, None, :]  # (S, N, m, H)
+    jw = vd[..., :, None] * xn[None, :, None, None, :]  # (S, N, m, H, n)
     jv = np.zeros((s, n, n_out, n_out, h))
     jc = np.zeros((s, n, n_out, n_out))
     for k in range(n_out):
         jv[:, :, k, k, :] = g
         jc[:, :, k, k] = 1.0
-    return np.concatenate([jw.reshape(s, n, n_out, h * n_in), vd, jv.reshape(s, n, n_out, n_out * h), jc], axis=3)
+    return np.concatenate(
+        [jw.reshape(s, n, n_out, h * n_in), vd, jv.reshape(s, n, n_out, n_out * h), jc], axis=3
+    )
 
 
 @dataclass
@@ -90,13 +97,26 @@ class FFNet:
     def predict(self, x) -> np.ndarray:
         x = np.asarray(x, dtype=float)
         xn = self.x_scale.transform(x[:, self.keep])
-        o = forward(self.theta[None], xn, int(self.keep.sum()), self.n_hidden, len(self.t_scale.lo),
-                    self.activation)[0]
+        o = forward(
+            self.theta[None],
+            xn,
+            int(self.keep.sum()),
+            self.n_hidden,
+            len(self.t_scale.lo),
+            self.activation,
+        )[0]
         return self.t_scale.inverse(o)
 
 
-def train_feedforward(x, t, n_hidden: int, rng: np.random.Generator, activation: Activation = "tansig",
-                      lm: LMParams = LMParams(), validation: bool = True) -> FFNet:
+def train_feedforward(
+    x,
+    t,
+    n_hidden: int,
+    rng: np.random.Generator,
+    activation: Activation = "tansig",
+    lm: LMParams = LMParams(),
+    validation: bool = True,
+) -> FFNet:
     """``train(feedforwardnet(n_hidden), x', t')`` with MATLAB's defaults (module docstring): ``x (N, n)``,
     ``t (N, m)``; ``rng`` draws the initial weights, then the ``dividerand`` split (with ``validation``;
     without it every sample trains and there is no validation stop).  ``activation``: MATLAB's default
@@ -106,20 +126,24 @@ def train_feedforward(x, t, n_hidden: int, rng: np.random.Generator, activation:
     check_choice("activation", activation, ACTIVATIONS)
     x, t = np.asarray(x, dtype=float), np.asarray(t, dtype=float)
     if x.ndim != 2 or t.ndim != 2 or len(x) != len(t):
-        raise InputError(f"network input and target must be 2-D with one row per sample, got {x.shape}, {t.shape}")
+        raise InputError(
+            f"network input and target must be 2-D with one row per sample, got {x.shape}, {t.shape}"
+        )
     if len(x) < 10:
         raise InputError(f"a network needs at least 10 samples, got {len(x)}")
-    keep = np.ptp(x, axis=0) > 0                                                # removeconstantrows
+    keep = np.ptp(x, axis=0) > 0  # removeconstantrows
     if not keep.any():
         raise InputError("network input: every column is constant")
     xs = MinMax.fit(x[:, keep], name="network input", out=(-1, 1))
     ts = MinMax.fit(t, name="network target", out=(-1, 1))
     n_in, n_out, n = int(keep.sum()), t.shape[1], len(x)
     xn = xs.transform(x[:, keep])
-    active = TANSIG_ACTIVE if activation == "tansig" else (-4.0, 4.0)       # logsig: MATLAB's 'active' range
+    active = (
+        TANSIG_ACTIVE if activation == "tansig" else (-4.0, 4.0)
+    )  # logsig: MATLAB's 'active' range
     w, b = nguyen_widrow(n_hidden, rng, n_in, active)
     theta0 = np.concatenate([w.ravel(), b, rng.uniform(-1.0, 1.0, n_out * n_hidden + n_out)])[None]
-    scale = ts.gain                                                            # d o / d o' per output
+    scale = ts.gain  # d o / d o' per output
 
     def residuals(th):
         o = forward(th, xn, n_in, n_hidden, n_out, activation)
@@ -136,6 +160,18 @@ def train_feedforward(x, t, n_hidden: int, rng: np.random.Generator, activation:
         tr_mask[tr], val_mask[va] = True, True
         tr_mask, val_mask = np.repeat(tr_mask, n_out), np.repeat(val_mask, n_out)
     res = levenberg_marquardt(residuals, jac, theta0, lm, tr_mask, val_mask)
-    return FFNet(res.theta[0].copy(), n_hidden, keep, xs, ts, activation, time.perf_counter() - t0,
-                 {"epochs": int(res.epochs[0]), "stop": res.stop[0], "best_epoch": int(res.best_epoch[0]),
-                  "n_weights": n_weights(n_in, n_hidden, n_out)})
+    return FFNet(
+        res.theta[0].copy(),
+        n_hidden,
+        keep,
+        xs,
+        ts,
+        activation,
+        time.perf_counter() - t0,
+        {
+            "epochs": int(res.epochs[0]),
+            "stop": res.stop[0],
+            "best_epoch": int(res.best_epoch[0]),
+            "n_weights": n_weights(n_in, n_hidden, n_out),
+        },
+    )

@@ -19,6 +19,7 @@ first, fine moves at the end), and a failed prey moves toward the board instead 
 Each generation makes exactly two objective calls, each with all fish's candidates as one batch: (1) the
 swarm centres and all prey trial points, (2) the resulting moves.  Every candidate is clipped to the bounds.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -56,9 +57,9 @@ class FishSwarmParams:
 
 @dataclass(frozen=True)
 class FishSwarmResult:
-    x: np.ndarray            # best point (original units)
-    fun: float               # its value
-    history: np.ndarray      # bulletin-board value after each generation
+    x: np.ndarray  # best point (original units)
+    fun: float  # its value
+    history: np.ndarray  # bulletin-board value after each generation
     n_evaluations: int
     n_calls: int
 
@@ -70,8 +71,9 @@ def _toward(x, target, step, rng):
     return x + u * step * rng.random((x.shape[0], 1))
 
 
-def minimise(objective, bounds, params: FishSwarmParams = FishSwarmParams(), seed: int = 0,
-             init=None) -> FishSwarmResult:
+def minimise(
+    objective, bounds, params: FishSwarmParams = FishSwarmParams(), seed: int = 0, init=None
+) -> FishSwarmResult:
     """Minimise ``objective`` over the box ``bounds`` ((D, 2) array of [low, high]) with (I)AFSA.
 
     Parameters
@@ -91,7 +93,9 @@ def minimise(objective, bounds, params: FishSwarmParams = FishSwarmParams(), see
     """
     b = np.asarray(bounds, float)
     if b.ndim != 2 or b.shape[1] != 2 or np.any(b[:, 1] <= b[:, 0]) or not np.all(np.isfinite(b)):
-        raise InputError(f"parameter bounds={bounds!r}: expected finite (D, 2) rows [low, high] with low < high")
+        raise InputError(
+            f"parameter bounds={bounds!r}: expected finite (D, 2) rows [low, high] with low < high"
+        )
     lo, span = b[:, 0], b[:, 1] - b[:, 0]
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     P, D, T = int(params.n_fish), b.shape[0], int(params.try_number)

@@ -35,6 +35,7 @@ the compiler used in the vectorised sigmoid but not in its scalar tail; its roun
 processor (the ``rcpps`` estimate is not specified by the instruction set), so the kernels were pinned to
 ``haswell`` and still could differ between processor makers.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -70,7 +71,7 @@ def _bits_to_f32(typingctx, i):
 def logsig32(z):
     """``1 / (1 + exp(-z))`` in float32 (see the module docstring)."""
     y = min(max(z * -_LOG2E, _F(-126.0)), _F(126.0))
-    k = np.int32(y + _F(127.5))                      # y + 127.5 > 0, so truncation = floor: k - 127 = round(y)
+    k = np.int32(y + _F(127.5))  # y + 127.5 > 0, so truncation = floor: k - 127 = round(y)
     f = y - (_F(k) - _F(127.0))
     q = _P0
     q = q * f + _P1
@@ -189,7 +190,7 @@ _U = np.uint64
 def xoshiro_states(rngs) -> np.ndarray:
     """One xoshiro256** state per numpy Generator in ``rngs``: ``(S, 4)`` uint64, each drawn from its
     generator (never all zero)."""
-    out = np.stack([g.integers(1, 2 ** 63, size=4, dtype=np.int64).astype(np.uint64) for g in rngs])
+    out = np.stack([g.integers(1, 2**63, size=4, dtype=np.int64).astype(np.uint64) for g in rngs])
     return np.ascontiguousarray(out)
 
 
@@ -256,7 +257,7 @@ def sample_uniform(state, count):
     """``count`` uniforms in [0, 1) (53 bits) from run 0 of ``state`` (for tests)."""
     out = np.empty(count)
     for k in range(count):
-        out[k] = np.float64(next_u64(state, 0) >> _U(11)) * 2.0 ** -53
+        out[k] = np.float64(next_u64(state, 0) >> _U(11)) * 2.0**-53
     return out
 
 
@@ -277,7 +278,7 @@ def de_trials(pop, state, f, cr, bound, trial):
     for s in range(n_runs):
         for i in range(n_pop):
             fi = f[s, i]
-            threshold = np.int64(np.ceil(cr[s, i] * 65536.0))       # U < c  <=>  k < ceil(c 2^16)
+            threshold = np.int64(np.ceil(cr[s, i] * 65536.0))  # U < c  <=>  k < ceil(c 2^16)
             r1, r2, r3, x = _parents(state, s, i, n_pop)
             jr = _below(x, dim)
             n_out = 0
@@ -295,7 +296,7 @@ def de_trials(pop, state, f, cr, bound, trial):
             if n_out:
                 for j in range(dim):
                     if abs(trial[s, i, j]) > bound:
-                        unit = np.float64(next_u64(state, s) >> _U(11)) * 2.0 ** -53
+                        unit = np.float64(next_u64(state, s) >> _U(11)) * 2.0**-53
                         trial[s, i, j] = -bound + 2.0 * bound * unit
 
 
@@ -321,7 +322,9 @@ def ade_rates_into(fit, f_gen, f_min, f_max, cr_min, cr_max, f_mode, cr_rank, f_
                 q = (fit[s, i] - lo) / (hi - lo) if hi > lo else 0.0
                 f_out[s, i] = f_min + (top - f_min) * q
             if not cr_rank:
-                cr_out[s, i] = cr_min + (cr_max - cr_min) * (fit[s, i] - lo) / (hi - lo) if hi > lo else cr_min
+                cr_out[s, i] = (
+                    cr_min + (cr_max - cr_min) * (fit[s, i] - lo) / (hi - lo) if hi > lo else cr_min
+                )
         if cr_rank:
             order = np.argsort(fit[s], kind="mergesort")
             for r in range(n_pop):
@@ -347,7 +350,14 @@ def de_select(pop, fit, trial, tfit, best, accepted):
 
 # ----------------------------------------------------------------------------------------------- trainlm
 #: Stop reasons of :func:`lm_1m1`, by code (0 = still training).
-LM_STOPS = ("", "maximum epoch", "performance goal", "maximum mu", "minimum gradient", "validation stop")
+LM_STOPS = (
+    "",
+    "maximum epoch",
+    "performance goal",
+    "maximum mu",
+    "minimum gradient",
+    "validation stop",
+)
 
 
 @njit(cache=True)
@@ -396,8 +406,27 @@ def _wmse(r, w, wsum):
 
 
 @njit(cache=True)
-def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_max, goal, mu0, mu_dec, mu_inc,
-           mu_max, min_grad, max_fail):
+def lm_1m1(
+    theta0,
+    xn,
+    t,
+    m,
+    tansig,
+    lo,
+    out_lo,
+    gain,
+    wt,
+    wv,
+    do_val,
+    epochs_max,
+    goal,
+    mu0,
+    mu_dec,
+    mu_inc,
+    mu_max,
+    min_grad,
+    max_fail,
+):
     """MATLAB's ``trainlm`` for S independent 1-M-1 nets (the algorithm, stop tests and their order as in
     :func:`navlib.methods.lm.levenberg_marquardt`, which is the generic reference this kernel is tested
     against), compiled for the network of :mod:`navlib.methods.bpnet`: one net after another, each with
@@ -434,13 +463,24 @@ def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_ma
             for i in range(n):
                 for p in range(dim):
                     jw[i, p] = w[i] * jac[i, p]
-            jj = np.dot(jw.T, jac)                     # J' W J and J' W e (BLAS)
+            jj = np.dot(jw.T, jac)  # J' W J and J' W e (BLAS)
             je = np.dot(jw.T, r)
             g2 = 0.0
             for p in range(dim):
                 g2 += (2.0 * je[p] / wsum) ** 2
-            why = (1 if epoch == epochs_max else 2 if perf <= goal else 3 if mu > mu_max
-                   else 4 if np.sqrt(g2) <= min_grad else 5 if do_val and fails >= max_fail else 0)
+            why = (
+                1
+                if epoch == epochs_max
+                else 2
+                if perf <= goal
+                else 3
+                if mu > mu_max
+                else 4
+                if np.sqrt(g2) <= min_grad
+                else 5
+                if do_val and fails >= max_fail
+                else 0
+            )
             if why:
                 stop[s] = why
                 break
@@ -451,7 +491,7 @@ def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_ma
                     a[p, p] += mu
                 try:
                     step = -np.linalg.solve(a, je)
-                except Exception:      # singular: a NaN step fails the test below and raises mu
+                except Exception:  # singular: a NaN step fails the test below and raises mu
                     step = np.full(dim, np.nan)
                 trial = theta + step
                 _net_residuals(trial, xn, t, m, tansig, lo, out_lo, gain, r2, h2)
@@ -491,6 +531,7 @@ def lm_1m1(theta0, xn, t, m, tansig, lo, out_lo, gain, wt, wv, do_val, epochs_ma
 # through scipy's BLAS); sums in numpy's order (pairwise in blocks of 8 over a contiguous run, column sums
 # row after row).  No fast-math flags at all, not even ``contract``: a fused multiply-add rounds once where
 # numpy rounds twice.
+
 
 @njit(cache=True, error_model="numpy")
 def _block_sum(a: np.ndarray, lo: int, n: int) -> float:
@@ -534,7 +575,7 @@ def pairwise_sum(a: np.ndarray) -> float:
     while top > 0:
         top -= 1
         lo, n, op = los[top], ns[top], ops[top]
-        if op == 1:                          # both halves done: left + right
+        if op == 1:  # both halves done: left + right
             nv -= 1
             vals[nv - 1] = vals[nv - 1] + vals[nv]
         elif n <= 128:
@@ -543,7 +584,7 @@ def pairwise_sum(a: np.ndarray) -> float:
         else:
             n2 = n // 2
             n2 -= n2 % 8
-            ops[top] = 1                     # stays below the halves, so it runs after both
+            ops[top] = 1  # stays below the halves, so it runs after both
             los[top + 1], ns[top + 1], ops[top + 1] = lo + n2, n - n2, 0
             los[top + 2], ns[top + 2], ops[top + 2] = lo, n2, 0
             top += 3
@@ -569,7 +610,9 @@ def blas_matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     p, q = a.shape
     r = b.shape[1]
     if p == 1 and r == 1:
-        return np.full((1, 1), np.dot(np.ascontiguousarray(a).reshape(q), np.ascontiguousarray(b).reshape(q)))
+        return np.full(
+            (1, 1), np.dot(np.ascontiguousarray(a).reshape(q), np.ascontiguousarray(b).reshape(q))
+        )
     if p == 1:
         return np.dot(np.ascontiguousarray(a).reshape(q), b).reshape(1, r)
     if r == 1:
@@ -598,7 +641,9 @@ def elm_loss_grad(w, b, beta, X, T, sigmoid):
     r = blas_matmul(a2, beta) - T
     loss = pairwise_sum(r * r) / r.size
     d3 = (2.0 / r.size) * r
-    d2 = blas_matmul(d3, np.ascontiguousarray(beta.T)) * (a2 * (1.0 - a2) if sigmoid else 1.0 - a2 * a2)
+    d2 = blas_matmul(d3, np.ascontiguousarray(beta.T)) * (
+        a2 * (1.0 - a2) if sigmoid else 1.0 - a2 * a2
+    )
     return loss, blas_matmul(X.T, d2), column_sums(d2), blas_matmul(a2.T, d3)
 
 
@@ -620,13 +665,17 @@ def elm_back_tune(w, b, beta, X, T, sigmoid, steps, step, max_halvings, armijo):
             w1, b1, beta1 = w - step * gw, b - step * gb, beta - step * gbeta
             # A step too small to change any weight gives exactly the current loss (the same
             # computation on the same numbers), which the test below rejects: skip evaluating it.
-            if not (np.array_equal(w1, w) and np.array_equal(b1, b) and np.array_equal(beta1, beta)):
+            if not (
+                np.array_equal(w1, w) and np.array_equal(b1, b) and np.array_equal(beta1, beta)
+            ):
                 new = elm_loss(w1, b1, beta1, X, T, sigmoid)
                 if new <= loss - armijo * step * g2 and new < loss:
                     found = True
                     break
             step *= 0.5
-        if not found:  # no decrease found at any step size: (numerically) stationary, stop this stage
+        if (
+            not found
+        ):  # no decrease found at any step size: (numerically) stationary, stop this stage
             break
         w, b, beta = w1, b1, beta1
         loss, gw, gb, gbeta = elm_loss_grad(w, b, beta, X, T, sigmoid)

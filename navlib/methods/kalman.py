@@ -16,6 +16,7 @@
 - :func:`innovation_loop` -- the decision rule (the workbench's loop applied to the filter): name a candidate
   only when adding its state removes the structure, otherwise say that the candidates do not explain it.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace as replace_spec
@@ -64,14 +65,27 @@ class FilterSpec:
     candidates: tuple = ()
 
     def __post_init__(self):
-        for f in ("phi_level_arcsec", "phi_azimuth_arcsec", "vel_m_s", "pos_m", "drift_deg_h", "bias_ug",
-                  "scale_ppm"):
+        for f in (
+            "phi_level_arcsec",
+            "phi_azimuth_arcsec",
+            "vel_m_s",
+            "pos_m",
+            "drift_deg_h",
+            "bias_ug",
+            "scale_ppm",
+        ):
             check_param(f, getattr(self, f), lo=0.0, lo_open=True)
         c = self.candidates
-        if (not isinstance(c, tuple) or len(set(c)) != len(c) or any(n not in CANDIDATES for n in c)
-                or (self.scale_states and any(n.startswith("gyro") for n in c))):
-            raise InputError(f"parameter candidates={c!r}: a tuple of distinct names of {', '.join(CANDIDATES)}"
-                             " (no gyro scale factor with scale_states=True)")
+        if (
+            not isinstance(c, tuple)
+            or len(set(c)) != len(c)
+            or any(n not in CANDIDATES for n in c)
+            or (self.scale_states and any(n.startswith("gyro") for n in c))
+        ):
+            raise InputError(
+                f"parameter candidates={c!r}: a tuple of distinct names of {', '.join(CANDIDATES)}"
+                " (no gyro scale factor with scale_states=True)"
+            )
 
     @property
     def n_states(self) -> int:
@@ -79,12 +93,16 @@ class FilterSpec:
 
     def p0(self, lat_rad: float) -> np.ndarray:
         r = 6.371e6
-        sd = [self.phi_level_arcsec * ARCSEC] * 2 + [self.phi_azimuth_arcsec * ARCSEC] + [self.vel_m_s] * 3
+        sd = (
+            [self.phi_level_arcsec * ARCSEC] * 2
+            + [self.phi_azimuth_arcsec * ARCSEC]
+            + [self.vel_m_s] * 3
+        )
         sd += [self.pos_m / r, self.pos_m / (r * np.cos(lat_rad)), self.pos_m]
         sd += [self.drift_deg_h * DEG / 3600] * 3 + [self.bias_ug * UG] * 3
         if self.scale_states:
             sd += [self.scale_ppm * 1e-6] * 3
-        sd += [self.scale_ppm * 1e-6] * len(self.candidates)     # one dimensionless scale factor each
+        sd += [self.scale_ppm * 1e-6] * len(self.candidates)  # one dimensionless scale factor each
         return np.diag(np.square(sd))
 
 
@@ -114,8 +132,14 @@ def kalman_filter(phi, q, h, z, r, x0, p0):
     q = np.asarray(q, float)
     x = np.broadcast_to(np.asarray(x0, float), (n, d)).copy()
     p = np.broadcast_to(np.asarray(p0, float), (n, d, d)).copy()
-    out = {"x": np.empty((n, steps, d)), "P": np.empty((n, steps, d, d)), "K": np.empty((n, steps, d, m)),
-           "x_prior": np.empty((n, steps, d)), "innov": np.empty((n, steps, m)), "S": np.empty((n, steps, m, m))}
+    out = {
+        "x": np.empty((n, steps, d)),
+        "P": np.empty((n, steps, d, d)),
+        "K": np.empty((n, steps, d, m)),
+        "x_prior": np.empty((n, steps, d)),
+        "innov": np.empty((n, steps, m)),
+        "S": np.empty((n, steps, m, m)),
+    }
     eye = np.eye(d)
     ht = h.T
     for k in range(steps):
@@ -178,7 +202,7 @@ def run_filter(run: InsRun, spec: FilterSpec = FilterSpec()) -> FilterResult:
         F = np.pad(F, [(0, 0)] * (F.ndim - 2) + [(0, len(spec.candidates))] * 2)
         for j, name in enumerate(spec.candidates):
             field, col, sgn, row = CANDIDATES[name]
-            F[..., row:row + 3, d0 + j] = sgn * getattr(run, field)[:, sl, :, col]
+            F[..., row : row + 3, d0 + j] = sgn * getattr(run, field)[:, sl, :, col]
     phi = discretise(F, period)
     q = process_noise(run.imu, period, spec.n_states)
     h = np.zeros((3, spec.n_states))
@@ -192,10 +216,16 @@ def run_filter(run: InsRun, spec: FilterSpec = FilterSpec()) -> FilterResult:
     phi_hat = kf["x"][..., :3]
     c_est = rotvec_to_dcm(phi_hat) @ c
     att_true = run.att_true[:, sl]
-    return FilterResult(t_s=t[sl], att_err_arcsec=attitude_error_arcsec(c_est, att_true),
-                        ins_err_arcsec=attitude_error_arcsec(c, att_true),
-                        phi_err=misalignment(c, run.cbn_true[:, sl]) - phi_hat,
-                        rate_deg_s=run.rate_b[:, sl] / DEG, kf=kf, phi=phi, spec=spec)
+    return FilterResult(
+        t_s=t[sl],
+        att_err_arcsec=attitude_error_arcsec(c_est, att_true),
+        ins_err_arcsec=attitude_error_arcsec(c, att_true),
+        phi_err=misalignment(c, run.cbn_true[:, sl]) - phi_hat,
+        rate_deg_s=run.rate_b[:, sl] / DEG,
+        kf=kf,
+        phi=phi,
+        spec=spec,
+    )
 
 
 # ------------------------------------------------------------------------------------------- gain features
@@ -247,9 +277,11 @@ def gain_features(result: FilterResult, kind: FeatureSet) -> np.ndarray:
 #: The candidate unmodelled effects: name -> (``InsRun`` field of ``C_b^n diag(.)``, body axis, sign, first
 #: state row it drives: 0 for the attitude, 3 for the velocity).
 CANDIDATES = {
-    "gyro scale factor x": ("cw_b", 0, -1.0, 0), "gyro scale factor y": ("cw_b", 1, -1.0, 0),
+    "gyro scale factor x": ("cw_b", 0, -1.0, 0),
+    "gyro scale factor y": ("cw_b", 1, -1.0, 0),
     "gyro scale factor z": ("cw_b", 2, -1.0, 0),
-    "accelerometer scale factor x": ("cf_b", 0, 1.0, 3), "accelerometer scale factor y": ("cf_b", 1, 1.0, 3),
+    "accelerometer scale factor x": ("cf_b", 0, 1.0, 3),
+    "accelerometer scale factor y": ("cf_b", 1, 1.0, 3),
     "accelerometer scale factor z": ("cf_b", 2, 1.0, 3),
 }
 
@@ -264,10 +296,10 @@ def innovation_signatures(run: InsRun, result: FilterResult) -> dict[str, np.nda
     n, steps, d, m = K.shape
     period = float(result.t_s[1] - result.t_s[0])
     names = list(CANDIDATES)
-    src = np.zeros((n, steps, len(names), d))                            # b_k T, every candidate at once
+    src = np.zeros((n, steps, len(names), d))  # b_k T, every candidate at once
     for j, name in enumerate(names):
         field, col, sgn, row = CANDIDATES[name]
-        src[:, :, j, row:row + 3] = getattr(run, field)[:, 1:, :, col] * (sgn * period)
+        src[:, :, j, row : row + 3] = getattr(run, field)[:, 1:, :, col] * (sgn * period)
     e = np.zeros((n, len(names), d))
     g = np.empty((n, len(names), steps, m))
     for k in range(steps):
@@ -297,15 +329,25 @@ def _glr(sig: dict, nu: np.ndarray, s: np.ndarray, alpha: float) -> GlrResult:
         num = float(np.sum(g * sinv_nu))
         testable = info > 1e-6
         chi2 = num**2 / info if testable else np.nan
-        rows.append({"candidate": name, "testable": testable, "chi2": chi2,
-                     "estimate": num / info if testable else np.nan,
-                     "p_value": float(stats.chi2.sf(chi2, 1)) if testable else np.nan})
+        rows.append(
+            {
+                "candidate": name,
+                "testable": testable,
+                "chi2": chi2,
+                "estimate": num / info if testable else np.nan,
+                "p_value": float(stats.chi2.sf(chi2, 1)) if testable else np.nan,
+            }
+        )
     df = pd.DataFrame(rows)
     n_test = max(int(df["testable"].sum()), 1)
     df["p_bonferroni"] = np.minimum(df["p_value"] * n_test, 1.0)
     df["significant"] = df["p_bonferroni"] < alpha
     sig_rows = df[df["significant"]]
-    named = None if sig_rows.empty else str(sig_rows.sort_values("chi2", ascending=False)["candidate"].iloc[0])
+    named = (
+        None
+        if sig_rows.empty
+        else str(sig_rows.sort_values("chi2", ascending=False)["candidate"].iloc[0])
+    )
     return GlrResult(table=df, named=named, alpha=alpha)
 
 
@@ -322,15 +364,19 @@ def innovation_glr(run: InsRun, result: FilterResult, alpha: float = 0.01) -> Gl
     return _glr(innovation_signatures(run, result), result.kf["innov"], result.kf["S"], alpha)
 
 
-def innovation_glr_per_run(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[GlrResult]:
+def innovation_glr_per_run(
+    run: InsRun, result: FilterResult, alpha: float = 0.01
+) -> list[GlrResult]:
     """The test of :func:`innovation_glr` on each run alone (the sums over one run's epochs): one
     :class:`GlrResult` per run, in run order, so that how often the test names an effect is a rate over
     independent runs."""
     check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
     sig = innovation_signatures(run, result)
     nu, s = result.kf["innov"], result.kf["S"]
-    return [_glr({k: g[i:i + 1] for k, g in sig.items()}, nu[i:i + 1], s[i:i + 1], alpha)
-            for i in range(nu.shape[0])]
+    return [
+        _glr({k: g[i : i + 1] for k, g in sig.items()}, nu[i : i + 1], s[i : i + 1], alpha)
+        for i in range(nu.shape[0])
+    ]
 
 
 def rate_correlation(result: FilterResult, axis: int = 2) -> tuple[float, float]:
@@ -397,8 +443,10 @@ def innovation_structure_test(nu, s, x, alpha: float = 0.01) -> StructureResult:
     check_param("alpha", alpha, lo=0.0, lo_open=True, hi=0.5)
     nu, s, x = np.asarray(nu, float), np.asarray(s, float), np.asarray(x, float)
     if nu.ndim != 2 or nu.shape[1] != 3 or s.shape != nu.shape + (3,) or x.shape[:2] != nu.shape:
-        raise InputError(f"innovation_structure_test: shapes nu {nu.shape}, S {s.shape}, X {x.shape}; "
-                         "expected (steps, 3), (steps, 3, 3), (steps, 3, p)")
+        raise InputError(
+            f"innovation_structure_test: shapes nu {nu.shape}, S {s.shape}, X {x.shape}; "
+            "expected (steps, 3), (steps, 3, 3), (steps, 3, p)"
+        )
     chol = np.linalg.cholesky(s)
     u = np.linalg.solve(chol, nu[..., None])[..., 0].reshape(-1)
     a = np.linalg.solve(chol, x).reshape(-1, x.shape[-1])
@@ -412,7 +460,9 @@ def innovation_structure_test(nu, s, x, alpha: float = 0.01) -> StructureResult:
     return StructureResult(chi2, p, pv, bool(pv < alpha), coef, z, alpha)
 
 
-def innovation_structure_per_run(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[StructureResult]:
+def innovation_structure_per_run(
+    run: InsRun, result: FilterResult, alpha: float = 0.01
+) -> list[StructureResult]:
     """:func:`innovation_structure_test` of the filter's innovations on each run alone, regressed on the
     INS's body rates and their derivatives (:func:`rate_regressors`)."""
     x = rate_regressors(run.cbn[:, 1:], result.rate_deg_s * DEG, result.t_s)
@@ -450,8 +500,14 @@ class LoopDecision:
 
 def _take(run: InsRun, idx) -> InsRun:
     """The runs ``idx`` of ``run`` (every per-run array indexed on its first axis)."""
-    return replace_spec(run, **{f.name: getattr(run, f.name)[idx] for f in fields(run)
-                           if isinstance(getattr(run, f.name), np.ndarray) and getattr(run, f.name).ndim >= 2})
+    return replace_spec(
+        run,
+        **{
+            f.name: getattr(run, f.name)[idx]
+            for f in fields(run)
+            if isinstance(getattr(run, f.name), np.ndarray) and getattr(run, f.name).ndim >= 2
+        },
+    )
 
 
 def innovation_loop(run: InsRun, result: FilterResult, alpha: float = 0.01) -> list[LoopDecision]:
@@ -487,17 +543,38 @@ def innovation_loop(run: InsRun, result: FilterResult, alpha: float = 0.01) -> l
         a = after.get(i)
         if nm is not None and not a.flagged:
             decision, remains = nm, ()
-            msg = (f"add '{nm}': with its state the innovations show no structure (chi2 {a.chi2:.1f}, "
-                   f"{a.dof} dof" + (f"; before {b.chi2:.1f})" if b.flagged else ")"))
+            msg = (
+                f"add '{nm}': with its state the innovations show no structure (chi2 {a.chi2:.1f}, "
+                f"{a.dof} dof" + (f"; before {b.chi2:.1f})" if b.flagged else ")")
+            )
         elif nm is None and not b.flagged:
             decision, remains = NOTHING, ()
-            msg = "the innovations are consistent with the filter's model: no candidate, no structure"
+            msg = (
+                "the innovations are consistent with the filter's model: no candidate, no structure"
+            )
         else:
             left = a if a is not None else b
             decision, remains = NOT_EXPLAINED, left.terms()
-            msg = (f"{NOT_EXPLAINED}: structure in the {', '.join(remains) or 'rates and their derivatives'}"
-                   + (f" remains after adding '{nm}'" if nm is not None else "; no candidate is significant")
-                   + f" (chi2 {left.chi2:.1f}, {left.dof} dof)")
-        out.append(LoopDecision(nm, b.flagged, b.chi2, nm, None if a is None else a.flagged,
-                                None if a is None else a.chi2, decision, remains, msg))
+            msg = (
+                f"{NOT_EXPLAINED}: structure in the {', '.join(remains) or 'rates and their derivatives'}"
+                + (
+                    f" remains after adding '{nm}'"
+                    if nm is not None
+                    else "; no candidate is significant"
+                )
+                + f" (chi2 {left.chi2:.1f}, {left.dof} dof)"
+            )
+        out.append(
+            LoopDecision(
+                nm,
+                b.flagged,
+                b.chi2,
+                nm,
+                None if a is None else a.flagged,
+                None if a is None else a.chi2,
+                decision,
+                remains,
+                msg,
+            )
+        )
     return out

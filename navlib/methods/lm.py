@@ -19,6 +19,7 @@ are returned, as MATLAB does; without one, the final weights.
 The implementation is batched: ``S`` networks of ``D`` weights each train together, each with its own
 ``mu``, masks and stopping state; every step is the same as training that network alone.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -79,7 +80,7 @@ def dividerand(n: int, rng: np.random.Generator, ratios=(0.7, 0.15, 0.15)):
     n_val, n_test = int(round(r[1] * n)), int(round(r[2] * n))
     perm = rng.permutation(n)
     n_tr = n - n_val - n_test
-    return np.sort(perm[:n_tr]), np.sort(perm[n_tr:n_tr + n_val]), np.sort(perm[n_tr + n_val:])
+    return np.sort(perm[:n_tr]), np.sort(perm[n_tr : n_tr + n_val]), np.sort(perm[n_tr + n_val :])
 
 
 def _solve(a: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -101,9 +102,14 @@ def _mse(r: np.ndarray, w: np.ndarray) -> np.ndarray:
     return np.einsum("sn,sn->s", w * r, r) / w.sum(axis=1)
 
 
-def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray],
-                        jacobian: Callable[[np.ndarray], np.ndarray], theta0, params: LMParams = LMParams(),
-                        train_mask=None, val_mask=None) -> LMResult:
+def levenberg_marquardt(
+    residuals: Callable[[np.ndarray], np.ndarray],
+    jacobian: Callable[[np.ndarray], np.ndarray],
+    theta0,
+    params: LMParams = LMParams(),
+    train_mask=None,
+    val_mask=None,
+) -> LMResult:
     """Train ``S`` networks by ``trainlm`` (module docstring).
 
     ``residuals(theta (K, D)) -> (K, N)`` gives output - target for every sample; ``jacobian(theta) ->
@@ -113,8 +119,11 @@ def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray],
     s_count, dim = theta.shape
     r = residuals(theta)
     n = r.shape[1]
-    wt = np.ones((s_count, n)) if train_mask is None else np.broadcast_to(
-        np.asarray(train_mask, bool), (s_count, n)).astype(float)
+    wt = (
+        np.ones((s_count, n))
+        if train_mask is None
+        else np.broadcast_to(np.asarray(train_mask, bool), (s_count, n)).astype(float)
+    )
     if np.any(wt.sum(axis=1) == 0):
         raise InputError("levenberg_marquardt: a network has no training samples")
     do_val = val_mask is not None
@@ -138,16 +147,26 @@ def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray],
     J = jacobian(theta)
     for epoch in range(p.epochs + 1):
         idx = np.flatnonzero(active)
-        rows = np.flatnonzero(wt[idx].any(axis=0))                         # samples some net trains on
+        rows = np.flatnonzero(wt[idx].any(axis=0))  # samples some net trains on
         Ju = J[idx][:, rows] if rows.size < n else J[idx]
-        Jt = Ju.transpose(0, 2, 1) * wt[idx][:, None, rows]                # (S, D, N_used), masked
+        Jt = Ju.transpose(0, 2, 1) * wt[idx][:, None, rows]  # (S, D, N_used), masked
         jj = np.matmul(Jt, Ju)
         je = np.matmul(Jt, r[idx][:, rows, None])[..., 0]
         grad = np.linalg.norm(2.0 * je / wt[idx].sum(axis=1)[:, None], axis=1)
-        for k, i in enumerate(idx):      # MATLAB's stopping tests, in its order
-            why = ("maximum epoch" if epoch == p.epochs else "performance goal" if perf[i] <= p.goal
-                   else "maximum mu" if mu[i] > p.mu_max else "minimum gradient" if grad[k] <= p.min_grad
-                   else "validation stop" if do_val and fails[i] >= p.max_fail else "")
+        for k, i in enumerate(idx):  # MATLAB's stopping tests, in its order
+            why = (
+                "maximum epoch"
+                if epoch == p.epochs
+                else "performance goal"
+                if perf[i] <= p.goal
+                else "maximum mu"
+                if mu[i] > p.mu_max
+                else "minimum gradient"
+                if grad[k] <= p.min_grad
+                else "validation stop"
+                if do_val and fails[i] >= p.max_fail
+                else ""
+            )
             if why:
                 stop[i], active[i] = why, False
         keep = active[idx]
@@ -179,9 +198,15 @@ def levenberg_marquardt(residuals: Callable[[np.ndarray], np.ndarray],
             better = vperf[idx] < best_v[idx]
             worse = vperf[idx] > best_v[idx]
             bi = idx[better]
-            best_theta[bi], best_v[bi], best_epoch[bi], fails[bi] = theta[bi], vperf[bi], epoch + 1, 0
+            best_theta[bi], best_v[bi], best_epoch[bi], fails[bi] = (
+                theta[bi],
+                vperf[bi],
+                epoch + 1,
+                0,
+            )
             fails[idx[worse]] += 1
     if not do_val:
         best_theta, best_epoch = theta, epochs.copy()
-    return LMResult(theta=best_theta, epochs=epochs, stop=stop, perf=hist, val_perf=vhist,
-                    best_epoch=best_epoch)
+    return LMResult(
+        theta=best_theta, epochs=epochs, stop=stop, perf=hist, val_perf=vhist, best_epoch=best_epoch
+    )

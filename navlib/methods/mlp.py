@@ -17,6 +17,7 @@ Used by paper D's ANN baseline (2-n-1, mapminmax, Nguyen-Widrow, L-BFGS) and pap
 (9-10-3, 45-10-3, 6-10-3: logsig, standardised, torch initialisation, Adam).  Paper A's 1-M-1 network
 with MATLAB's ``trainlm`` is :mod:`navlib.methods.bpnet`.
 """
+
 from __future__ import annotations
 
 import time
@@ -29,10 +30,14 @@ from .._optional import require
 from ..errors import InputError, check_param
 from .seeding import as_int
 
-torch = require("torch", __name__)      # the [nets] extra
+torch = require("torch", __name__)  # the [nets] extra
 
-_CHOICES = {"hidden": ("tansig", "logsig"), "trainer": ("lbfgs", "adam"),
-            "scaling": ("mapminmax", "standardize"), "init": ("nguyen_widrow", "torch")}
+_CHOICES = {
+    "hidden": ("tansig", "logsig"),
+    "trainer": ("lbfgs", "adam"),
+    "scaling": ("mapminmax", "standardize"),
+    "init": ("nguyen_widrow", "torch"),
+}
 
 
 @dataclass(frozen=True)
@@ -57,8 +62,9 @@ class MLPParams:
         check_param("learning_rate", self.learning_rate, lo=0, lo_open=True, hi=10)
         for name, allowed in _CHOICES.items():
             if getattr(self, name) not in allowed:
-                raise InputError(f"parameter {name}={getattr(self, name)!r}: must be one of "
-                                 f"{', '.join(allowed)}")
+                raise InputError(
+                    f"parameter {name}={getattr(self, name)!r}: must be one of {', '.join(allowed)}"
+                )
 
 
 def _act(z, kind):
@@ -78,7 +84,7 @@ class _Scaler:
             raise InputError(f"MLP: {name} contain NaN or infinite values")
         if kind == "mapminmax":
             lo, hi = A.min(axis=0), A.max(axis=0)
-            hi = np.where(hi > lo, hi, lo + 2.0)          # a constant column is shifted, not scaled
+            hi = np.where(hi > lo, hi, lo + 2.0)  # a constant column is shifted, not scaled
             return cls((lo + hi) / 2, (hi - lo) / 2)
         mu, sd = A.mean(axis=0), A.std(axis=0)
         return cls(mu, np.where(sd > 1e-12 * (1 + np.abs(mu)), sd, 1.0))
@@ -95,8 +101,15 @@ class MLP:
     in target units, or (...,) for a single output.  ``loss_history``: training loss per epoch (scaled
     targets); ``seconds_per_pass``: mean time of one training epoch."""
 
-    def __init__(self, params: MLPParams, weights: dict, x_scale: _Scaler, y_scale: _Scaler,
-                 loss_history, seconds_per_pass: float):
+    def __init__(
+        self,
+        params: MLPParams,
+        weights: dict,
+        x_scale: _Scaler,
+        y_scale: _Scaler,
+        loss_history,
+        seconds_per_pass: float,
+    ):
         self.params = params
         self.weights = weights
         self.x_scale, self.y_scale = x_scale, y_scale
@@ -108,7 +121,9 @@ class MLP:
         if X.ndim == 1:
             X = X[None, :]
         if X.shape[-1] != self.params.n_in:
-            raise InputError(f"MLP.predict: {X.shape[-1]} input columns, the net has {self.params.n_in}")
+            raise InputError(
+                f"MLP.predict: {X.shape[-1]} input columns, the net has {self.params.n_in}"
+            )
         lead = X.shape[:-1]
         xs = torch.from_numpy(self.x_scale.forward(X.reshape(-1, self.params.n_in)))
         w = self.weights
@@ -123,15 +138,19 @@ def _initial_weights(p: MLPParams, seed: int) -> dict:
         torch.manual_seed(as_int(np.random.SeedSequence(seed)))
         l1 = torch.nn.Linear(p.n_in, p.n_hidden, dtype=torch.float64)
         l2 = torch.nn.Linear(p.n_hidden, p.n_out, dtype=torch.float64)
-        return {k: v.detach().numpy().copy() for k, v in
-                dict(W1=l1.weight, b1=l1.bias, W2=l2.weight, b2=l2.bias).items()}
+        return {
+            k: v.detach().numpy().copy()
+            for k, v in dict(W1=l1.weight, b1=l1.bias, W2=l2.weight, b2=l2.bias).items()
+        }
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     h, n = p.n_hidden, p.n_in
     beta = 0.7 * h ** (1.0 / n)
     W1 = rng.uniform(-1, 1, (h, n))
     W1 = beta * W1 / np.linalg.norm(W1, axis=1, keepdims=True)
     b1 = beta * np.linspace(-1, 1, h) * np.sign(rng.uniform(-1, 1, h))
-    return dict(W1=W1, b1=b1, W2=rng.uniform(-0.5, 0.5, (p.n_out, h)), b2=rng.uniform(-0.5, 0.5, p.n_out))
+    return dict(
+        W1=W1, b1=b1, W2=rng.uniform(-0.5, 0.5, (p.n_out, h)), b2=rng.uniform(-0.5, 0.5, p.n_out)
+    )
 
 
 def train_mlp(X, Y, params: MLPParams = MLPParams(), seed: int = 0) -> MLP:
@@ -160,12 +179,16 @@ def train_mlp(X, Y, params: MLPParams = MLPParams(), seed: int = 0) -> MLP:
     X = X.reshape(-1, p.n_in)
     Y = np.asarray(Y, float).reshape(-1, p.n_out) if np.size(Y) == len(X) * p.n_out else None
     if Y is None or len(X) < 2:
-        raise InputError(f"MLP: {len(X)} input rows do not match the targets for a {p.n_in}-{p.n_hidden}-"
-                         f"{p.n_out} net (need at least 2 rows, n_out target columns each)")
+        raise InputError(
+            f"MLP: {len(X)} input rows do not match the targets for a {p.n_in}-{p.n_hidden}-"
+            f"{p.n_out} net (need at least 2 rows, n_out target columns each)"
+        )
     xsc, ysc = _Scaler.fit(X, p.scaling, "inputs"), _Scaler.fit(Y, p.scaling, "targets")
     xs, ys = torch.from_numpy(xsc.forward(X)), torch.from_numpy(ysc.forward(Y))
-    w = {k: torch.tensor(v, dtype=torch.float64, requires_grad=True)
-         for k, v in _initial_weights(p, seed).items()}
+    w = {
+        k: torch.tensor(v, dtype=torch.float64, requires_grad=True)
+        for k, v in _initial_weights(p, seed).items()
+    }
 
     def loss_fn():
         out = _act(xs @ w["W1"].T + w["b1"], p.hidden) @ w["W2"].T + w["b2"]
@@ -174,8 +197,15 @@ def train_mlp(X, Y, params: MLPParams = MLPParams(), seed: int = 0) -> MLP:
     hist = np.empty(p.epochs)
     t0 = time.perf_counter()
     if p.trainer == "lbfgs":
-        opt = torch.optim.LBFGS(list(w.values()), lr=1.0, max_iter=20, history_size=20,
-                                line_search_fn="strong_wolfe", tolerance_grad=1e-12, tolerance_change=1e-15)
+        opt = torch.optim.LBFGS(
+            list(w.values()),
+            lr=1.0,
+            max_iter=20,
+            history_size=20,
+            line_search_fn="strong_wolfe",
+            tolerance_grad=1e-12,
+            tolerance_change=1e-15,
+        )
 
         def closure():
             opt.zero_grad()

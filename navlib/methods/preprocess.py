@@ -12,6 +12,7 @@ Patent text (our translation):
 
 The patent gives no window length, no rule for "abnormal" and no split seed: those are parameters here.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -21,8 +22,16 @@ from scipy import ndimage
 
 from ..errors import InputError, check_param
 
-__all__ = ["MEDIAN_MODES", "median_filter", "field_gravity_dot", "DotScreen", "dot_product_screen",
-           "reject_dot_product_outliers", "train_test_split", "MAD_TO_SIGMA"]
+__all__ = [
+    "MEDIAN_MODES",
+    "median_filter",
+    "field_gravity_dot",
+    "DotScreen",
+    "dot_product_screen",
+    "reject_dot_product_outliers",
+    "train_test_split",
+    "MAD_TO_SIGMA",
+]
 
 MEDIAN_MODES = ("nearest", "reflect", "mirror", "wrap", "closed")
 MAD_TO_SIGMA = 1.482602218505602  # 1 / Phi^-1(3/4): MAD of a normal sample * this = sigma
@@ -58,13 +67,15 @@ def median_filter(values, window: int, *, mode: str = "nearest") -> np.ndarray:
     size = (window,) + (1,) * (v.ndim - 1)
     if mode == "closed":
         if n - 1 < window:
-            raise InputError(f"parameter window={window}: a closed sweep of {n} samples needs "
-                             f"window <= {n - 1}")
-        padded = np.concatenate([v[n - 1 - half:n - 1], v, v[1:half + 1]], axis=0)
-        return ndimage.median_filter(padded, size=size, mode="nearest")[half:half + n]
+            raise InputError(
+                f"parameter window={window}: a closed sweep of {n} samples needs window <= {n - 1}"
+            )
+        padded = np.concatenate([v[n - 1 - half : n - 1], v, v[1 : half + 1]], axis=0)
+        return ndimage.median_filter(padded, size=size, mode="nearest")[half : half + n]
     if mode == "wrap" and n < window:
-        raise InputError(f"parameter window={window}: a periodic sweep of {n} samples needs "
-                         f"window <= {n}")
+        raise InputError(
+            f"parameter window={window}: a periodic sweep of {n} samples needs window <= {n}"
+        )
     return ndimage.median_filter(v, size=size, mode=mode)
 
 
@@ -107,8 +118,9 @@ class DotScreen:
         return int(np.size(self.keep) - np.count_nonzero(self.keep))
 
 
-def dot_product_screen(mag_xyz, grav_xyz, *, threshold: float = 4.0, normalize: bool = False,
-                       min_scale: float = 0.0) -> DotScreen:
+def dot_product_screen(
+    mag_xyz, grav_xyz, *, threshold: float = 4.0, normalize: bool = False, min_scale: float = 0.0
+) -> DotScreen:
     """Flag readings whose field-gravity inner product is abnormal (patent, second step: "discard data
     whose geomagnetic/gravity inner product is abnormal").
 
@@ -135,11 +147,13 @@ def dot_product_screen(mag_xyz, grav_xyz, *, threshold: float = 4.0, normalize: 
     return DotScreen(dot=s, center=c, scale=scale, threshold=float(threshold), keep=keep)
 
 
-def reject_dot_product_outliers(mag_xyz, grav_xyz, *, threshold: float = 4.0,
-                                normalize: bool = False, min_scale: float = 0.0) -> np.ndarray:
+def reject_dot_product_outliers(
+    mag_xyz, grav_xyz, *, threshold: float = 4.0, normalize: bool = False, min_scale: float = 0.0
+) -> np.ndarray:
     """Boolean keep-mask (True = clean) of :func:`dot_product_screen`."""
-    return dot_product_screen(mag_xyz, grav_xyz, threshold=threshold, normalize=normalize,
-                              min_scale=min_scale).keep
+    return dot_product_screen(
+        mag_xyz, grav_xyz, threshold=threshold, normalize=normalize, min_scale=min_scale
+    ).keep
 
 
 def train_test_split(n: int, frac: float = 0.9, rng=None) -> tuple[np.ndarray, np.ndarray]:

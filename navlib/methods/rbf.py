@@ -33,6 +33,7 @@ ratio of two round-off numbers, and when only such candidates are left the desig
 solution when rank-deficient), MATLAB's ``/`` returns a basic solution instead; on the training points both
 fit equally well.
 """
+
 from __future__ import annotations
 
 import math
@@ -56,7 +57,11 @@ def spread_from_gaussian_width(delta: float) -> float:
     """The MATLAB SPREAD whose neurons are ``exp(-u^2 / delta^2)`` (a Gaussian of width ``delta``, the form
     papers often print): ``radbas(b u) = exp(-(b u)^2)`` with ``b = sqrt(-ln 0.5) / SPREAD`` equals it when
     ``b = 1 / delta``, i.e. ``SPREAD = sqrt(ln 2) delta`` (0.8326 ``delta``)."""
-    if not (isinstance(delta, (int, float, np.integer, np.floating)) and math.isfinite(delta) and delta > 0):
+    if not (
+        isinstance(delta, (int, float, np.integer, np.floating))
+        and math.isfinite(delta)
+        and delta > 0
+    ):
         raise InputError(f"parameter delta={delta!r}: the Gaussian width must be a positive number")
     return LN2_SQRT * float(delta)
 
@@ -81,7 +86,9 @@ class InputScaler:
 
     def __post_init__(self):
         if len(self.offset) != len(self.scale):
-            raise InputError(f"InputScaler: offset has {len(self.offset)} entries, scale {len(self.scale)}")
+            raise InputError(
+                f"InputScaler: offset has {len(self.offset)} entries, scale {len(self.scale)}"
+            )
         for i, s in enumerate(self.scale):
             if not (math.isfinite(s) and s != 0):
                 raise InputError(f"parameter scale[{i}]={s!r}: must be finite and non-zero")
@@ -114,7 +121,9 @@ class InputScaler:
     def transform(self, x) -> np.ndarray:
         x = as_2d(x, "x")
         if x.shape[1] != self.n_inputs:
-            raise InputError(f"input has {x.shape[1]} column(s), the scaler expects {self.n_inputs}")
+            raise InputError(
+                f"input has {x.shape[1]} column(s), the scaler expects {self.n_inputs}"
+            )
         return (x - np.asarray(self.offset)) / np.asarray(self.scale)
 
 
@@ -127,8 +136,8 @@ class RBFNet:
 
     centers: np.ndarray
     b: float
-    weights: np.ndarray          # (m, s)
-    bias: np.ndarray             # (s,)
+    weights: np.ndarray  # (m, s)
+    bias: np.ndarray  # (s,)
     scaler: InputScaler
     spread: float
     center_index: np.ndarray
@@ -180,7 +189,9 @@ def _prepare(x, t, spread, scaler):
     if q < 1:
         raise InputError("no training rows")
     if q < n:
-        raise InputError(f"{q} training row(s) for {n} inputs: need at least as many rows as inputs")
+        raise InputError(
+            f"{q} training row(s) for {n} inputs: need at least as many rows as inputs"
+        )
     for name, a in (("x", X), ("t", T)):
         bad = np.argwhere(~np.isfinite(a))
         if bad.size:
@@ -205,9 +216,17 @@ def _errors(a1, w, bias, T):
 
 
 # ----------------------------------------------------------------------------------------------- design
-def newrb(x, t, *, goal: float = 0.0, spread: float = 1.0, max_neurons: int | None = None,
-          goal_kind: str = "mse", scaler: InputScaler | None = None,
-          degenerate_tol: float = 1e-11) -> RBFNet:
+def newrb(
+    x,
+    t,
+    *,
+    goal: float = 0.0,
+    spread: float = 1.0,
+    max_neurons: int | None = None,
+    goal_kind: str = "mse",
+    scaler: InputScaler | None = None,
+    degenerate_tol: float = 1e-11,
+) -> RBFNet:
     """MATLAB ``newrb(P, T, goal, spread, MN)`` by orthogonal least squares (see module docstring).
 
     ``x``: (Q,) or (Q, n) raw inputs; ``t``: (Q,) or (Q, s) targets; ``goal`` in the units of
@@ -232,21 +251,21 @@ def newrb(x, t, *, goal: float = 0.0, spread: float = 1.0, max_neurons: int | No
         raise InputError(f"parameter max_neurons={max_neurons!r}: must be a whole number >= 1")
     b = width_from_spread(spread)
 
-    P = radbas(b * _dist(Xs, Xs))            # column j: neuron centred on sample j, at every sample
+    P = radbas(b * _dist(Xs, Xs))  # column j: neuron centred on sample j, at every sample
     norm0 = np.sqrt((P * P).sum(axis=0))
     d = T
-    dd = (d * d).sum(axis=0)                 # (s,)
-    dd = np.where(dd > 0, dd, 1.0)           # all-zero targets: every score is 0, avoid 0/0
+    dd = (d * d).sum(axis=0)  # (s,)
+    dd = np.where(dd > 0, dd, 1.0)  # all-zero targets: every score is 0, avoid 0/0
 
     def scores(Pm):
         """OLS error-reduction score per remaining candidate; -1 for a candidate whose orthogonalised
         column has collapsed to round-off (linearly dependent on the chosen ones)."""
         pp = (Pm * Pm).sum(axis=0)
-        pd = Pm.T @ d                        # (cand, s)
+        pd = Pm.T @ d  # (cand, s)
         with np.errstate(divide="ignore", invalid="ignore"):
-            e = pd ** 2 / (pp[:, None] * dd[None, :])
+            e = pd**2 / (pp[:, None] * dd[None, :])
         e[~np.isfinite(e)] = 0.0
-        sc = (e ** 2).sum(axis=1)            # MATLAB findLargeColumn: sum of squares over outputs
+        sc = (e**2).sum(axis=1)  # MATLAB findLargeColumn: sum of squares over outputs
         sc[np.sqrt(pp) <= degenerate_tol * norm0[left]] = -1.0
         return sc
 
@@ -254,8 +273,8 @@ def newrb(x, t, *, goal: float = 0.0, spread: float = 1.0, max_neurons: int | No
     used: list[int] = []
     W_orth: list[np.ndarray] = []
     mean_err = T - T.mean(axis=0)
-    perf_mse = [float(np.mean(mean_err ** 2))]
-    perf_sse = [float(np.sum(mean_err ** 2))]
+    perf_mse = [float(np.mean(mean_err**2))]
+    perf_sse = [float(np.sum(mean_err**2))]
     stop = "max_neurons reached"
     w2 = np.zeros((0, T.shape[1]))
     b2 = T.mean(axis=0)
@@ -269,7 +288,7 @@ def newrb(x, t, *, goal: float = 0.0, spread: float = 1.0, max_neurons: int | No
         if not np.any(sc >= 0):
             stop = "no independent candidate"
             break
-        pick = int(np.argmax(sc))            # first maximum wins
+        pick = int(np.argmax(sc))  # first maximum wins
         W_orth.append(Pm[:, pick].copy())
         used.append(int(left[pick]))
         Pm = np.delete(Pm, pick, axis=1)
@@ -283,10 +302,21 @@ def newrb(x, t, *, goal: float = 0.0, spread: float = 1.0, max_neurons: int | No
         if k >= 2 and err < g:
             stop = "goal met"
             break
-    return RBFNet(centers=Xs[used].copy(), b=b, weights=np.asarray(w2), bias=np.asarray(b2),
-                  scaler=scaler, spread=float(spread), center_index=np.asarray(used, dtype=int),
-                  perf_mse=np.asarray(perf_mse), perf_sse=np.asarray(perf_sse), goal=g,
-                  goal_kind=goal_kind, stop_reason=stop, single_output=single)
+    return RBFNet(
+        centers=Xs[used].copy(),
+        b=b,
+        weights=np.asarray(w2),
+        bias=np.asarray(b2),
+        scaler=scaler,
+        spread=float(spread),
+        center_index=np.asarray(used, dtype=int),
+        perf_mse=np.asarray(perf_mse),
+        perf_sse=np.asarray(perf_sse),
+        goal=g,
+        goal_kind=goal_kind,
+        stop_reason=stop,
+        single_output=single,
+    )
 
 
 def newrbe(x, t, *, spread: float = 1.0, scaler: InputScaler | None = None) -> RBFNet:
@@ -299,11 +329,21 @@ def newrbe(x, t, *, spread: float = 1.0, scaler: InputScaler | None = None) -> R
     w2, b2 = _solve_output(a1, T)
     mse, sse = _errors(a1, w2, b2, T)
     mean_err = T - T.mean(axis=0)
-    return RBFNet(centers=Xs.copy(), b=b, weights=w2, bias=b2, scaler=scaler, spread=float(spread),
-                  center_index=np.arange(Xs.shape[0]),
-                  perf_mse=np.array([np.mean(mean_err ** 2), mse]),
-                  perf_sse=np.array([np.sum(mean_err ** 2), sse]), goal=0.0, goal_kind="mse",
-                  stop_reason="exact design", single_output=single)
+    return RBFNet(
+        centers=Xs.copy(),
+        b=b,
+        weights=w2,
+        bias=b2,
+        scaler=scaler,
+        spread=float(spread),
+        center_index=np.arange(Xs.shape[0]),
+        perf_mse=np.array([np.mean(mean_err**2), mse]),
+        perf_sse=np.array([np.sum(mean_err**2), sse]),
+        goal=0.0,
+        goal_kind="mse",
+        stop_reason="exact design",
+        single_output=single,
+    )
 
 
 def leave_one_out(x, t, fit) -> np.ndarray:
@@ -320,5 +360,5 @@ def leave_one_out(x, t, fit) -> np.ndarray:
         keep = np.arange(q) != i
         model = fit(X[keep], T[keep])
         f = model.predict if hasattr(model, "predict") else model
-        out[i] = float(np.ravel(f(X[i:i + 1]))[0])
+        out[i] = float(np.ravel(f(X[i : i + 1]))[0])
     return out

@@ -12,6 +12,7 @@ of ``feedforwardnet``) is the same map onto [-1, 1]: ``MinMax.fit(values, out=(-
 
     x' = y_min + (y_max - y_min) (x - x_min) / (x_max - x_min).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -35,7 +36,9 @@ class MinMax:
     out_hi: float = 1.0
 
     @classmethod
-    def fit(cls, values, *, name: str = "values", out: tuple[float, float] = (0.0, 1.0)) -> "MinMax":
+    def fit(
+        cls, values, *, name: str = "values", out: tuple[float, float] = (0.0, 1.0)
+    ) -> "MinMax":
         """Scaler mapping the column minima to ``out[0]`` and maxima to ``out[1]`` (default 0 and 1;
         ``(-1, 1)`` is MATLAB's ``mapminmax``).
 
@@ -50,8 +53,10 @@ class MinMax:
         lo, hi = v2.min(axis=0), v2.max(axis=0)
         flat = np.flatnonzero(hi <= lo)
         if flat.size:
-            raise InputError(f"{name}: column {int(flat[0])} is constant ({lo[flat[0]]:g}); "
-                             "min-max scaling needs a range")
+            raise InputError(
+                f"{name}: column {int(flat[0])} is constant ({lo[flat[0]]:g}); "
+                "min-max scaling needs a range"
+            )
         if not out[1] > out[0]:
             raise InputError(f"{name}: output range {out!r} must be increasing")
         return cls(lo=lo, hi=hi, out_lo=float(out[0]), out_hi=float(out[1]))

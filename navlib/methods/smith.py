@@ -19,6 +19,7 @@ has ``2K + 1`` coefficients; Smith's series is ``K = 2``.  Eight readings 45 deg
 ``k`` of the horizontal field leaves harmonics of about ``k^n / n`` rad at order ``n``: the 3rd-order series
 absorbs what the 5-term series cannot.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -77,8 +78,10 @@ def fit_smith(measured_deg, true_deg, order: int = 2) -> SmithModel:
         raise InputError("measured and true headings must be 1-D arrays of the same length")
     need = 2 * int(order) + 1
     if len(np.unique(np.round(np.mod(m, 360.0), 6))) < need:
-        raise InputError(f"a harmonic series of order {order} ({need} coefficients) needs at least {need} "
-                         f"distinct headings, got {len(m)} readings")
+        raise InputError(
+            f"a harmonic series of order {order} ({need} coefficients) needs at least {need} "
+            f"distinct headings, got {len(m)} readings"
+        )
     coef, *_ = np.linalg.lstsq(design(m, order), wrap_deg(m - t), rcond=None)
     return SmithModel(coef)
 
@@ -127,5 +130,7 @@ def eight_position_indices(true_deg, step_deg: float = 45.0, tol_deg: float = 1e
     missing = np.arange(0.0, 360.0, step_deg)[idx < 0]
     if missing.size:
         within = "at" if tol_deg <= 1e-6 else f"within {tol_deg:g} deg of"
-        raise InputError(f"no reading {within} true heading {missing[0]:g} deg for the 8-position fit")
+        raise InputError(
+            f"no reading {within} true heading {missing[0]:g} deg for the 8-position fit"
+        )
     return idx

@@ -22,6 +22,7 @@
 the input's sigma and the centre's coordinate; product AND; consequents ``f_r = p_r . x + r_r`` from one
 global least-squares solve on the normalised firing strengths.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -44,7 +45,9 @@ class SubclustOptions:
         check_param("accept", self.accept, lo=0, hi=1)
         check_param("reject", self.reject, lo=0, hi=1)
         if self.reject > self.accept:
-            raise InputError(f"parameter reject={self.reject!r}: must not exceed accept={self.accept!r}")
+            raise InputError(
+                f"parameter reject={self.reject!r}: must not exceed accept={self.accept!r}"
+            )
 
 
 def _radii(radii, n_dim: int) -> np.ndarray:
@@ -69,7 +72,9 @@ def _bounds(X: np.ndarray, bounds):
     span = hi - lo
     if np.any(span <= 0):
         k = int(np.flatnonzero(span <= 0)[0])
-        raise InputError(f"subclust: data column {k} has no spread (min = max = {lo[k]:g}); drop it")
+        raise InputError(
+            f"subclust: data column {k} has no spread (min = max = {lo[k]:g}); drop it"
+        )
     return lo, hi
 
 
@@ -85,8 +90,16 @@ def unit_sqdist(X, bounds=None) -> np.ndarray:
     return np.sum((Z[:, None, :] - Z[None, :, :]) ** 2, axis=2)
 
 
-def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions(), *,
-             return_trace: bool = False, max_centers: int | None = None, sqdist=None):
+def subclust(
+    X,
+    radii,
+    bounds=None,
+    options: SubclustOptions = SubclustOptions(),
+    *,
+    return_trace: bool = False,
+    max_centers: int | None = None,
+    sqdist=None,
+):
     """Subtractive clustering exactly as MATLAB ``subclust`` (see the module docstring).
 
     Parameters
@@ -134,7 +147,7 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
         pot = np.exp((-4.0 / r[0] ** 2) * sqdist).sum(axis=1)
     else:
         Zs = Z / r
-        sq = np.sum(Zs ** 2, axis=1)
+        sq = np.sum(Zs**2, axis=1)
         d2 = np.maximum(sq[:, None] + sq[None, :] - 2.0 * Zs @ Zs.T, 0.0)
         pot = np.exp(-4.0 * d2).sum(axis=1)
     centres = np.empty((0, d))
@@ -149,7 +162,11 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
             take = True
             trace.append("accept")
         elif ratio > options.reject:
-            dmin = np.sqrt(np.min(np.sum(((x - centres) / r) ** 2, axis=1))) if len(centres) else np.inf
+            dmin = (
+                np.sqrt(np.min(np.sum(((x - centres) / r) ** 2, axis=1)))
+                if len(centres)
+                else np.inf
+            )
             take = bool(ratio + dmin >= 1.0)
             trace.append("grey-accept" if take else "grey-reject")
         else:
@@ -164,7 +181,7 @@ def subclust(X, radii, bounds=None, options: SubclustOptions = SubclustOptions()
                 e = np.exp((-4.0 / (options.squash * r[0]) ** 2) * sqdist[k])
             else:
                 dz = (Z - x) / (options.squash * r)
-                e = np.exp(-4.0 * np.sum(dz ** 2, axis=1))
+                e = np.exp(-4.0 * np.sum(dz**2, axis=1))
             pot = np.maximum(pot - pmax * e, 0.0)
         else:
             pot[k] = 0.0
@@ -195,8 +212,10 @@ class SugenoFIS:
     def __post_init__(self):
         c, s, p = (np.asarray(a, float) for a in (self.centers, self.sigmas, self.consequents))
         if c.ndim != 2 or s.shape != c.shape or p.shape != (c.shape[0], c.shape[1] + 1):
-            raise InputError(f"SugenoFIS: centers {c.shape}, sigmas {s.shape}, consequents {p.shape} "
-                             "do not fit (R, n), (R, n), (R, n + 1)")
+            raise InputError(
+                f"SugenoFIS: centers {c.shape}, sigmas {s.shape}, consequents {p.shape} "
+                "do not fit (R, n), (R, n), (R, n + 1)"
+            )
         if np.any(s <= 0):
             raise InputError("SugenoFIS: sigmas must be > 0")
         object.__setattr__(self, "centers", c)
@@ -211,7 +230,7 @@ class SugenoFIS:
         """Rule firing strengths ``w`` (N, R)."""
         X = np.atleast_2d(np.asarray(X, float))
         z = (X[:, None, :] - self.centers[None]) / self.sigmas[None]
-        return np.exp(-0.5 * np.sum(z ** 2, axis=2))
+        return np.exp(-0.5 * np.sum(z**2, axis=2))
 
     def __call__(self, X) -> np.ndarray:
         """Outputs (N,) as MATLAB ``evalfis`` (weighted average; 0 where no rule fires, as MATLAB's

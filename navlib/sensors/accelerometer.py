@@ -39,6 +39,7 @@ The Fourier coefficients of one tumble (``q`` over 24 equally spaced positions) 
 
     A0 = K0 + K1 K2/2,  A1 = 1000 K1,  B1 = K1 delta_o,  A2 = K1 K2/2,  B2 = K1 Kip/2.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -60,19 +61,19 @@ class AccelCoefficients:
 
     Units are in the names: ``mg``, ``per_c`` (relative per degC), ``mg_g2`` (mg per g^2)."""
 
-    k0c_mg: float = 0.8                 # bias at 55 degC
-    bias_lin_mg_c: float = 0.0175       # b1
-    bias_quad_mg_c2: float = 2.0e-5     # b2
-    bias_cub_mg_c3: float = 2.0e-7      # b3
-    bias_step_mg: float = 0.12          # height s of the tanh step
-    bias_step_c: float = 10.0           # its centre T_s
-    bias_step_width_c: float = 8.0      # its width w
-    sf_lin_per_c: float = -4.2e-5       # k1 (relative scale-factor change per degC)
-    sf_quad_per_c2: float = 1.5e-8      # k2
-    k2c_mg_g2: float = 0.02             # K2 at 55 degC (20 ug/g^2)
-    k2_temp_mg_g2_c: float = -0.002     # k2t (K2 change per degC)
-    kip_mg_g2: float = 0.03             # cross-coupling Kip (30 ug/g^2)
-    delta_o_mg: float = 0.2             # misalignment delta_o (0.2 mrad = 0.2 mg per g of a_p)
+    k0c_mg: float = 0.8  # bias at 55 degC
+    bias_lin_mg_c: float = 0.0175  # b1
+    bias_quad_mg_c2: float = 2.0e-5  # b2
+    bias_cub_mg_c3: float = 2.0e-7  # b3
+    bias_step_mg: float = 0.12  # height s of the tanh step
+    bias_step_c: float = 10.0  # its centre T_s
+    bias_step_width_c: float = 8.0  # its width w
+    sf_lin_per_c: float = -4.2e-5  # k1 (relative scale-factor change per degC)
+    sf_quad_per_c2: float = 1.5e-8  # k2
+    k2c_mg_g2: float = 0.02  # K2 at 55 degC (20 ug/g^2)
+    k2_temp_mg_g2_c: float = -0.002  # k2t (K2 change per degC)
+    kip_mg_g2: float = 0.03  # cross-coupling Kip (30 ug/g^2)
+    delta_o_mg: float = 0.2  # misalignment delta_o (0.2 mrad = 0.2 mg per g of a_p)
 
     def __post_init__(self):
         for name in self.__dataclass_fields__:
@@ -86,13 +87,18 @@ class AccelCoefficients:
         d = t - T_REF_C
         w = self.bias_step_width_c
         step = np.tanh((t - self.bias_step_c) / w) - np.tanh((T_REF_C - self.bias_step_c) / w)
-        return (self.k0c_mg + self.bias_lin_mg_c * d + self.bias_quad_mg_c2 * d ** 2
-                + self.bias_cub_mg_c3 * d ** 3 + self.bias_step_mg * step)
+        return (
+            self.k0c_mg
+            + self.bias_lin_mg_c * d
+            + self.bias_quad_mg_c2 * d**2
+            + self.bias_cub_mg_c3 * d**3
+            + self.bias_step_mg * step
+        )
 
     def scale_factor(self, temperature_c) -> np.ndarray:
         """``K1(T) = 1 + kappa(T)`` relative to the nominal scale factor."""
         d = np.asarray(temperature_c, float) - T_REF_C
-        return 1.0 + self.sf_lin_per_c * d + self.sf_quad_per_c2 * d ** 2
+        return 1.0 + self.sf_lin_per_c * d + self.sf_quad_per_c2 * d**2
 
     def second_order_mg_g2(self, temperature_c) -> np.ndarray:
         """``K2(T)`` in mg/g^2."""
@@ -104,10 +110,16 @@ class AccelCoefficients:
         q = np.deg2rad(np.asarray(position_deg, float))
         ai, ap = np.cos(q), np.sin(q)
         k1 = self.scale_factor(temperature_c)
-        return self.bias_mg(temperature_c) + k1 * (1000.0 * ai + self.second_order_mg_g2(temperature_c) * ai ** 2
-                                                   + self.kip_mg_g2 * ai * ap + self.delta_o_mg * ap)
+        return self.bias_mg(temperature_c) + k1 * (
+            1000.0 * ai
+            + self.second_order_mg_g2(temperature_c) * ai**2
+            + self.kip_mg_g2 * ai * ap
+            + self.delta_o_mg * ap
+        )
 
-    def batch_member(self, spread_rel: float, seed: int | np.random.SeedSequence) -> "AccelCoefficients":
+    def batch_member(
+        self, spread_rel: float, seed: int | np.random.SeedSequence
+    ) -> "AccelCoefficients":
         """Another unit of the same batch: every temperature coefficient (and the bias, K2, Kip, delta_o at
         55 degC) multiplied by ``1 + spread_rel z`` with ``z ~ N(0, 1)`` drawn from ``seed`` (an integer
         entropy or a ``SeedSequence``); the step position and width stay (same construction).  The same
@@ -115,7 +127,9 @@ class AccelCoefficients:
         deviation from this one."""
         check_param("batch_spread_rel", spread_rel, lo=0, hi=1)
         rng = np.random.default_rng(child(seed))
-        names = [n for n in self.__dataclass_fields__ if n not in ("bias_step_c", "bias_step_width_c")]
+        names = [
+            n for n in self.__dataclass_fields__ if n not in ("bias_step_c", "bias_step_width_c")
+        ]
         f = 1.0 + spread_rel * rng.standard_normal(len(names))
         return replace(self, **{n: getattr(self, n) * fi for n, fi in zip(names, f)})
 
@@ -144,20 +158,28 @@ class TumbleExperiment:
         check_param("t_stop_c", self.t_stop_c, lo=-60, hi=130)
         check_param("t_step_c", self.t_step_c, lo=0.5, hi=100)
         if self.t_stop_c <= self.t_start_c:
-            raise InputError(f"parameter t_stop_c={self.t_stop_c!r}: must be above t_start_c={self.t_start_c!r}")
+            raise InputError(
+                f"parameter t_stop_c={self.t_stop_c!r}: must be above t_start_c={self.t_start_c!r}"
+            )
         check_param("n_positions", self.n_positions, lo=4, hi=360, integer=True)
         if 360 % int(self.n_positions):
-            raise InputError(f"parameter n_positions={self.n_positions!r}: must divide 360 (whole-degree grid)")
+            raise InputError(
+                f"parameter n_positions={self.n_positions!r}: must divide 360 (whole-degree grid)"
+            )
         check_param("noise_ug", self.noise_ug, lo=0, hi=10000)
         check_param("lag_tau_min", self.lag_tau_min, lo=0, hi=600)
         check_param("soak_min", self.soak_min, lo=0, hi=1440)
         check_param("dwell_min", self.dwell_min, lo=0, hi=60)
         check_param("start_chamber_c", self.start_chamber_c, lo=-60, hi=130)
         if not np.any(np.isclose(self.set_points_c, self.reference_c)):
-            raise InputError(f"parameter reference_c={self.reference_c!r}: must be one of the set points "
-                             f"{self.t_start_c:g}..{self.t_stop_c:g} step {self.t_step_c:g}")
+            raise InputError(
+                f"parameter reference_c={self.reference_c!r}: must be one of the set points "
+                f"{self.t_start_c:g}..{self.t_stop_c:g} step {self.t_step_c:g}"
+            )
         if self.set_points_c.size < 3:
-            raise InputError("parameters t_start_c..t_stop_c step t_step_c: fewer than 3 temperatures")
+            raise InputError(
+                "parameters t_start_c..t_stop_c step t_step_c: fewer than 3 temperatures"
+            )
 
     @property
     def set_points_c(self) -> np.ndarray:
@@ -173,7 +195,7 @@ def sensor_temperatures_c(exp: TumbleExperiment) -> np.ndarray:
     """Sensor temperature of every reading, ``(n_set_points, n_positions)``: first-order lag toward each set
     point, starting from the previous point's final temperature (the chamber's start temperature first)."""
     sp = exp.set_points_c
-    t_read = exp.soak_min + exp.dwell_min * np.arange(exp.n_positions)        # minutes after the step
+    t_read = exp.soak_min + exp.dwell_min * np.arange(exp.n_positions)  # minutes after the step
     out = np.empty((sp.size, exp.n_positions))
     prev = exp.start_chamber_c
     for k, s in enumerate(sp):
@@ -184,8 +206,12 @@ def sensor_temperatures_c(exp: TumbleExperiment) -> np.ndarray:
     return out
 
 
-def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence,
-                    unit: str = "A") -> pd.DataFrame:
+def simulate_tumble(
+    coef: AccelCoefficients,
+    exp: TumbleExperiment,
+    seed: int | np.random.SeedSequence,
+    unit: str = "A",
+) -> pd.DataFrame:
     """One unit's multi-position full-temperature test: a tidy frame with ``set_point_c``, ``temperature_c``
     (the sensor's, lagged), ``position_deg``, ``output_mg`` (noisy), ``true_output_mg`` (noise-free) and
     ``unit``; 552 rows for the paper's experiment.  Noise from ``np.random.SeedSequence(seed)`` (or from
@@ -198,12 +224,21 @@ def simulate_tumble(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | 
     sp = np.broadcast_to(exp.set_points_c[:, None], temps.shape)
     true = coef.output_mg(temps, pos)
     noisy = true + 1e-3 * exp.noise_ug * rng.standard_normal(true.shape)
-    return pd.DataFrame({"set_point_c": sp.ravel(), "temperature_c": temps.ravel(),
-                         "position_deg": pos.ravel(), "output_mg": noisy.ravel(),
-                         "true_output_mg": true.ravel(), "unit": str(unit)})
+    return pd.DataFrame(
+        {
+            "set_point_c": sp.ravel(),
+            "temperature_c": temps.ravel(),
+            "position_deg": pos.ravel(),
+            "output_mg": noisy.ravel(),
+            "true_output_mg": true.ravel(),
+            "unit": str(unit),
+        }
+    )
 
 
-def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence) -> pd.DataFrame:
+def bias_test(
+    coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.random.SeedSequence
+) -> pd.DataFrame:
     """The 0/180 deg bias test at each set point: ``(U(0) + U(180))/2 = K0 + K1 K2`` (the second-order term
     stays in: this is what the paper's bias test measures).  Columns ``set_point_c``, ``temperature_c``,
     ``bias_mg`` (measured), ``true_bias_mg`` (the same test without noise).  ``seed``: an integer entropy
@@ -212,8 +247,14 @@ def bias_test(coef: AccelCoefficients, exp: TumbleExperiment, seed: int | np.ran
     temps = sensor_temperatures_c(exp)[:, 0]
     u = coef.output_mg(temps[:, None], np.array([0.0, 180.0])[None, :])
     noisy = u + 1e-3 * exp.noise_ug * rng.standard_normal(u.shape)
-    return pd.DataFrame({"set_point_c": exp.set_points_c, "temperature_c": temps,
-                         "bias_mg": noisy.mean(axis=1), "true_bias_mg": u.mean(axis=1)})
+    return pd.DataFrame(
+        {
+            "set_point_c": exp.set_points_c,
+            "temperature_c": temps,
+            "bias_mg": noisy.mean(axis=1),
+            "true_bias_mg": u.mean(axis=1),
+        }
+    )
 
 
 # ------------------------------------------------------------------------------------- Fourier analysis
@@ -226,7 +267,9 @@ def tumble_fourier(position_deg, output_mg) -> dict:
     q = np.deg2rad(np.asarray(position_deg, float))
     u = np.asarray(output_mg, float)
     if np.unique(np.round(q, 9)).size < 7:
-        raise InputError(f"tumble Fourier fit: {np.unique(np.round(q, 9)).size} distinct positions, needs >= 7")
+        raise InputError(
+            f"tumble Fourier fit: {np.unique(np.round(q, 9)).size} distinct positions, needs >= 7"
+        )
     X = np.column_stack([np.ones_like(q)] + [f(k * q) for k in (1, 2, 3) for f in (np.cos, np.sin)])
     c, *_ = np.linalg.lstsq(X, u, rcond=None)
     return dict(zip(FOURIER_TERMS, c))
@@ -236,8 +279,13 @@ def coefficients_from_fourier(f: dict) -> dict:
     """IEEE 1293 coefficients from the Fourier terms: ``K1 = A1/1000``, ``K2 = 2 A2/K1`` (mg/g^2),
     ``K0 = A0 - A2`` (mg), ``Kip = 2 B2/K1`` (mg/g^2), ``delta_o = B1/K1`` (mg/g)."""
     k1 = f["A1"] / 1000.0
-    return {"k0_mg": f["A0"] - f["A2"], "k1": k1, "k2_mg_g2": 2 * f["A2"] / k1,
-            "kip_mg_g2": 2 * f["B2"] / k1, "delta_o_mg": f["B1"] / k1}
+    return {
+        "k0_mg": f["A0"] - f["A2"],
+        "k1": k1,
+        "k2_mg_g2": 2 * f["A2"] / k1,
+        "kip_mg_g2": 2 * f["B2"] / k1,
+        "delta_o_mg": f["B1"] / k1,
+    }
 
 
 def tumble_coefficients(df: pd.DataFrame, by: str = "set_point_c") -> pd.DataFrame:
@@ -256,14 +304,20 @@ DATA_SEEDS = {"noise_a": 12, "batch_b": 2, "noise_b": 13}
 BATCH_SPREAD_REL = 0.25
 
 
-def paper_units(exp: TumbleExperiment = DEFAULT_EXPERIMENT, coef: AccelCoefficients = DEFAULT_COEFFICIENTS,
-                batch_spread_rel: float = BATCH_SPREAD_REL, seeds: dict | None = None) -> pd.DataFrame:
+def paper_units(
+    exp: TumbleExperiment = DEFAULT_EXPERIMENT,
+    coef: AccelCoefficients = DEFAULT_COEFFICIENTS,
+    batch_spread_rel: float = BATCH_SPREAD_REL,
+    seeds: dict | None = None,
+) -> pd.DataFrame:
     """Both units of the chapter: unit ``A`` (the modelled one) and unit ``B`` (same batch, coefficients
     within ``batch_spread_rel``), stacked."""
     s = {**DATA_SEEDS, **(seeds or {})}
     b = coef.batch_member(batch_spread_rel, s["batch_b"])
-    return pd.concat([simulate_tumble(coef, exp, s["noise_a"], "A"),
-                      simulate_tumble(b, exp, s["noise_b"], "B")], ignore_index=True)
+    return pd.concat(
+        [simulate_tumble(coef, exp, s["noise_a"], "A"), simulate_tumble(b, exp, s["noise_b"], "B")],
+        ignore_index=True,
+    )
 
 
 def write_paper_data(path, overwrite: bool = False):

@@ -34,6 +34,7 @@ trace-free distortion: a two-cycle error), ``hard_iron`` = ``(hx, hy)`` in units
 error).  This model is *exact* (not a truncated harmonic series); Archibald Smith's A..E deviation
 series (:mod:`navlib.methods.smith`) is its first-order harmonic approximation.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
@@ -98,23 +99,36 @@ class CompassErrors:
     """
 
     hard_iron_ut: tuple[float, float, float] = (-6.1, 7.7, 3.0)
-    soft_iron: tuple[tuple[float, float, float], ...] = ((0.08, 0.08, 0.01),
-                                                          (-0.03, -0.08, 0.00),
-                                                          (0.01, 0.00, 0.03))
+    soft_iron: tuple[tuple[float, float, float], ...] = (
+        (0.08, 0.08, 0.01),
+        (-0.03, -0.08, 0.00),
+        (0.01, 0.00, 0.03),
+    )
     scale_error: tuple[float, float, float] = (0.015, -0.01, 0.005)
-    nonorthogonality_deg: tuple[float, float, float] = (0.4, 0.2, -0.3)   # xy, xz, yz
-    misalignment_deg: tuple[float, float, float] = (0.3, -0.5, 1.6)       # roll, pitch, yaw
-    hard_iron_tc_ut_per_c: tuple[float, float, float] = (0.0, 0.0, 0.0)  # hard-iron drift with temperature
+    nonorthogonality_deg: tuple[float, float, float] = (0.4, 0.2, -0.3)  # xy, xz, yz
+    misalignment_deg: tuple[float, float, float] = (0.3, -0.5, 1.6)  # roll, pitch, yaw
+    hard_iron_tc_ut_per_c: tuple[float, float, float] = (
+        0.0,
+        0.0,
+        0.0,
+    )  # hard-iron drift with temperature
     reference_temperature_c: float = 20.0
-    noise_ut: float = 0.04                                                # white noise per axis, 1 sigma
+    noise_ut: float = 0.04  # white noise per axis, 1 sigma
 
     def __post_init__(self):
         check_param("noise_ut", self.noise_ut, lo=0)
-        for name in ("hard_iron_ut", "scale_error", "nonorthogonality_deg", "misalignment_deg",
-                     "hard_iron_tc_ut_per_c"):
+        for name in (
+            "hard_iron_ut",
+            "scale_error",
+            "nonorthogonality_deg",
+            "misalignment_deg",
+            "hard_iron_tc_ut_per_c",
+        ):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (3,) or not np.all(np.isfinite(v)):
-                raise InputError(f"parameter {name}={getattr(self, name)!r}: must be three finite numbers")
+                raise InputError(
+                    f"parameter {name}={getattr(self, name)!r}: must be three finite numbers"
+                )
         s = np.asarray(self.soft_iron, dtype=float)
         if s.shape != (3, 3) or not np.all(np.isfinite(s)):
             raise InputError("parameter soft_iron: must be a 3x3 matrix of finite numbers")
@@ -123,18 +137,25 @@ class CompassErrors:
 
     def scaled(self, factor: float) -> "CompassErrors":
         """All deterministic error sources multiplied by ``factor`` (noise unchanged)."""
-        return replace(self,
-                       hard_iron_ut=tuple(factor * np.asarray(self.hard_iron_ut)),
-                       soft_iron=tuple(map(tuple, factor * np.asarray(self.soft_iron))),
-                       scale_error=tuple(factor * np.asarray(self.scale_error)),
-                       nonorthogonality_deg=tuple(factor * np.asarray(self.nonorthogonality_deg)),
-                       misalignment_deg=tuple(factor * np.asarray(self.misalignment_deg)),
-                       hard_iron_tc_ut_per_c=tuple(factor * np.asarray(self.hard_iron_tc_ut_per_c)))
+        return replace(
+            self,
+            hard_iron_ut=tuple(factor * np.asarray(self.hard_iron_ut)),
+            soft_iron=tuple(map(tuple, factor * np.asarray(self.soft_iron))),
+            scale_error=tuple(factor * np.asarray(self.scale_error)),
+            nonorthogonality_deg=tuple(factor * np.asarray(self.nonorthogonality_deg)),
+            misalignment_deg=tuple(factor * np.asarray(self.misalignment_deg)),
+            hard_iron_tc_ut_per_c=tuple(factor * np.asarray(self.hard_iron_tc_ut_per_c)),
+        )
 
 
-NO_ERRORS = CompassErrors(hard_iron_ut=(0.0, 0.0, 0.0), soft_iron=((0.0,) * 3,) * 3,
-                          scale_error=(0.0, 0.0, 0.0), nonorthogonality_deg=(0.0, 0.0, 0.0),
-                          misalignment_deg=(0.0, 0.0, 0.0), noise_ut=0.0)
+NO_ERRORS = CompassErrors(
+    hard_iron_ut=(0.0, 0.0, 0.0),
+    soft_iron=((0.0,) * 3,) * 3,
+    scale_error=(0.0, 0.0, 0.0),
+    nonorthogonality_deg=(0.0, 0.0, 0.0),
+    misalignment_deg=(0.0, 0.0, 0.0),
+    noise_ut=0.0,
+)
 
 
 @dataclass(frozen=True)
@@ -188,8 +209,11 @@ def sensor_matrix(err: CompassErrors) -> np.ndarray:
     """``(I + K) N R``: scale errors, non-orthogonality (small angles xy, xz, yz) and mounting rotation."""
     a_xy, a_xz, a_yz = np.radians(np.asarray(err.nonorthogonality_deg, dtype=float))
     nonorth = np.array([[1.0, 0.0, 0.0], [a_xy, 1.0, 0.0], [a_xz, a_yz, 1.0]])
-    return np.diag(1.0 + np.asarray(err.scale_error, dtype=float)) @ nonorth @ mounting_matrix(
-        err.misalignment_deg)
+    return (
+        np.diag(1.0 + np.asarray(err.scale_error, dtype=float))
+        @ nonorth
+        @ mounting_matrix(err.misalignment_deg)
+    )
 
 
 def heading_from_field(m_xyz) -> np.ndarray:
@@ -198,9 +222,13 @@ def heading_from_field(m_xyz) -> np.ndarray:
     return heading_deg(m[..., 0], m[..., 1])
 
 
-def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField | None = None,
-                   config: SweepConfig = SweepConfig(), seed: int | None = 0,
-                   sweep: int = 1) -> pd.DataFrame:
+def simulate_sweep(
+    errors: CompassErrors = CompassErrors(),
+    earth: EarthField | None = None,
+    config: SweepConfig = SweepConfig(),
+    seed: int | None = 0,
+    sweep: int = 1,
+) -> pd.DataFrame:
     """One turntable sweep. Returns a frame with ``true_heading_deg``, ``measured_heading_deg`` (in [0, 360)),
     ``heading_error_deg`` (wrapped measured - true), the raw field ``mag_x_ut, mag_y_ut, mag_z_ut``, the
     accelerometer ``acc_x_ms2, acc_y_ms2, acc_z_ms2`` (specific force, sensor frame), ``temperature_c``,
@@ -209,13 +237,14 @@ def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField | 
     earth = EarthField() if earth is None else earth
     rng = np.random.default_rng(seed)
     psi = config.start_deg + config.step_deg * np.arange(config.n_points)
-    true = np.where(psi == 360.0, 360.0, np.mod(psi, 360.0))   # paper A reads 0..360 inclusive
+    true = np.where(psi == 360.0, 360.0, np.mod(psi, 360.0))  # paper A reads 0..360 inclusive
     p = np.radians(psi)
     H, Z = earth.horizontal_ut, earth.vertical_ut
     m_b = np.stack([H * np.cos(p), -H * np.sin(p), np.full_like(p, Z)], axis=1)
     temp = config.temperature_c + config.temperature_rate_c_per_point * np.arange(config.n_points)
-    h = (np.asarray(errors.hard_iron_ut, dtype=float)[None, :]
-         + np.outer(temp - errors.reference_temperature_c, np.asarray(errors.hard_iron_tc_ut_per_c)))
+    h = np.asarray(errors.hard_iron_ut, dtype=float)[None, :] + np.outer(
+        temp - errors.reference_temperature_c, np.asarray(errors.hard_iron_tc_ut_per_c)
+    )
     carrier = m_b @ (np.eye(3) + np.asarray(errors.soft_iron, dtype=float)).T + h
     T = sensor_matrix(errors)
     mag = carrier @ T.T + errors.noise_ut * rng.standard_normal(carrier.shape)
@@ -223,28 +252,43 @@ def simulate_sweep(errors: CompassErrors = CompassErrors(), earth: EarthField | 
     if glitch.any():
         d = rng.standard_normal((int(glitch.sum()), 3))
         mag[glitch] += config.glitch_ut * d / np.linalg.norm(d, axis=1, keepdims=True)
-    f_body = np.array([0.0, 0.0, -config.gravity_ms2])      # level and static: specific force points up
+    f_body = np.array([0.0, 0.0, -config.gravity_ms2])  # level and static: specific force points up
     acc = np.tile(mounting_matrix(errors.misalignment_deg) @ f_body, (config.n_points, 1))
     acc += config.gravity_noise_ms2 * rng.standard_normal(acc.shape)
     measured = heading_from_field(mag)
-    return pd.DataFrame({
-        "true_heading_deg": true, "measured_heading_deg": measured,
-        "heading_error_deg": wrap_deg(measured - true),
-        "mag_x_ut": mag[:, 0], "mag_y_ut": mag[:, 1], "mag_z_ut": mag[:, 2],
-        "acc_x_ms2": acc[:, 0], "acc_y_ms2": acc[:, 1], "acc_z_ms2": acc[:, 2],
-        "temperature_c": temp, "glitch": glitch.astype(int), "sweep": sweep,
-    })
+    return pd.DataFrame(
+        {
+            "true_heading_deg": true,
+            "measured_heading_deg": measured,
+            "heading_error_deg": wrap_deg(measured - true),
+            "mag_x_ut": mag[:, 0],
+            "mag_y_ut": mag[:, 1],
+            "mag_z_ut": mag[:, 2],
+            "acc_x_ms2": acc[:, 0],
+            "acc_y_ms2": acc[:, 1],
+            "acc_z_ms2": acc[:, 2],
+            "temperature_c": temp,
+            "glitch": glitch.astype(int),
+            "sweep": sweep,
+        }
+    )
 
 
-def simulate_train_test(errors: CompassErrors = CompassErrors(), earth: EarthField | None = None,
-                        config: SweepConfig = SweepConfig(), seed: int = 2024) -> pd.DataFrame:
+def simulate_train_test(
+    errors: CompassErrors = CompassErrors(),
+    earth: EarthField | None = None,
+    config: SweepConfig = SweepConfig(),
+    seed: int = 2024,
+) -> pd.DataFrame:
     """Paper A's experiment: the same carrier swept twice with independent noise; ``sweep`` 1 trains,
     ``sweep`` 2 tests. Both are drawn deterministically from ``seed``; ``earth`` None: the IGRF default
     (paper A's own sweeps pass :data:`PAPER_A_EARTH`)."""
     earth = EarthField() if earth is None else earth
     s1, s2 = np.random.SeedSequence(seed).spawn(2)
-    return pd.concat([simulate_sweep(errors, earth, config, seed=np.random.default_rng(s1), sweep=1),
-                      simulate_sweep(errors, earth, config, seed=np.random.default_rng(s2), sweep=2)],
-                     ignore_index=True)
-
-
+    return pd.concat(
+        [
+            simulate_sweep(errors, earth, config, seed=np.random.default_rng(s1), sweep=1),
+            simulate_sweep(errors, earth, config, seed=np.random.default_rng(s2), sweep=2),
+        ],
+        ignore_index=True,
+    )

@@ -8,6 +8,7 @@ is downloaded at run time).
 coordinates (WGS84) by ``ppigrf.igrf``.  Reported in NED, uT: north, east, down, horizontal, intensity
 ``F``, dip (inclination, positive downward) and declination (positive east of true north).
 """
+
 from __future__ import annotations
 
 import datetime as dt
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, check_param
+
 
 @dataclass(frozen=True)
 class Site:
@@ -59,7 +61,7 @@ class EarthField:
 
     @property
     def intensity_ut(self) -> float:
-        return float(np.sqrt(self.north_ut ** 2 + self.east_ut ** 2 + self.down_ut ** 2))
+        return float(np.sqrt(self.north_ut**2 + self.east_ut**2 + self.down_ut**2))
 
     @property
     def dip_deg(self) -> float:
@@ -70,19 +72,34 @@ class EarthField:
         return float(np.degrees(np.arctan2(self.east_ut, self.north_ut)))
 
     def to_dict(self) -> dict:
-        return {"north_ut": self.north_ut, "east_ut": self.east_ut, "down_ut": self.down_ut,
-                "horizontal_ut": self.horizontal_ut, "intensity_ut": self.intensity_ut, "dip_deg": self.dip_deg,
-                "declination_deg": self.declination_deg}
+        return {
+            "north_ut": self.north_ut,
+            "east_ut": self.east_ut,
+            "down_ut": self.down_ut,
+            "horizontal_ut": self.horizontal_ut,
+            "intensity_ut": self.intensity_ut,
+            "dip_deg": self.dip_deg,
+            "declination_deg": self.declination_deg,
+        }
 
 
 def igrf_field(site: Site) -> EarthField:
     """The IGRF-14 main field at ``site`` (module docstring)."""
     try:
         import ppigrf  # noqa: PLC0415  # lazy: ppigrf reads its coefficient files at import (0.3 s)
-    except ImportError:                                 # a core dependency; said in one line if absent
-        raise InputError("the Earth-field model needs the package ppigrf (pip install ppigrf==2.1.0)") from None
+    except ImportError:  # a core dependency; said in one line if absent
+        raise InputError(
+            "the Earth-field model needs the package ppigrf (pip install ppigrf==2.1.0)"
+        ) from None
     when = parse_date(site.date)
-    be, bn, bu = ppigrf.igrf(site.lon_deg, site.lat_deg, site.height_m / 1000.0,
-                             dt.datetime(when.year, when.month, when.day))
-    return EarthField(float(np.ravel(bn)[0]) / 1000.0, float(np.ravel(be)[0]) / 1000.0,
-                      -float(np.ravel(bu)[0]) / 1000.0)
+    be, bn, bu = ppigrf.igrf(
+        site.lon_deg,
+        site.lat_deg,
+        site.height_m / 1000.0,
+        dt.datetime(when.year, when.month, when.day),
+    )
+    return EarthField(
+        float(np.ravel(bn)[0]) / 1000.0,
+        float(np.ravel(be)[0]) / 1000.0,
+        -float(np.ravel(bu)[0]) / 1000.0,
+    )

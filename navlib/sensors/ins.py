@@ -34,6 +34,7 @@ The system is linear and time-invariant; the forcing is held constant over each 
 exact average of ``Rz(theta)`` over the step).  Each step is then propagated exactly with the matrix
 exponential of the augmented system ``[[A, B], [0, 0]]`` -- 72 h at 60 s steps is 4320 small mat-vec products.
 """
+
 from __future__ import annotations
 
 import math
@@ -48,10 +49,12 @@ from scipy.optimize import minimize_scalar
 from ..angles import ARCSEC, DEG
 from ..errors import InputError, check_param
 from ..seeding import child, sequence
-from ..data.gyro_tables import LOCAL_LATITUDE_DEG  # paper C, the test site (re-exported: ins.LOCAL_LATITUDE_DEG)
+from ..data.gyro_tables import (
+    LOCAL_LATITUDE_DEG,
+)  # paper C, the test site (re-exported: ins.LOCAL_LATITUDE_DEG)
 
-DEG_H = DEG / 3600.0            # 1 deg/h in rad/s
-UG = 9.80665e-6                 # 1 micro-g in m/s^2
+DEG_H = DEG / 3600.0  # 1 deg/h in rad/s
+UG = 9.80665e-6  # 1 micro-g in m/s^2
 NMI = 1852.0
 
 STATE_NAMES = ("phi_E", "phi_N", "phi_U", "dV_E", "dV_N", "dL", "dlon")
@@ -111,8 +114,13 @@ class ImuErrors:
     accel_noise_ug_rt_hz: float = 0.0
 
     def __post_init__(self):
-        for f in ("gyro_bias_x_deg_h", "gyro_bias_y_deg_h", "axial_drift_deg_h", "accel_bias_x_ug",
-                  "accel_bias_y_ug"):
+        for f in (
+            "gyro_bias_x_deg_h",
+            "gyro_bias_y_deg_h",
+            "axial_drift_deg_h",
+            "accel_bias_x_ug",
+            "accel_bias_y_ug",
+        ):
             check_param(f, getattr(self, f))
         check_param("gyro_arw_deg_rt_h", self.gyro_arw_deg_rt_h, lo=0)
         check_param("accel_noise_ug_rt_hz", self.accel_noise_ug_rt_hz, lo=0)
@@ -130,8 +138,17 @@ class InitialErrors:
     vel_north_m_s: float = 0.0
 
     def state(self) -> np.ndarray:
-        return np.array([self.tilt_east_arcsec * ARCSEC, self.tilt_north_arcsec * ARCSEC,
-                         self.azimuth_arcsec * ARCSEC, self.vel_east_m_s, self.vel_north_m_s, 0.0, 0.0])
+        return np.array(
+            [
+                self.tilt_east_arcsec * ARCSEC,
+                self.tilt_north_arcsec * ARCSEC,
+                self.azimuth_arcsec * ARCSEC,
+                self.vel_east_m_s,
+                self.vel_north_m_s,
+                0.0,
+                0.0,
+            ]
+        )
 
 
 @dataclass(frozen=True)
@@ -147,14 +164,17 @@ class Rotation:
 
     def __post_init__(self):
         if self.kind not in ("none", "indexing", "continuous"):
-            raise InputError(f"parameter rotation kind={self.kind!r}: must be 'none', 'indexing' or "
-                             f"'continuous'")
+            raise InputError(
+                f"parameter rotation kind={self.kind!r}: must be 'none', 'indexing' or 'continuous'"
+            )
         check_param("dwell_s", self.dwell_s, lo=0, lo_open=True)
         check_param("rate_deg_s", self.rate_deg_s)
         if self.kind == "indexing" and not self.positions_deg:
             raise InputError("parameter positions_deg: needs at least one position")
 
-    def mean_cos_sin(self, t0_s: float, n_steps: int, step_s: float) -> tuple[np.ndarray, np.ndarray]:
+    def mean_cos_sin(
+        self, t0_s: float, n_steps: int, step_s: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Average of ``cos(theta)``, ``sin(theta)`` over each step ``[t0 + k step, t0 + (k+1) step)``."""
         k = np.arange(n_steps)
         if self.kind == "none":
@@ -168,8 +188,10 @@ class Rotation:
             return (np.sin(th0 + d) - np.sin(th0)) / d, (np.cos(th0) - np.cos(th0 + d)) / d
         ratio = self.dwell_s / step_s
         if abs(ratio - round(ratio)) > 1e-9:
-            raise InputError(f"parameter dwell_s={self.dwell_s!r}: must be a whole multiple of the step "
-                             f"({step_s:g} s)")
+            raise InputError(
+                f"parameter dwell_s={self.dwell_s!r}: must be a whole multiple of the step "
+                f"({step_s:g} s)"
+            )
         pos = np.asarray(self.positions_deg, float) * DEG
         idx = (np.floor((t0_s + k * step_s) / self.dwell_s + 1e-9).astype(int)) % len(pos)
         return np.cos(pos[idx]), np.sin(pos[idx])
@@ -208,8 +230,11 @@ class ColdStart:
 
     def temperature_c(self, t_h) -> np.ndarray:
         t = np.asarray(t_h, float)
-        return np.interp(t, [0.0, self.align_h, self.align_h + self.identify_h],
-                         [self.align_temp_min_c, self.calib_temp_min_c, self.calib_temp_max_c])
+        return np.interp(
+            t,
+            [0.0, self.align_h, self.align_h + self.identify_h],
+            [self.align_temp_min_c, self.calib_temp_min_c, self.calib_temp_max_c],
+        )
 
     def rate_c_h(self, t_h) -> np.ndarray:
         t = np.asarray(t_h, float)
@@ -218,8 +243,11 @@ class ColdStart:
         return np.where(t < self.align_h, r1, np.where(t < self.align_h + self.identify_h, r2, 0.0))
 
     def axial_drift_deg_h(self, t_h, final_drift_deg_h: float) -> np.ndarray:
-        return (final_drift_deg_h + self.drift_per_c_deg_h * (self.temperature_c(t_h) - self.calib_temp_max_c)
-                + self.drift_per_c_h_deg_h * self.rate_c_h(t_h))
+        return (
+            final_drift_deg_h
+            + self.drift_per_c_deg_h * (self.temperature_c(t_h) - self.calib_temp_max_c)
+            + self.drift_per_c_h_deg_h * self.rate_c_h(t_h)
+        )
 
 
 # ---------------------------------------------------------------------------------------------- the model
@@ -257,7 +285,7 @@ class NavErrors:
     """Error history on a grid of ``t_h`` hours (relative to the start of this navigation run)."""
 
     t_h: np.ndarray
-    states: np.ndarray           # (K+1, 7), see STATE_NAMES; angles in rad, velocities in m/s
+    states: np.ndarray  # (K+1, 7), see STATE_NAMES; angles in rad, velocities in m/s
     earth: Earth
 
     @property
@@ -286,10 +314,18 @@ class NavErrors:
         return self.states[int(np.argmin(np.abs(self.t_h - t_h)))]
 
 
-def simulate(duration_h: float, *, earth: Earth = Earth(), imu: ImuErrors = ImuErrors(),
-             initial: InitialErrors | np.ndarray = InitialErrors(), rotation: Rotation = Rotation(),
-             step_s: float = 60.0, axial_drift_deg_h: np.ndarray | None = None, t0_s: float = 0.0,
-             seed: int | None = 0) -> NavErrors:
+def simulate(
+    duration_h: float,
+    *,
+    earth: Earth = Earth(),
+    imu: ImuErrors = ImuErrors(),
+    initial: InitialErrors | np.ndarray = InitialErrors(),
+    rotation: Rotation = Rotation(),
+    step_s: float = 60.0,
+    axial_drift_deg_h: np.ndarray | None = None,
+    t0_s: float = 0.0,
+    seed: int | None = 0,
+) -> NavErrors:
     """Propagate the navigation errors for ``duration_h`` hours.
 
     ``axial_drift_deg_h``: optional per-step axial drift (length = number of steps) replacing the constant
@@ -299,7 +335,9 @@ def simulate(duration_h: float, *, earth: Earth = Earth(), imu: ImuErrors = ImuE
     check_param("step_s", step_s, lo=0, lo_open=True)
     n = int(round(duration_h * 3600.0 / step_s))
     if n < 1:
-        raise InputError(f"parameter duration_h={duration_h!r}: shorter than one step ({step_s:g} s)")
+        raise InputError(
+            f"parameter duration_h={duration_h!r}: shorter than one step ({step_s:g} s)"
+        )
     Phi, Gam = _discrete(earth, float(step_s))
     cs, sn = rotation.mean_cos_sin(t0_s, n, step_s)
     gx, gy = imu.gyro_bias_x_deg_h * DEG_H, imu.gyro_bias_y_deg_h * DEG_H
@@ -316,7 +354,7 @@ def simulate(duration_h: float, *, earth: Earth = Earth(), imu: ImuErrors = ImuE
     ayb = np.full(n, ay)
     if imu.gyro_arw_deg_rt_h > 0 or imu.accel_noise_ug_rt_hz > 0:
         rng = np.random.default_rng(seed)
-        sg = imu.gyro_arw_deg_rt_h * DEG / 60.0 / math.sqrt(step_s)      # deg/sqrt(h) -> rad/s per step
+        sg = imu.gyro_arw_deg_rt_h * DEG / 60.0 / math.sqrt(step_s)  # deg/sqrt(h) -> rad/s per step
         sa = imu.accel_noise_ug_rt_hz * UG / math.sqrt(step_s)
         noise = rng.standard_normal((n, 5))
         gxb, gyb, ez = gxb + sg * noise[:, 0], gyb + sg * noise[:, 1], ez + sg * noise[:, 2]
@@ -337,9 +375,15 @@ def simulate(duration_h: float, *, earth: Earth = Earth(), imu: ImuErrors = ImuE
 
 
 # ---------------------------------------------------------------------------------------------- Table 1
-def table1_latitude_error(t_h, *, earth: Earth = Earth(), axial_drift_deg_h: float = 0.0,
-                          north_accel_bias_ug: float = 0.0, azimuth_error_arcsec: float = 0.0,
-                          north_velocity_error_m_s: float = 0.0) -> np.ndarray:
+def table1_latitude_error(
+    t_h,
+    *,
+    earth: Earth = Earth(),
+    axial_drift_deg_h: float = 0.0,
+    north_accel_bias_ug: float = 0.0,
+    azimuth_error_arcsec: float = 0.0,
+    north_velocity_error_m_s: float = 0.0,
+) -> np.ndarray:
     """Paper C Table 1, latitude error (deg) on a static base, in this module's sign conventions::
 
         dL = (cos L / W)(1 - cos W t) eps                                    axial gyro drift
@@ -353,7 +397,7 @@ def table1_latitude_error(t_h, *, earth: Earth = Earth(), axial_drift_deg_h: flo
     W, ws, R, L = earth.earth_rate_rad_s, earth.schuler_rad_s, earth.radius_m, earth.lat_rad
     c = math.cos(L)
     dl = (c / W) * (1 - np.cos(W * t)) * axial_drift_deg_h * DEG_H
-    dl = dl + north_accel_bias_ug * UG / (R * (W ** 2 - ws ** 2)) * (np.cos(ws * t) - np.cos(W * t))
+    dl = dl + north_accel_bias_ug * UG / (R * (W**2 - ws**2)) * (np.cos(ws * t) - np.cos(W * t))
     dl = dl - azimuth_error_arcsec * ARCSEC * (c * np.sin(W * t) + (W / ws) * c * np.sin(ws * t))
     dl = dl + north_velocity_error_m_s * np.sin(ws * t) / (R * ws)
     return dl / DEG
@@ -365,14 +409,18 @@ def latitude_error_per_drift(t_h: float = 12.0, earth: Earth = Earth()) -> float
     return float(table1_latitude_error(t_h, earth=earth, axial_drift_deg_h=1.0))
 
 
-def drift_from_latitude_error(latitude_error_deg, t_h: float = 12.0, earth: Earth = Earth()) -> np.ndarray:
+def drift_from_latitude_error(
+    latitude_error_deg, t_h: float = 12.0, earth: Earth = Earth()
+) -> np.ndarray:
     """Inverse of the Table 1 axial-drift term: the axial drift (deg/h) that alone would produce
     ``latitude_error_deg`` after ``t_h`` hours of navigation on a static base -- the physics baseline."""
     check_param("t_h", t_h, lo=0, lo_open=True)
     k = latitude_error_per_drift(t_h, earth)
     if 1 - math.cos(earth.earth_rate_rad_s * t_h * 3600.0) < 0.01:
-        raise InputError(f"parameter t_h={t_h!r}: too close to a whole number of sidereal days, the latitude "
-                         f"error hardly depends on the axial drift then")
+        raise InputError(
+            f"parameter t_h={t_h!r}: too close to a whole number of sidereal days, the latitude "
+            f"error hardly depends on the axial drift then"
+        )
     return np.asarray(latitude_error_deg, float) / k
 
 
@@ -400,11 +448,11 @@ class Procedure:
 class ProcedureResult:
     identify_run: NavErrors
     latitude_error_12h_deg: float
-    final_drift_deg_h: float              # the axial drift during the navigation after identification
+    final_drift_deg_h: float  # the axial drift during the navigation after identification
     identified_drift_deg_h: float
-    after: NavErrors                      # navigation with the identified drift subtracted
-    before: NavErrors                     # same navigation without any axial compensation
-    best_drift_deg_h: float               # the paper's "true drift": compensation minimising the 72 h error
+    after: NavErrors  # navigation with the identified drift subtracted
+    before: NavErrors  # same navigation without any axial compensation
+    best_drift_deg_h: float  # the paper's "true drift": compensation minimising the 72 h error
     unit_response: NavErrors = field(repr=False, default=None)
 
     def position_error_nmi_for(self, compensation_deg_h: float) -> np.ndarray:
@@ -424,10 +472,17 @@ class ProcedureResult:
         return float(self.before.position_error_nmi.max())
 
 
-def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors = ImuErrors(),
-                  initial: InitialErrors = InitialErrors(), earth: Earth = Earth(),
-                  rotation: Rotation = Rotation(), procedure: Procedure = Procedure(),
-                  cold: ColdStart | None = None, seed: int | np.random.SeedSequence | None = 0) -> ProcedureResult:
+def run_procedure(
+    identify: Callable[[float], float] | None,
+    *,
+    imu: ImuErrors = ImuErrors(),
+    initial: InitialErrors = InitialErrors(),
+    earth: Earth = Earth(),
+    rotation: Rotation = Rotation(),
+    procedure: Procedure = Procedure(),
+    cold: ColdStart | None = None,
+    seed: int | np.random.SeedSequence | None = 0,
+) -> ProcedureResult:
     """Run align -> identify -> compensate -> navigate.
 
     ``seed`` (an integer entropy or a ``numpy.random.SeedSequence``) draws the noise of the identification
@@ -441,30 +496,58 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
     p = procedure
     dt = p.step_s
     n_id = int(round(p.identify_h * 3600 / dt))
-    t_mid = p.align_h + (np.arange(n_id) + 0.5) * dt / 3600.0           # hours since power-on
+    t_mid = p.align_h + (np.arange(n_id) + 0.5) * dt / 3600.0  # hours since power-on
     drift_hist = None
     if cold is not None:
         drift_hist = cold.axial_drift_deg_h(t_mid, imu.axial_drift_deg_h)
     t0 = p.align_h * 3600.0
-    run1 = simulate(p.identify_h, earth=earth, imu=imu, initial=initial, rotation=rotation, step_s=dt,
-                    axial_drift_deg_h=drift_hist, t0_s=t0, seed=seed)
+    run1 = simulate(
+        p.identify_h,
+        earth=earth,
+        imu=imu,
+        initial=initial,
+        rotation=rotation,
+        step_s=dt,
+        axial_drift_deg_h=drift_hist,
+        t0_s=t0,
+        seed=seed,
+    )
     lat12 = float(run1.latitude_error_deg[-1])
-    est = float(drift_from_latitude_error(lat12, p.identify_h, earth) if identify is None
-                else identify(lat12))
+    est = float(
+        drift_from_latitude_error(lat12, p.identify_h, earth)
+        if identify is None
+        else identify(lat12)
+    )
     x_reset = run1.states[-1].copy()
-    x_reset[3:] = 0.0                                                      # velocity and position known
+    x_reset[3:] = 0.0  # velocity and position known
     t1 = t0 + p.identify_h * 3600.0
     # the navigation stage draws its own noise: part 1 of the run's seed (SeedSequence spawn key, no arithmetic)
     seed2 = None if seed is None else child(seed, 1)
 
     def nav(drift):
-        return simulate(p.navigate_h, earth=earth, imu=replace(imu, axial_drift_deg_h=drift),
-                        initial=x_reset, rotation=rotation, step_s=dt, t0_s=t1, seed=seed2)
+        return simulate(
+            p.navigate_h,
+            earth=earth,
+            imu=replace(imu, axial_drift_deg_h=drift),
+            initial=x_reset,
+            rotation=rotation,
+            step_s=dt,
+            t0_s=t1,
+            seed=seed2,
+        )
 
     after = nav(imu.axial_drift_deg_h - est)
     before = nav(imu.axial_drift_deg_h)
-    unit = simulate(p.navigate_h, earth=earth, imu=ImuErrors(axial_drift_deg_h=1.0), initial=np.zeros(7),
-                    rotation=rotation, step_s=dt, t0_s=t1, seed=None)
+    unit = simulate(
+        p.navigate_h,
+        earth=earth,
+        imu=ImuErrors(axial_drift_deg_h=1.0),
+        initial=np.zeros(7),
+        rotation=rotation,
+        step_s=dt,
+        t0_s=t1,
+        seed=None,
+    )
     # position error is affine in the residual drift e: p(e) = p(0) + e * p_unit
     base_n = before.north_m - imu.axial_drift_deg_h * unit.north_m
     base_e = before.east_m - imu.axial_drift_deg_h * unit.east_m
@@ -473,37 +556,70 @@ def run_procedure(identify: Callable[[float], float] | None, *, imu: ImuErrors =
         return float(np.max(np.hypot(base_n + e * unit.north_m, base_e + e * unit.east_m)))
 
     span = 0.02
-    res = minimize_scalar(worst, bounds=(imu.axial_drift_deg_h - span, imu.axial_drift_deg_h + span),
-                          method="bounded", options={"xatol": 1e-8})
-    best = imu.axial_drift_deg_h - float(res.x)   # compensation value c with residual e = drift - c
-    return ProcedureResult(identify_run=run1, latitude_error_12h_deg=lat12,
-                           final_drift_deg_h=imu.axial_drift_deg_h, identified_drift_deg_h=est, after=after,
-                           before=before, best_drift_deg_h=best, unit_response=unit)
+    res = minimize_scalar(
+        worst,
+        bounds=(imu.axial_drift_deg_h - span, imu.axial_drift_deg_h + span),
+        method="bounded",
+        options={"xatol": 1e-8},
+    )
+    best = imu.axial_drift_deg_h - float(res.x)  # compensation value c with residual e = drift - c
+    return ProcedureResult(
+        identify_run=run1,
+        latitude_error_12h_deg=lat12,
+        final_drift_deg_h=imu.axial_drift_deg_h,
+        identified_drift_deg_h=est,
+        after=after,
+        before=before,
+        best_drift_deg_h=best,
+        unit_response=unit,
+    )
 
 
-def random_test(rng: np.random.Generator, *, axial_drift_deg_h: float, gyro_bias_sd_deg_h: float = 0.002,
-                accel_bias_sd_ug: float = 20.0, gyro_arw_deg_rt_h: float = 0.0003,
-                tilt_sd_arcsec: float = 1.0, azimuth_sd_arcsec: float = 10.0,
-                velocity_sd_m_s: float = 0.01) -> tuple[ImuErrors, InitialErrors]:
+def random_test(
+    rng: np.random.Generator,
+    *,
+    axial_drift_deg_h: float,
+    gyro_bias_sd_deg_h: float = 0.002,
+    accel_bias_sd_ug: float = 20.0,
+    gyro_arw_deg_rt_h: float = 0.0003,
+    tilt_sd_arcsec: float = 1.0,
+    azimuth_sd_arcsec: float = 10.0,
+    velocity_sd_m_s: float = 0.01,
+) -> tuple[ImuErrors, InitialErrors]:
     """Draw one simulated test: residual horizontal sensor errors after calibration and the alignment
     outcome, all zero-mean normal with the given standard deviations."""
     g = rng.normal(0, gyro_bias_sd_deg_h, 2)
     a = rng.normal(0, accel_bias_sd_ug, 2)
     tl = rng.normal(0, tilt_sd_arcsec, 2)
-    imu = ImuErrors(gyro_bias_x_deg_h=float(g[0]), gyro_bias_y_deg_h=float(g[1]),
-                    axial_drift_deg_h=float(axial_drift_deg_h), accel_bias_x_ug=float(a[0]),
-                    accel_bias_y_ug=float(a[1]), gyro_arw_deg_rt_h=gyro_arw_deg_rt_h)
-    init = InitialErrors(tilt_east_arcsec=float(tl[0]), tilt_north_arcsec=float(tl[1]),
-                         azimuth_arcsec=float(rng.normal(0, azimuth_sd_arcsec)),
-                         vel_east_m_s=float(rng.normal(0, velocity_sd_m_s)),
-                         vel_north_m_s=float(rng.normal(0, velocity_sd_m_s)))
+    imu = ImuErrors(
+        gyro_bias_x_deg_h=float(g[0]),
+        gyro_bias_y_deg_h=float(g[1]),
+        axial_drift_deg_h=float(axial_drift_deg_h),
+        accel_bias_x_ug=float(a[0]),
+        accel_bias_y_ug=float(a[1]),
+        gyro_arw_deg_rt_h=gyro_arw_deg_rt_h,
+    )
+    init = InitialErrors(
+        tilt_east_arcsec=float(tl[0]),
+        tilt_north_arcsec=float(tl[1]),
+        azimuth_arcsec=float(rng.normal(0, azimuth_sd_arcsec)),
+        vel_east_m_s=float(rng.normal(0, velocity_sd_m_s)),
+        vel_north_m_s=float(rng.normal(0, velocity_sd_m_s)),
+    )
     return imu, init
 
 
-def simulated_tests(axial_drifts_deg_h, *, seed: int, identify: Callable[[float], float] | None = None,
-                    cold: list[ColdStart | None] | None = None, earth: Earth = Earth(),
-                    rotation: Rotation = Rotation(), procedure: Procedure = Procedure(),
-                    **error_sd) -> list[ProcedureResult]:
+def simulated_tests(
+    axial_drifts_deg_h,
+    *,
+    seed: int,
+    identify: Callable[[float], float] | None = None,
+    cold: list[ColdStart | None] | None = None,
+    earth: Earth = Earth(),
+    rotation: Rotation = Rotation(),
+    procedure: Procedure = Procedure(),
+    **error_sd,
+) -> list[ProcedureResult]:
     """Run the procedure once per axial drift, each test with its own residual sensor errors and alignment
     outcome drawn by :func:`random_test` (``error_sd``: its standard deviations); ``cold[i]`` optionally
     gives test i a cold-start temperature history.  Test ``i`` draws its errors from
@@ -515,8 +631,19 @@ def simulated_tests(axial_drifts_deg_h, *, seed: int, identify: Callable[[float]
     out = []
     for i, d in enumerate(drifts):
         errors = sequence(seed, i, 0)
-        imu, init = random_test(np.random.default_rng(errors), axial_drift_deg_h=float(d), **error_sd)
-        out.append(run_procedure(identify, imu=imu, initial=init, earth=earth, rotation=rotation,
-                                 procedure=procedure, cold=None if cold is None else cold[i],
-                                 seed=sequence(seed, i, 1)))
+        imu, init = random_test(
+            np.random.default_rng(errors), axial_drift_deg_h=float(d), **error_sd
+        )
+        out.append(
+            run_procedure(
+                identify,
+                imu=imu,
+                initial=init,
+                earth=earth,
+                rotation=rotation,
+                procedure=procedure,
+                cold=None if cold is None else cold[i],
+                seed=sequence(seed, i, 1),
+            )
+        )
     return out

@@ -25,6 +25,7 @@ Discretisation over the filter period ``T`` (paper E's Phi_k,k-1 and Gamma_k,k-1
 ``T <= 1 s``) and ``Q_k = Q T`` with the white-noise densities of the gyros (ARW) and accelerometers (VRW)
 on the attitude and velocity states; the constants have no process noise.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -33,8 +34,23 @@ from .strapdown import ImuSpec, skew
 from .trajectory import EARTH_RATE_RAD_S, radii
 
 N_BASE = 15
-STATE_NAMES = ("phi_E", "phi_N", "phi_U", "dv_E", "dv_N", "dv_U", "dL", "dlon", "dh",
-               "eps_x", "eps_y", "eps_z", "nabla_x", "nabla_y", "nabla_z")
+STATE_NAMES = (
+    "phi_E",
+    "phi_N",
+    "phi_U",
+    "dv_E",
+    "dv_N",
+    "dv_U",
+    "dL",
+    "dlon",
+    "dh",
+    "eps_x",
+    "eps_y",
+    "eps_z",
+    "nabla_x",
+    "nabla_y",
+    "nabla_z",
+)
 SCALE_NAMES = ("sg_x", "sg_y", "sg_z")
 GRAVITY_GRADIENT_S2 = 3.086e-6
 

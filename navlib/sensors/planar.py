@@ -15,6 +15,7 @@ error), and ``temperature`` = ``k`` (the hard iron's drift with temperature).  T
 truncated harmonic series); Archibald Smith's A..E series (:mod:`navlib.methods.smith`) is its first-order
 harmonic approximation.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -61,8 +62,10 @@ class PlanarModel:
         h = np.repeat(np.array([[p["hard_x"]], [p["hard_y"]]]), n, axis=1)
         if p["temp_x_per_c"] or p["temp_y_per_c"]:
             if temperature_c is None:
-                raise InputError("the temperature effect needs the temperature of every reading "
-                                 "(column 'temperature_c')")
+                raise InputError(
+                    "the temperature effect needs the temperature of every reading "
+                    "(column 'temperature_c')"
+                )
             dt = np.asarray(temperature_c, dtype=float) - self.reference_temperature_c
             h = h + np.array([[p["temp_x_per_c"]], [p["temp_y_per_c"]]]) * dt[None, :]
         return h
@@ -90,15 +93,26 @@ class PlanarModel:
         v = S @ np.stack([r0, r1]) + self._offset(p, len(t), temperature_c)
         k = np.degrees(1.0) / np.sum(v * v, axis=0)
         one, zero = np.ones_like(t), np.zeros_like(t)
-        dt = (np.asarray(temperature_c, dtype=float) - self.reference_temperature_c
-              if temperature_c is not None else zero)
-        dv = {"soft_e": (r0, -r1), "soft_f": (r1, r0), "hard_x": (one, zero), "hard_y": (zero, one),
-              "temp_x_per_c": (dt, zero), "temp_y_per_c": (zero, dt)}
+        dt = (
+            np.asarray(temperature_c, dtype=float) - self.reference_temperature_c
+            if temperature_c is not None
+            else zero
+        )
+        dv = {
+            "soft_e": (r0, -r1),
+            "soft_f": (r1, r0),
+            "hard_x": (one, zero),
+            "hard_y": (zero, one),
+            "temp_x_per_c": (dt, zero),
+            "temp_y_per_c": (zero, dt),
+        }
         cols = [one if n == "yaw_deg" else k * (v[1] * dv[n][0] - v[0] * dv[n][1]) for n in names]
         return np.column_stack(cols) if cols else np.zeros((len(t), 0))
 
     def predict_error(self, true_deg, temperature_c=None) -> np.ndarray:
-        return wrap_deg(self.predict_measured(true_deg, temperature_c) - np.asarray(true_deg, dtype=float))
+        return wrap_deg(
+            self.predict_measured(true_deg, temperature_c) - np.asarray(true_deg, dtype=float)
+        )
 
     def correct(self, measured_deg, temperature_c=None) -> np.ndarray:
         """Invert the model: the true heading (deg, [0, 360)) that yields each measured heading.  Solves
@@ -111,17 +125,23 @@ class PlanarModel:
         Si = np.linalg.inv(S)
         a_vec = Si @ (_rotation(p["yaw_deg"]).T @ u)
         b_vec = Si @ self._offset(p, len(a), temperature_c)
-        A = np.sum(a_vec ** 2, axis=0)
+        A = np.sum(a_vec**2, axis=0)
         B = -2 * np.sum(b_vec * a_vec, axis=0)
-        C = np.sum(b_vec ** 2, axis=0) - 1.0
-        disc = np.maximum(B ** 2 - 4 * A * C, 0.0)
+        C = np.sum(b_vec**2, axis=0) - 1.0
+        disc = np.maximum(B**2 - 4 * A * C, 0.0)
         lam = (-B + np.sqrt(disc)) / (2 * A)
         r = lam * a_vec - b_vec
         return heading_deg(r[0], r[1])
 
 
-def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron", "soft_iron"),
-                     initial: dict | None = None, temperature_c=None, full_output: bool = False):
+def fit_planar_model(
+    true_deg,
+    measured_deg,
+    effects=("misalignment", "hard_iron", "soft_iron"),
+    initial: dict | None = None,
+    temperature_c=None,
+    full_output: bool = False,
+):
     """Fit the exact planar model's named effects by nonlinear least squares (scipy ``least_squares``,
     trust-region reflective) on the wrapped heading residual ``wrap(model(true) - measured)``.
 
@@ -130,7 +150,9 @@ def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron
     effects = tuple(effects)
     unknown = [e for e in effects if e not in PLANAR_EFFECTS]
     if unknown:
-        raise InputError(f"unknown compass effect '{unknown[0]}'; known: {', '.join(PLANAR_EFFECTS)}")
+        raise InputError(
+            f"unknown compass effect '{unknown[0]}'; known: {', '.join(PLANAR_EFFECTS)}"
+        )
     names = [n for e in effects for n in PLANAR_EFFECTS[e]]
     true_deg = np.asarray(true_deg, dtype=float)
     measured_deg = np.asarray(measured_deg, dtype=float)
@@ -144,8 +166,9 @@ def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron
         t_ref = float(np.mean(temperature_c))
     x0 = np.array([(initial or {}).get(n, 0.0) for n in names])
     if "yaw_deg" in names and not initial:
-        x0[names.index("yaw_deg")] = float(np.degrees(np.angle(np.mean(
-            np.exp(1j * np.radians(measured_deg - true_deg))))))
+        x0[names.index("yaw_deg")] = float(
+            np.degrees(np.angle(np.mean(np.exp(1j * np.radians(measured_deg - true_deg)))))
+        )
 
     def resid(x):
         model = PlanarModel(effects, dict(zip(names, x)), t_ref)
@@ -156,7 +179,8 @@ def fit_planar_model(true_deg, measured_deg, effects=("misalignment", "hard_iron
     if not names:
         model = PlanarModel(effects, {}, t_ref)
         return (model, None) if full_output else model
-    sol = least_squares(resid, np.clip(x0, lo + 1e-9, hi - 1e-9), bounds=(lo, hi), x_scale="jac",
-                        method="trf")
+    sol = least_squares(
+        resid, np.clip(x0, lo + 1e-9, hi - 1e-9), bounds=(lo, hi), x_scale="jac", method="trf"
+    )
     model = PlanarModel(effects, dict(zip(names, map(float, sol.x))), t_ref)
     return (model, sol) if full_output else model

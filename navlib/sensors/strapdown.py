@@ -34,6 +34,7 @@ exact up to the variation of ``w_in^n`` within an epoch), the velocity gets Cori
 ``(g^n - (2 w_ie^n + w_en^n) x v_mid) T`` with a midpoint velocity, and position follows by the trapezoid
 rule.  Earth rate, transport rate and gravity come from the INS's own position and velocity.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -45,8 +46,8 @@ from ..angles import ARCSEC, DEG
 from ..errors import InputError, check_param
 from .trajectory import Trajectory, dcm_to_euler, earth_rates, euler_to_dcm, gravity, radii
 
-UG = 9.80665e-6            #: one micro-g in m/s^2
-DEG_H = DEG / 3600.0       #: one deg/h in rad/s
+UG = 9.80665e-6  #: one micro-g in m/s^2
+DEG_H = DEG / 3600.0  #: one deg/h in rad/s
 
 
 @dataclass(frozen=True)
@@ -147,7 +148,9 @@ def rotvec_to_dcm(v):
 def dcm_to_rotvec(c):
     """The small-angle inverse of :func:`rotvec_to_dcm`: ``vee((C - C^T)/2)`` scaled by ``theta/sin(theta)``."""
     c = np.asarray(c, float)
-    w = 0.5 * np.stack([c[..., 2, 1] - c[..., 1, 2], c[..., 0, 2] - c[..., 2, 0], c[..., 1, 0] - c[..., 0, 1]], -1)
+    w = 0.5 * np.stack(
+        [c[..., 2, 1] - c[..., 1, 2], c[..., 0, 2] - c[..., 2, 0], c[..., 1, 0] - c[..., 0, 1]], -1
+    )
     s = np.linalg.norm(w, axis=-1, keepdims=True)
     th = np.arcsin(np.clip(s, 0, 1))
     return w * np.where(s > 1e-15, th / np.where(s > 1e-15, s, 1.0), 1.0)
@@ -203,7 +206,7 @@ def delayed_attitude(traj: Trajectory, t_s, latency_ms: float) -> np.ndarray:
     t_s = np.asarray(t_s, dtype=float)
     k = np.searchsorted(traj.t_s, t_s)
     if latency_ms == 0.0 and np.array_equal(traj.t_s[np.minimum(k, len(traj.t_s) - 1)], t_s):
-        return euler_to_dcm(traj.att[k])                    # on the IMU grid: the truth itself
+        return euler_to_dcm(traj.att[k])  # on the IMU grid: the truth itself
     slerp = Slerp(traj.t_s, Rotation.from_matrix(euler_to_dcm(traj.att)))
     return slerp(np.clip(t_s - 1e-3 * latency_ms, traj.t_s[0], traj.t_s[-1])).as_matrix()
 
@@ -222,13 +225,21 @@ def decimation(traj: Trajectory, star: StarSensorSpec) -> int:
     """IMU samples per star-sensor epoch; the star rate must divide the IMU rate."""
     d = traj.profile.imu_rate_hz / star.rate_hz
     if abs(d - round(d)) > 1e-9 or round(d) < 1:
-        raise InputError(f"parameter star_rate_hz={star.rate_hz!r}: must divide the IMU rate "
-                         f"{traj.profile.imu_rate_hz:g} Hz")
+        raise InputError(
+            f"parameter star_rate_hz={star.rate_hz!r}: must divide the IMU rate "
+            f"{traj.profile.imu_rate_hz:g} Hz"
+        )
     return int(round(d))
 
 
-def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = StarSensorSpec(),
-              init: InitialError = InitialError(), ideal: bool = False) -> InsRun:
+def strapdown(
+    traj,
+    seeds,
+    imu: ImuSpec = ImuSpec(),
+    star: StarSensorSpec = StarSensorSpec(),
+    init: InitialError = InitialError(),
+    ideal: bool = False,
+) -> InsRun:
     """Fly ``len(seeds)`` INS runs along ``traj`` with IMU errors and star-sensor fixes.
 
     ``traj`` is one :class:`~navlib.sensors.trajectory.Trajectory` for every run, or a sequence of them, one
@@ -250,10 +261,14 @@ def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = Star
         raise InputError("parameter seeds: at least one run")
     trajs = [traj] * len(seeds) if isinstance(traj, Trajectory) else list(traj)
     if len(trajs) != len(seeds) or any(not isinstance(t, Trajectory) for t in trajs):
-        raise InputError(f"parameter traj: one Trajectory, or one per seed ({len(seeds)}), got {len(trajs)}")
+        raise InputError(
+            f"parameter traj: one Trajectory, or one per seed ({len(seeds)}), got {len(trajs)}"
+        )
     traj = trajs[0]
     if any(t.t_s.shape != traj.t_s.shape or not np.array_equal(t.t_s, traj.t_s) for t in trajs[1:]):
-        raise InputError("parameter traj: the trajectories must share their sample times (duration, IMU rate)")
+        raise InputError(
+            "parameter traj: the trajectories must share their sample times (duration, IMU rate)"
+        )
     one = all(t is traj for t in trajs)
     decim = decimation(traj, star)
     n, m = len(seeds), traj.profile.n_steps
@@ -263,16 +278,18 @@ def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = Star
     g_imu = [np.random.default_rng(r[1]) for r in rngs]
     g_star = [np.random.default_rng(r[2]) for r in rngs]
 
-    c_true0 = euler_to_dcm(traj.att[0]) if one else euler_to_dcm(np.stack([t.att[0] for t in trajs]))
+    c_true0 = (
+        euler_to_dcm(traj.att[0]) if one else euler_to_dcm(np.stack([t.att[0] for t in trajs]))
+    )
     if ideal:
         phi0 = np.zeros((n, 3))
     else:
         sd = np.array([init.level_arcsec, init.level_arcsec, init.azimuth_arcsec]) * ARCSEC
         phi0 = np.stack([g.standard_normal(3) * sd for g in g_init])
-    c = rotvec_to_dcm(-phi0) @ c_true0                      # C = exp(-[phi x]) C_true
+    c = rotvec_to_dcm(-phi0) @ c_true0  # C = exp(-[phi x]) C_true
     v = np.stack([t.vn[0] for t in trajs])
     p = np.stack([t.pos[0] for t in trajs])
-    dtheta = traj.dtheta[None] if one else np.stack([t.dtheta for t in trajs])     # (1 or n, m, 3)
+    dtheta = traj.dtheta[None] if one else np.stack([t.dtheta for t in trajs])  # (1 or n, m, 3)
     dvel = traj.dvel[None] if one else np.stack([t.dvel for t in trajs])
 
     # IMU errors (all samples at once)
@@ -309,9 +326,18 @@ def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = Star
         pj = pj @ e_all[:, :, j]
     # slow loop, once per epoch: navigation-frame rotation, Coriolis, gravity, position (two-speed
     # mechanisation; the left (n-frame) and right (b-frame) rotations of C commute exactly)
-    out = {k: np.empty((n, n_ep) + sh) for k, sh in
-           [("cbn", (3, 3)), ("vn", (3,)), ("pos", (3,)), ("fn", (3,)), ("rate_b", (3,)), ("cw_b", (3, 3)),
-            ("cf_b", (3, 3))]}
+    out = {
+        k: np.empty((n, n_ep) + sh)
+        for k, sh in [
+            ("cbn", (3, 3)),
+            ("vn", (3,)),
+            ("pos", (3,)),
+            ("fn", (3,)),
+            ("rate_b", (3,)),
+            ("cw_b", (3, 3)),
+            ("cf_b", (3, 3)),
+        ]
+    }
     out["cbn"][:, 0], out["vn"][:, 0], out["pos"][:, 0] = c, v, p
     for k in ("fn", "rate_b", "cw_b", "cf_b"):
         out[k][:, 0] = 0.0
@@ -337,7 +363,7 @@ def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = Star
         out["cbn"][:, j], out["vn"][:, j], out["pos"][:, j] = c, v, p
     idx = np.arange(n_ep) * decim
     paths = [traj] if one else trajs
-    att_true = np.stack([t.att[idx] for t in paths])                        # (1 or n, n_ep, 3)
+    att_true = np.stack([t.att[idx] for t in paths])  # (1 or n, n_ep, 3)
     cbn_true = euler_to_dcm(att_true)
     if ideal:
         dstar = np.zeros((n, n_ep, 3))
@@ -349,9 +375,21 @@ def strapdown(traj, seeds, imu: ImuSpec = ImuSpec(), star: StarSensorSpec = Star
         if star.smear_arcsec_per_deg_s:
             c_star = c_star @ rotvec_to_dcm(smear_error(t, idx, star.smear_arcsec_per_deg_s))
         star_cbn.append(c_star)
-    star_cbn = np.stack(star_cbn) @ rotvec_to_dcm(dstar)                    # noise about body axes
-    return InsRun(t_s=traj.t_s[idx], cbn=out["cbn"], att=dcm_to_euler(out["cbn"]), vn=out["vn"],
-                  pos=out["pos"], cbn_true=np.broadcast_to(cbn_true, (n, n_ep, 3, 3)),
-                  att_true=np.broadcast_to(att_true, (n, n_ep, 3)), fn=out["fn"], rate_b=out["rate_b"],
-                  cw_b=out["cw_b"], cf_b=out["cf_b"], star_att=dcm_to_euler(star_cbn), star_cbn=star_cbn,
-                  imu=imu, star=star)
+    star_cbn = np.stack(star_cbn) @ rotvec_to_dcm(dstar)  # noise about body axes
+    return InsRun(
+        t_s=traj.t_s[idx],
+        cbn=out["cbn"],
+        att=dcm_to_euler(out["cbn"]),
+        vn=out["vn"],
+        pos=out["pos"],
+        cbn_true=np.broadcast_to(cbn_true, (n, n_ep, 3, 3)),
+        att_true=np.broadcast_to(att_true, (n, n_ep, 3)),
+        fn=out["fn"],
+        rate_b=out["rate_b"],
+        cw_b=out["cw_b"],
+        cf_b=out["cf_b"],
+        star_att=dcm_to_euler(star_cbn),
+        star_cbn=star_cbn,
+        imu=imu,
+        star=star,
+    )

@@ -25,6 +25,7 @@ standard deviation that gyro white noise adds; :meth:`IdentificationMap.latitude
 test's 12 h latitude error without re-running the simulator (agreement with :func:`navlib.sensors.ins.simulate`
 is tested).
 """
+
 from __future__ import annotations
 
 import math
@@ -58,7 +59,9 @@ class ThermalGyro:
         """``k_G tau``: the drift per C/h of a steady ramp (the rate-term limit)."""
         return self.gradient_coeff_deg_h_per_c * self.lag_h
 
-    def sensor_temperature_c(self, t_h, knots_h, case_c, start_c: float | None = None) -> np.ndarray:
+    def sensor_temperature_c(
+        self, t_h, knots_h, case_c, start_c: float | None = None
+    ) -> np.ndarray:
         """``T_s(t)`` for a case temperature piecewise linear through ``(knots_h, case_c)`` (constant after
         the last knot), exactly: on a segment ``T_c = a + r s``,
         ``T_s(s) = a + r s - r tau + (T_s(0) - a + r tau) exp(-s / tau)``.  ``start_c``: ``T_s`` at
@@ -72,7 +75,7 @@ class ThermalGyro:
         tau = self.lag_h
         ts0 = [float(kc[0]) if start_c is None else float(start_c)]
         rates = np.r_[np.diff(kc) / np.diff(kt), 0.0]
-        for i in range(kt.size - 1):                       # T_s at each knot
+        for i in range(kt.size - 1):  # T_s at each knot
             a, r, d = kc[i], rates[i], kt[i + 1] - kt[i]
             ts0.append(a + r * d - r * tau + (ts0[i] - a + r * tau) * math.exp(-d / tau))
         seg = np.clip(np.searchsorted(kt, t, side="right") - 1, 0, kt.size - 1)
@@ -80,18 +83,24 @@ class ThermalGyro:
         a, r, s0 = kc[seg], rates[seg], np.asarray(ts0)[seg]
         return a + r * s - r * tau + (s0 - a + r * tau) * np.exp(-s / tau)
 
-    def axial_drift_deg_h(self, t_h, knots_h, case_c, final_drift_deg_h: float,
-                          end_c: float | None = None) -> np.ndarray:
+    def axial_drift_deg_h(
+        self, t_h, knots_h, case_c, final_drift_deg_h: float, end_c: float | None = None
+    ) -> np.ndarray:
         """``eps(t) = eps_final + k_T (T_s - T_end) + k_G (T_c - T_s)``; ``T_end`` defaults to the last knot's
         case temperature."""
         t = np.asarray(t_h, float)
         tc = np.interp(t, knots_h, case_c)
         ts = self.sensor_temperature_c(t, knots_h, case_c)
         te = float(np.asarray(case_c, float)[-1]) if end_c is None else float(end_c)
-        return (final_drift_deg_h + self.temp_coeff_deg_h_per_c * (ts - te)
-                + self.gradient_coeff_deg_h_per_c * (tc - ts))
+        return (
+            final_drift_deg_h
+            + self.temp_coeff_deg_h_per_c * (ts - te)
+            + self.gradient_coeff_deg_h_per_c * (tc - ts)
+        )
 
-    def steady_state_drift_deg_h(self, case_c: float, final_drift_deg_h: float, end_c: float) -> float:
+    def steady_state_drift_deg_h(
+        self, case_c: float, final_drift_deg_h: float, end_c: float
+    ) -> float:
         """The drift at a constant case temperature once the lag has settled: ``eps_final + k_T (T_c - T_end)``."""
         return float(final_drift_deg_h + self.temp_coeff_deg_h_per_c * (case_c - end_c))
 
@@ -99,8 +108,10 @@ class ThermalGyro:
 def cold_start_knots(history: ins.ColdStart) -> tuple[np.ndarray, np.ndarray]:
     """The case-temperature knots of a cold-start history: power-on, end of alignment, end of identification
     (``(0, align_h, align_h + identify_h)`` h, ``(align_temp_min_c, calib_temp_min_c, calib_temp_max_c)``)."""
-    return (np.array([0.0, history.align_h, history.align_h + history.identify_h]),
-            np.array([history.align_temp_min_c, history.calib_temp_min_c, history.calib_temp_max_c]))
+    return (
+        np.array([0.0, history.align_h, history.align_h + history.identify_h]),
+        np.array([history.align_temp_min_c, history.calib_temp_min_c, history.calib_temp_max_c]),
+    )
 
 
 @dataclass(frozen=True)
@@ -118,22 +129,38 @@ class IdentificationMap:
     t_mid_h: np.ndarray
     step_s: float
 
-    def latitude_error_deg(self, axial_deg_h, imu: ins.ImuErrors, initial: ins.InitialErrors,
-                           noise: np.ndarray | float = 0.0) -> np.ndarray:
+    def latitude_error_deg(
+        self,
+        axial_deg_h,
+        imu: ins.ImuErrors,
+        initial: ins.InitialErrors,
+        noise: np.ndarray | float = 0.0,
+    ) -> np.ndarray:
         """The 12 h latitude error for axial drift histories ``axial_deg_h`` (rows: tests; columns: steps),
         the residual errors ``imu``/``initial`` (the axial field of ``imu`` is ignored) and standard-normal
         ``noise`` draws scaled by the gyro noise."""
         ax = np.atleast_2d(np.asarray(axial_deg_h, float))
         if ax.shape[1] != self.axial.size:
-            raise InputError(f"parameter axial_deg_h: {ax.shape[1]} steps, the run has {self.axial.size}")
-        b = np.array([imu.gyro_bias_x_deg_h, imu.gyro_bias_y_deg_h, imu.accel_bias_x_ug, imu.accel_bias_y_ug])
-        return (ax @ self.axial + float(b @ self.biases) + float(initial.state() @ self.initial)
-                + self.noise_per_arw * imu.gyro_arw_deg_rt_h * np.asarray(noise, float))
+            raise InputError(
+                f"parameter axial_deg_h: {ax.shape[1]} steps, the run has {self.axial.size}"
+            )
+        b = np.array(
+            [imu.gyro_bias_x_deg_h, imu.gyro_bias_y_deg_h, imu.accel_bias_x_ug, imu.accel_bias_y_ug]
+        )
+        return (
+            ax @ self.axial
+            + float(b @ self.biases)
+            + float(initial.state() @ self.initial)
+            + self.noise_per_arw * imu.gyro_arw_deg_rt_h * np.asarray(noise, float)
+        )
 
 
 @lru_cache(maxsize=8)
-def identification_map(earth: ins.Earth = ins.Earth(), procedure: ins.Procedure = ins.Procedure(),
-                       rotation: ins.Rotation = ins.Rotation()) -> IdentificationMap:
+def identification_map(
+    earth: ins.Earth = ins.Earth(),
+    procedure: ins.Procedure = ins.Procedure(),
+    rotation: ins.Rotation = ins.Rotation(),
+) -> IdentificationMap:
     """The exact linear map of the identification run (adjoint of ``x_{k+1} = Phi x_k + Gam u_k``):
     ``dL_n = l_0 . x_0 + sum_k (Gam^T l_{k+1}) . u_k`` with ``l_n = e_dL``, ``l_k = Phi^T l_{k+1}``; the body
     inputs enter ``u_k`` through the rotation as in :func:`navlib.sensors.ins.simulate` (same step, same
@@ -157,8 +184,10 @@ def identification_map(earth: ins.Earth = ins.Earth(), procedure: ins.Procedure 
     dgy = -sens[:, 0] * sn + sens[:, 1] * cs
     dax = sens[:, 3] * cs + sens[:, 4] * sn
     day = -sens[:, 3] * sn + sens[:, 4] * cs
-    biases = np.array([dgx.sum() * ins.DEG_H, dgy.sum() * ins.DEG_H, dax.sum() * ins.UG, day.sum() * ins.UG])
-    sg = DEG / 60.0 / math.sqrt(dt)                        # 1 deg/sqrt(h) of ARW -> rad/s per step
-    noise = sg * math.sqrt(float(np.sum(dgx ** 2 + dgy ** 2 + sens[:, 2] ** 2)))
+    biases = np.array(
+        [dgx.sum() * ins.DEG_H, dgy.sum() * ins.DEG_H, dax.sum() * ins.UG, day.sum() * ins.UG]
+    )
+    sg = DEG / 60.0 / math.sqrt(dt)  # 1 deg/sqrt(h) of ARW -> rad/s per step
+    noise = sg * math.sqrt(float(np.sum(dgx**2 + dgy**2 + sens[:, 2] ** 2)))
     t_mid = procedure.align_h + (np.arange(n) + 0.5) * dt / 3600.0
     return IdentificationMap(sens[:, 2] * ins.DEG_H, biases, lam.copy(), noise, t_mid, dt)

@@ -22,6 +22,7 @@ forces, ``w_ib^b = C_n^b (w_ie^n + w_en^n + w_nb^n)`` and ``f^b = C_n^b (dv^n/dt
 - g^n)``; position follows from the velocity on a grid of half steps (trapezoid).  Integrating the
 increments back with :func:`navlib.sensors.strapdown.strapdown` reproduces the truth (tested).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -34,9 +35,9 @@ from ..angles import DEG
 from ..errors import InputError, check_param
 
 # WGS-84
-EARTH_A_M = 6378137.0                  #: equatorial radius (m)
-EARTH_E2 = 0.00669437999013            #: first eccentricity squared
-EARTH_RATE_RAD_S = 7.2921151467e-5     #: Earth rotation rate (rad/s)
+EARTH_A_M = 6378137.0  #: equatorial radius (m)
+EARTH_E2 = 0.00669437999013  #: first eccentricity squared
+EARTH_RATE_RAD_S = 7.2921151467e-5  #: Earth rotation rate (rad/s)
 
 
 def radii(lat_rad, h_m):
@@ -61,7 +62,9 @@ def earth_rates(pos, vn):
     vn = np.asarray(vn, float)
     lat, h = pos[..., 0], pos[..., 2]
     rmh, rnh = radii(lat, h)
-    wie = np.stack([np.zeros_like(lat), EARTH_RATE_RAD_S * np.cos(lat), EARTH_RATE_RAD_S * np.sin(lat)], -1)
+    wie = np.stack(
+        [np.zeros_like(lat), EARTH_RATE_RAD_S * np.cos(lat), EARTH_RATE_RAD_S * np.sin(lat)], -1
+    )
     wen = np.stack([-vn[..., 1] / rmh, vn[..., 0] / rnh, vn[..., 0] * np.tan(lat) / rnh], -1)
     return wie, wen
 
@@ -89,8 +92,14 @@ def dcm_to_euler(c):
     """Euler angles ``(pitch, roll, yaw)`` (rad) of ``C_b^n = Rz(yaw) Rx(pitch) Ry(roll)``:
     ``pitch = asin(C32)``, ``roll = atan2(-C31, C33)``, ``yaw = atan2(-C12, C22)``."""
     c = np.asarray(c, float)
-    return np.stack([np.arcsin(np.clip(c[..., 2, 1], -1, 1)), np.arctan2(-c[..., 2, 0], c[..., 2, 2]),
-                     np.arctan2(-c[..., 0, 1], c[..., 1, 1])], -1)
+    return np.stack(
+        [
+            np.arcsin(np.clip(c[..., 2, 1], -1, 1)),
+            np.arctan2(-c[..., 2, 0], c[..., 2, 2]),
+            np.arctan2(-c[..., 0, 1], c[..., 1, 1]),
+        ],
+        -1,
+    )
 
 
 def euler_rate_matrix(att):
@@ -147,9 +156,14 @@ class FlightProfile:
         check_param("yaw_amplitude_deg", self.yaw_amplitude_deg, lo=0.0, hi=90.0)
         check_param("turn_period_s", self.turn_period_s, lo=2.0, hi=3600.0)
         check_param("manoeuvre_seed", self.manoeuvre_seed, lo=0, integer=True)
-        if abs(self.duration_s * self.imu_rate_hz - round(self.duration_s * self.imu_rate_hz)) > 1e-6:
-            raise InputError(f"parameter duration_s={self.duration_s!r}: must be a whole number of IMU "
-                             f"samples at imu_rate_hz={self.imu_rate_hz!r}")
+        if (
+            abs(self.duration_s * self.imu_rate_hz - round(self.duration_s * self.imu_rate_hz))
+            > 1e-6
+        ):
+            raise InputError(
+                f"parameter duration_s={self.duration_s!r}: must be a whole number of IMU "
+                f"samples at imu_rate_hz={self.imu_rate_hz!r}"
+            )
 
     @property
     def n_steps(self) -> int:
@@ -205,7 +219,9 @@ def _kinematics(profile: FlightProfile, t: np.ndarray):
     cp = np.cos(p)
     s = profile.speed_m_s
     vn = s * np.stack([-np.sin(yaw) * cp, np.cos(yaw) * cp, np.sin(p)], -1)
-    an = s * np.stack([-np.cos(yaw) * cp * yaw_dot, -np.sin(yaw) * cp * yaw_dot, np.zeros_like(t)], -1)
+    an = s * np.stack(
+        [-np.cos(yaw) * cp * yaw_dot, -np.sin(yaw) * cp * yaw_dot, np.zeros_like(t)], -1
+    )
     return att, att_dot, vn, an
 
 
@@ -220,7 +236,9 @@ def _position(profile: FlightProfile, t: np.ndarray, vn: np.ndarray) -> np.ndarr
         rmh, rnh = radii(lat, h)
         lat = lat0 + cumulative_trapezoid(vn[:, 1] / rmh, t, initial=0.0)
     rmh, rnh = radii(lat, h)
-    lon = profile.longitude_deg * DEG + cumulative_trapezoid(vn[:, 0] / (rnh * np.cos(lat)), t, initial=0.0)
+    lon = profile.longitude_deg * DEG + cumulative_trapezoid(
+        vn[:, 0] / (rnh * np.cos(lat)), t, initial=0.0
+    )
     return np.stack([lat, lon, h], -1)
 
 
@@ -250,5 +268,13 @@ def generate(profile: FlightProfile = FlightProfile()) -> Trajectory:
     tf = np.arange(2 * n + 1) * (dt / 2)
     att, vn, pos, w_b, f_b = _body_signals(profile, tf)
     simpson = lambda x: (x[0:-2:2] + 4 * x[1:-1:2] + x[2::2]) * (dt / 6)  # noqa: E731
-    return Trajectory(profile=profile, t_s=tf[::2], att=att[::2], vn=vn[::2], pos=pos[::2],
-                      dtheta=simpson(w_b), dvel=simpson(f_b), rate_b=w_b[1::2])
+    return Trajectory(
+        profile=profile,
+        t_s=tf[::2],
+        att=att[::2],
+        vn=vn[::2],
+        pos=pos[::2],
+        dtheta=simpson(w_b),
+        dvel=simpson(f_b),
+        rate_b=w_b[1::2],
+    )

@@ -29,6 +29,8 @@ and import the module below (and name its measured columns in :data:`navlib.work
 the outlier screen needs).  ``fit_model``, ``Fit.add``, ``diagnose``, ``loop`` and the CLI
 (``python -m navlib loop accelerometer FILE``) then work unchanged.
 """
+
 from . import accelerometer, fit, magnetometer, magnetometer_free  # noqa: F401  (importing registers the compass, drift, magnetometer
+
 #                                                and accelerometer systems)
 from .effects import SYSTEMS, Effect, System, get_system, load_effects, register_system  # noqa: F401

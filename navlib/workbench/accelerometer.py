@@ -19,6 +19,7 @@ microgravity for the sensors of paper D and are left out, so every fit is one li
 Structure tests: a third harmonic in position (a ``K3 a^3`` term or a dividing-head error), a cubic in
 temperature, and a position-dependent temperature step (thermal lag during the tumble).
 """
+
 from __future__ import annotations
 
 import os
@@ -36,31 +37,63 @@ from .diagnose import diagnose
 from .trials import SYSTEM_KEYS, _seed_label, run_trials, trial_seed, wilson
 
 ACCELEROMETER_EFFECTS = {
-    "bias": Effect("bias", ("k0_mg",), ("mg",),
-                   "Output at zero input (pick-off null, servo offset): a constant offset in every position."),
-    "scale_factor": Effect("scale_factor", ("k1_mg_g",), ("mg/g",),
-                           "Scale-factor error (magnet, coil, readout resistor): an error proportional to "
-                           "the input a = cos q, i.e. a one-cycle cosine in position."),
-    "bias_temperature": Effect("bias_temperature", ("bias_t1_mg_c", "bias_t2_mg_c2"), ("mg/degC", "mg/degC^2"),
-                               "Bias drift with temperature (head deformation, pick-off and capacitance "
-                               "gain, gap change): an offset that follows T (needs 3 temperatures).",
-                               columns=("temperature_c",)),
-    "scale_factor_temperature": Effect("scale_factor_temperature", ("sf_t1_mg_g_c", "sf_t2_mg_g_c2"),
-                                       ("mg/g/degC", "mg/g/degC^2"),
-                                       "Scale-factor drift with temperature (magnet and coil temperature "
-                                       "coefficients): a cos q error whose size follows T (needs 3 "
-                                       "temperatures).", columns=("temperature_c",)),
-    "second_order": Effect("second_order", ("k2_mg_g2",), ("mg/g^2",),
-                           "Second-order nonlinearity K2 a^2: a two-cycle cosine in position plus an offset."),
-    "second_order_temperature": Effect("second_order_temperature", ("k2_t_mg_g2_c",), ("mg/g^2/degC",),
-                                       "K2 changing with temperature: the two-cycle error grows with T; makes "
-                                       "the apparent scale factor depend on the input (paper D, Fig 4).",
-                                       columns=("temperature_c",)),
-    "cross_coupling": Effect("cross_coupling", ("kip_mg_g2",), ("mg/g^2",),
-                             "Cross-coupling Kip a a_p between input and pendulum axes: a two-cycle sine."),
-    "misalignment": Effect("misalignment", ("delta_o_mg",), ("mg/g",),
-                           "Input-axis misalignment about the output axis (mrad): a one-cycle sine, the "
-                           "pendulum-axis acceleration leaking in."),
+    "bias": Effect(
+        "bias",
+        ("k0_mg",),
+        ("mg",),
+        "Output at zero input (pick-off null, servo offset): a constant offset in every position.",
+    ),
+    "scale_factor": Effect(
+        "scale_factor",
+        ("k1_mg_g",),
+        ("mg/g",),
+        "Scale-factor error (magnet, coil, readout resistor): an error proportional to "
+        "the input a = cos q, i.e. a one-cycle cosine in position.",
+    ),
+    "bias_temperature": Effect(
+        "bias_temperature",
+        ("bias_t1_mg_c", "bias_t2_mg_c2"),
+        ("mg/degC", "mg/degC^2"),
+        "Bias drift with temperature (head deformation, pick-off and capacitance "
+        "gain, gap change): an offset that follows T (needs 3 temperatures).",
+        columns=("temperature_c",),
+    ),
+    "scale_factor_temperature": Effect(
+        "scale_factor_temperature",
+        ("sf_t1_mg_g_c", "sf_t2_mg_g_c2"),
+        ("mg/g/degC", "mg/g/degC^2"),
+        "Scale-factor drift with temperature (magnet and coil temperature "
+        "coefficients): a cos q error whose size follows T (needs 3 "
+        "temperatures).",
+        columns=("temperature_c",),
+    ),
+    "second_order": Effect(
+        "second_order",
+        ("k2_mg_g2",),
+        ("mg/g^2",),
+        "Second-order nonlinearity K2 a^2: a two-cycle cosine in position plus an offset.",
+    ),
+    "second_order_temperature": Effect(
+        "second_order_temperature",
+        ("k2_t_mg_g2_c",),
+        ("mg/g^2/degC",),
+        "K2 changing with temperature: the two-cycle error grows with T; makes "
+        "the apparent scale factor depend on the input (paper D, Fig 4).",
+        columns=("temperature_c",),
+    ),
+    "cross_coupling": Effect(
+        "cross_coupling",
+        ("kip_mg_g2",),
+        ("mg/g^2",),
+        "Cross-coupling Kip a a_p between input and pendulum axes: a two-cycle sine.",
+    ),
+    "misalignment": Effect(
+        "misalignment",
+        ("delta_o_mg",),
+        ("mg/g",),
+        "Input-axis misalignment about the output axis (mrad): a one-cycle sine, the "
+        "pendulum-axis acceleration leaking in.",
+    ),
 }
 
 
@@ -68,7 +101,12 @@ ACCELEROMETER_EFFECTS = {
 #: 1002.2 mg/g); outside it the output is in another unit or the input axis is reversed.
 SCALE_BAND = (0.5, 2.0)
 #: Units an output may have been written in by mistake, with the factor that converts them to mg.
-OUTPUT_UNITS = (("g", 1000.0), ("m/s^2", 1000.0 / 9.80665), ("ft/s^2", 1000.0 / 32.174), ("ug", 1e-3))
+OUTPUT_UNITS = (
+    ("g", 1000.0),
+    ("m/s^2", 1000.0 / 9.80665),
+    ("ft/s^2", 1000.0 / 32.174),
+    ("ug", 1e-3),
+)
 
 
 def output_slope(df: pd.DataFrame) -> float:
@@ -100,37 +138,59 @@ def load_accelerometer(path: str | os.PathLike, unit: str | None = None) -> pd.D
     units = list(dict.fromkeys(df["unit"]))
     if unit is not None:
         if str(unit) not in units:
-            raise InputError(f"{name}: no rows of unit {str(unit)!r} in column 'unit' (it names "
-                             f"{', '.join(units)})")
+            raise InputError(
+                f"{name}: no rows of unit {str(unit)!r} in column 'unit' (it names "
+                f"{', '.join(units)})"
+            )
         df = df[df["unit"] == str(unit)].reset_index(drop=True)
     elif len(units) != 1:
-        raise InputError(f"{name}: column 'unit' names {len(units)} accelerometers "
-                         f"({', '.join(units)}); the workbench fits one: choose it with --unit "
-                         f"(python: unit=...)")
+        raise InputError(
+            f"{name}: column 'unit' names {len(units)} accelerometers "
+            f"({', '.join(units)}); the workbench fits one: choose it with --unit "
+            f"(python: unit=...)"
+        )
     require_levels(df, positions=5, what="the accelerometer model", name=name)
     require_variation(df, ["output_mg"], path, "a tumble test")
     slope = output_slope(df)
     lo, hi = SCALE_BAND
     if not lo * 1000.0 <= slope <= hi * 1000.0:
         if slope < 0:
-            look = ("the output falls as the input rises: the input axis is reversed, or position_deg "
-                    "counts the other way (the input is a = cos q)")
+            look = (
+                "the output falls as the input rises: the input axis is reversed, or position_deg "
+                "counts the other way (the input is a = cos q)"
+            )
         else:
             near = [(u, f) for u, f in OUTPUT_UNITS if lo * 1000.0 <= slope * f <= hi * 1000.0]
-            look = (f"the output looks like {near[0][0]} (multiply by {near[0][1]:.6g} for mg)" if near else
-                    "the output is not in mg (output divided by the nominal scale factor)")
-        raise InputError(f"{name}: column 'output_mg' changes by {slope:.4g} mg per g of input, where 1000 "
-                         f"is expected ({lo * 1000:g}..{hi * 1000:g} accepted): {look}")
+            look = (
+                f"the output looks like {near[0][0]} (multiply by {near[0][1]:.6g} for mg)"
+                if near
+                else "the output is not in mg (output divided by the nominal scale factor)"
+            )
+        raise InputError(
+            f"{name}: column 'output_mg' changes by {slope:.4g} mg per g of input, where 1000 "
+            f"is expected ({lo * 1000:g}..{hi * 1000:g} accepted): {look}"
+        )
     return df
 
 
 def _columns(data: pd.DataFrame, name: str, t_c: float) -> list[np.ndarray]:
     q = np.deg2rad(data["position_deg"].to_numpy(float))
     a, ap = np.cos(q), np.sin(q)
-    dt = (data["temperature_c"].to_numpy(float) - t_c) if "temperature_c" in data else np.zeros_like(a)
-    return {"bias": [np.ones_like(a)], "scale_factor": [a], "bias_temperature": [dt, dt ** 2],
-            "scale_factor_temperature": [a * dt, a * dt ** 2], "second_order": [a ** 2],
-            "second_order_temperature": [a ** 2 * dt], "cross_coupling": [a * ap], "misalignment": [ap]}[name]
+    dt = (
+        (data["temperature_c"].to_numpy(float) - t_c)
+        if "temperature_c" in data
+        else np.zeros_like(a)
+    )
+    return {
+        "bias": [np.ones_like(a)],
+        "scale_factor": [a],
+        "bias_temperature": [dt, dt**2],
+        "scale_factor_temperature": [a * dt, a * dt**2],
+        "second_order": [a**2],
+        "second_order_temperature": [a**2 * dt],
+        "cross_coupling": [a * ap],
+        "misalignment": [ap],
+    }[name]
 
 
 def design(data: pd.DataFrame, effects, t_c: float) -> np.ndarray:
@@ -153,17 +213,36 @@ def _fit_accelerometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) -
             require_levels(data, temperatures=need, what=f"effect '{name}'", name="tumble data")
     t_c = float(data["temperature_c"].mean())
     X = design(data, cat, t_c)
-    beta, jac, names = fit_linear(y, X, [p for e in cat for p in ACCELEROMETER_EFFECTS[e].params], users, data,
-                                  start, what="readings", model=" + ".join(e.name for e in effects))
+    beta, jac, names = fit_linear(
+        y,
+        X,
+        [p for e in cat for p in ACCELEROMETER_EFFECTS[e].params],
+        users,
+        data,
+        start,
+        what="readings",
+        model=" + ".join(e.name for e in effects),
+    )
     nc = X.shape[1]
     params = dict(zip(names, map(float, beta)))
 
     def predict(frame):
-        return nominal_mg(frame) + design(frame, cat, t_c) @ beta[:nc] + user_columns(users, params, frame,
-                                                                                        (len(frame),))
+        return (
+            nominal_mg(frame)
+            + design(frame, cat, t_c) @ beta[:nc]
+            + user_columns(users, params, frame, (len(frame),))
+        )
 
-    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, data["output_mg"].to_numpy(float) - predict(data),
-               jac, predict, {"temperature_centre_c": t_c})
+    return Fit(
+        SYSTEM,
+        tuple(e.name for e in effects),
+        params,
+        data,
+        data["output_mg"].to_numpy(float) - predict(data),
+        jac,
+        predict,
+        {"temperature_centre_c": t_c},
+    )
 
 
 def accelerometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
@@ -175,42 +254,69 @@ def accelerometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     if d["set_point_c"].nunique() >= 4:
         x = d["temperature_c"].to_numpy(float)
         x = (x - x.mean()) / (np.std(x) or 1.0)
-        out.append(("cubic in temperature", (x ** 3 - 3 * x)[:, None], 1.0))
+        out.append(("cubic in temperature", (x**3 - 3 * x)[:, None], 1.0))
     return out
 
 
 MEASURED["accelerometer"] = (("output_mg",), False)
-SYSTEM = register_system(System(
-    "accelerometer", "mg", ACCELEROMETER_EFFECTS, load_accelerometer, _fit_accelerometer, accelerometer_structure,
-    "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg",
-    columns=tuple(TUMBLE_COLUMNS)))
+SYSTEM = register_system(
+    System(
+        "accelerometer",
+        "mg",
+        ACCELEROMETER_EFFECTS,
+        load_accelerometer,
+        _fit_accelerometer,
+        accelerometer_structure,
+        "accelerometer tumble test (output / nominal scale factor); residual = measured - model output, mg",
+        columns=tuple(TUMBLE_COLUMNS),
+    )
+)
 
 
 # ------------------------------------------------------------------------------------------ trials
-def simulate_catalogue(params: dict, *, temperatures_c=None, positions: int = 24, noise_ug: float = 3.0,
-                       seed=0) -> pd.DataFrame:
+def simulate_catalogue(
+    params: dict, *, temperatures_c=None, positions: int = 24, noise_ug: float = 3.0, seed=0
+) -> pd.DataFrame:
     """Tumble data from the catalogue model (effects absent = 0) on the paper's grid (-40..70 degC every
     5 degC, 24 positions) plus white noise ``noise_ug``."""
     t = np.arange(-40.0, 70.1, 5.0) if temperatures_c is None else np.asarray(temperatures_c, float)
     q = np.arange(positions) * 360.0 / positions
     T, Q = np.meshgrid(t, q, indexing="ij")
-    frame = pd.DataFrame({"set_point_c": T.ravel(), "temperature_c": T.ravel(), "position_deg": Q.ravel(),
-                          "unit": "sim"})
+    frame = pd.DataFrame(
+        {
+            "set_point_c": T.ravel(),
+            "temperature_c": T.ravel(),
+            "position_deg": Q.ravel(),
+            "unit": "sim",
+        }
+    )
     X = design(frame, tuple(ACCELEROMETER_EFFECTS), float(frame["temperature_c"].mean()))
     beta = np.array([params.get(p, 0.0) for e in ACCELEROMETER_EFFECTS.values() for p in e.params])
     rng = np.random.default_rng(seed)
-    frame["output_mg"] = nominal_mg(frame) + X @ beta + 1e-3 * noise_ug * rng.standard_normal(len(frame))
+    frame["output_mg"] = (
+        nominal_mg(frame) + X @ beta + 1e-3 * noise_ug * rng.standard_normal(len(frame))
+    )
     return frame
 
 
 #: Typical sizes of each parameter for random draws (paper D's sensor: bias ~1 mg, 1.7 mg bias drift ...).
-PARAM_SCALE = {"k0_mg": 1.0, "k1_mg_g": 1.0, "bias_t1_mg_c": 0.015, "bias_t2_mg_c2": 1e-4,
-               "sf_t1_mg_g_c": 0.04, "sf_t2_mg_g_c2": 2e-4, "k2_mg_g2": 0.02, "k2_t_mg_g2_c": 0.002,
-               "kip_mg_g2": 0.03, "delta_o_mg": 0.2}
+PARAM_SCALE = {
+    "k0_mg": 1.0,
+    "k1_mg_g": 1.0,
+    "bias_t1_mg_c": 0.015,
+    "bias_t2_mg_c2": 1e-4,
+    "sf_t1_mg_g_c": 0.04,
+    "sf_t2_mg_g_c2": 2e-4,
+    "k2_mg_g2": 0.02,
+    "k2_t_mg_g2_c": 0.002,
+    "kip_mg_g2": 0.03,
+    "delta_o_mg": 0.2,
+}
 
 
-def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float,
-                        seed: int | np.random.SeedSequence) -> dict:
+def hidden_effect_trial(
+    hidden: str | None, ratio: float, noise_ug: float, seed: int | np.random.SeedSequence
+) -> dict:
     """One trial: with ``hidden`` set, data contain every effect (random, ``hidden`` rescaled so that its
     RMS is ``ratio`` x noise) and the model is the catalogue without ``hidden``; with ``None`` the data
     contain a random subset and the model is exactly that subset (a correct answer is "consistent with
@@ -224,12 +330,17 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float,
         if hidden not in cat:
             raise InputError(f"unknown accelerometer effect '{hidden}'; known: {', '.join(cat)}")
         present = cat
-    params = {p: PARAM_SCALE[p] * rng.uniform(-1, 1) for e in present for p in ACCELEROMETER_EFFECTS[e].params}
+    params = {
+        p: PARAM_SCALE[p] * rng.uniform(-1, 1)
+        for e in present
+        for p in ACCELEROMETER_EFFECTS[e].params
+    }
     if hidden is not None:
         probe = simulate_catalogue(params, noise_ug=0.0)
         x = design(probe, (hidden,), float(probe["temperature_c"].mean())) @ np.array(
-            [params[p] for p in ACCELEROMETER_EFFECTS[hidden].params])
-        s = ratio * 1e-3 * noise_ug / np.sqrt(np.mean(x ** 2))
+            [params[p] for p in ACCELEROMETER_EFFECTS[hidden].params]
+        )
+        s = ratio * 1e-3 * noise_ug / np.sqrt(np.mean(x**2))
         for p in ACCELEROMETER_EFFECTS[hidden].params:
             params[p] *= s
         model = tuple(e for e in cat if e != hidden)
@@ -237,15 +348,25 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ug: float,
         model = present
     data = simulate_catalogue(params, noise_ug=noise_ug, seed=rng)
     d = diagnose(fit_model("accelerometer", data, model))
-    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise_ug": noise_ug,
-            "seed": _seed_label(seed),
-            "named": d.missing or "(none)",
-            "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
-            "consistent_with_noise": d.consistent_with_noise}
+    return {
+        "hidden": hidden or "(none)",
+        "ratio": ratio if hidden else 0.0,
+        "noise_ug": noise_ug,
+        "seed": _seed_label(seed),
+        "named": d.missing or "(none)",
+        "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
+        "consistent_with_noise": d.consistent_with_noise,
+    }
 
 
-def hidden_effect_study(ratios=(3.0, 10.0), noise_ug=3.0, seeds=range(10), none_seeds=None,
-                        workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
+def hidden_effect_study(
+    ratios=(3.0, 10.0),
+    noise_ug=3.0,
+    seeds=range(10),
+    none_seeds=None,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame:
     """Detection trials for every hidden effect, size and seed, plus nothing-hidden trials (false alarms;
     default twice as many seeds), at the noise ``noise_ug`` (ug, one level or a sequence of levels).  Each
     trial's seed is :func:`navlib.workbench.trials.trial_seed` of its coordinates (the accelerometer, noise
@@ -255,13 +376,21 @@ def hidden_effect_study(ratios=(3.0, 10.0), noise_ug=3.0, seeds=range(10), none_
     seeds = list(seeds)
     none_seeds = list(none_seeds) if none_seeds is not None else list(range(2 * len(seeds)))
     noises = [float(noise_ug)] if np.ndim(noise_ug) == 0 else [float(v) for v in noise_ug]
-    base = (SYSTEM_KEYS[SYSTEM.name], 0)            # system, table size (the fixed grid)
+    base = (SYSTEM_KEYS[SYSTEM.name], 0)  # system, table size (the fixed grid)
     args = []
     for k, noise in enumerate(noises):
-        args += [(h, r, noise, trial_seed("hidden effect", *base, k, i, j, s))
-                 for i, h in enumerate(ACCELEROMETER_EFFECTS, start=1) for j, r in enumerate(ratios) for s in seeds]
-        args += [(None, 0.0, noise, trial_seed("hidden effect", *base, k, 0, 0, s)) for s in none_seeds]
-    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "accelerometer trials"))
+        args += [
+            (h, r, noise, trial_seed("hidden effect", *base, k, i, j, s))
+            for i, h in enumerate(ACCELEROMETER_EFFECTS, start=1)
+            for j, r in enumerate(ratios)
+            for s in seeds
+        ]
+        args += [
+            (None, 0.0, noise, trial_seed("hidden effect", *base, k, 0, 0, s)) for s in none_seeds
+        ]
+    return pd.DataFrame(
+        run_trials(hidden_effect_trial, args, workers, scheduler, "accelerometer trials")
+    )
 
 
 def detection_table(study: pd.DataFrame) -> pd.DataFrame:
@@ -271,14 +400,32 @@ def detection_table(study: pd.DataFrame) -> pd.DataFrame:
     for (h, r), g in study[study["hidden"] != "(none)"].groupby(["hidden", "ratio"], sort=False):
         k = int(g["correct"].sum())
         lo, hi = wilson(k, len(g))
-        rows.append({"hidden effect": h, "size (x noise)": r, "rate": "correctly named", "trials": len(g),
-                     "value": k / len(g), "95% low": lo, "95% high": hi})
+        rows.append(
+            {
+                "hidden effect": h,
+                "size (x noise)": r,
+                "rate": "correctly named",
+                "trials": len(g),
+                "value": k / len(g),
+                "95% low": lo,
+                "95% high": hi,
+            }
+        )
     none = study[study["hidden"] == "(none)"]
     if len(none):
         k = int((~none["correct"].astype(bool)).sum())
         lo, hi = wilson(k, len(none))
-        rows.append({"hidden effect": "(none)", "size (x noise)": 0.0, "rate": "false alarms",
-                     "trials": len(none), "value": k / len(none), "95% low": lo, "95% high": hi})
+        rows.append(
+            {
+                "hidden effect": "(none)",
+                "size (x noise)": 0.0,
+                "rate": "false alarms",
+                "trials": len(none),
+                "value": k / len(none),
+                "95% low": lo,
+                "95% high": hi,
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -289,7 +436,9 @@ def unit_loop(data: pd.DataFrame, unit: str = "A", start=("bias",), noise_ug: fl
     (:func:`navlib.workbench.loop.known_noise_band`, in mg).  Returns ``(LoopResult, band or None)``."""
 
     if "unit" in data and unit not in set(data["unit"]):
-        raise InputError(f"unit={unit!r}: the tumble frame holds {', '.join(map(str, dict.fromkeys(data['unit'])))}")
+        raise InputError(
+            f"unit={unit!r}: the tumble frame holds {', '.join(map(str, dict.fromkeys(data['unit'])))}"
+        )
     rows = data[data["unit"] == unit].reset_index(drop=True) if "unit" in data else data
     result = loop(SYSTEM.name, rows, list(start))
     band = None

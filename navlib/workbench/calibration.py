@@ -22,6 +22,7 @@ residuals and Jacobian when the workbench's screen finds serially correlated noi
 squares), after setting aside the rows the screen calls outliers.  ``A``'s entries are linear in the scale
 and soft-iron parameters, so their standard errors are those of the parameters.
 """
+
 from __future__ import annotations
 
 import json
@@ -35,9 +36,22 @@ from ..data.tables import read_table, write_new, write_new_csv
 from ..errors import InputError
 from .fit import fit_model
 from .local_field import field_check, parameter_covariance
-from .magnetometer_free import (ACC, DERIVED, FREE_EFFECTS, MAG, SYSTEM, accelerometer_motion, check_units,
-                                correction_matrix, field_summary, free_columns, full_params, has_acc, load_free,
-                                site_of)
+from .magnetometer_free import (
+    ACC,
+    DERIVED,
+    FREE_EFFECTS,
+    MAG,
+    SYSTEM,
+    accelerometer_motion,
+    check_units,
+    correction_matrix,
+    field_summary,
+    free_columns,
+    full_params,
+    has_acc,
+    load_free,
+    site_of,
+)
 from .screen import screen
 from ..threads import one_blas_thread
 
@@ -47,7 +61,9 @@ DEFAULT_MODEL = ("hard_iron", "scale", "soft_iron")
 
 
 @one_blas_thread
-def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=None, date=None) -> dict:
+def calibrate(
+    data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=None, date=None
+) -> dict:
     """The calibration of ``data`` (a frame of :func:`navlib.workbench.magnetometer_free.load_free`) with
     the effects ``model``, as a JSON-ready dict (module docstring); where the site is known (``site`` =
     ``(lat, lon[, height_m])``, ``date``, or the data's site columns:
@@ -85,38 +101,78 @@ def calibrate(data: pd.DataFrame, model=DEFAULT_MODEL, source: str = "", site=No
     effects = {}
     for e in fit.effects:
         eff = FREE_EFFECTS[e]
-        effects[e] = {q: {"value": fit.params[q], "std": float(std[q]), "unit": u}
-                      for q, u in zip(eff.params, eff.units)}
+        effects[e] = {
+            q: {"value": fit.params[q], "std": float(std[q]), "unit": u}
+            for q, u in zip(eff.params, eff.units)
+        }
     p = full_params(fit.params)
     A = correction_matrix(p)
     dA = np.zeros((3, 3))
-    for (i, j), q in {(0, 0): "scale_x", (1, 1): "scale_y", (0, 1): "soft_xy", (0, 2): "soft_xz",
-                      (1, 2): "soft_yz"}.items():
+    for (i, j), q in {
+        (0, 0): "scale_x",
+        (1, 1): "scale_y",
+        (0, 1): "soft_xy",
+        (0, 2): "soft_xz",
+        (1, 2): "soft_yz",
+    }.items():
         dA[i, j] = dA[j, i] = std.get(q, 0.0)
-    dA[2, 2] = float(np.sqrt(cov[names.index("scale_x"), names.index("scale_x")]
-                             + cov[names.index("scale_y"), names.index("scale_y")]
-                             + 2 * cov[names.index("scale_x"), names.index("scale_y")])) if "scale" in fit.effects else 0.0
+    dA[2, 2] = (
+        float(
+            np.sqrt(
+                cov[names.index("scale_x"), names.index("scale_x")]
+                + cov[names.index("scale_y"), names.index("scale_y")]
+                + 2 * cov[names.index("scale_x"), names.index("scale_y")]
+            )
+        )
+        if "scale" in fit.effects
+        else 0.0
+    )
     hard = ["hard_x_ut", "hard_y_ut", "hard_z_ut"]
     summary = field_summary(fit)
     out = {
-        "format": FORMAT, "version": VERSION, "system": SYSTEM.name, "source": source,
-        "model": list(fit.effects), "rows": int(len(fit.data)), "outliers_set_aside": len(sc.outliers),
+        "format": FORMAT,
+        "version": VERSION,
+        "system": SYSTEM.name,
+        "source": source,
+        "model": list(fit.effects),
+        "rows": int(len(fit.data)),
+        "outliers_set_aside": len(sc.outliers),
         "residual_rms_ut": fit.rms,
         "noise": noise.describe() if noise.series is not None else "independent samples",
-        "columns": {"field": list(MAG), "acceleration": list(ACC) if has_acc(data) else None,
-                    "temperature": "temperature_c" if "temperature" in fit.effects else None},
-        "expected_field_strength_ut": {"value": fit.params["field_ut"], "std": float(std["field_ut"]), "unit": "uT"},
+        "columns": {
+            "field": list(MAG),
+            "acceleration": list(ACC) if has_acc(data) else None,
+            "temperature": "temperature_c" if "temperature" in fit.effects else None,
+        },
+        "expected_field_strength_ut": {
+            "value": fit.params["field_ut"],
+            "std": float(std["field_ut"]),
+            "unit": "uT",
+        },
         "effects": effects,
-        "magcal": {"convention": "m_corrected = (m - b(T)) A (row vectors); |m_corrected| = expected field strength",
-                   "A": A.tolist(), "A_std": dA.tolist(),
-                   "b_ut": [p[q] for q in hard], "b_std_ut": [float(std.get(q, 0.0)) for q in hard],
-                   "expected_field_strength_ut": fit.params["field_ut"]},
-        "temperature": ({"centre_c": fit.model["temperature_centre_c"],
-                         "coef_ut_per_c": [p["temp_x_ut_c"], p["temp_y_ut_c"], p["temp_z_ut_c"]]}
-                        if "temperature" in fit.effects else None),
-        "to_accelerometer_axes": (Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"],
-                                                                     p["mis_z_deg"]])).as_matrix().tolist()
-                                  if "misalignment" in fit.effects else None),
+        "magcal": {
+            "convention": "m_corrected = (m - b(T)) A (row vectors); |m_corrected| = expected field strength",
+            "A": A.tolist(),
+            "A_std": dA.tolist(),
+            "b_ut": [p[q] for q in hard],
+            "b_std_ut": [float(std.get(q, 0.0)) for q in hard],
+            "expected_field_strength_ut": fit.params["field_ut"],
+        },
+        "temperature": (
+            {
+                "centre_c": fit.model["temperature_centre_c"],
+                "coef_ut_per_c": [p["temp_x_ut_c"], p["temp_y_ut_c"], p["temp_z_ut_c"]],
+            }
+            if "temperature" in fit.effects
+            else None
+        ),
+        "to_accelerometer_axes": (
+            Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]]))
+            .as_matrix()
+            .tolist()
+            if "misalignment" in fit.effects
+            else None
+        ),
     }
     if "dip (deg)" in summary:
         out["dip_deg"] = summary["dip (deg)"]
@@ -162,7 +218,11 @@ def _key_text(path: tuple) -> str:
 
 
 def _short(v) -> str:
-    text = json.dumps(v, allow_nan=True) if isinstance(v, (dict, list, str, int, float, bool, type(None))) else repr(v)
+    text = (
+        json.dumps(v, allow_nan=True)
+        if isinstance(v, (dict, list, str, int, float, bool, type(None)))
+        else repr(v)
+    )
     return text if len(text) <= 40 else text[:37] + "..."
 
 
@@ -172,12 +232,16 @@ def _get(cal: dict, path: tuple, name: str, required: bool = True):
     node = cal
     for i, k in enumerate(path):
         if not isinstance(node, dict):
-            raise InputError(f"{name}: key '{_key_text(path[:i])}' must be a JSON object, got {_short(node)}")
+            raise InputError(
+                f"{name}: key '{_key_text(path[:i])}' must be a JSON object, got {_short(node)}"
+            )
         if k not in node:
             if not required:
                 return None
-            raise InputError(f"{name}: key '{_key_text(path[:i + 1])}' is missing (a calibration written by "
-                             f"`navlib calibrate` has it)")
+            raise InputError(
+                f"{name}: key '{_key_text(path[: i + 1])}' is missing (a calibration written by "
+                f"`navlib calibrate` has it)"
+            )
         node = node[k]
     return node
 
@@ -188,14 +252,19 @@ def _number(value, path: tuple, name: str) -> float:
         raise InputError(f"{name}: key '{_key_text(path)}' = {_short(value)} is not a number")
     v = float(value)
     if not np.isfinite(v):
-        raise InputError(f"{name}: key '{_key_text(path)}' = {_short(value)} is not a finite number")
+        raise InputError(
+            f"{name}: key '{_key_text(path)}' = {_short(value)} is not a finite number"
+        )
     return v
 
 
 def _array(value, path: tuple, shape: tuple, name: str) -> np.ndarray:
     """``value`` as a float array of ``shape`` (nested JSON lists), every entry checked by :func:`_number`."""
-    what = (f"{shape[0]} numbers" if len(shape) == 1 else
-            f"a {shape[0]}x{shape[1]} array ({shape[0]} rows of {shape[1]} numbers)")
+    what = (
+        f"{shape[0]} numbers"
+        if len(shape) == 1
+        else f"a {shape[0]}x{shape[1]} array ({shape[0]} rows of {shape[1]} numbers)"
+    )
 
     def walk(v, p, dims):
         if not dims:
@@ -217,50 +286,77 @@ def check_calibration(cal, name: str) -> dict:
     file), the key, its value and the limit.  Returns the values: ``{"A", "b", "field_ut", "temperature":
     (centre, coef) or None, "rotation": R or None}``."""
     if not isinstance(cal, dict) or cal.get("format") != FORMAT:
-        raise InputError(f"{name}: not a navlib calibration file (no \"format\": \"{FORMAT}\")")
+        raise InputError(f'{name}: not a navlib calibration file (no "format": "{FORMAT}")')
     if cal.get("system") != SYSTEM.name:
-        raise InputError(f"{name}: a calibration of the system {cal.get('system')!r}; apply corrects "
-                         f"'{SYSTEM.name}' calibrations (python -m navlib calibrate magnetometer)")
+        raise InputError(
+            f"{name}: a calibration of the system {cal.get('system')!r}; apply corrects "
+            f"'{SYSTEM.name}' calibrations (python -m navlib calibrate magnetometer)"
+        )
     version = cal.get("version")
     if isinstance(version, bool) or version != VERSION:
-        raise InputError(f"{name}: calibration format version {version!r}; this navlib reads {VERSION}")
+        raise InputError(
+            f"{name}: calibration format version {version!r}; this navlib reads {VERSION}"
+        )
     A = _array(_get(cal, ("magcal", "A"), name), ("magcal", "A"), (3, 3), name)
     b = _array(_get(cal, ("magcal", "b_ut"), name), ("magcal", "b_ut"), (3,), name)
     key = ("magcal", "expected_field_strength_ut")
     field = _number(_get(cal, key, name), key, name)
     if field <= 0:
-        raise InputError(f"{name}: key '{_key_text(key)}' = {field:g} must be a positive field strength (uT)")
+        raise InputError(
+            f"{name}: key '{_key_text(key)}' = {field:g} must be a positive field strength (uT)"
+        )
     top = _get(cal, ("expected_field_strength_ut",), name, required=False)
     if top is not None:
-        value = _number(_get(cal, ("expected_field_strength_ut", "value"), name),
-                        ("expected_field_strength_ut", "value"), name)
+        value = _number(
+            _get(cal, ("expected_field_strength_ut", "value"), name),
+            ("expected_field_strength_ut", "value"),
+            name,
+        )
         if abs(value - field) > 1e-9 * field:
-            raise InputError(f"{name}: key 'expected_field_strength_ut.value' = {value:g} differs from "
-                             f"'magcal.expected_field_strength_ut' = {field:g} (a hand edit of one of them?)")
+            raise InputError(
+                f"{name}: key 'expected_field_strength_ut.value' = {value:g} differs from "
+                f"'magcal.expected_field_strength_ut' = {field:g} (a hand edit of one of them?)"
+            )
     with np.errstate(all="ignore"):
         cond = float(np.linalg.cond(A))
-    if not cond <= COND_LIMIT:                        # also NaN / inf: singular
+    if not cond <= COND_LIMIT:  # also NaN / inf: singular
         said = "infinite: A is singular" if not np.isfinite(cond) or cond > 1e12 else f"{cond:.3g}"
-        raise InputError(f"{name}: key 'magcal.A': condition number {said} (the limit is {COND_LIMIT:g}): "
-                         f"not the correction of a working magnetometer")
+        raise InputError(
+            f"{name}: key 'magcal.A': condition number {said} (the limit is {COND_LIMIT:g}): "
+            f"not the correction of a working magnetometer"
+        )
     temperature = _get(cal, ("temperature",), name, required=False)
     temp = None
     if temperature is not None:
-        centre = _number(_get(cal, ("temperature", "centre_c"), name), ("temperature", "centre_c"), name)
-        coef = _array(_get(cal, ("temperature", "coef_ut_per_c"), name), ("temperature", "coef_ut_per_c"), (3,),
-                      name)
+        centre = _number(
+            _get(cal, ("temperature", "centre_c"), name), ("temperature", "centre_c"), name
+        )
+        coef = _array(
+            _get(cal, ("temperature", "coef_ut_per_c"), name),
+            ("temperature", "coef_ut_per_c"),
+            (3,),
+            name,
+        )
         temp = (centre, coef)
     axes = _get(cal, ("to_accelerometer_axes",), name, required=False)
     R = None
     if axes is not None:
         R = _array(axes, ("to_accelerometer_axes",), (3, 3), name)
         if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.linalg.det(R) > 0):
-            raise InputError(f"{name}: key 'to_accelerometer_axes' is not a rotation matrix (R R^T = I, det R = 1 "
-                             f"to 1e-6)")
-    columns = _get(cal, ("columns", "field"), name, required=False) if cal.get("columns") is not None else None
+            raise InputError(
+                f"{name}: key 'to_accelerometer_axes' is not a rotation matrix (R R^T = I, det R = 1 "
+                f"to 1e-6)"
+            )
+    columns = (
+        _get(cal, ("columns", "field"), name, required=False)
+        if cal.get("columns") is not None
+        else None
+    )
     if columns is not None and columns != list(MAG):
-        raise InputError(f"{name}: key 'columns.field' = {_short(columns)}: apply corrects the columns "
-                         f"{', '.join(MAG)}")
+        raise InputError(
+            f"{name}: key 'columns.field' = {_short(columns)}: apply corrects the columns "
+            f"{', '.join(MAG)}"
+        )
     return {"A": A, "b": b, "field_ut": field, "temperature": temp, "rotation": R}
 
 
@@ -272,7 +368,9 @@ def read_calibration(path) -> dict:
     try:
         cal = json.loads(Path(path).read_text())
     except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise InputError(f"{name}: not a calibration file (not JSON: {str(err).splitlines()[0]})") from None
+        raise InputError(
+            f"{name}: not a calibration file (not JSON: {str(err).splitlines()[0]})"
+        ) from None
     check_calibration(cal, name)
     return cal
 
@@ -302,20 +400,28 @@ def check_corrected(cal: dict, corrected: pd.DataFrame, cal_name: str, data_name
     u = corrected[list(MAG)].to_numpy(float)
     bad = np.flatnonzero(~np.all(np.isfinite(u), axis=1))
     if bad.size:
-        raise InputError(f"{data_name}: row {bad[0] + 1} (and {bad.size - 1} more): the field corrected with "
-                         f"{cal_name} is not finite; nothing written")
+        raise InputError(
+            f"{data_name}: row {bad[0] + 1} (and {bad.size - 1} more): the field corrected with "
+            f"{cal_name} is not finite; nothing written"
+        )
     expected = float(cal["magcal"]["expected_field_strength_ut"])
-    big = np.max(np.abs(u), axis=1)                 # |u| without overflow: scaled by the largest component
+    big = np.max(np.abs(u), axis=1)  # |u| without overflow: scaled by the largest component
     size = big * np.linalg.norm(u / np.where(big > 0, big, 1.0)[:, None], axis=1)
     seen = float(np.median(size))
     rel = seen / expected - 1.0
-    said = (f"the corrected field strength (median |m_corrected|) is {seen:.4g} uT, {100 * rel:+.3g} % from "
-            f"{cal_name}'s expected_field_strength_ut {expected:.4g} uT")
+    said = (
+        f"the corrected field strength (median |m_corrected|) is {seen:.4g} uT, {100 * rel:+.3g} % from "
+        f"{cal_name}'s expected_field_strength_ut {expected:.4g} uT"
+    )
     if not abs(rel) <= FIELD_REFUSE_REL:
-        raise InputError(f"{data_name}: {said} (more than {100 * FIELD_REFUSE_REL:g} %: a calibration of another "
-                         f"sensor, unit or site?); nothing written")
+        raise InputError(
+            f"{data_name}: {said} (more than {100 * FIELD_REFUSE_REL:g} %: a calibration of another "
+            f"sensor, unit or site?); nothing written"
+        )
     if abs(rel) > FIELD_WARN_REL:
-        return [f"{data_name}: {said} (more than {100 * FIELD_WARN_REL:g} %: another site, or steel nearby?)"]
+        return [
+            f"{data_name}: {said} (more than {100 * FIELD_WARN_REL:g} %: another site, or steel nearby?)"
+        ]
     return []
 
 
@@ -331,8 +437,10 @@ def apply_file(cal_path, data_path, out_path) -> tuple[Path, int, list[str]]:
     frame = read_table(data_path, free_columns(), min_rows=1, kind="magnetometer file")
     check_units(frame, name)
     if cal.get("temperature") and "temperature_c" not in frame:
-        raise InputError(f"{name}: the calibration corrects a temperature-dependent offset: the file needs a "
-                         f"'temperature_c' column")
+        raise InputError(
+            f"{name}: the calibration corrects a temperature-dependent offset: the file needs a "
+            f"'temperature_c' column"
+        )
     corrected = apply_calibration(cal, frame)
     warnings = check_corrected(cal, corrected, Path(cal_path).name, name)
     return write_new_csv(corrected, out_path), len(frame), warnings

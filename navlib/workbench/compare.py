@@ -31,6 +31,7 @@ Systems register a :class:`Comparison` (:func:`register_comparison`): its loader
 split rules and fitting.  The compass's (:data:`COMPASS`) fits paper A's and document B's methods from
 :mod:`navlib.methods.compass_methods`; drift and accelerometer can follow with their papers' methods.
 """
+
 from __future__ import annotations
 
 import os
@@ -71,16 +72,23 @@ class Fold:
     test_what: str
 
     def to_dict(self, k: int) -> dict:
-        return {"fold": k + 1, "train": self.train_what, "test": self.test_what,
-                "train_rows": int(self.train.size), "test_rows": int(self.test.size)}
+        return {
+            "fold": k + 1,
+            "train": self.train_what,
+            "test": self.test_what,
+            "train_rows": int(self.train.size),
+            "test_rows": int(self.test.size),
+        }
 
 
 def sweep_folds(frame: pd.DataFrame, name: str = "data") -> list[Fold]:
     """One fold per sweep: test on it, train on the others (column ``sweep``; at least two sweeps)."""
     ids = sorted(int(v) for v in pd.unique(frame["sweep"])) if "sweep" in frame else []
     if len(ids) < 2:
-        raise InputError(f"{name}: --split sweep needs at least 2 sweeps in column 'sweep', the file has "
-                         f"{len(ids)} (no 'sweep' column, or one value in it); use --split heading or random")
+        raise InputError(
+            f"{name}: --split sweep needs at least 2 sweeps in column 'sweep', the file has "
+            f"{len(ids)} (no 'sweep' column, or one value in it); use --split heading or random"
+        )
     s = frame["sweep"].to_numpy()
     folds = []
     for i in ids:
@@ -95,8 +103,10 @@ def check_bin_deg(bin_deg: float) -> float:
     check_param("--bin-deg", bin_deg, lo=0, lo_open=True, hi=180)
     n = 360.0 / float(bin_deg)
     if abs(n - round(n)) > 1e-9 or round(n) % 2:
-        raise InputError(f"parameter --bin-deg={bin_deg:g}: must cut 360 deg into an even number of bins "
-                         f"(e.g. 5, 10, 15, 30, 45, 90)")
+        raise InputError(
+            f"parameter --bin-deg={bin_deg:g}: must cut 360 deg into an even number of bins "
+            f"(e.g. 5, 10, 15, 30, 45, 90)"
+        )
     return float(bin_deg)
 
 
@@ -104,19 +114,26 @@ def bin_folds(angle_deg, bin_deg: float, what: str = "heading") -> list[Fold]:
     """Two folds from alternate bins of ``bin_deg`` of an angle (deg): bin ``floor(mod(a, 360) / w)``;
     fold 1 trains on the even bins and tests on the odd ones, fold 2 the reverse."""
     w = check_bin_deg(bin_deg)
-    k = np.floor(np.mod(np.asarray(angle_deg, dtype=float), 360.0) / w).astype(int) % int(round(360.0 / w))
+    k = np.floor(np.mod(np.asarray(angle_deg, dtype=float), 360.0) / w).astype(int) % int(
+        round(360.0 / w)
+    )
     odd = k % 2 == 1
     even_name, odd_name = f"even {w:g}-deg {what} bins", f"odd {w:g}-deg {what} bins"
-    return [Fold(np.flatnonzero(~odd), np.flatnonzero(odd), even_name, odd_name),
-            Fold(np.flatnonzero(odd), np.flatnonzero(~odd), odd_name, even_name)]
+    return [
+        Fold(np.flatnonzero(~odd), np.flatnonzero(odd), even_name, odd_name),
+        Fold(np.flatnonzero(odd), np.flatnonzero(~odd), odd_name, even_name),
+    ]
 
 
 def random_folds(n_rows: int, seed: int) -> list[Fold]:
     """Two folds from the rows in a random order (generator of spawn key ``(0,)`` of ``SeedSequence(seed)``)
     cut in two halves: fold 1 tests on the first half, fold 2 on the second."""
     order = np.random.default_rng(sequence(seed, 0)).permutation(int(n_rows))
-    a, b = np.sort(order[: n_rows // 2]), np.sort(order[n_rows // 2:])
-    return [Fold(b, a, "random half 2", "random half 1"), Fold(a, b, "random half 1", "random half 2")]
+    a, b = np.sort(order[: n_rows // 2]), np.sort(order[n_rows // 2 :])
+    return [
+        Fold(b, a, "random half 2", "random half 1"),
+        Fold(a, b, "random half 1", "random half 2"),
+    ]
 
 
 def check_folds(folds: Sequence[Fold], name: str, n_rows: int) -> None:
@@ -124,12 +141,18 @@ def check_folds(folds: Sequence[Fold], name: str, n_rows: int) -> None:
     are disjoint from their training parts and together hold every row once."""
     for k, f in enumerate(folds):
         if f.train.size < MIN_TRAIN_ROWS or f.test.size < 1:
-            raise InputError(f"{name}: fold {k + 1} (train {f.train_what}, test {f.test_what}) has "
-                             f"{f.train.size} training and {f.test.size} test rows; at least {MIN_TRAIN_ROWS} "
-                             f"and 1 are needed (choose another --split)")
+            raise InputError(
+                f"{name}: fold {k + 1} (train {f.train_what}, test {f.test_what}) has "
+                f"{f.train.size} training and {f.test.size} test rows; at least {MIN_TRAIN_ROWS} "
+                f"and 1 are needed (choose another --split)"
+            )
     tested = np.sort(np.concatenate([f.test for f in folds]))
-    if not np.array_equal(tested, np.arange(n_rows)) or any(np.intersect1d(f.train, f.test).size for f in folds):
-        raise AssertionError("split: every row must be a test row exactly once, never in its own training part")
+    if not np.array_equal(tested, np.arange(n_rows)) or any(
+        np.intersect1d(f.train, f.test).size for f in folds
+    ):
+        raise AssertionError(
+            "split: every row must be a test row exactly once, never in its own training part"
+        )
 
 
 # ------------------------------------------------------------------------------------------ systems
@@ -180,7 +203,9 @@ def register_comparison(c: Comparison) -> Comparison:
 
 def get_comparison(system: str) -> Comparison:
     if system not in COMPARISONS:
-        raise InputError(f"compare: unknown system {system!r}; known: {', '.join(sorted(COMPARISONS))}")
+        raise InputError(
+            f"compare: unknown system {system!r}; known: {', '.join(sorted(COMPARISONS))}"
+        )
     return COMPARISONS[system]
 
 
@@ -195,8 +220,10 @@ def resolve_methods(c: Comparison, names: str | Sequence[str] | None) -> tuple[l
         raise InputError("parameter --methods: empty; give method ids separated by commas")
     unknown = [n for n in items if n not in c.methods]
     if unknown:
-        raise InputError(f"parameter --methods: unknown method {unknown[0]!r} for {c.system}; known: "
-                         f"{', '.join(c.methods)}")
+        raise InputError(
+            f"parameter --methods: unknown method {unknown[0]!r} for {c.system}; known: "
+            f"{', '.join(c.methods)}"
+        )
     return list(dict.fromkeys(items)), True
 
 
@@ -214,19 +241,24 @@ class CompassSettings:
         return {"ls_tolerance_deg": self.params.ls_tol_deg, "bin_deg": self.bin_deg}
 
 
-def compass_settings(ls_tolerance_deg: float = 5.0, bin_deg: float = 15.0,
-                     params: cm.MethodParams | None = None) -> CompassSettings:
+def compass_settings(
+    ls_tolerance_deg: float = 5.0, bin_deg: float = 15.0, params: cm.MethodParams | None = None
+) -> CompassSettings:
     """Paper A's and document B's settings (``params``, default
     :class:`navlib.methods.compass_methods.MethodParams`), the 8-position least squares taking the nearest
     reading within ``ls_tolerance_deg`` of each position, the heading split's bins ``bin_deg`` wide."""
     check_param("--ls-tolerance", ls_tolerance_deg, lo=0, hi=22.5)
     if params is not None and not isinstance(params, cm.MethodParams):
         raise InputError("parameter params: must be a navlib.methods.compass_methods.MethodParams")
-    return CompassSettings(replace(params or cm.MethodParams(), ls_tol_deg=float(ls_tolerance_deg)),
-                           check_bin_deg(bin_deg))
+    return CompassSettings(
+        replace(params or cm.MethodParams(), ls_tol_deg=float(ls_tolerance_deg)),
+        check_bin_deg(bin_deg),
+    )
 
 
-def _compass_folds(frame: pd.DataFrame, rule: str, settings: CompassSettings, name: str, seed: int) -> list[Fold]:
+def _compass_folds(
+    frame: pd.DataFrame, rule: str, settings: CompassSettings, name: str, seed: int
+) -> list[Fold]:
     if rule == "sweep":
         return sweep_folds(frame, name)
     if rule == "heading":
@@ -238,7 +270,9 @@ def _compass_folds(frame: pd.DataFrame, rule: str, settings: CompassSettings, na
 EIGHT_POSITION = tuple(cm.LS_MODELS)
 
 
-def _compass_cannot_fit(mid: str, train: pd.DataFrame, settings: CompassSettings, part: str) -> str | None:
+def _compass_cannot_fit(
+    mid: str, train: pd.DataFrame, settings: CompassSettings, part: str
+) -> str | None:
     """Why ``mid`` cannot be fitted on the training rows ``train`` (named ``part``): the 8-position LS needs
     a reading within the tolerance of each of 0, 45, ..., 315 deg true heading (the nearest one is used)."""
     if mid not in EIGHT_POSITION:
@@ -248,9 +282,11 @@ def _compass_cannot_fit(mid: str, train: pd.DataFrame, settings: CompassSettings
     if (idx >= 0).all():
         return None
     missing = ", ".join(f"{45 * k:g}" for k in np.flatnonzero(idx < 0))
-    return (f"needs 8 headings (a reading within {tol:g} deg of each of 0, 45, ..., 315 deg true heading, the "
-            f"nearest one is used; --ls-tolerance widens it) and {part} has {int((idx >= 0).sum())} (none near "
-            f"{missing} deg)")
+    return (
+        f"needs 8 headings (a reading within {tol:g} deg of each of 0, 45, ..., 315 deg true heading, the "
+        f"nearest one is used; --ls-tolerance widens it) and {part} has {int((idx >= 0).sum())} (none near "
+        f"{missing} deg)"
+    )
 
 
 def network_input(measured_train, measured) -> np.ndarray:
@@ -268,7 +304,9 @@ def network_input(measured_train, measured) -> np.ndarray:
     return cut + np.mod(np.asarray(measured, dtype=float) - cut, 360.0)
 
 
-def compass_errors(mid: str, settings: CompassSettings, train: dict, test: dict, rngs) -> list[np.ndarray]:
+def compass_errors(
+    mid: str, settings: CompassSettings, train: dict, test: dict, rngs
+) -> list[np.ndarray]:
     """Fit method ``mid`` on the training rows (one run per generator) and return each run's wrapped error
     ``wrap(compensated - true)`` (deg) on the test rows.  The network input is :func:`network_input`, its
     reference heading unwrapped next to it (``x + wrap(psi - x)``: the target is continuous too)."""
@@ -276,29 +314,49 @@ def compass_errors(mid: str, settings: CompassSettings, train: dict, test: dict,
     x_test = network_input(train["measured_heading_deg"], test["measured_heading_deg"])
     ref = x_train + wrap_deg(np.asarray(train["true_heading_deg"], dtype=float) - x_train)
     fitted = cm.fit_method(mid, x_train, ref, settings.params, rngs=rngs)
-    return [wrap_deg(f.correct(x_test) - np.asarray(test["true_heading_deg"], dtype=float)) for f in fitted]
+    return [
+        wrap_deg(f.correct(x_test) - np.asarray(test["true_heading_deg"], dtype=float))
+        for f in fitted
+    ]
 
 
 #: The default methods of ``navlib compare compass``: uncompensated; paper A's 8-position LS under the
 #: three models; the exact planar model fitted to every training reading; MATLAB's BP (trainlm); DE-BP and
 #: ADE-BP in the primary reading of paper A's claims register (reading 4: the full DE stage, then
 #: trainlm); document B's plain and back-tuned ELM.
-COMPASS_DEFAULT = ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "physical", "bp_matlab") + \
-    cm.READINGS[cm.R4][2:] + cm.ELM_METHODS
+COMPASS_DEFAULT = (
+    ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "physical", "bp_matlab")
+    + cm.READINGS[cm.R4][2:]
+    + cm.ELM_METHODS
+)
 
 #: The compass's comparison: paper A's and document B's methods (:mod:`navlib.methods.compass_methods`) on a
 #: compass sweep file (:func:`navlib.data.compass_sweeps.load_sweeps`).
-COMPASS = register_comparison(Comparison(
-    system="compass", unit="deg", load=load_sweeps,
-    methods={mid: spec.label for mid, spec in cm.METHODS.items()}, default=COMPASS_DEFAULT,
-    stochastic=lambda mid: cm.METHODS[mid].stochastic, splits=SPLITS, folds=_compass_folds,
-    settings=compass_settings, cannot_fit=_compass_cannot_fit, run=compass_errors,
-    cost=lambda mid, s: cm.unit_cost((mid,), s.params), columns=("true_heading_deg", "measured_heading_deg"),
-    x_column="true_heading_deg", x_label="true heading (deg)"))
+COMPASS = register_comparison(
+    Comparison(
+        system="compass",
+        unit="deg",
+        load=load_sweeps,
+        methods={mid: spec.label for mid, spec in cm.METHODS.items()},
+        default=COMPASS_DEFAULT,
+        stochastic=lambda mid: cm.METHODS[mid].stochastic,
+        splits=SPLITS,
+        folds=_compass_folds,
+        settings=compass_settings,
+        cannot_fit=_compass_cannot_fit,
+        run=compass_errors,
+        cost=lambda mid, s: cm.unit_cost((mid,), s.params),
+        columns=("true_heading_deg", "measured_heading_deg"),
+        x_column="true_heading_deg",
+        x_label="true heading (deg)",
+    )
+)
 
 
 # ------------------------------------------------------------------------------------------ the runs
-def _task(system: str, mid: str, settings, train: dict, test: dict, fold: int, seeds: tuple, seed: int) -> list:
+def _task(
+    system: str, mid: str, settings, train: dict, test: dict, fold: int, seeds: tuple, seed: int
+) -> list:
     """One engine task: method ``mid`` in fold ``fold`` for the runs ``seeds`` (each from the generator of
     spawn key ``(1, fold, k)`` of ``SeedSequence(seed)``).  Module level: workers import it."""
     c = COMPARISONS[system]
@@ -336,7 +394,7 @@ class CompareResult:
     def rms(self, mid: str) -> np.ndarray:
         """Held-out RMS per run (eq-compare-rms), one value for a deterministic method."""
         e = self.errors[mid]
-        return np.sqrt(np.mean(e ** 2, axis=1))
+        return np.sqrt(np.mean(e**2, axis=1))
 
     def estimate(self, mid: str) -> tuple[verdicts.Estimate | None, str]:
         """Median held-out RMS over the runs with its 95 % interval (exact for one deterministic run)."""
@@ -361,16 +419,27 @@ class CompareResult:
             est, why = verdicts.exact(float(a[0] - b[0])), ""
         else:
             est, why = verdicts.attempt(verdicts.paired_difference, a, b)
-        reproduced, basis = verdicts.decide(est.interval if est else None, 0.0, "above", margin=self.margin)
+        reproduced, basis = verdicts.decide(
+            est.interval if est else None, 0.0, "above", margin=self.margin
+        )
         if est is None:
             basis = "no statistic"
-        finding = {True: "best is better", False: f"{self.labels[mid]} is better", None: "not told apart"}[reproduced]
+        finding = {
+            True: "best is better",
+            False: f"{self.labels[mid]} is better",
+            None: "not told apart",
+        }[reproduced]
         if basis == "equivalent":
             finding = f"no difference at {self.margin:g} {self.unit}"
         elif basis == "no statistic":
             finding = "too few seeds for an interval"
-        return {"difference": est, "verdict": verdicts.verdict_name(reproduced, basis), "basis": basis,
-                "finding": finding, "why": why}
+        return {
+            "difference": est,
+            "verdict": verdicts.verdict_name(reproduced, basis),
+            "basis": basis,
+            "finding": finding,
+            "why": why,
+        }
 
     def median_run(self, mid: str) -> int:
         """The run whose RMS is the median (the lower middle for an even count): the one the figure draws."""
@@ -389,14 +458,25 @@ class CompareResult:
             e = self.errors[mid]
             vs = None if mid == best else self.versus_best(mid)
             d = vs["difference"] if vs else None
-            rows.append({"method": mid, "label": self.labels[mid], "runs": int(e.shape[0]),
-                         "rms": float(np.median(self.rms(mid))), "rms_lo": est.lo if est else np.nan,
-                         "rms_hi": est.hi if est else np.nan, "rms_why": why,
-                         "min_error": float(np.median(e.min(axis=1))), "max_error": float(np.median(e.max(axis=1))),
-                         "vs_best": d.value if d else (0.0 if mid == best else np.nan),
-                         "vs_best_lo": d.lo if d else np.nan, "vs_best_hi": d.hi if d else np.nan,
-                         "verdict": vs["verdict"] if vs else "", "basis": vs["basis"] if vs else "",
-                         "finding": vs["finding"] if vs else "best"})
+            rows.append(
+                {
+                    "method": mid,
+                    "label": self.labels[mid],
+                    "runs": int(e.shape[0]),
+                    "rms": float(np.median(self.rms(mid))),
+                    "rms_lo": est.lo if est else np.nan,
+                    "rms_hi": est.hi if est else np.nan,
+                    "rms_why": why,
+                    "min_error": float(np.median(e.min(axis=1))),
+                    "max_error": float(np.median(e.max(axis=1))),
+                    "vs_best": d.value if d else (0.0 if mid == best else np.nan),
+                    "vs_best_lo": d.lo if d else np.nan,
+                    "vs_best_hi": d.hi if d else np.nan,
+                    "verdict": vs["verdict"] if vs else "",
+                    "basis": vs["basis"] if vs else "",
+                    "finding": vs["finding"] if vs else "best",
+                }
+            )
         t = pd.DataFrame(rows)
         order = np.lexsort((np.arange(len(t)), t["rms"].to_numpy()))
         self._table = t.iloc[order].reset_index(drop=True)
@@ -408,13 +488,20 @@ class CompareResult:
         by: dict[str, list[str]] = {}
         for r in self.not_run:
             by.setdefault(r["why"], []).append(r["method"])
-        return [f"not run: {', '.join(ms)}: {why}" if len(ms) > 1 else f"not run: {ms[0]} {why}"
-                for why, ms in by.items()]
+        return [
+            f"not run: {', '.join(ms)}: {why}" if len(ms) > 1 else f"not run: {ms[0]} {why}"
+            for why, ms in by.items()
+        ]
 
     def to_dict(self) -> dict:
         """The result as JSON-ready data (snake_case keys, no NaN: a missing interval is null)."""
+
         def est(e):
-            return None if e is None else {"value": e.value, "lo": e.lo, "hi": e.hi, "rule": e.rule, "n": e.n}
+            return (
+                None
+                if e is None
+                else {"value": e.value, "lo": e.lo, "hi": e.hi, "rule": e.rule, "n": e.n}
+            )
 
         methods = []
         best = self.best
@@ -422,29 +509,61 @@ class CompareResult:
             mid = row.method
             e, why = self.estimate(mid)
             vs = None if mid == best else self.versus_best(mid)
-            methods.append({"method": mid, "label": row.label, "rank": rank, "stochastic": self.stochastic[mid],
-                            "runs": row.runs, "rms": est(e), "rms_why": why or None,
-                            "rms_per_run": [float(v) for v in self.rms(mid)],
-                            "median_min_error": row.min_error, "median_max_error": row.max_error,
-                            "versus_best": None if vs is None else {
-                                "difference": est(vs["difference"]), "verdict": vs["verdict"],
-                                "basis": vs["basis"], "finding": vs["finding"], "why": vs["why"] or None}})
-        return {"system": self.system, "file": self.source, "unit": self.unit, "rows": int(len(self.frame)),
-                "split": {"rule": self.rule, "folds": [f.to_dict(k) for k, f in enumerate(self.folds)]},
-                "seeds": self.seeds, "seed": self.seed, "margin": self.margin, "settings": self.settings,
-                "best": best, "claim": "the best method has the smaller held-out rms (paired over the same seeds)",
-                "methods": methods, "not_run": list(self.not_run)}
+            methods.append(
+                {
+                    "method": mid,
+                    "label": row.label,
+                    "rank": rank,
+                    "stochastic": self.stochastic[mid],
+                    "runs": row.runs,
+                    "rms": est(e),
+                    "rms_why": why or None,
+                    "rms_per_run": [float(v) for v in self.rms(mid)],
+                    "median_min_error": row.min_error,
+                    "median_max_error": row.max_error,
+                    "versus_best": None
+                    if vs is None
+                    else {
+                        "difference": est(vs["difference"]),
+                        "verdict": vs["verdict"],
+                        "basis": vs["basis"],
+                        "finding": vs["finding"],
+                        "why": vs["why"] or None,
+                    },
+                }
+            )
+        return {
+            "system": self.system,
+            "file": self.source,
+            "unit": self.unit,
+            "rows": int(len(self.frame)),
+            "split": {"rule": self.rule, "folds": [f.to_dict(k) for k, f in enumerate(self.folds)]},
+            "seeds": self.seeds,
+            "seed": self.seed,
+            "margin": self.margin,
+            "settings": self.settings,
+            "best": best,
+            "claim": "the best method has the smaller held-out rms (paired over the same seeds)",
+            "methods": methods,
+            "not_run": list(self.not_run),
+        }
 
     def text(self) -> str:
         """The comparison as text: what was split how, the table, what was not run."""
         u = self.unit
-        lines = [f"{self.system}: {os.path.basename(self.source) or self.source}, {len(self.frame)} rows; "
-                 f"split by {self.rule}, {len(self.folds)} folds; {self.seeds} seeds (seed {self.seed})"]
+        lines = [
+            f"{self.system}: {os.path.basename(self.source) or self.source}, {len(self.frame)} rows; "
+            f"split by {self.rule}, {len(self.folds)} folds; {self.seeds} seeds (seed {self.seed})"
+        ]
         for k, f in enumerate(self.folds):
-            lines.append(f"  fold {k + 1}: train {f.train_what} ({f.train.size} rows), test {f.test_what} "
-                         f"({f.test.size} rows)")
-        lines.append(f"held-out rms over every test row, median over seeds [95 % interval], {u}; "
-                     f"best: {self.labels[self.best]}")
+            lines.append(
+                f"  fold {k + 1}: train {f.train_what} ({f.train.size} rows), test {f.test_what} "
+                f"({f.test.size} rows)"
+            )
+        lines.append(
+            f"held-out rms over every test row, median over seeds [95 % interval], {u}; "
+            f"best: {self.labels[self.best]}"
+        )
         t = self.table()
 
         def iv(v, lo, hi, spec):
@@ -454,24 +573,42 @@ class CompareResult:
                 return spec.format(v)
             return f"{spec.format(v)} [{spec.format(lo)}, {spec.format(hi)}]"
 
-        show = pd.DataFrame({
-            "method": t["label"], "runs": t["runs"],
-            f"rms ({u}) [95 %]": [iv(*v, "{:.3f}") for v in zip(t.rms, t.rms_lo, t.rms_hi)],
-            f"range ({u})": [f"{a:+.2f}..{b:+.2f}" for a, b in zip(t.min_error, t.max_error)],
-            f"minus best ({u}) [95 %]": [iv(*v, "{:+.3f}") if m != self.best else "-"
-                                         for m, *v in zip(t.method, t.vs_best, t.vs_best_lo, t.vs_best_hi)],
-            "verdict": t["finding"]})
+        show = pd.DataFrame(
+            {
+                "method": t["label"],
+                "runs": t["runs"],
+                f"rms ({u}) [95 %]": [iv(*v, "{:.3f}") for v in zip(t.rms, t.rms_lo, t.rms_hi)],
+                f"range ({u})": [f"{a:+.2f}..{b:+.2f}" for a, b in zip(t.min_error, t.max_error)],
+                f"minus best ({u}) [95 %]": [
+                    iv(*v, "{:+.3f}") if m != self.best else "-"
+                    for m, *v in zip(t.method, t.vs_best, t.vs_best_lo, t.vs_best_hi)
+                ],
+                "verdict": t["finding"],
+            }
+        )
         lines += ["", show.to_string(index=False)]
         lines += self.not_run_lines()
-        lines.append("verdict: the book's rule (navlib.verdicts.decide) on the paired difference to the best over "
-                     "the same seeds; the intervals cover training randomness, not another recording")
+        lines.append(
+            "verdict: the book's rule (navlib.verdicts.decide) on the paired difference to the best over "
+            "the same seeds; the intervals cover training randomness, not another recording"
+        )
         return "\n".join(lines)
 
 
 # ------------------------------------------------------------------------------------------ the study
-def compare(system: str, source, methods: str | Sequence[str] | None = None, split: str | None = None,
-            seeds: int = 10, seed: int = 0, margin: float | None = None, workers: int = 1,
-            scheduler: str | None = None, frame: pd.DataFrame | None = None, **options) -> CompareResult:
+def compare(
+    system: str,
+    source,
+    methods: str | Sequence[str] | None = None,
+    split: str | None = None,
+    seeds: int = 10,
+    seed: int = 0,
+    margin: float | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
+    frame: pd.DataFrame | None = None,
+    **options,
+) -> CompareResult:
     """Fit ``methods`` (ids of the system's :class:`Comparison`; None: its default) on the folds of
     ``split`` (``sweep``, ``heading``, ``random``; None: ``sweep`` when the file has two sweeps or more,
     else ``heading``) of the file ``source`` and score them on the held-out rows (module docstring, eq.
@@ -524,22 +661,39 @@ def compare(system: str, source, methods: str | Sequence[str] | None = None, spl
     check_folds(folds, name, len(data))
     not_run, run = [], []
     for mid in mids:
-        why = next((w for k, f in enumerate(folds) if (w := c.cannot_fit(
-            mid, data.iloc[f.train], settings, f"the training part of fold {k + 1} ({f.train_what})"))), None)
+        why = next(
+            (
+                w
+                for k, f in enumerate(folds)
+                if (
+                    w := c.cannot_fit(
+                        mid,
+                        data.iloc[f.train],
+                        settings,
+                        f"the training part of fold {k + 1} ({f.train_what})",
+                    )
+                )
+            ),
+            None,
+        )
         if why is None:
             run.append(mid)
         elif explicit:
-            raise InputError(f"{name}: method {mid} ({c.methods[mid]}) {why}; leave it out of --methods")
+            raise InputError(
+                f"{name}: method {mid} ({c.methods[mid]}) {why}; leave it out of --methods"
+            )
         else:
             not_run.append({"method": mid, "label": c.methods[mid], "why": why})
     if not run:
-        raise InputError(f"{name}: none of the methods can be fitted on this split ({not_run[0]['why']})")
+        raise InputError(
+            f"{name}: none of the methods can be fitted on this split ({not_run[0]['why']})"
+        )
     arrays = {col: data[col].to_numpy(float) for col in c.columns}
     tasks, cost, owner = [], [], []
     for mid in run:
         stochastic = c.stochastic(mid)
         ks = list(range(seeds)) if stochastic else [0]
-        chunks = [tuple(ks[i:i + SEED_BATCH]) for i in range(0, len(ks), SEED_BATCH)]
+        chunks = [tuple(ks[i : i + SEED_BATCH]) for i in range(0, len(ks), SEED_BATCH)]
         for k, f in enumerate(folds):
             train = {col: a[f.train] for col, a in arrays.items()}
             test = {col: a[f.test] for col, a in arrays.items()}
@@ -547,8 +701,15 @@ def compare(system: str, source, methods: str | Sequence[str] | None = None, spl
                 tasks.append((c.system, mid, settings, train, test, k, ch, int(seed)))
                 cost.append(c.cost(mid, settings) * len(ch))
                 owner.append((mid, k))
-    parts = engine.run(_task, tasks, workers=workers, scheduler=scheduler, cost=cost, label=f"compare {system}",
-                       weight=[len(t[6]) for t in tasks])
+    parts = engine.run(
+        _task,
+        tasks,
+        workers=workers,
+        scheduler=scheduler,
+        cost=cost,
+        label=f"compare {system}",
+        weight=[len(t[6]) for t in tasks],
+    )
     errors = {}
     for mid in run:
         n_runs = seeds if c.stochastic(mid) else 1
@@ -557,9 +718,25 @@ def compare(system: str, source, methods: str | Sequence[str] | None = None, spl
             runs = [r for (m, kk), part in zip(owner, parts) if m == mid and kk == k for r in part]
             e[:, f.test] = np.asarray(runs)
         errors[mid] = e
-    return CompareResult(c.system, c.unit, str(source), data, split, folds, int(seeds), int(seed), run,
-                         {m: c.methods[m] for m in run}, {m: bool(c.stochastic(m)) for m in run}, errors,
-                         not_run, settings=settings.to_dict(), margin=margin, x_column=c.x_column, x_label=c.x_label)
+    return CompareResult(
+        c.system,
+        c.unit,
+        str(source),
+        data,
+        split,
+        folds,
+        int(seeds),
+        int(seed),
+        run,
+        {m: c.methods[m] for m in run},
+        {m: bool(c.stochastic(m)) for m in run},
+        errors,
+        not_run,
+        settings=settings.to_dict(),
+        margin=margin,
+        x_column=c.x_column,
+        x_label=c.x_label,
+    )
 
 
 # ------------------------------------------------------------------------------------------ the report
@@ -578,7 +755,9 @@ def claimed_report(folder):
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as err:
-        raise InputError(f"{folder}: cannot create the report folder ({err.strerror or err})") from None
+        raise InputError(
+            f"{folder}: cannot create the report folder ({err.strerror or err})"
+        ) from None
     made = []
     try:
         for name in REPORT_FILES:
@@ -587,9 +766,13 @@ def claimed_report(folder):
                 with open(p, "x"):
                     pass
             except FileExistsError:
-                raise InputError(f"{p}: already exists; not overwritten (choose another --report folder)") from None
+                raise InputError(
+                    f"{p}: already exists; not overwritten (choose another --report folder)"
+                ) from None
             except OSError as err:
-                raise InputError(f"{p}: cannot write the report there ({err.strerror or err})") from None
+                raise InputError(
+                    f"{p}: cannot write the report there ({err.strerror or err})"
+                ) from None
             made.append(p)
         yield tuple(made)
     except BaseException:
@@ -616,20 +799,26 @@ def report_figure(result: CompareResult):
     import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
     t = result.table()
-    n = len(t) + (len(t) % 2 if len(t) > 1 else 0)          # an even count: two columns
+    n = len(t) + (len(t) % 2 if len(t) > 1 else 0)  # an even count: two columns
     fig, axes = panels(n, panel_height_in=2.0, sharex=True)
     axes = [axes] if n == 1 else list(axes)
-    for ax in axes[len(t):]:
+    for ax in axes[len(t) :]:
         ax.set_visible(False)
-    axes = axes[:len(t)]
+    axes = axes[: len(t)]
     x = result.frame[result.x_column].to_numpy(float)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, row in zip(axes, t.itertuples()):
         e = result.errors[row.method][result.median_run(row.method)]
         for k, f in enumerate(result.folds):
             o = f.test[np.argsort(x[f.test], kind="stable")]
-            ax.plot(*_broken(x[o], e[o], GAP_DEG), ".-", ms=3, lw=0.6, color=colours[k % len(colours)],
-                    label=f"test {f.test_what}")
+            ax.plot(
+                *_broken(x[o], e[o], GAP_DEG),
+                ".-",
+                ms=3,
+                lw=0.6,
+                color=colours[k % len(colours)],
+                label=f"test {f.test_what}",
+            )
         ax.axhline(0.0, color="0.4", lw=0.6)
         ax.set_title(f"{row.label}: rms {row.rms:.3g} {result.unit}", fontsize=10)
         ax.set_ylabel(f"error ({result.unit})")
@@ -649,31 +838,52 @@ def write_report(result: CompareResult, paths) -> tuple[Path, Path]:
 
     md, png = (Path(p) for p in paths)
     fig = report_figure(result)
-    with open(png, "wb") as fh:                       # the file this run claimed
+    with open(png, "wb") as fh:  # the file this run claimed
         fig.savefig(fh, dpi=DPI, format="png")
     plt.close(fig)
     u = result.unit
-    lines = [f"# navlib compare {result.system}: `{result.source}`", "",
-             f"{len(result.frame)} rows, split by {result.rule} into {len(result.folds)} folds "
-             f"(every row a test row once); {result.seeds} seeds per stochastic method (seed {result.seed}).", ""]
-    lines += [f"- fold {k + 1}: train {f.train_what} ({f.train.size} rows), test {f.test_what} ({f.test.size} rows)"
-              for k, f in enumerate(result.folds)]
-    lines += ["", f"| method | runs | held-out rms ({u}) | 95 % interval | error range ({u}) | minus best ({u}) "
-              f"| 95 % interval | verdict |", "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        f"# navlib compare {result.system}: `{result.source}`",
+        "",
+        f"{len(result.frame)} rows, split by {result.rule} into {len(result.folds)} folds "
+        f"(every row a test row once); {result.seeds} seeds per stochastic method (seed {result.seed}).",
+        "",
+    ]
+    lines += [
+        f"- fold {k + 1}: train {f.train_what} ({f.train.size} rows), test {f.test_what} ({f.test.size} rows)"
+        for k, f in enumerate(result.folds)
+    ]
+    lines += [
+        "",
+        f"| method | runs | held-out rms ({u}) | 95 % interval | error range ({u}) | minus best ({u}) "
+        f"| 95 % interval | verdict |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
 
     def iv(lo, hi, spec):
-        return "-" if not (np.isfinite(lo) and np.isfinite(hi)) else f"{spec.format(lo)} .. {spec.format(hi)}"
+        return (
+            "-"
+            if not (np.isfinite(lo) and np.isfinite(hi))
+            else f"{spec.format(lo)} .. {spec.format(hi)}"
+        )
 
     for r in result.table().itertuples():
-        lines.append(f"| {r.label} | {r.runs} | {r.rms:.3f} | {iv(r.rms_lo, r.rms_hi, '{:.3f}')} | "
-                     f"{r.min_error:+.2f} .. {r.max_error:+.2f} | "
-                     f"{'-' if r.method == result.best else f'{r.vs_best:+.3f}'} | "
-                     f"{iv(r.vs_best_lo, r.vs_best_hi, '{:+.3f}')} | {r.finding} |")
+        lines.append(
+            f"| {r.label} | {r.runs} | {r.rms:.3f} | {iv(r.rms_lo, r.rms_hi, '{:.3f}')} | "
+            f"{r.min_error:+.2f} .. {r.max_error:+.2f} | "
+            f"{'-' if r.method == result.best else f'{r.vs_best:+.3f}'} | "
+            f"{iv(r.vs_best_lo, r.vs_best_hi, '{:+.3f}')} | {r.finding} |"
+        )
     lines += [""] + [f"{line[0].upper()}{line[1:]}." for line in result.not_run_lines()]
-    lines += ["", "Held-out rms: every test row once, median over the seeds with its distribution-free 95 % "
-              "interval (one exact value for a deterministic method). Verdict: the book's rule "
-              "(`navlib.verdicts.decide`) on the median paired difference to the best method over the same "
-              "seeds. The intervals cover the training randomness, not another recording of the compass.", "",
-              f"![error against {result.x_label} per method]({png.name})", ""]
+    lines += [
+        "",
+        "Held-out rms: every test row once, median over the seeds with its distribution-free 95 % "
+        "interval (one exact value for a deterministic method). Verdict: the book's rule "
+        "(`navlib.verdicts.decide`) on the median paired difference to the best method over the same "
+        "seeds. The intervals cover the training randomness, not another recording of the compass.",
+        "",
+        f"![error against {result.x_label} per method]({png.name})",
+        "",
+    ]
     md.write_text("\n".join(lines), encoding="utf-8")
     return md, png

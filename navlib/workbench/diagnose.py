@@ -59,6 +59,7 @@ attitude bad in segments), so residuals more than ``RATIO_MAX`` times the noise 
 are reported as slow structure, and a candidate that takes out more than ``EXPLAINED_MAX`` times that
 noise and lowers the held-out RMS is named although the whitened test leaves it undecided.
 """
+
 from __future__ import annotations
 
 import math
@@ -81,8 +82,16 @@ from .linalg import orth_basis
 from .noise_size import NoiseSize, noise_size
 from .screen import Screening, screen as screen_data
 from .reml import _Prepared
-from .serial import (NoiseModel, colour, select_ar1_many, select_bases, select_many, whiten, whiten_each,
-                     whiten_transpose)
+from .serial import (
+    NoiseModel,
+    colour,
+    select_ar1_many,
+    select_bases,
+    select_many,
+    whiten,
+    whiten_each,
+    whiten_transpose,
+)
 from ..threads import one_blas_thread
 
 SMALL_SAMPLE = 12
@@ -107,20 +116,20 @@ _BATCH = 20
 @dataclass
 class Candidate:
     effect: str
-    rms: float                  # residual RMS after adding the effect
-    loo_rms: float              # held-out (leave-one-out) RMS after adding it
-    variance_explained: float   # share of the current residual sum of squares it removes
+    rms: float  # residual RMS after adding the effect
+    loo_rms: float  # held-out (leave-one-out) RMS after adding it
+    variance_explained: float  # share of the current residual sum of squares it removes
     p_value: float
-    test: str                   # 'F', 'F (GLS)' (correlated noise) or 'permutation'
+    test: str  # 'F', 'F (GLS)' (correlated noise) or 'permutation'
     significant: bool = False
     log_p: float = field(default=0.0, repr=False)
-    explains: str = ""          # the structure it removes ("" if no structure was found)
+    explains: str = ""  # the structure it removes ("" if no structure was found)
 
 
 @dataclass
 class Finding:
     what: str
-    amplitude: float            # size of the structure, in the data's unit
+    amplitude: float  # size of the structure, in the data's unit
     p_value: float
     significant: bool = False
     log_p: float = field(default=0.0, repr=False)
@@ -152,8 +161,19 @@ class Diagnosis:
         return [o.to_dict() for o in self.screening.outliers] if self.screening is not None else []
 
     def to_dict(self) -> dict:
-        d = {k: getattr(self, k) for k in ("system", "model", "unit", "n", "rms", "loo_rms", "missing",
-                                            "consistent_with_noise")}
+        d = {
+            k: getattr(self, k)
+            for k in (
+                "system",
+                "model",
+                "unit",
+                "n",
+                "rms",
+                "loo_rms",
+                "missing",
+                "consistent_with_noise",
+            )
+        }
         d["candidates"] = [asdict(c) for c in self.candidates]
         for c in d["candidates"]:
             c.pop("log_p")
@@ -162,10 +182,17 @@ class Diagnosis:
         for s in d["structure"]:
             s.pop("log_p")
             if not np.isfinite(s["p_value"]):
-                s["p_value"] = None                     # the size check's finding has no p-value
+                s["p_value"] = None  # the size check's finding has no p-value
         d["noise_size"] = self.noise_size.to_dict() if self.noise_size is not None else None
-        d.update({"untestable": dict(self.untestable), "alpha": self.alpha, "tests": self.tests,
-                  "message": self.message, "outliers": self.outliers})
+        d.update(
+            {
+                "untestable": dict(self.untestable),
+                "alpha": self.alpha,
+                "tests": self.tests,
+                "message": self.message,
+                "outliers": self.outliers,
+            }
+        )
         if self.calibration is not None:
             d["calibration"] = self.calibration.to_dict()
         if self.screening is not None:
@@ -175,48 +202,78 @@ class Diagnosis:
         return d
 
     def candidate_table(self) -> pd.DataFrame:
-        rows = [{"effect": c.effect, f"rms after ({self.unit})": c.rms, f"held-out rms ({self.unit})": c.loo_rms,
-                 "variance explained": c.variance_explained, "p": c.p_value, "test": c.test,
-                 "significant": c.significant} for c in self.candidates]
+        rows = [
+            {
+                "effect": c.effect,
+                f"rms after ({self.unit})": c.rms,
+                f"held-out rms ({self.unit})": c.loo_rms,
+                "variance explained": c.variance_explained,
+                "p": c.p_value,
+                "test": c.test,
+                "significant": c.significant,
+            }
+            for c in self.candidates
+        ]
         return pd.DataFrame(rows).set_index("effect") if rows else pd.DataFrame()
 
     def structure_table(self) -> pd.DataFrame:
-        rows = [{"structure": s.what, f"amplitude ({self.unit})": s.amplitude, "p": s.p_value,
-                 "significant": s.significant} for s in self.structure]
+        rows = [
+            {
+                "structure": s.what,
+                f"amplitude ({self.unit})": s.amplitude,
+                "p": s.p_value,
+                "significant": s.significant,
+            }
+            for s in self.structure
+        ]
         return pd.DataFrame(rows).set_index("structure") if rows else pd.DataFrame()
 
     def _level_line(self) -> str:
         cal = self.calibration
         if cal is None or cal.method == "Bonferroni":
             return f"tests: {self.tests}, each at alpha/m = {self.alpha / max(self.tests, 1):.2g}"
-        return (f"tests: {self.tests}, family-wise alpha = {self.alpha:g}: significant below p = {cal.level:.2g} "
-                f"(parametric bootstrap of the smallest p, {cal.replicates} replicates"
-                f"{', stopped early' if cal.stopped_early else ''})")
+        return (
+            f"tests: {self.tests}, family-wise alpha = {self.alpha:g}: significant below p = {cal.level:.2g} "
+            f"(parametric bootstrap of the smallest p, {cal.replicates} replicates"
+            f"{', stopped early' if cal.stopped_early else ''})"
+        )
 
     def report(self) -> str:
         """A readable multi-line report (the CLI's output without --json)."""
         used = len(self.screening.kept) if self.screening is not None else None
-        size = (f"rows: {used}" + (f" ({self.n} observations)" if self.n != used else "")
-                if used else f"observations: {self.n}")
-        lines = [f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   {size}",
-                 f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
-                 self._level_line()]
+        size = (
+            f"rows: {used}" + (f" ({self.n} observations)" if self.n != used else "")
+            if used
+            else f"observations: {self.n}"
+        )
+        lines = [
+            f"system: {self.system}   model: {' + '.join(self.model) or '(none)'}   {size}",
+            f"residual rms: {_fmt(self.rms)} {self.unit}   held-out rms: {_fmt(self.loo_rms)} {self.unit}",
+            self._level_line(),
+        ]
         if self.screening is not None and self.screening.noise.series is not None:
             lines.append("noise: " + self.screening.noise.describe())
         if self.candidates:
             lines.append("")
-            lines.append(f"{'candidate':<20}{'rms after':>12}{'held-out':>12}{'var. expl.':>12}{'p':>11}  sig.")
+            lines.append(
+                f"{'candidate':<20}{'rms after':>12}{'held-out':>12}{'var. expl.':>12}{'p':>11}  sig."
+            )
             for c in self.candidates:
-                lines.append(f"{c.effect:<20}{_fmt(c.rms):>12}{_fmt(c.loo_rms):>12}{c.variance_explained:>12.3f}"
-                             f"{c.p_value:>11.2g}  {'yes' if c.significant else 'no'}")
+                lines.append(
+                    f"{c.effect:<20}{_fmt(c.rms):>12}{_fmt(c.loo_rms):>12}{c.variance_explained:>12.3f}"
+                    f"{c.p_value:>11.2g}  {'yes' if c.significant else 'no'}"
+                )
         for name, why in self.untestable.items():
             lines.append(f"not testable: {name} ({why})")
         found = [s for s in self.structure if s.significant]
         if found:
             lines.append("")
             lines.append("structure no catalogued effect explains:")
-            lines.extend(f"  {s.what}: amplitude {_fmt(s.amplitude)} {self.unit}, "
-                         + (f"p = {s.p_value:.2g}" if np.isfinite(s.p_value) else "by the size check") for s in found)
+            lines.extend(
+                f"  {s.what}: amplitude {_fmt(s.amplitude)} {self.unit}, "
+                + (f"p = {s.p_value:.2g}" if np.isfinite(s.p_value) else "by the size check")
+                for s in found
+            )
         lines.append("")
         lines.append(self.message)
         return "\n".join(lines)
@@ -234,19 +291,26 @@ def _f_test(rss0: float, rss1: float, q: int, df2: int) -> tuple[float, float]:
         return (0.0, -np.inf) if rss0 > 0 else (1.0, 0.0)
     f = max((rss0 - rss1) / q, 0.0) / (rss1 / df2)
     with np.errstate(divide="ignore"):
-        logp = float(np.log(special.fdtrc(q, df2, f)))      # scipy.stats.f.logsf, without importing scipy.stats
+        logp = float(
+            np.log(special.fdtrc(q, df2, f))
+        )  # scipy.stats.f.logsf, without importing scipy.stats
     return float(math.exp(logp)), logp
 
 
-def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n_random: int = 5000) -> float:
+def _permutation_p(
+    fit: Fit, effect: str, observed_drop: float, seed: int = 0, n_random: int = 5000
+) -> float:
     """Permutation test of a drift covariate: shuffle the candidate's column across rows (every
     permutation when n! <= 5040, else ``n_random`` random ones) and count how often the shuffled column
     removes at least as much RSS as the real one.  Vectorised: with ``M0 = I - Q Q'`` the residual maker
     of the current design (``Q`` an orthonormal basis of it; ``M0`` is never formed), a column ``x``
     removes ``(x' M0 y)^2 / (x' M0 x)``.  Bias (a constant) cannot be permuted: returns None and the F test
     is used."""
-    col = {"earth_rate": "latitude_error_deg", "temperature": "temperature_c",
-           "temperature_change": "temperature_change_c"}.get(effect)
+    col = {
+        "earth_rate": "latitude_error_deg",
+        "temperature": "temperature_c",
+        "temperature_change": "temperature_change_c",
+    }.get(effect)
     if col is None:
         return None
     data = fit.data
@@ -263,11 +327,11 @@ def _permutation_p(fit: Fit, effect: str, observed_drop: float, seed: int = 0, n
         rng = np.random.default_rng(seed)
         perms = np.array([rng.permutation(n) for _ in range(n_random)])
         exact = False
-    Xp = x1[perms]                                    # (P, n) permuted columns (centring is invariant)
-    Mx = Xp - (Xp @ Q) @ Q.T                           # M0 x of each permuted column (M0 symmetric, idempotent)
+    Xp = x1[perms]  # (P, n) permuted columns (centring is invariant)
+    Mx = Xp - (Xp @ Q) @ Q.T  # M0 x of each permuted column (M0 symmetric, idempotent)
     a = Mx @ y
     b = np.einsum("pn,pn->p", Mx, Mx)
-    drops = np.where(b > 1e-300, a ** 2 / np.where(b > 1e-300, b, 1.0), 0.0)
+    drops = np.where(b > 1e-300, a**2 / np.where(b > 1e-300, b, 1.0), 0.0)
     hits = np.sum(drops >= observed_drop * (1 - 1e-9))
     return float(hits / len(perms)) if exact else float((1 + hits) / (1 + len(perms)))
 
@@ -284,7 +348,9 @@ def _gls(fit: Fit, noise: NoiseModel | None) -> tuple[np.ndarray, np.ndarray]:
     return _gls_of(fit.residuals, fit.jacobian, noise)
 
 
-def _gls_of(r: np.ndarray, J: np.ndarray, noise: NoiseModel | None) -> tuple[np.ndarray, np.ndarray]:
+def _gls_of(
+    r: np.ndarray, J: np.ndarray, noise: NoiseModel | None
+) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_gls` of a residual ``r`` and a Jacobian ``J``."""
     if noise is None or not noise.correlated:
         return r, _projector(J)
@@ -293,8 +359,9 @@ def _gls_of(r: np.ndarray, J: np.ndarray, noise: NoiseModel | None) -> tuple[np.
     return e - Q @ (Q.T @ e), Q
 
 
-def _shape_bases(Q: np.ndarray, shapes: list, noise: NoiseModel | None,
-                 n: int) -> list[tuple[int, np.ndarray, int, int]]:
+def _shape_bases(
+    Q: np.ndarray, shapes: list, noise: NoiseModel | None, n: int
+) -> list[tuple[int, np.ndarray, int, int]]:
     """For each structure shape ``X0`` the part the model of (whitened) Jacobian basis ``Q`` cannot absorb:
     ``(index, u, q, df2)`` with ``u`` an orthonormal basis of it (q columns) and ``df2`` the F test's
     denominator degrees of freedom; shapes the model already spans, or with too few rows left, are
@@ -312,17 +379,18 @@ def _unspanned(Q: np.ndarray, shapes: list, n: int) -> list[tuple[int, np.ndarra
         # directions of the shape the model cannot absorb: singular values of Xp above SPANNED (unit columns;
         # the Gram matrix is small: a structure shape has at most a few tens of columns)
         w, V = np.linalg.eigh(Xp.T @ Xp)
-        keep = w > SPANNED ** 2
+        keep = w > SPANNED**2
         q = int(np.sum(keep))
         df2 = n - Q.shape[1] - q
         if q == 0 or df2 < 3:
-            continue                                   # the model already spans this shape, or too few rows
+            continue  # the model already spans this shape, or too few rows
         out.append((i, (Xp @ V[:, keep]) / np.sqrt(w[keep]), q, df2))
     return out
 
 
-def _shape_tests(e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel | None,
-                 n: int) -> list[tuple[int, float, float]]:
+def _shape_tests(
+    e: np.ndarray, Q: np.ndarray, shapes: list, noise: NoiseModel | None, n: int
+) -> list[tuple[int, float, float]]:
     """F tests of structure shapes ``X0`` against the (whitened, projected) residual ``e`` of a model with
     (whitened) Jacobian basis ``Q``: ``(index, p, log p)`` of each shape the model does not already span."""
     rss = float(e @ e)
@@ -343,7 +411,7 @@ def _structure(fit: Fit, noise: NoiseModel | None = None) -> list[Finding]:
     out = []
     for i, p, logp in _shape_tests(e, Q, [X0 for _, X0, _ in spec], noise, len(r)):
         what, X0, scale = spec[i]
-        qx = orth_basis(X0)                             # amplitude: the shape fitted to the residual itself
+        qx = orth_basis(X0)  # amplitude: the shape fitted to the residual itself
         amp = scale * float(np.sqrt(np.mean((qx @ (qx.T @ r)) ** 2)))
         out.append(Finding(what, amp, p, log_p=logp))
     return out
@@ -359,7 +427,9 @@ def _candidate_p(fit: Fit, f1: Fit, noise: NoiseModel) -> tuple[float, float]:
     return _f_test(float(e0 @ e0), float(e1 @ e1), q, df2)
 
 
-def _conditional_p(fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | None = None) -> float:
+def _conditional_p(
+    fit: Fit, f1: Fit, found: list[Finding], noise: NoiseModel | None = None
+) -> float:
     """p of the candidate's improvement when the structure ``found`` is allowed for in both models: the
     residuals of ``fit`` and of ``f1`` (= fit + candidate) are each regressed on their model's Jacobian and
     the structure shapes, and the two remaining sums of squares are F-tested (all whitened when the noise
@@ -390,8 +460,12 @@ class Calibration:
     stopped_early: bool = False
 
     def to_dict(self) -> dict:
-        return {"level": self.level, "method": self.method, "replicates": self.replicates,
-                "stopped_early": self.stopped_early}
+        return {
+            "level": self.level,
+            "method": self.method,
+            "replicates": self.replicates,
+            "stopped_early": self.stopped_early,
+        }
 
 
 def bootstrap_replicates(alpha: float) -> int:
@@ -407,8 +481,9 @@ _KEEP_BASES = 4
 _REESTIMATES: dict = {}
 
 
-def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: float,
-                     seed: int) -> Calibration:
+def _bootstrap_level(
+    fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: float, seed: int
+) -> Calibration:
     """The family-wise critical p-value on correlated noise, by a parametric bootstrap of the smallest
     plug-in p-value of the family (Westfall and Young 1993, *Resampling-Based Multiple Testing*, single-step
     minP; module docstring).  Each replicate: AR noise with the estimated partial autocorrelations on the
@@ -425,7 +500,7 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     seed, not on the model tested: the diagnoses of one loop share them (:func:`_reestimates`)."""
     noise = sc.noise
     B = bootstrap_replicates(alpha)
-    K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))     # >= 2: B >= 2.5 / alpha - 1
+    K = int(math.ceil(alpha * (B + 1) - 1 - 1e-12))  # >= 2: B >= 2.5 / alpha - 1
     family = _Family(fit, fits, noise.series, noise.order)
     rng = np.random.default_rng(child(seed, _BOOTSTRAP_KEY))
     ser = noise.series
@@ -438,13 +513,15 @@ def _bootstrap_level(fit: Fit, fits: dict, sc: Screening, alpha: float, p_min: f
     for start in range(0, B, batch):
         if start not in memo["batches"]:
             if U is None:
-                U = rng.standard_normal((len(ser.order), B))    # every replicate's draw, made once
-            E = colour(U[:, start:start + batch], noise.kappa, ser, fit.n)
+                U = rng.standard_normal((len(ser.order), B))  # every replicate's draw, made once
+            E = colour(U[:, start : start + batch], noise.kappa, ser, fit.n)
             memo["batches"][start] = (E, _reestimate(E, memo["bases"], noise, sc.regressors))
         E, models = memo["batches"][start]
         minima = np.r_[minima, family.minima(E, models)]
         if np.sum(minima <= p_min) >= K:
-            return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", len(minima), True)
+            return Calibration(
+                float(np.sort(minima)[K - 1]), "parametric bootstrap", len(minima), True
+            )
     return Calibration(float(np.sort(minima)[K - 1]), "parametric bootstrap", B)
 
 
@@ -460,8 +537,12 @@ def _reestimates(sc: Screening, seed: int, B: int, n: int) -> dict:
     memo = _REESTIMATES.get(key)
     if memo is None or memo["noise"]() is not noise or memo["regressors"] is not sc.regressors:
         _REESTIMATES.clear()
-        memo = {"noise": weakref.ref(noise), "regressors": sc.regressors, "batches": {},
-                "bases": select_bases(*sc.regressors, noise.series, n, order=noise.order)}
+        memo = {
+            "noise": weakref.ref(noise),
+            "regressors": sc.regressors,
+            "batches": {},
+            "bases": select_bases(*sc.regressors, noise.series, n, order=noise.order),
+        }
         _REESTIMATES[key] = memo
         weakref.finalize(noise, _REESTIMATES.pop, key, None)
     return memo
@@ -473,7 +554,10 @@ def _reestimate(E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> l
     given; the AR order fixed at the data's).  AR(1): every column's correlation on the grid at once
     (:func:`navlib.workbench.serial.select_ar1_many`)."""
     if noise.order == 1:
-        return [NoiseModel((float(k),), noise.series, len(E)) for k in select_ar1_many(E, bases, noise.series)]
+        return [
+            NoiseModel((float(k),), noise.series, len(E))
+            for k in select_ar1_many(E, bases, noise.series)
+        ]
     return select_many(E, *regressors, noise.series, bases, order=noise.order, start_at=noise.kappa)
 
 
@@ -499,11 +583,16 @@ class _Family:
 
     def __init__(self, fit: Fit, fits: dict, series, order: int):
         self.n = fit.n
-        cands = [(f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()]
+        cands = [
+            (f1.jacobian, f1.n_params - fit.n_params, f1.n - f1.n_params) for f1 in fits.values()
+        ]
         cands = [c for c in cands if c[1] > 0 and c[2] > 0]
         self.tests = [(q, df2) for _, q, df2 in cands]
         shapes = [np.asarray(X0, float) for _, X0, _ in fit.spec.structure(fit)]
-        jacobians = [np.asarray(J, float).reshape(self.n, -1) for J in [fit.jacobian] + [J1 for J1, _, _ in cands]]
+        jacobians = [
+            np.asarray(J, float).reshape(self.n, -1)
+            for J in [fit.jacobian] + [J1 for J1, _, _ in cands]
+        ]
         self.series = series
         self.gram = series.projection is None
         blocks = ([orth_basis(J) for J in jacobians] if self.gram else jacobians) + shapes
@@ -512,8 +601,8 @@ class _Family:
         X = np.column_stack(blocks)
         self.F = X[series.order]
         self.pre = _Prepared(X, series, max(order, 1)) if self.gram else None
-        self._cache: dict = {}                         # by noise model: _factors (Gram path)
-        self._whitened: dict = {}                      # and _bases (whitened path)
+        self._cache: dict = {}  # by noise model: _factors (Gram path)
+        self._whitened: dict = {}  # and _bases (whitened path)
 
     def minima(self, E: np.ndarray, models: list) -> np.ndarray:
         """The smallest p of the family on each column of ``E`` (residual vectors in observation order), each
@@ -525,14 +614,18 @@ class _Family:
             orders.setdefault(nm.order if nm.correlated else 0, []).append(b)
         for cols in orders.values():
             if self.gram:
-                try:                                   # every column at once, each under its own model
+                try:  # every column at once, each under its own model
                     out[cols] = self._min_p_many(Eo[:, cols], [models[b] for b in cols])
                     continue
-                except np.linalg.LinAlgError:          # a Gram block numerically singular: one model at a time
+                except (
+                    np.linalg.LinAlgError
+                ):  # a Gram block numerically singular: one model at a time
                     pass
             groups: dict = {}
             for b in cols:
-                groups.setdefault(tuple(models[b].kappa) if models[b].correlated else (), []).append(b)
+                groups.setdefault(
+                    tuple(models[b].kappa) if models[b].correlated else (), []
+                ).append(b)
             for same in groups.values():
                 run = self._min_p if self.gram else self._min_p_whitened
                 out[same] = run(Eo[:, same], models[same[0]])
@@ -545,8 +638,8 @@ class _Family:
         (batched LAPACK); raises ``LinAlgError`` when a block is not numerically positive definite."""
         kappas = [tuple(nm.kappa) if nm.correlated else () for nm in models]
         We = whiten_each(Eo, kappas, self.series)
-        c = np.einsum("ij,ij->j", We, We)                                           # e' R^-1 e
-        h = (self.F.T @ whiten_each(We, kappas, self.series, transpose=True)).T     # F' R^-1 e: (B, m)
+        c = np.einsum("ij,ij->j", We, We)  # e' R^-1 e
+        h = (self.F.T @ whiten_each(We, kappas, self.series, transpose=True)).T  # F' R^-1 e: (B, m)
         m = self.F.shape[1]
         H = (np.array([self.pre.weights(k)[1] for k in kappas]) @ self.pre.Gq).reshape(-1, m, m)
         a0 = self.spans[0]
@@ -559,17 +652,21 @@ class _Family:
             fit1 = np.einsum("bi,bi->b", z1, z1)
             best = np.minimum(best, _f_p(fit1 - fit0, c - fit1, q, df2))
         k0 = a0.stop - a0.start
-        for s in self.spans[1 + len(self.tests):]:
+        for s in self.spans[1 + len(self.tests) :]:
             Hss = H[:, s, s]
-            d = np.maximum(np.sqrt(np.maximum(np.diagonal(Hss, axis1=1, axis2=2), 0.0)), 1e-300)     # (B, q)
+            d = np.maximum(
+                np.sqrt(np.maximum(np.diagonal(Hss, axis1=1, axis2=2), 0.0)), 1e-300
+            )  # (B, q)
             Bm = _lower_solve(L0, H[:, a0, s]) / d[:, None, :]
-            w, V = np.linalg.eigh(Hss / (d[:, :, None] * d[:, None, :]) - Bm.transpose(0, 2, 1) @ Bm)
-            keep = w > SPANNED ** 2
+            w, V = np.linalg.eigh(
+                Hss / (d[:, :, None] * d[:, None, :]) - Bm.transpose(0, 2, 1) @ Bm
+            )
+            keep = w > SPANNED**2
             y = np.einsum("bsr,bs->br", V, h[:, s] / d - np.einsum("bks,bk->bs", Bm, z0))
             drop = np.sum(np.where(keep, y * y / np.where(keep, w, 1.0), 0.0), axis=1)
             q = np.sum(keep, axis=1)
             df2 = self.n - k0 - q
-            ok = (q > 0) & (df2 >= 3)                  # else the model spans the shape, or too few rows
+            ok = (q > 0) & (df2 >= 3)  # else the model spans the shape, or too few rows
             p = _f_p(drop, rss0 - drop, np.maximum(q, 1), np.maximum(df2, 1))
             best = np.minimum(best, np.where(ok, p, 1.0))
         return best
@@ -582,18 +679,18 @@ class _Family:
             _, ws, _ = self.pre.weights(kappa)
             m = self.F.shape[1]
             H = (ws @ self.pre.Gq).reshape(m, m)
-            T = [_inverse_factor(H[s, s]) for s in self.spans[:1 + len(self.tests)]]
+            T = [_inverse_factor(H[s, s]) for s in self.spans[: 1 + len(self.tests)]]
             a0, T0 = self.spans[0], T[0]
             shapes = []
-            for s in self.spans[1 + len(self.tests):]:
+            for s in self.spans[1 + len(self.tests) :]:
                 d = np.maximum(np.sqrt(np.maximum(np.diag(H[s, s]), 0.0)), 1e-300)
                 Bm = (T0 @ H[a0, s]) / d
                 w, V = np.linalg.eigh(H[s, s] / np.outer(d, d) - Bm.T @ Bm)
-                keep = w > SPANNED ** 2
+                keep = w > SPANNED**2
                 q = int(np.sum(keep))
                 df2 = self.n - T0.shape[0] - q
                 if q == 0 or df2 < 3:
-                    continue                           # the model already spans this shape, or too few rows
+                    continue  # the model already spans this shape, or too few rows
                 shapes.append((s, V[:, keep] / np.sqrt(w[keep]), Bm, d, q, df2))
             if len(self._cache) >= _KEEP_BASES:
                 self._cache.pop(next(iter(self._cache)))
@@ -606,8 +703,8 @@ class _Family:
         kappa = tuple(nm.kappa) if nm.correlated else ()
         T, shapes = self._factors(kappa)
         We = whiten(Eo, kappa, self.series, ordered=True)
-        c = np.einsum("ij,ij->j", We, We)                          # e' R^-1 e
-        h = self.F.T @ whiten_transpose(We, kappa, self.series)    # F' R^-1 e
+        c = np.einsum("ij,ij->j", We, We)  # e' R^-1 e
+        h = self.F.T @ whiten_transpose(We, kappa, self.series)  # F' R^-1 e
         z0 = T[0] @ h[self.spans[0]]
         fit0 = np.einsum("ij,ij->j", z0, z0)
         rss0 = c - fit0
@@ -634,7 +731,7 @@ class _Family:
             Q1s = [(_projector(W1), q, df2) for W1, (q, df2) in zip(blocks[1:], self.tests)]
             if len(self._whitened) >= _KEEP_BASES:
                 self._whitened.pop(next(iter(self._whitened)))
-            self._whitened[key] = (Q0, Q1s, _unspanned(Q0, blocks[1 + len(self.tests):], self.n))
+            self._whitened[key] = (Q0, Q1s, _unspanned(Q0, blocks[1 + len(self.tests) :], self.n))
         return self._whitened[key]
 
     def _min_p_whitened(self, Eo: np.ndarray, nm: NoiseModel) -> np.ndarray:
@@ -691,7 +788,9 @@ def _f_p(drop: np.ndarray, rss1: np.ndarray, q: int, df2: int) -> np.ndarray:
 
 
 @one_blas_thread
-def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True) -> Diagnosis:
+def diagnose(
+    fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Screening = True
+) -> Diagnosis:
     """Rank the effects not yet in ``fit`` by the evidence that adding each explains the residuals; name the
     one to add, or say the residuals are consistent with noise, or name the structure no effect explains.
 
@@ -747,17 +846,37 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
         if sc.outliers:
             fit = sc.refit(fit)
         elif sc.rich is not None and sc.rich.data is fit.data:
-            reuse = sc.rich                            # fitted from fit.params: the same as fit.add
+            reuse = sc.rich  # fitted from fit.params: the same as fit.add
     noise = sc.noise
     ok, why = testable(fit.available, fit.data)
     untestable = {k: v for k, v in why.items() if k not in fit.effects}
     unit = fit.unit
     if fit.rms <= sc.floor:
-        msg = (f"the residuals are consistent with noise: their rms {_fmt(fit.rms)} {unit} is at the data's "
-               f"numerical precision (at most {sc.floor / sc.scale:.0e} of the measured values' rms "
-               f"{_fmt(sc.scale)} {unit}); nothing to test")
-        return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, None, True,
-                                 [], [], untestable, alpha, 0, msg, sc, Calibration(alpha, "Bonferroni")))
+        msg = (
+            f"the residuals are consistent with noise: their rms {_fmt(fit.rms)} {unit} is at the data's "
+            f"numerical precision (at most {sc.floor / sc.scale:.0e} of the measured values' rms "
+            f"{_fmt(sc.scale)} {unit}); nothing to test"
+        )
+        return _finish(
+            Diagnosis(
+                fit.system,
+                list(fit.effects),
+                unit,
+                fit.n,
+                fit.rms,
+                fit.loo_rms,
+                None,
+                True,
+                [],
+                [],
+                untestable,
+                alpha,
+                0,
+                msg,
+                sc,
+                Calibration(alpha, "Bonferroni"),
+            )
+        )
     cands = []
     fits = {}
     for effect in ok:
@@ -768,20 +887,32 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
                 f1 = reuse
             else:
                 f1 = fit.add(effect)
-        except InputError as err:                      # e.g. too few rows for one more parameter
+        except InputError as err:  # e.g. too few rows for one more parameter
             untestable[effect] = str(err)
             continue
         fits[effect] = f1
         drop = max(fit.rss - f1.rss, 0.0)
         p, logp = _candidate_p(fit, f1, noise)
         test = "F" if not noise.correlated else "F (GLS)"
-        if (fit.system == "drift" and fit.n <= SMALL_SAMPLE
-                and all(e in fit.spec.catalogue for e in fit.effects + (effect,))):
+        if (
+            fit.system == "drift"
+            and fit.n <= SMALL_SAMPLE
+            and all(e in fit.spec.catalogue for e in fit.effects + (effect,))
+        ):
             pp = _permutation_p(fit, effect, drop, seed)
             if pp is not None:
                 p, logp, test = pp, math.log(max(pp, 1e-300)), "permutation"
-        cands.append(Candidate(effect, f1.rms, f1.loo_rms, drop / fit.rss if fit.rss > 0 else 0.0, p, test,
-                               log_p=logp))
+        cands.append(
+            Candidate(
+                effect,
+                f1.rms,
+                f1.loo_rms,
+                drop / fit.rss if fit.rss > 0 else 0.0,
+                p,
+                test,
+                log_p=logp,
+            )
+        )
     structure = _structure(fit, noise)
     m = len(cands) + len(structure)
     if noise.correlated and sc.regressors is not None and m:
@@ -820,51 +951,92 @@ def diagnose(fit: Fit, alpha: float = None, seed: int = 0, *, screen: bool | Scr
         # "consistent with noise" needs the residual small against the noise the data show at short lags,
         # and no candidate taking out much more than that (module noise_size)
         size = noise_size(fit, fits, unit, noise.effective_samples if noise.correlated else None)
-        big = None if size is None or size.biggest is None else next(c for c in cands if c.effect == size.biggest)
-        if size is not None and size.problem and size.problem.startswith("'") and big.loo_rms < fit.loo_rms:
-            missing = big.effect                       # too large to be noise, and it predicts better
+        big = (
+            None
+            if size is None or size.biggest is None
+            else next(c for c in cands if c.effect == size.biggest)
+        )
+        if (
+            size is not None
+            and size.problem
+            and size.problem.startswith("'")
+            and big.loo_rms < fit.loo_rms
+        ):
+            missing = big.effect  # too large to be noise, and it predicts better
         elif size is not None and size.problem:
-            amp = float(np.sqrt(max(size.rms ** 2 - size.short ** 2, 0.0)))
+            amp = float(np.sqrt(max(size.rms**2 - size.short**2, 0.0)))
             if size.problem.startswith("'"):
                 amp = size.explained
             found = [Finding(size.problem, amp, float("nan"), significant=True)]
             structure = structure + found
     if missing and size is not None and missing == size.biggest and size.problem:
         c = next(c for c in cands if c.effect == missing)
-        msg = (f"add '{missing}': it takes out {_fmt(size.explained)} {unit} rms, "
-               f"{size.explained / size.short:.1f} times the sample-to-sample noise ({_fmt(size.short)} {unit}: "
-               f"too large for noise), and lowers the held-out rms from {_fmt(fit.loo_rms)} to {_fmt(c.loo_rms)} "
-               f"{unit}; the correlated-noise test alone leaves it undecided (p = {c.p_value:.2g})")
+        msg = (
+            f"add '{missing}': it takes out {_fmt(size.explained)} {unit} rms, "
+            f"{size.explained / size.short:.1f} times the sample-to-sample noise ({_fmt(size.short)} {unit}: "
+            f"too large for noise), and lowers the held-out rms from {_fmt(fit.loo_rms)} to {_fmt(c.loo_rms)} "
+            f"{unit}; the correlated-noise test alone leaves it undecided (p = {c.p_value:.2g})"
+        )
     elif missing:
         c = next(c for c in cands if c.effect == missing)
-        msg = (f"add '{missing}': it removes {100 * c.variance_explained:.1f} % of the residual variance "
-               f"(p = {c.p_value:.2g}, {c.test} test) and lowers the held-out rms from {_fmt(fit.loo_rms)} to "
-               f"{_fmt(c.loo_rms)} {unit}")
+        msg = (
+            f"add '{missing}': it removes {100 * c.variance_explained:.1f} % of the residual variance "
+            f"(p = {c.p_value:.2g}, {c.test} test) and lowers the held-out rms from {_fmt(fit.loo_rms)} to "
+            f"{_fmt(c.loo_rms)} {unit}"
+        )
         if c.explains:
             msg += f"; it explains the {c.explains}"
     elif found:
-        msg = ("no catalogued effect explains the residuals, but they are not noise: "
-               + "; ".join(f"{s.what} (amplitude {_fmt(s.amplitude)} {unit})" for s in found)
-               + " -- look for an effect the catalogue lacks")
+        msg = (
+            "no catalogued effect explains the residuals, but they are not noise: "
+            + "; ".join(f"{s.what} (amplitude {_fmt(s.amplitude)} {unit})" for s in found)
+            + " -- look for an effect the catalogue lacks"
+        )
         if blocked:
-            msg += (f" ({', '.join(blocked)} would remove some variance but leave this structure in place, "
-                    f"so it is not named)")
+            msg += (
+                f" ({', '.join(blocked)} would remove some variance but leave this structure in place, "
+                f"so it is not named)"
+            )
     else:
-        msg = (f"the residuals are consistent with noise: no candidate effect and no structure is significant "
-               f"at the family-wise level alpha = {alpha:g} over {m} tests")
+        msg = (
+            f"the residuals are consistent with noise: no candidate effect and no structure is significant "
+            f"at the family-wise level alpha = {alpha:g} over {m} tests"
+        )
         if fit.n <= SMALL_SAMPLE:
             msg += f" (only {fit.n} rows: small effects cannot be excluded)"
         elif noise.correlated and noise.effective_samples < FEW_EFFECTIVE:
-            msg += (f" (the noise is so correlated that a slowly varying effect sees only about "
-                    f"{noise.effective_samples:.0f} independent samples: small slow effects cannot be excluded)")
+            msg += (
+                f" (the noise is so correlated that a slowly varying effect sees only about "
+                f"{noise.effective_samples:.0f} independent samples: small slow effects cannot be excluded)"
+            )
     if missing and found:
         msg += "; structure it does not explain remains: " + "; ".join(s.what for s in found)
     if noise.correlated:
-        msg += (f" [serially correlated noise, AR({noise.order}) with lag-1 correlation {noise.lag1:.2f}: "
-                f"tests on whitened residuals]")
-    return _finish(Diagnosis(fit.system, list(fit.effects), unit, fit.n, fit.rms, fit.loo_rms, missing,
-                             missing is None and not found, cands, structure, untestable, alpha, m, msg, sc, cal,
-                             size))
+        msg += (
+            f" [serially correlated noise, AR({noise.order}) with lag-1 correlation {noise.lag1:.2f}: "
+            f"tests on whitened residuals]"
+        )
+    return _finish(
+        Diagnosis(
+            fit.system,
+            list(fit.effects),
+            unit,
+            fit.n,
+            fit.rms,
+            fit.loo_rms,
+            missing,
+            missing is None and not found,
+            cands,
+            structure,
+            untestable,
+            alpha,
+            m,
+            msg,
+            sc,
+            cal,
+            size,
+        )
+    )
 
 
 def _finish(d: Diagnosis) -> Diagnosis:

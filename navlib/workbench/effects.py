@@ -43,6 +43,7 @@ top level of the file is loaded)::
             p["q3_sin_deg"] * np.sin(np.radians(3 * d["true_heading_deg"]))
             + p["q3_cos_deg"] * np.cos(np.radians(3 * d["true_heading_deg"]))))
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -96,13 +97,16 @@ class Effect:
     columns: tuple[str, ...] = ()
     system: str | None = None
     contribution: Callable[[Mapping[str, float], pd.DataFrame], np.ndarray] | None = field(
-        default=None, compare=False, repr=False)
+        default=None, compare=False, repr=False
+    )
     source: str = field(default="", compare=False, repr=False)
 
     def __post_init__(self):
         if not str(self.name).isidentifier():
-            raise InputError(f"effect name {self.name!r}: must be an identifier (letters, digits, _)")
-        for attr in ("params", "units", "columns"):          # a lone name, not its letters
+            raise InputError(
+                f"effect name {self.name!r}: must be an identifier (letters, digits, _)"
+            )
+        for attr in ("params", "units", "columns"):  # a lone name, not its letters
             value = getattr(self, attr)
             object.__setattr__(self, attr, (value,) if isinstance(value, str) else tuple(value))
             if not all(isinstance(v, str) and v for v in getattr(self, attr)):
@@ -110,10 +114,14 @@ class Effect:
         if len(set(self.params)) != len(self.params):
             raise InputError(f"effect '{self.name}': a parameter is named twice in {self.params}")
         if not self.params or len(self.params) != len(self.units):
-            raise InputError(f"effect '{self.name}': give one unit per parameter (got {len(self.params)} "
-                             f"parameters, {len(self.units)} units)")
+            raise InputError(
+                f"effect '{self.name}': give one unit per parameter (got {len(self.params)} "
+                f"parameters, {len(self.units)} units)"
+            )
         if self.contribution is not None and not callable(self.contribution):
-            raise InputError(f"effect '{self.name}': contribution must be a function (params, data) -> array")
+            raise InputError(
+                f"effect '{self.name}': contribution must be a function (params, data) -> array"
+            )
 
 
 @dataclass(frozen=True)
@@ -192,57 +200,89 @@ def get_system(name: str) -> System:
 
 COMPASS_EFFECTS = {
     "misalignment": Effect(
-        "misalignment", PLANAR_EFFECTS["misalignment"], ("deg",),
+        "misalignment",
+        PLANAR_EFFECTS["misalignment"],
+        ("deg",),
         "The sensor's axes are turned about the vertical relative to the carrier's datum (mounting yaw). "
-        "Every heading reads too high or too low by the same amount: a constant residual."),
+        "Every heading reads too high or too low by the same amount: a constant residual.",
+    ),
     "hard_iron": Effect(
-        "hard_iron", PLANAR_EFFECTS["hard_iron"], ("H", "H"),
+        "hard_iron",
+        PLANAR_EFFECTS["hard_iron"],
+        ("H", "H"),
         "Permanent magnetisation of the carrier (steel, magnets, DC currents) adds a field fixed to the "
-        "carrier. It shows as a one-cycle residual (one maximum and one minimum per revolution)."),
+        "carrier. It shows as a one-cycle residual (one maximum and one minimum per revolution).",
+    ),
     "soft_iron": Effect(
-        "soft_iron", PLANAR_EFFECTS["soft_iron"], ("-", "-"),
+        "soft_iron",
+        PLANAR_EFFECTS["soft_iron"],
+        ("-", "-"),
         "Soft steel near the sensor is magnetised by the Earth field itself and distorts it symmetrically "
-        "(with per-axis scale mismatch). It shows as a two-cycle residual (two maxima per revolution)."),
+        "(with per-axis scale mismatch). It shows as a two-cycle residual (two maxima per revolution).",
+    ),
     "temperature": Effect(
-        "temperature", PLANAR_EFFECTS["temperature"], ("H/degC", "H/degC"),
+        "temperature",
+        PLANAR_EFFECTS["temperature"],
+        ("H/degC", "H/degC"),
         "The hard-iron field (magnet and sensor offsets) drifts as the carrier warms. The one-cycle residual "
         "changes with temperature: repeated sweeps at different temperatures disagree.",
-        ("temperature_c",)),
+        ("temperature_c",),
+    ),
 }
 
 DRIFT_EFFECTS = {
     "earth_rate": Effect(
-        "earth_rate", ("earth_rate_gain",), ("-",),
+        "earth_rate",
+        ("earth_rate_gain",),
+        ("-",),
         "An axial gyro drift tilts the azimuth reference; through the Earth rate it builds a latitude error "
         "that after 12 h is 2 cos L / w_ie times the drift (paper C, Table 1). Gain 1 is the textbook "
-        "formula. Missing, the residual follows the 12 h latitude error."),
+        "formula. Missing, the residual follows the 12 h latitude error.",
+    ),
     "bias": Effect(
-        "bias", ("bias_deg_h",), ("deg/h",),
+        "bias",
+        ("bias_deg_h",),
+        ("deg/h",),
         "A constant part of the drift not seen in the latitude error (e.g. a calibration offset of the "
-        "identification procedure). Missing, the residuals have a non-zero mean."),
+        "identification procedure). Missing, the residuals have a non-zero mean.",
+    ),
     "temperature": Effect(
-        "temperature", ("temperature_coef_deg_h_per_c",), ("deg/h/degC",),
+        "temperature",
+        ("temperature_coef_deg_h_per_c",),
+        ("deg/h/degC",),
         "The gyro's drift depends on its temperature (thermal gradients in the laser block, bias "
         "temperature coefficient). Missing, the residual trends with the mean temperature of the test.",
-        ("temperature_c",)),
+        ("temperature_c",),
+    ),
     "temperature_change": Effect(
-        "temperature_change", ("temperature_change_coef_deg_h_per_c",), ("deg/h/degC",),
+        "temperature_change",
+        ("temperature_change_coef_deg_h_per_c",),
+        ("deg/h/degC",),
         "A cold start: while the system warms during alignment, transient thermal gradients shift the drift "
         "that the 12 h identification sees. Missing, the residual trends with the temperature change.",
-        ("temperature_change_c",)),
+        ("temperature_change_c",),
+    ),
 }
 
 
 def catalogue_frame(effects: Mapping[str, Effect]) -> pd.DataFrame:
     """Effects as a table: effect, parameters (units), needed columns, meaning."""
-    return pd.DataFrame([{"effect": e.name,
-                          "parameters": ", ".join(f"{p} [{u}]" for p, u in zip(e.params, e.units)),
-                          "needs columns": ", ".join(e.columns) or "-",
-                          "meaning": e.meaning} for e in effects.values()]).set_index("effect")
+    return pd.DataFrame(
+        [
+            {
+                "effect": e.name,
+                "parameters": ", ".join(f"{p} [{u}]" for p, u in zip(e.params, e.units)),
+                "needs columns": ", ".join(e.columns) or "-",
+                "meaning": e.meaning,
+            }
+            for e in effects.values()
+        ]
+    ).set_index("effect")
 
 
-def resolve(available: Mapping[str, Effect], names, data: pd.DataFrame | None = None,
-            system: str = "") -> tuple[Effect, ...]:
+def resolve(
+    available: Mapping[str, Effect], names, data: pd.DataFrame | None = None, system: str = ""
+) -> tuple[Effect, ...]:
     """Validate effect names against ``available`` (unknown names, repeats, needed columns absent, not
     numbers or constant) and return the Effect objects in the order of ``available`` (catalogue first, then
     user effects)."""
@@ -271,8 +311,10 @@ def column_problem(effect: Effect, data: pd.DataFrame) -> tuple[str, str] | None
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             cell = show(data[col].iloc[bad[0]])
-            return (f"'{col}' row {bad[0] + 1} is '{cell}', not a number",
-                    f"the column '{col}' to hold finite numbers, but row {bad[0] + 1} holds '{cell}'")
+            return (
+                f"'{col}' row {bad[0] + 1} is '{cell}', not a number",
+                f"the column '{col}' to hold finite numbers, but row {bad[0] + 1} holds '{cell}'",
+            )
         if np.ptp(values) == 0:
             return f"'{col}' is constant", f"'{col}' to vary, but it is constant in the data"
     return None
@@ -305,7 +347,9 @@ def _first_line(err: BaseException) -> str:
     return f"{type(err).__name__}: {show(text.splitlines()[0])}" if text else type(err).__name__
 
 
-def call_contribution(effect: Effect, params: Mapping[str, float], data: pd.DataFrame, shape) -> np.ndarray:
+def call_contribution(
+    effect: Effect, params: Mapping[str, float], data: pd.DataFrame, shape
+) -> np.ndarray:
     """``effect.contribution(params, data)`` as a float array of ``shape``, with the user's code fenced.
 
     The contribution gets its own dictionary of parameters and a read-only copy of ``data`` (a shallow
@@ -322,35 +366,52 @@ def call_contribution(effect: Effect, params: Mapping[str, float], data: pd.Data
             out = effect.contribution(dict(params), frame)
     except SystemExit as err:
         raise UserCodeError(f"{who}: contribution called sys.exit({err.code!r})") from err
-    except Exception as err:                       # the user's code: any failure of it is theirs, named
-        hint = " (contributions get a read-only copy of the data)" if "read-only" in str(err) else ""
+    except Exception as err:  # the user's code: any failure of it is theirs, named
+        hint = (
+            " (contributions get a read-only copy of the data)" if "read-only" in str(err) else ""
+        )
         raise UserCodeError(f"{who}: contribution raised {_first_line(err)}{hint}") from err
     if out is None:
         raise UserCodeError(f"{who}: contribution returned None (a missing return?)")
     arr = np.asarray(out)
     if arr.dtype.kind not in "biuf":
-        kind = {"U": "text", "S": "bytes", "c": "complex numbers", "M": "dates", "m": "time spans"}.get(
-            arr.dtype.kind, f"{type(arr.flat[0]).__name__ if arr.size else 'empty'} objects")
+        kind = {
+            "U": "text",
+            "S": "bytes",
+            "c": "complex numbers",
+            "M": "dates",
+            "m": "time spans",
+        }.get(arr.dtype.kind, f"{type(arr.flat[0]).__name__ if arr.size else 'empty'} objects")
         v = arr.flat[0] if arr.size else None
         first = show(repr(v.item() if isinstance(v, np.generic) else v))[:40] if arr.size else ""
-        raise UserCodeError(f"{who}: contribution returned {kind}{f' ({first}, ...)' if first else ''}, "
-                            f"not real numbers")
+        raise UserCodeError(
+            f"{who}: contribution returned {kind}{f' ({first}, ...)' if first else ''}, "
+            f"not real numbers"
+        )
     arr = arr.astype(float, copy=False)
     if arr.shape != tuple(shape):
-        raise UserCodeError(f"{who}: contribution returned shape {arr.shape}, the measurement has shape "
-                            f"{tuple(shape)} (one value{' per axis' if len(shape) > 1 else ''} per row)")
+        raise UserCodeError(
+            f"{who}: contribution returned shape {arr.shape}, the measurement has shape "
+            f"{tuple(shape)} (one value{' per axis' if len(shape) > 1 else ''} per row)"
+        )
     bad = np.argwhere(~np.isfinite(arr))
     if bad.size:
         r = int(bad[0][0])
         values = ", ".join(f"{k}={v:.6g}" for k, v in params.items())
-        raise UserCodeError(f"{who}: contribution returned {arr[tuple(bad[0])]} at row {r + 1} "
-                            f"(parameters {values})")
+        raise UserCodeError(
+            f"{who}: contribution returned {arr[tuple(bad[0])]} at row {r + 1} "
+            f"(parameters {values})"
+        )
     return arr
 
 
 def _user_line(err: BaseException, path: Path) -> str:
     """The line of ``path`` the exception came from (the deepest frame in that file), or ''."""
-    lines = [f.lineno for f in traceback.extract_tb(err.__traceback__) if Path(f.filename).resolve() == path]
+    lines = [
+        f.lineno
+        for f in traceback.extract_tb(err.__traceback__)
+        if Path(f.filename).resolve() == path
+    ]
     return f"line {lines[-1]}: " if lines else ""
 
 
@@ -370,20 +431,22 @@ def load_effects(path, system: str, catalogue: Mapping[str, Effect]) -> tuple[Ef
     loader = importlib.machinery.SourceFileLoader(module_name, str(p))
     spec = importlib.util.spec_from_loader(module_name, loader)
     module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module               # dataclasses and pickling look their module up
+    sys.modules[module_name] = module  # dataclasses and pickling look their module up
     try:
         with contextlib.redirect_stdout(sys.stderr):
             loader.exec_module(module)
     except SyntaxError as err:
         raise InputError(f"{p.name}: line {err.lineno}: {err.msg}") from None
     except SystemExit as err:
-        raise InputError(f"{p.name}: calls sys.exit({err.code!r}) while it is loaded; an effects file "
-                         f"should only define effects") from None
-    except Exception as err:                        # the user's file: any failure of it is theirs, named
+        raise InputError(
+            f"{p.name}: calls sys.exit({err.code!r}) while it is loaded; an effects file "
+            f"should only define effects"
+        ) from None
+    except Exception as err:  # the user's file: any failure of it is theirs, named
         raise InputError(f"{p.name}: {_user_line(err, p.resolve())}{_first_line(err)}") from err
     finally:
         sys.modules.pop(module_name, None)
-    named = {}                                      # each Effect object once, with its first variable name
+    named = {}  # each Effect object once, with its first variable name
     for var, v in vars(module).items():
         if isinstance(v, Effect) and id(v) not in named:
             named[id(v)] = (var, v)
@@ -391,24 +454,35 @@ def load_effects(path, system: str, catalogue: Mapping[str, Effect]) -> tuple[Ef
     found = [(var, e) for var, e in everything if e.system == system]
     if not found:
         others = sorted({str(e.system) for _, e in everything})
-        what = (f"its effects are for system {', '.join(map(repr, others))}" if others
-                else "it defines no Effect at top level")
+        what = (
+            f"its effects are for system {', '.join(map(repr, others))}"
+            if others
+            else "it defines no Effect at top level"
+        )
         raise InputError(f"{p.name}: defines no Effect with system='{system}' ({what})")
     taken = {q: f"the catalogue's '{e.name}'" for e in catalogue.values() for q in e.params}
     names = {}
     for var, e in found:
         if e.name in catalogue:
-            raise InputError(f"{p.name}: effect '{e.name}' is already in the {system} catalogue; rename it")
+            raise InputError(
+                f"{p.name}: effect '{e.name}' is already in the {system} catalogue; rename it"
+            )
         if e.name in names:
-            raise InputError(f"{p.name}: two effects are named '{e.name}' (variables '{names[e.name]}' and "
-                             f"'{var}'); give each its own name")
+            raise InputError(
+                f"{p.name}: two effects are named '{e.name}' (variables '{names[e.name]}' and "
+                f"'{var}'); give each its own name"
+            )
         names[e.name] = var
         if e.contribution is None:
-            raise InputError(f"{p.name}: effect '{e.name}' has no contribution(params, data) function")
+            raise InputError(
+                f"{p.name}: effect '{e.name}' has no contribution(params, data) function"
+            )
         for q in e.params:
             if q in taken:
-                raise InputError(f"{p.name}: effect '{e.name}': parameter '{q}' is already a parameter of "
-                                 f"{taken[q]}; rename it")
+                raise InputError(
+                    f"{p.name}: effect '{e.name}': parameter '{q}' is already a parameter of "
+                    f"{taken[q]}; rename it"
+                )
             taken[q] = f"effect '{e.name}'"
     return tuple(replace(e, source=p.name) for _, e in found)
 

@@ -7,6 +7,7 @@ system's *linearised* solution (for the compass the first-order harmonic model, 
 one-cycle and soft iron a two-cycle error; for a linear model the exact solution), so a refit never ends
 worse than the linearised model that motivated it.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -24,8 +25,16 @@ from ..data.tables import read_table, require_variation
 from ..errors import InputError
 from ..sensors.ins import latitude_error_per_drift
 from ..sensors.planar import PLANAR_EFFECTS, PlanarModel
-from .effects import (COMPASS_EFFECTS, DRIFT_EFFECTS, Effect, System, call_contribution, get_system,
-                      register_system, resolve)
+from .effects import (
+    COMPASS_EFFECTS,
+    DRIFT_EFFECTS,
+    Effect,
+    System,
+    call_contribution,
+    get_system,
+    register_system,
+    resolve,
+)
 from .linalg import orth_basis
 from .serial import ar1_noise
 from ..threads import one_blas_thread
@@ -35,8 +44,10 @@ RAD = 180.0 / np.pi
 #: Each system's measured columns, in the order of the residual's axes (``residual[i * k + j]`` is row i,
 #: column j), and whether the measurement is an angle whose residual is wrapped to (-180, 180] deg.  The
 #: outlier screen names a column from here; a system module adds its own entry when it registers.
-MEASURED: dict[str, tuple[tuple[str, ...], bool]] = {"compass": (("measured_heading_deg",), True),
-                                                    "drift": (("drift_deg_h",), False)}
+MEASURED: dict[str, tuple[tuple[str, ...], bool]] = {
+    "compass": (("measured_heading_deg",), True),
+    "drift": (("drift_deg_h",), False),
+}
 
 
 def measured_columns(system: str, axes: int) -> tuple[str, ...]:
@@ -53,7 +64,7 @@ def residuals_on(fit: "Fit", frame: pd.DataFrame) -> np.ndarray:
     ``frame``, shape (rows, axes): also on rows the fit did not use."""
     cols, wrapped = MEASURED[fit.system]
     model = np.asarray(fit.predict(frame), float).reshape(len(frame), -1)
-    r = frame[list(cols[:model.shape[1]])].to_numpy(float) - model
+    r = frame[list(cols[: model.shape[1]])].to_numpy(float) - model
     return wrap_deg(r) if wrapped else r
 
 
@@ -95,11 +106,11 @@ class Fit:
 
     @property
     def rss(self) -> float:
-        return float(np.sum(self.residuals ** 2))
+        return float(np.sum(self.residuals**2))
 
     @property
     def rms(self) -> float:
-        return float(np.sqrt(np.mean(self.residuals ** 2)))
+        return float(np.sqrt(np.mean(self.residuals**2)))
 
     @property
     def loo_residuals(self) -> np.ndarray:
@@ -107,12 +118,12 @@ class Fit:
         if J.shape[1] == 0:
             return self.residuals.copy()
         q = orth_basis(J)
-        h = np.clip(np.sum(q ** 2, axis=1), 0.0, 1.0 - 1e-9)
+        h = np.clip(np.sum(q**2, axis=1), 0.0, 1.0 - 1e-9)
         return self.residuals / (1.0 - h)
 
     @property
     def loo_rms(self) -> float:
-        return float(np.sqrt(np.mean(self.loo_residuals ** 2)))
+        return float(np.sqrt(np.mean(self.loo_residuals**2)))
 
     @property
     def user_effects(self) -> tuple[Effect, ...]:
@@ -122,24 +133,43 @@ class Fit:
         """The same data fitted with one more effect (one call), starting from this fit's parameters."""
         if effect in self.effects:
             raise InputError(f"effect '{effect}' is already in the model")
-        return fit_model(self.spec, self.data, self.effects + (effect,), start=self.params,
-                         user_effects=self.user_effects)
+        return fit_model(
+            self.spec,
+            self.data,
+            self.effects + (effect,),
+            start=self.params,
+            user_effects=self.user_effects,
+        )
 
     def remove(self, effect: str) -> "Fit":
         if effect not in self.effects:
             raise InputError(f"effect '{effect}' is not in the model")
-        return fit_model(self.spec, self.data, tuple(e for e in self.effects if e != effect),
-                         user_effects=self.user_effects)
+        return fit_model(
+            self.spec,
+            self.data,
+            tuple(e for e in self.effects if e != effect),
+            user_effects=self.user_effects,
+        )
 
     def summary(self) -> dict:
-        return {"model": " + ".join(self.effects) or "(none)", "parameters": self.n_params,
-                f"rms ({self.unit})": self.rms, f"min ({self.unit})": float(self.residuals.min()),
-                f"max ({self.unit})": float(self.residuals.max()), f"held-out rms ({self.unit})": self.loo_rms}
+        return {
+            "model": " + ".join(self.effects) or "(none)",
+            "parameters": self.n_params,
+            f"rms ({self.unit})": self.rms,
+            f"min ({self.unit})": float(self.residuals.min()),
+            f"max ({self.unit})": float(self.residuals.max()),
+            f"held-out rms ({self.unit})": self.loo_rms,
+        }
 
 
 @one_blas_thread
-def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
-              user_effects: tuple[Effect, ...] = ()) -> Fit:
+def fit_model(
+    system,
+    data: pd.DataFrame,
+    effects,
+    start: dict | None = None,
+    user_effects: tuple[Effect, ...] = (),
+) -> Fit:
     """Fit the named effects of ``system`` (a name or a :class:`.System`) to ``data`` (a validated frame,
     see :func:`load`); ``user_effects`` are extra effects (with a contribution) the names may refer to."""
     spec = get_system(system) if isinstance(system, str) else system
@@ -147,14 +177,20 @@ def fit_model(system, data: pd.DataFrame, effects, start: dict | None = None,
     taken = {q: f"effect '{e.name}'" for e in spec.catalogue.values() for q in e.params}
     for i, e in enumerate(user_effects):
         if e.name in spec.catalogue or any(u.name == e.name for u in user_effects[:i]):
-            raise InputError(f"{e.source or 'user effects'}: effect '{e.name}' is given twice (or is in the "
-                             f"{spec.name} catalogue); give each effect its own name")
+            raise InputError(
+                f"{e.source or 'user effects'}: effect '{e.name}' is given twice (or is in the "
+                f"{spec.name} catalogue); give each effect its own name"
+            )
         if e.contribution is None:
-            raise InputError(f"{e.source or 'user effects'}: effect '{e.name}' has no contribution(params, data)")
+            raise InputError(
+                f"{e.source or 'user effects'}: effect '{e.name}' has no contribution(params, data)"
+            )
         for q in e.params:
             if q in taken:
-                raise InputError(f"{e.source or 'user effects'}: effect '{e.name}': parameter '{q}' is already a "
-                                 f"parameter of {taken[q]}")
+                raise InputError(
+                    f"{e.source or 'user effects'}: effect '{e.name}': parameter '{q}' is already a "
+                    f"parameter of {taken[q]}"
+                )
             taken[q] = f"effect '{e.name}'"
     available = {**spec.catalogue, **{e.name: e for e in user_effects}}
     chosen = resolve(available, effects, data, spec.name)
@@ -213,8 +249,15 @@ def best_least_squares(model_minus_obs, starts, lo, hi, jac="2-point", tr_solver
     margin = np.where(finite, 1e-9 * (np.abs(np.where(finite, hi - lo, 0.0)) + 1), 0.0)
     for x0 in starts:
         x0 = np.clip(np.asarray(x0, float), lo + margin, hi - margin)
-        sol = least_squares(model_minus_obs, x0, jac=jac, bounds=(lo, hi), x_scale="jac", method="trf",
-                            tr_solver=tr_solver or ("lsmr" if len(x0) > 6 else "exact"))
+        sol = least_squares(
+            model_minus_obs,
+            x0,
+            jac=jac,
+            bounds=(lo, hi),
+            x_scale="jac",
+            method="trf",
+            tr_solver=tr_solver or ("lsmr" if len(x0) > 6 else "exact"),
+        )
         if best is None or sol.cost < best.cost:
             best = sol
     return best
@@ -225,10 +268,20 @@ def compass_linear_design(data: pd.DataFrame, names, t_ref: float) -> np.ndarray
     """First-order (harmonic) model of the planar parameters, deg per unit parameter, about zero:
     ``err = yaw - (h_x + k_x dT) sin psi - (h_y + k_y dT) cos psi - e sin 2 psi - f cos 2 psi`` (rad)."""
     psi = np.radians(data["true_heading_deg"].to_numpy(float))
-    dt = (data["temperature_c"].to_numpy(float) - t_ref) if "temperature_c" in data else np.zeros(len(psi))
-    col = {"yaw_deg": np.ones_like(psi), "hard_x": -RAD * np.sin(psi), "hard_y": -RAD * np.cos(psi),
-           "soft_e": -RAD * np.sin(2 * psi), "soft_f": -RAD * np.cos(2 * psi),
-           "temp_x_per_c": -RAD * dt * np.sin(psi), "temp_y_per_c": -RAD * dt * np.cos(psi)}
+    dt = (
+        (data["temperature_c"].to_numpy(float) - t_ref)
+        if "temperature_c" in data
+        else np.zeros(len(psi))
+    )
+    col = {
+        "yaw_deg": np.ones_like(psi),
+        "hard_x": -RAD * np.sin(psi),
+        "hard_y": -RAD * np.cos(psi),
+        "soft_e": -RAD * np.sin(2 * psi),
+        "soft_f": -RAD * np.cos(2 * psi),
+        "temp_x_per_c": -RAD * dt * np.sin(psi),
+        "temp_y_per_c": -RAD * dt * np.cos(psi),
+    }
     return np.column_stack([col[n] for n in names]) if names else np.zeros((len(psi), 0))
 
 
@@ -251,28 +304,43 @@ def _fit_compass(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         pm = PlanarModel(planar, {k: p[k] for k in pnames}, t_ref)
         return pm.predict_measured(true, temp) + user_columns(users, p, data, shape)
 
-    def resid(x):                                   # model - measured, wrapped
+    def resid(x):  # model - measured, wrapped
         return wrap_deg(model(x) - meas)
 
     if not names:
         r = wrap_deg(meas - model(np.zeros(0)))
         pm = PlanarModel(planar, {}, t_ref)
-        return Fit(SYSTEMS_BASE["compass"], planar, {}, data, r, np.zeros((len(r), 0)),
-                   lambda f: PlanarModel(planar, {}, t_ref).predict_measured(f["true_heading_deg"].to_numpy(float)),
-                   pm)
+        return Fit(
+            SYSTEMS_BASE["compass"],
+            planar,
+            {},
+            data,
+            r,
+            np.zeros((len(r), 0)),
+            lambda f: PlanarModel(planar, {}, t_ref).predict_measured(
+                f["true_heading_deg"].to_numpy(float)
+            ),
+            pm,
+        )
     lo = np.array([-180.0 if n == "yaw_deg" else -0.95 for n in pnames] + [-np.inf] * len(unames))
     hi = np.array([180.0 if n == "yaw_deg" else 0.95 for n in pnames] + [np.inf] * len(unames))
     # start 1: the previous model's parameters, new ones at zero (yaw from the mean error if new)
     x1 = np.array([(start or {}).get(n, 0.0) for n in names])
     if "yaw_deg" in pnames and "yaw_deg" not in (start or {}):
-        x1[pnames.index("yaw_deg")] = float(np.degrees(np.angle(np.mean(np.exp(1j * np.radians(meas - true))))))
+        x1[pnames.index("yaw_deg")] = float(
+            np.degrees(np.angle(np.mean(np.exp(1j * np.radians(meas - true)))))
+        )
     # start 2: the linearised (harmonic) model fitted by linear least squares
-    X = np.column_stack([compass_linear_design(data, pnames, t_ref), user_design(users, data, shape)])
+    X = np.column_stack(
+        [compass_linear_design(data, pnames, t_ref), user_design(users, data, shape)]
+    )
     x2 = lstsq(X, wrap_deg(meas - true))
     jac = "2-point"
-    if not users:                                   # the planar model's exact derivatives
+    if not users:  # the planar model's exact derivatives
+
         def jac(x):
             return PlanarModel(planar, dict(zip(names, x)), t_ref).jacobian(true, names, temp)
+
     sol = best_least_squares(resid, [x1, x2], lo, hi, jac=jac)
     params = dict(zip(names, map(float, sol.x)))
     pm = PlanarModel(planar, {k: params[k] for k in pnames}, t_ref)
@@ -280,11 +348,20 @@ def _fit_compass(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
 
     def predict(frame):
         t = frame["temperature_c"].to_numpy(float) if "temperature_c" in frame else None
-        return (pm.predict_measured(frame["true_heading_deg"].to_numpy(float), t)
-                + user_columns(users, params, frame, (len(frame),)))
+        return pm.predict_measured(frame["true_heading_deg"].to_numpy(float), t) + user_columns(
+            users, params, frame, (len(frame),)
+        )
 
-    return Fit(SYSTEMS_BASE["compass"], tuple(e.name for e in effects), params, data, r, np.asarray(sol.jac),
-               predict, pm)
+    return Fit(
+        SYSTEMS_BASE["compass"],
+        tuple(e.name for e in effects),
+        params,
+        data,
+        r,
+        np.asarray(sol.jac),
+        predict,
+        pm,
+    )
 
 
 def harmonic_columns(data: pd.DataFrame, k: int) -> np.ndarray:
@@ -297,16 +374,23 @@ def compass_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     an offset and a one-cycle error that differ between sweeps, and a trend in time."""
     data = fit.data
     out = [("constant offset", harmonic_columns(data, 0), 1.0)]
-    out += [(f"heading harmonic {k} (period {360 // k} deg)", harmonic_columns(data, k), np.sqrt(2.0))
-            for k in range(1, 7)]
+    out += [
+        (f"heading harmonic {k} (period {360 // k} deg)", harmonic_columns(data, k), np.sqrt(2.0))
+        for k in range(1, 7)
+    ]
     if "sweep" in data and data["sweep"].nunique() > 1:
         ids = sorted(data["sweep"].unique())
         d = np.column_stack([(data["sweep"] == i).to_numpy(float) for i in ids[1:]])
         d = d - d.mean(axis=0)
         out.append(("offset differing between sweeps", d, 2.0))
         h1 = harmonic_columns(data, 1)
-        out.append(("one-cycle error differing between sweeps",
-                    np.column_stack([d * h1[:, [0]], d * h1[:, [1]]]), 2.0))
+        out.append(
+            (
+                "one-cycle error differing between sweeps",
+                np.column_stack([d * h1[:, [0]], d * h1[:, [1]]]),
+                2.0,
+            )
+        )
     if "time_s" in data and np.ptp(data["time_s"].to_numpy(float)) > 0:
         t = data["time_s"].to_numpy(float)
         out.append(("trend in time", (t - t.mean())[:, None], np.sqrt(3.0)))
@@ -318,7 +402,9 @@ def load_compass(path) -> pd.DataFrame:
 
 
 # ----------------------------------------------------------------------------------------------- drift
-def drift_design(data: pd.DataFrame, effects, centres: dict | None = None) -> tuple[np.ndarray, dict]:
+def drift_design(
+    data: pd.DataFrame, effects, centres: dict | None = None
+) -> tuple[np.ndarray, dict]:
     """Design matrix of the linear drift model; ``centres`` holds the means the temperature terms are
     centred on (taken from ``data`` when not given)."""
     k = latitude_error_per_drift(12.0)
@@ -336,8 +422,17 @@ def drift_design(data: pd.DataFrame, effects, centres: dict | None = None) -> tu
     return (np.column_stack(cols) if cols else np.zeros((len(data), 0))), centres
 
 
-def fit_linear(y: np.ndarray, X: np.ndarray, cat_names, users, data: pd.DataFrame, start,
-               *, what: str = "rows", model: str = "") -> tuple[np.ndarray, np.ndarray, list[str]]:
+def fit_linear(
+    y: np.ndarray,
+    X: np.ndarray,
+    cat_names,
+    users,
+    data: pd.DataFrame,
+    start,
+    *,
+    what: str = "rows",
+    model: str = "",
+) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Least squares for a model linear in its catalogued parameters, ``y ~ X beta_cat + sum of user
     effects``.  The linear problem (user effects linearised by :func:`user_design`) is solved first; with
     user effects, which may be nonlinear, the solution is refined by nonlinear least squares from it and
@@ -371,20 +466,24 @@ def fit_linear(y: np.ndarray, X: np.ndarray, cat_names, users, data: pd.DataFram
     """
     names = list(cat_names) + [p for e in users for p in e.params]
     if len(names) >= len(y):
-        raise InputError(f"{len(y)} {what} cannot determine {len(names)} parameters of the model {model}; "
-                         f"at least {len(names) + 1} {what} are needed")
+        raise InputError(
+            f"{len(y)} {what} cannot determine {len(names)} parameters of the model {model}; "
+            f"at least {len(names) + 1} {what} are needed"
+        )
     shape = (len(y),)
     XU = np.column_stack([X, user_design(users, data, shape)])
     beta = lstsq(XU, y)
     jac = XU
-    if users:                                       # a user effect may be nonlinear: refine
+    if users:  # a user effect may be nonlinear: refine
         nc = X.shape[1]
 
         def resid(x):
             return X @ x[:nc] + user_columns(users, dict(zip(names, x)), data, shape) - y
 
         inf = np.full(len(names), np.inf)
-        sol = best_least_squares(resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf)
+        sol = best_least_squares(
+            resid, [beta, np.array([(start or {}).get(n, 0.0) for n in names])], -inf, inf
+        )
         beta, jac = sol.x, np.asarray(sol.jac)
     return beta, jac, names
 
@@ -394,8 +493,15 @@ def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     cat = tuple(e.name for e in effects if e.contribution is None)
     users = tuple(e for e in effects if e.contribution is not None)
     X, centres = drift_design(data, cat)
-    beta, jac, names = fit_linear(y, X, [DRIFT_EFFECTS[e].params[0] for e in cat], users, data, start,
-                                  model=" + ".join(e.name for e in effects))
+    beta, jac, names = fit_linear(
+        y,
+        X,
+        [DRIFT_EFFECTS[e].params[0] for e in cat],
+        users,
+        data,
+        start,
+        model=" + ".join(e.name for e in effects),
+    )
     params = dict(zip(names, map(float, beta)))
     nc = X.shape[1]
 
@@ -403,8 +509,16 @@ def _fit_drift(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         Xf, _ = drift_design(frame, cat, centres)
         return Xf @ beta[:nc] + user_columns(users, params, frame, (len(frame),))
 
-    return Fit(SYSTEMS_BASE["drift"], tuple(e.name for e in effects), params, data, y - predict(data), jac,
-               predict, centres)
+    return Fit(
+        SYSTEMS_BASE["drift"],
+        tuple(e.name for e in effects),
+        params,
+        data,
+        y - predict(data),
+        jac,
+        predict,
+        centres,
+    )
 
 
 def drift_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
@@ -414,7 +528,7 @@ def drift_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
         if col in fit.data and np.ptp(fit.data[col].to_numpy(float)) > 0:
             x = fit.data[col].to_numpy(float)
             x = (x - x.mean()) / (np.std(x) or 1.0)
-            out.append((f"curvature in {col}", (x ** 2 - np.mean(x ** 2))[:, None], 1.0))
+            out.append((f"curvature in {col}", (x**2 - np.mean(x**2))[:, None], 1.0))
     return out
 
 
@@ -423,10 +537,12 @@ def drift_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
 GAIN_BAND = (0.2, 5.0)
 GAIN_CORRELATION = 0.9
 #: Unit mistakes and the factor they put on the earth-rate gain.
-DRIFT_UNIT_MISTAKES = (("drift_deg_h in deg/s (multiply by 3600)", 1 / 3600.0),
-                       ("drift_deg_h in rad/h (multiply by 57.3)", np.pi / 180.0),
-                       ("latitude_error_deg in radians (multiply by 57.3)", 180.0 / np.pi),
-                       ("latitude_error_deg in arcmin (divide by 60)", 1 / 60.0))
+DRIFT_UNIT_MISTAKES = (
+    ("drift_deg_h in deg/s (multiply by 3600)", 1 / 3600.0),
+    ("drift_deg_h in rad/h (multiply by 57.3)", np.pi / 180.0),
+    ("latitude_error_deg in radians (multiply by 57.3)", 180.0 / np.pi),
+    ("latitude_error_deg in arcmin (divide by 60)", 1 / 60.0),
+)
 
 
 def load_drift(path) -> pd.DataFrame:
@@ -446,33 +562,58 @@ def load_drift(path) -> pd.DataFrame:
         gain = float(np.polyfit(x, y, 1)[0])
         lo, hi = GAIN_BAND
         if gain < 0:
-            raise InputError(f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift falls as the 12 h "
-                             f"latitude error rises (earth-rate gain {gain:.3g}, textbook +1): the latitude error "
-                             f"must be indicated - true, and the drift of the same sign convention")
+            raise InputError(
+                f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift falls as the 12 h "
+                f"latitude error rises (earth-rate gain {gain:.3g}, textbook +1): the latitude error "
+                f"must be indicated - true, and the drift of the same sign convention"
+            )
         if not lo <= gain <= hi:
             near = [what for what, f in DRIFT_UNIT_MISTAKES if 0.5 <= gain / f <= 2.0]
             look = f"; {' or '.join(near)}?" if near else ""
-            raise InputError(f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift is {gain:.3g} times "
-                             f"what the 12 h latitude error implies (earth-rate gain; textbook 1, accepted "
-                             f"{lo:g}..{hi:g}){look}")
+            raise InputError(
+                f"{name}: columns 'latitude_error_deg', 'drift_deg_h': the drift is {gain:.3g} times "
+                f"what the 12 h latitude error implies (earth-rate gain; textbook 1, accepted "
+                f"{lo:g}..{hi:g}){look}"
+            )
     return frame
 
 
 SYSTEMS_BASE = {
-    "compass": System("compass", "deg", COMPASS_EFFECTS, load_compass, _fit_compass, compass_structure,
-                      "level compass heading; residual = measured - model heading, wrapped, deg",
-                      columns=tuple(SWEEP_COLUMNS)),
-    "drift": System("drift", "deg/h", DRIFT_EFFECTS, load_drift, _fit_drift, drift_structure,
-                    "axial gyro drift of a rotating INS; residual = measured - model drift, deg/h",
-                    columns=tuple(USER_COLUMNS)),
+    "compass": System(
+        "compass",
+        "deg",
+        COMPASS_EFFECTS,
+        load_compass,
+        _fit_compass,
+        compass_structure,
+        "level compass heading; residual = measured - model heading, wrapped, deg",
+        columns=tuple(SWEEP_COLUMNS),
+    ),
+    "drift": System(
+        "drift",
+        "deg/h",
+        DRIFT_EFFECTS,
+        load_drift,
+        _fit_drift,
+        drift_structure,
+        "axial gyro drift of a rotating INS; residual = measured - model drift, deg/h",
+        columns=tuple(USER_COLUMNS),
+    ),
 }
 for _s in SYSTEMS_BASE.values():
     register_system(_s)
 
 
 # ------------------------------------------------------------------------------------- simulated data
-def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 0.0, seed=0,
-             noise_correlation: float = 0.0) -> pd.DataFrame:
+def simulate(
+    system: str,
+    params: dict,
+    *,
+    n: int | None = None,
+    noise: float = 0.0,
+    seed=0,
+    noise_correlation: float = 0.0,
+) -> pd.DataFrame:
     """Data from the catalogue model with the given parameters (effects absent = 0) plus noise.
 
     compass: two sweeps of 121 readings (0..360 every 3 deg, one reading every 5 s) while the carrier warms
@@ -493,16 +634,29 @@ def simulate(system: str, params: dict, *, n: int | None = None, noise: float = 
         else:
             m = m + np.radians(noise) * rng.standard_normal(m.shape)
         meas = heading_deg(m[0], m[1])
-        return pd.DataFrame({"true_heading_deg": true, "measured_heading_deg": meas, "temperature_c": temp,
-                             "sweep": np.repeat([1, 2], 121), "time_s": 5.0 * np.arange(len(true))})
+        return pd.DataFrame(
+            {
+                "true_heading_deg": true,
+                "measured_heading_deg": meas,
+                "temperature_c": temp,
+                "sweep": np.repeat([1, 2], 121),
+                "time_s": 5.0 * np.arange(len(true)),
+            }
+        )
     if system != "drift":
         raise InputError(f"simulate: unknown system {system!r}; known: compass, drift")
     if noise_correlation:
-        raise InputError("simulate: noise_correlation must be 0 for the drift tables (not a time series)")
+        raise InputError(
+            "simulate: noise_correlation must be 0 for the drift tables (not a time series)"
+        )
     n = 16 if n is None else n
-    frame = pd.DataFrame({"latitude_error_deg": rng.uniform(-0.05, 0.05, n),
-                          "temperature_c": rng.uniform(10.0, 65.0, n),
-                          "temperature_change_c": rng.uniform(0.0, 30.0, n)})
+    frame = pd.DataFrame(
+        {
+            "latitude_error_deg": rng.uniform(-0.05, 0.05, n),
+            "temperature_c": rng.uniform(10.0, 65.0, n),
+            "temperature_change_c": rng.uniform(0.0, 30.0, n),
+        }
+    )
     X, _ = drift_design(frame, tuple(DRIFT_EFFECTS))
     beta = np.array([params.get(DRIFT_EFFECTS[e].params[0], 0.0) for e in DRIFT_EFFECTS])
     frame["drift_deg_h"] = X @ beta + noise * rng.standard_normal(n)

@@ -19,6 +19,7 @@ This is a description, not a test: with serially correlated noise every slow fac
 a share by chance; the loop's diagnosis made the tests.  :func:`reading` turns the table into one
 sentence naming the factor that holds the most and what it points at.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -39,7 +40,10 @@ def _quantile_cells(x: np.ndarray, k: int) -> np.ndarray:
 
 
 def _cell_labels(x: np.ndarray, cell: np.ndarray, unit: str) -> dict:
-    return {int(c): f"{np.min(x[cell == c]):.3g}-{np.max(x[cell == c]):.3g} {unit}" for c in np.unique(cell)}
+    return {
+        int(c): f"{np.min(x[cell == c]):.3g}-{np.max(x[cell == c]):.3g} {unit}"
+        for c in np.unique(cell)
+    }
 
 
 def factors(time_s=None, rate_dps=None, u=None, acc=None) -> dict:
@@ -85,33 +89,74 @@ def breakdown(residuals: np.ndarray, invariants, cells: dict) -> pd.DataFrame:
             cell, labels = cells[factor]
             ids, inv, counts = np.unique(cell, return_inverse=True, return_counts=True)
             means = np.bincount(inv, weights=x) / counts
-            between = float(np.sum(counts * means ** 2))
+            between = float(np.sum(counts * means**2))
             big = int(np.argmax(np.abs(means)))
-            rows.append({"invariant": name, "factor": factor, "cells": int(len(ids)),
-                         "share": between / total if total > 0 else 0.0,
-                         "amplitude_ut": float(np.sqrt(between / len(x))),
-                         "largest_cell": labels[int(ids[big])], "largest_mean_ut": float(means[big])})
-    return pd.DataFrame(rows, columns=["invariant", "factor", "cells", "share", "amplitude_ut", "largest_cell",
-                                       "largest_mean_ut"])
+            rows.append(
+                {
+                    "invariant": name,
+                    "factor": factor,
+                    "cells": int(len(ids)),
+                    "share": between / total if total > 0 else 0.0,
+                    "amplitude_ut": float(np.sqrt(between / len(x))),
+                    "largest_cell": labels[int(ids[big])],
+                    "largest_mean_ut": float(means[big]),
+                }
+            )
+    return pd.DataFrame(
+        rows,
+        columns=[
+            "invariant",
+            "factor",
+            "cells",
+            "share",
+            "amplitude_ut",
+            "largest_cell",
+            "largest_mean_ut",
+        ],
+    )
 
 
 _POINTS_AT = {
-    ("magnitude", "time"): "the field strength itself changes along the recording: a disturbance the sensor "
-                           "passed (iron, a magnet, a current) or an offset drifting with temperature",
-    ("magnitude", "turn rate"): "the error grows with the turn rate: a lag between the axes' samples, or "
-                                "filtering inside the sensor",
-    ("magnitude", "orientation"): "the strength depends on the direction beyond an ellipsoid: a magnet or "
-                                  "iron close to the sensor, or a non-linear axis",
-    ("magnitude", "acceleration"): "the strength changes when the sensor is moved hard: something moving "
-                                   "with the hand (a cable, a magnet) or a loose mount",
-    ("dip", "acceleration"): "the dip is wrong while the sensor accelerates: the accelerometer then measures "
-                             "more than gravity, so the reference direction (not the magnetometer) is off",
-    ("dip", "turn rate"): "the dip is wrong while the sensor turns: a lag between the magnetometer's and the "
-                          "accelerometer's samples, or acceleration of a sensor off the turn axis",
-    ("dip", "time"): "the angle between field and gravity changes along the recording: a disturbance the "
-                     "sensor passed, or the accelerometer's bias drifting",
-    ("dip", "orientation"): "the dip depends on the orientation: a misalignment or scale error of the "
-                            "accelerometer, which the magnetometer's model cannot take up",
+    (
+        "magnitude",
+        "time",
+    ): "the field strength itself changes along the recording: a disturbance the sensor "
+    "passed (iron, a magnet, a current) or an offset drifting with temperature",
+    (
+        "magnitude",
+        "turn rate",
+    ): "the error grows with the turn rate: a lag between the axes' samples, or "
+    "filtering inside the sensor",
+    (
+        "magnitude",
+        "orientation",
+    ): "the strength depends on the direction beyond an ellipsoid: a magnet or "
+    "iron close to the sensor, or a non-linear axis",
+    (
+        "magnitude",
+        "acceleration",
+    ): "the strength changes when the sensor is moved hard: something moving "
+    "with the hand (a cable, a magnet) or a loose mount",
+    (
+        "dip",
+        "acceleration",
+    ): "the dip is wrong while the sensor accelerates: the accelerometer then measures "
+    "more than gravity, so the reference direction (not the magnetometer) is off",
+    (
+        "dip",
+        "turn rate",
+    ): "the dip is wrong while the sensor turns: a lag between the magnetometer's and the "
+    "accelerometer's samples, or acceleration of a sensor off the turn axis",
+    (
+        "dip",
+        "time",
+    ): "the angle between field and gravity changes along the recording: a disturbance the "
+    "sensor passed, or the accelerometer's bias drifting",
+    (
+        "dip",
+        "orientation",
+    ): "the dip depends on the orientation: a misalignment or scale error of the "
+    "accelerometer, which the magnetometer's model cannot take up",
 }
 
 
@@ -122,8 +167,12 @@ def reading(table: pd.DataFrame) -> str:
         return "no factor to break the residuals down by (no time, rate, accelerometer or field columns)"
     top = table.loc[table["share"].idxmax()]
     if top["share"] < CLEAR_SHARE:
-        return (f"no single factor holds the residuals (largest: {top['factor']} of the {top['invariant']} "
-                f"invariant, {100 * top['share']:.0f} % of its variance)")
-    return (f"{top['factor']} holds {100 * top['share']:.0f} % of the {top['invariant']} invariant's residual "
-            f"variance (rms of the cell means {top['amplitude_ut']:.2g} uT; largest in {top['largest_cell']}, "
-            f"{top['largest_mean_ut']:+.2g} uT): {_POINTS_AT[(top['invariant'], top['factor'])]}")
+        return (
+            f"no single factor holds the residuals (largest: {top['factor']} of the {top['invariant']} "
+            f"invariant, {100 * top['share']:.0f} % of its variance)"
+        )
+    return (
+        f"{top['factor']} holds {100 * top['share']:.0f} % of the {top['invariant']} invariant's residual "
+        f"variance (rms of the cell means {top['amplitude_ut']:.2g} uT; largest in {top['largest_cell']}, "
+        f"{top['largest_mean_ut']:+.2g} uT): {_POINTS_AT[(top['invariant'], top['factor'])]}"
+    )

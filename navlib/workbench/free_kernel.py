@@ -17,6 +17,7 @@ with ``du/db_j = -M e_j``, ``du/dk_j = -(T - T_c) M e_j`` and ``du/dK = dK v``. 
 (step 1e-4 deg).
 Rows are interleaved as the fit's residual vector is: ``[e_0, e_1]`` of row 0, then of row 1, and so on.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -52,7 +53,9 @@ class FreeKernel:
 
     ``m``: (n, 3) field, uT; ``a``: (n, 3) acceleration or None; ``dt``: (n,) ``T - T_c`` or None."""
 
-    def __init__(self, names, m: np.ndarray, a: np.ndarray | None = None, dt: np.ndarray | None = None):
+    def __init__(
+        self, names, m: np.ndarray, a: np.ndarray | None = None, dt: np.ndarray | None = None
+    ):
         self.names = list(names)
         self.index = {q: i for i, q in enumerate(self.names)}
         self.m = np.asarray(m, float)
@@ -73,7 +76,7 @@ class FreeKernel:
         kt = np.array([self._get(x, q) for q in _TEMP])
         if self.dt is not None and np.any(kt):
             v = v - self.dt[:, None] * kt
-        u = v @ M          # M symmetric: rows of (M v)
+        u = v @ M  # M symmetric: rows of (M v)
         return M, v, u
 
     def _rotation(self, x) -> np.ndarray:
@@ -125,10 +128,10 @@ class FreeKernel:
         c = float(np.clip(raw, -CLIP, CLIP))
         s = np.sqrt(1.0 - c * c)
         J1 = (Jg - c * J0) / s
-        de1_dc = -e0 / s + (g - c * e0) * c / s ** 3
+        de1_dc = -e0 / s + (g - c * e0) * c / s**3
         free = abs(raw) < CLIP and F > 1e-9
         if "field_ut" in self.index:
-            J1[:, self.index["field_ut"]] = c / s + (de1_dc * (-D / F ** 2) if free else 0.0)
+            J1[:, self.index["field_ut"]] = c / s + (de1_dc * (-D / F**2) if free else 0.0)
         if "field_down_ut" in self.index:
             J1[:, self.index["field_down_ut"]] = -1.0 / s + (de1_dc / F if free else 0.0)
         mis = [self._get(x, q) for q in _MIS]

@@ -35,6 +35,7 @@ The kernels are compiled with numba (``cache=True``, no fast-math: the conventio
 :mod:`navlib.methods.jit`); each kernel's plain-Python ``py_func`` is its reference, and
 :func:`dense_covariance` the model's (tests).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -70,7 +71,9 @@ def propagation(kappa: float, clock: np.ndarray) -> np.ndarray:
     k = float(kappa)
     dt = np.diff(np.asarray(clock, float), prepend=clock[0] if len(clock) else 0.0)
     if np.any(dt < 0):
-        raise ValueError("a projected series must be in time order (serial.with_projection orders it)")
+        raise ValueError(
+            "a projected series must be in time order (serial.with_projection orders it)"
+        )
     phi = np.abs(k) ** dt
     if k < 0:
         phi = phi * np.where(np.round(dt) % 2 == 1, -1.0, 1.0)

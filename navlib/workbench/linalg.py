@@ -1,4 +1,5 @@
 """Linear algebra the workbench's fit, noise model, screening and diagnosis share."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -8,7 +9,7 @@ def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
     """An orthonormal basis of the column space of ``X``: columns are scaled to unit norm and a column is
     dropped when less than ``rtol`` of it is left after removing the previous ones."""
     n, k = X.shape
-    Q = np.zeros((n, k), order="F")                  # columns contiguous: Q[:, :r] is one block
+    Q = np.zeros((n, k), order="F")  # columns contiguous: Q[:, :r] is one block
     r = 0
     for j in range(k):
         v = X[:, j].astype(float)

@@ -7,6 +7,7 @@ and the sensor's scale tolerance; :func:`field_lines` gives it as report lines. 
 (:func:`navlib.workbench.calibration.calibrate`), the reference-free loop's final check
 (:mod:`navlib.workbench.magnetometer_free`) and ``navlib field``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -39,8 +40,10 @@ SCALE_TOL = 0.01
 #: value over that distance; at the pole itself ppigrf divides by sin(colatitude) = 0 and returns NaN).
 POLE_STEP_DEG = 1e-7
 #: What :func:`model_field` says at a geographic pole instead of a declination.
-POLE_NOTE = ("at a geographic pole the directions north and east are undefined, and so is the declination; "
-             "horizontal, down, intensity and dip are the field's limits at the pole")
+POLE_NOTE = (
+    "at a geographic pole the directions north and east are undefined, and so is the declination; "
+    "horizontal, down, intensity and dip are the field's limits at the pole"
+)
 
 
 def model_field(site) -> dict:
@@ -50,7 +53,12 @@ def model_field(site) -> dict:
     (:data:`POLE_NOTE`), and the other values are the limits at the pole (:data:`POLE_STEP_DEG`)."""
     if abs(site.lat_deg) < 90.0:
         return igrf_field(site).to_dict()
-    near = Site(float(np.copysign(90.0 - POLE_STEP_DEG, site.lat_deg)), site.lon_deg, site.height_m, site.date)
+    near = Site(
+        float(np.copysign(90.0 - POLE_STEP_DEG, site.lat_deg)),
+        site.lon_deg,
+        site.height_m,
+        site.date,
+    )
     out = igrf_field(near).to_dict()
     out.update(north_ut=None, east_ut=None, declination_deg=None, note=POLE_NOTE)
     return out
@@ -73,37 +81,50 @@ def field_check(fit, site=None, noise=None, scale_tol: float = SCALE_TOL) -> dic
         iD = names.index("field_down_ut")
         D = fit.params["field_down_ut"]
         x = float(np.clip(-D / F, -1, 1))
-        g = np.zeros(len(names))                       # d dip / d(F, D), rad
+        g = np.zeros(len(names))  # d dip / d(F, D), rad
         k = 1.0 / np.sqrt(max(1 - x * x, 1e-12))
-        g[iF], g[iD] = k * D / F ** 2, -k / F
+        g[iF], g[iD] = k * D / F**2, -k / F
         out["dip_deg"] = float(np.degrees(np.arcsin(x)))
         out["dip_std_deg"] = float(np.degrees(np.sqrt(g @ cov @ g)))
     if site is None:
         return out
     model = model_field(site)
     model_f, model_dip = model["intensity_ut"], model["dip_deg"]
-    out["model"] = {"name": "IGRF-14 (ppigrf)", "lat_deg": site.lat_deg, "lon_deg": site.lon_deg,
-                    "height_m": site.height_m, "date": str(site.date), "intensity_ut": model_f,
-                    "dip_deg": model_dip, "declination_deg": model["declination_deg"],
-                    **({"note": model["note"]} if "note" in model else {})}
+    out["model"] = {
+        "name": "IGRF-14 (ppigrf)",
+        "lat_deg": site.lat_deg,
+        "lon_deg": site.lon_deg,
+        "height_m": site.height_m,
+        "date": str(site.date),
+        "intensity_ut": model_f,
+        "dip_deg": model_dip,
+        "declination_deg": model["declination_deg"],
+        **({"note": model["note"]} if "note" in model else {}),
+    }
     tol_f = 1.96 * out["intensity_std_ut"] + CRUST_TOL_UT + scale_tol * model_f
     out["intensity_difference_ut"] = F - model_f
     out["intensity_tolerance_ut"] = tol_f
     anomalies = []
     if abs(F - model_f) > tol_f:
-        anomalies.append(f"intensity {F:.2f} uT against the model's {model_f:.2f} uT "
-                         f"(beyond +-{tol_f:.2f} uT)")
+        anomalies.append(
+            f"intensity {F:.2f} uT against the model's {model_f:.2f} uT (beyond +-{tol_f:.2f} uT)"
+        )
     if "dip_deg" in out:
         tol_d = 1.96 * out["dip_std_deg"] + float(np.degrees(CRUST_TOL_UT / model_f))
         out["dip_difference_deg"] = out["dip_deg"] - model_dip
         out["dip_tolerance_deg"] = tol_d
         if abs(out["dip_difference_deg"]) > tol_d:
-            anomalies.append(f"dip {out['dip_deg']:.2f} deg against the model's {model_dip:.2f} deg "
-                             f"(beyond +-{tol_d:.2f} deg)")
+            anomalies.append(
+                f"dip {out['dip_deg']:.2f} deg against the model's {model_dip:.2f} deg "
+                f"(beyond +-{tol_d:.2f} deg)"
+            )
     out["local_anomaly"] = bool(anomalies)
-    out["message"] = ("local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "
-                      "error beyond the tolerance)" if anomalies else
-                      "the local field agrees with the model within the uncertainty")
+    out["message"] = (
+        "local anomaly: " + "; ".join(anomalies) + " (steel or magnets nearby, or a sensor scale "
+        "error beyond the tolerance)"
+        if anomalies
+        else "the local field agrees with the model within the uncertainty"
+    )
     return out
 
 
@@ -115,7 +136,9 @@ def field_lines(check: dict) -> list[str]:
     lines = [est + " (95 %)"]
     if "model" in check:
         m = check["model"]
-        lines.append(f"model ({m['name']} at {m['lat_deg']:g}, {m['lon_deg']:g}, {m['height_m']:g} m, {m['date']}): "
-                     f"intensity {m['intensity_ut']:.2f} uT, dip {m['dip_deg']:.2f} deg")
+        lines.append(
+            f"model ({m['name']} at {m['lat_deg']:g}, {m['lon_deg']:g}, {m['height_m']:g} m, {m['date']}): "
+            f"intensity {m['intensity_ut']:.2f} uT, dip {m['dip_deg']:.2f} deg"
+        )
         lines.append(check["message"])
     return lines

@@ -3,6 +3,7 @@ consistent with noise or nothing more can be named.  The CLI command ``loop`` an
 :func:`loop`; :meth:`LoopResult.to_dict` is the ``--json`` schema and :func:`write_report` the
 ``--report DIR`` output.
 """
+
 from __future__ import annotations
 
 import textwrap
@@ -51,9 +52,15 @@ class LoopResult:
     @property
     def unexplained(self) -> list[dict]:
         """Significant structure left at the end that no effect explains."""
-        return [{"structure": s.what, "amplitude": float(s.amplitude),
-                 "p_value": float(s.p_value) if np.isfinite(s.p_value) else None}
-                for s in self.final_diagnosis.structure if s.significant]
+        return [
+            {
+                "structure": s.what,
+                "amplitude": float(s.amplitude),
+                "p_value": float(s.p_value) if np.isfinite(s.p_value) else None,
+            }
+            for s in self.final_diagnosis.structure
+            if s.significant
+        ]
 
     @property
     def untested(self) -> list[dict]:
@@ -73,9 +80,18 @@ class LoopResult:
 
     def steps_table(self) -> pd.DataFrame:
         unit = self.final.unit
-        return pd.DataFrame([{"step": i, "model": " + ".join(f.effects) or "(none)", f"rms ({unit})": f.rms,
-                              f"held-out rms ({unit})": f.loo_rms, "named": d.missing or "-"}
-                             for i, (f, d) in enumerate(zip(self.fits, self.diagnoses))]).set_index("step")
+        return pd.DataFrame(
+            [
+                {
+                    "step": i,
+                    "model": " + ".join(f.effects) or "(none)",
+                    f"rms ({unit})": f.rms,
+                    f"held-out rms ({unit})": f.loo_rms,
+                    "named": d.missing or "-",
+                }
+                for i, (f, d) in enumerate(zip(self.fits, self.diagnoses))
+            ]
+        ).set_index("step")
 
     def remaining(self) -> tuple[pd.DataFrame, str] | None:
         """What the final residuals still hold, by the factors the system knows (its ``remaining`` hook,
@@ -95,13 +111,29 @@ class LoopResult:
         (rms and residuals in the system's unit; ``untested``: :attr:`untested`; the screen's fields:
         :meth:`navlib.workbench.screen.Screening.to_dict`)."""
         f = self.final
-        out = {"system": f.system, "unit": f.unit,
-               "steps": [{"model": list(fi.effects), "rms": fi.rms, "loo_rms": fi.loo_rms, "missing": d.missing}
-                         for fi, d in zip(self.fits, self.diagnoses)],
-               "final": {"model": list(f.effects), "rms": f.rms, "loo_rms": f.loo_rms,
-                         "consistent_with_noise": self.consistent_with_noise, "unexplained": self.unexplained,
-                         "message": self.final_diagnosis.message},
-               "untested": self.untested, "outliers": self.outliers}
+        out = {
+            "system": f.system,
+            "unit": f.unit,
+            "steps": [
+                {
+                    "model": list(fi.effects),
+                    "rms": fi.rms,
+                    "loo_rms": fi.loo_rms,
+                    "missing": d.missing,
+                }
+                for fi, d in zip(self.fits, self.diagnoses)
+            ],
+            "final": {
+                "model": list(f.effects),
+                "rms": f.rms,
+                "loo_rms": f.loo_rms,
+                "consistent_with_noise": self.consistent_with_noise,
+                "unexplained": self.unexplained,
+                "message": self.final_diagnosis.message,
+            },
+            "untested": self.untested,
+            "outliers": self.outliers,
+        }
         rem = self.remaining()
         if rem is not None:
             out["remaining"] = {"by_factor": rem[0].to_dict(orient="records"), "reading": rem[1]}
@@ -113,8 +145,15 @@ class LoopResult:
 
 
 @one_blas_thread
-def loop(system, data: pd.DataFrame, start_model=(), *, user_effects: tuple[Effect, ...] = (),
-         alpha: float | None = None, max_steps: int = 8) -> LoopResult:
+def loop(
+    system,
+    data: pd.DataFrame,
+    start_model=(),
+    *,
+    user_effects: tuple[Effect, ...] = (),
+    alpha: float | None = None,
+    max_steps: int = 8,
+) -> LoopResult:
     """Run the workbench loop on ``data``.
 
     Starting from ``start_model`` (effect names), fit, :func:`~navlib.workbench.diagnose.diagnose`, add the
@@ -204,7 +243,9 @@ def noise_band(result: LoopResult, level: float = 0.95) -> tuple[float, float] |
     return (lo, hi) if hi > 0 else None
 
 
-def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -> tuple[float, float]:
+def known_noise_band(
+    sigma: float, n: int, n_params: int, level: float = 0.95
+) -> tuple[float, float]:
     """Where the rms of a correct model's residuals lies when the noise is known: white noise of standard
     deviation ``sigma`` on ``n`` observations and ``p = n_params`` fitted parameters give
     ``rms^2 = sigma^2 chi2(n - p) / n``; the band is its central ``level`` interval."""
@@ -213,7 +254,10 @@ def known_noise_band(sigma: float, n: int, n_params: int, level: float = 0.95) -
     check_param("sigma", sigma, lo=0, lo_open=True)
     check_param("n_params", n_params, lo=0, hi=n - 1, integer=True)
     tail, dof = (1.0 - level) / 2.0, n - n_params
-    return (float(sigma * np.sqrt(chi2.ppf(tail, dof) / n)), float(sigma * np.sqrt(chi2.ppf(1 - tail, dof) / n)))
+    return (
+        float(sigma * np.sqrt(chi2.ppf(tail, dof) / n)),
+        float(sigma * np.sqrt(chi2.ppf(1 - tail, dof) / n)),
+    )
 
 
 #: Characters per line of a staircase's title (the loop's outcome can be long): it stays within the column.
@@ -237,28 +281,47 @@ class Staircase:
     outcome: str = ""
 
 
-def staircase_of(result: LoopResult, title: str | None = None, floor: tuple[float, float] | None = None,
-                 floor_label: str | None = None) -> Staircase:
+def staircase_of(
+    result: LoopResult,
+    title: str | None = None,
+    floor: tuple[float, float] | None = None,
+    floor_label: str | None = None,
+) -> Staircase:
     """The :class:`Staircase` of a loop: the band is ``floor`` when the noise is known (e.g.
     :func:`known_noise_band` for simulated data), else :func:`noise_band` from the data, called the noise
     floor when the loop ended consistent with noise and the richest model's residual otherwise (it then
     holds the structure no effect explains).  The title defaults to ``"<system>: <outcome>"``."""
     if floor is None:
         floor = noise_band(result)
-        floor_label = floor_label or ("noise floor (95 %)" if result.consistent_with_noise
-                                      else "richest model's residual (95 %)")
+        floor_label = floor_label or (
+            "noise floor (95 %)"
+            if result.consistent_with_noise
+            else "richest model's residual (95 %)"
+        )
     held = [f.loo_rms for f in result.fits]
-    held = None if not np.any(np.isfinite(np.asarray(held, float))) else tuple(float(v) for v in held)
-    return Staircase(tuple(step_labels(result)), tuple(float(f.rms) for f in result.fits), held,
-                     None if floor is None else (float(floor[0]), float(floor[1])),
-                     floor_label or "noise floor (95 %)", result.final.unit,
-                     title if title is not None else f"{result.final.system}: {result.outcome()}",
-                     result.outcome())
+    held = (
+        None if not np.any(np.isfinite(np.asarray(held, float))) else tuple(float(v) for v in held)
+    )
+    return Staircase(
+        tuple(step_labels(result)),
+        tuple(float(f.rms) for f in result.fits),
+        held,
+        None if floor is None else (float(floor[0]), float(floor[1])),
+        floor_label or "noise floor (95 %)",
+        result.final.unit,
+        title if title is not None else f"{result.final.system}: {result.outcome()}",
+        result.outcome(),
+    )
 
 
-def staircase_figure(result, ax=None, title: str | None = None,
-                     floor: tuple[float, float] | None = None, floor_label: str | None = None,
-                     legend: bool = True):
+def staircase_figure(
+    result,
+    ax=None,
+    title: str | None = None,
+    floor: tuple[float, float] | None = None,
+    floor_label: str | None = None,
+    legend: bool = True,
+):
     """The loop as a picture, full column width: a staircase with one step per effect added (labelled
     with the effect), the rms after each step on a log axis, the held-out rms as a marker (none for a loop
     without a held-out set) and the noise floor as a band (:func:`navlib.plotstyle.staircase`).
@@ -266,17 +329,26 @@ def staircase_figure(result, ax=None, title: str | None = None,
     (``title`` then replaces its title).  Draws on ``ax`` if given (``legend=False``: no legend, e.g. for
     :func:`staircase_grid`); returns the figure."""
 
-    st = result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
+    st = (
+        result if isinstance(result, Staircase) else staircase_of(result, title, floor, floor_label)
+    )
     own = ax is None
     if own:
         fig, ax = rs.panels(1, panel_height_in=3.6)
-    rs.staircase(ax, list(st.labels), list(st.rms), None if st.held_out is None else list(st.held_out),
-                 floor=st.floor, floor_label=st.floor_label, unit=st.unit,
-                 title=textwrap.fill(title if title is not None else st.title, TITLE_WIDTH))
+    rs.staircase(
+        ax,
+        list(st.labels),
+        list(st.rms),
+        None if st.held_out is None else list(st.held_out),
+        floor=st.floor,
+        floor_label=st.floor_label,
+        unit=st.unit,
+        title=textwrap.fill(title if title is not None else st.title, TITLE_WIDTH),
+    )
     ticks = ax.get_xticklabels()
     lines = max(t.get_text().count("\n") + 1 for t in ticks)
     extra = 1.3 if any(t.get_rotation() for t in ticks) else 0.2 * max(0, lines - 2)
-    if own and extra:                                  # a figure of its own: room for the labels
+    if own and extra:  # a figure of its own: room for the labels
         w, h = ax.figure.get_size_inches()
         ax.figure.set_size_inches(w, h + extra)
     if legend:
@@ -295,29 +367,50 @@ def staircase_grid(staircases, ncols: int = 2, panel_height_in: float = 2.6):
     ``+``), slanted where they do not fit.  Returns the figure."""
     import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
 
-    items = [(k, v if isinstance(v, Staircase) else staircase_of(v)) for k, v in dict(staircases).items()]
+    items = [
+        (k, v if isinstance(v, Staircase) else staircase_of(v)) for k, v in dict(staircases).items()
+    ]
     if not items:
         raise InputError("staircase_grid: no loop to draw")
     check_param("ncols", ncols, lo=1, hi=3, integer=True)
     ncols = min(ncols, len(items))
     nrows = -(-len(items) // ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(rs.MAX_WIDTH_IN, panel_height_in * nrows + 0.5),
-                             layout="constrained", squeeze=False)
+    fig, axes = plt.subplots(
+        nrows,
+        ncols,
+        figsize=(rs.MAX_WIDTH_IN, panel_height_in * nrows + 0.5),
+        layout="constrained",
+        squeeze=False,
+    )
     handles, bands = {}, {st.floor_label for _, st in items if st.floor is not None}
     band = bands.pop() if len(bands) == 1 else "noise floor or richest model's residual (95 %)"
     for ax, (name, st) in zip(axes.ravel(), items):
-        short = Staircase(tuple(lab.replace("+ ", "").replace("start (none)", "none")
-                                .replace("start: ", "") for lab in st.labels),
-                          st.rms, st.held_out, st.floor, st.floor_label, st.unit, st.title, st.outcome)
+        short = Staircase(
+            tuple(
+                lab.replace("+ ", "").replace("start (none)", "none").replace("start: ", "")
+                for lab in st.labels
+            ),
+            st.rms,
+            st.held_out,
+            st.floor,
+            st.floor_label,
+            st.unit,
+            st.title,
+            st.outcome,
+        )
         title = name if not st.outcome else f"{name}: {st.outcome}"
-        staircase_figure(short, ax=ax, title=textwrap.shorten(title, 2 * GRID_TITLE_WIDTH, placeholder=" ..."),
-                         legend=False)
+        staircase_figure(
+            short,
+            ax=ax,
+            title=textwrap.shorten(title, 2 * GRID_TITLE_WIDTH, placeholder=" ..."),
+            legend=False,
+        )
         ax.title.set_text(textwrap.fill(ax.title.get_text(), GRID_TITLE_WIDTH))
         ax.set_xlabel("")
         for h, lab in zip(*ax.get_legend_handles_labels()):
             key = "band" if lab == st.floor_label else lab
             handles.setdefault(key, (h, band if key == "band" else lab))
-    for ax in axes.ravel()[len(items):]:
+    for ax in axes.ravel()[len(items) :]:
         ax.set_axis_off()
     hs, ls = zip(*handles.values())
     fig.legend(hs, ls, loc="outside lower center", ncol=3)
@@ -339,7 +432,11 @@ def report_figure(result: LoopResult):
         _measurement_panel(a1, result, short=True)
         for i, f in enumerate(result.fits):
             a2.plot(f.residuals, ".", ms=2, label=f"step {i}")
-        a2.set(xlabel="observation", ylabel=f"residual ({result.final.unit})", title="residuals after each step")
+        a2.set(
+            xlabel="observation",
+            ylabel=f"residual ({result.final.unit})",
+            title="residuals after each step",
+        )
         rs.legend_below(a1, ncol=3, markerscale=4)
         rs.legend_below(a2, ncol=min(4, len(result.fits)), markerscale=4)
     return fig
@@ -358,7 +455,13 @@ def _measurement_panel(ax, result: LoopResult, short: bool = False) -> None:
 
     if fits[0].system == "compass":
         h = data["true_heading_deg"].to_numpy(float)
-        ax.plot(h, wrap_deg(data["measured_heading_deg"].to_numpy(float) - h), "k.", ms=3, label="measured")
+        ax.plot(
+            h,
+            wrap_deg(data["measured_heading_deg"].to_numpy(float) - h),
+            "k.",
+            ms=3,
+            label="measured",
+        )
         for i, (f, style) in enumerate(((fits[0], "r."), (result.final, "b."))):
             ax.plot(h, wrap_deg(f.predict(data) - h), style, ms=2, label=label(i, f))
         ax.set(xlabel="true heading (deg)", ylabel="heading error (deg)")
@@ -376,6 +479,7 @@ def loop_figure(result: LoopResult):
     """Three panels: measurement against the start and final models, residuals at each step, the error
     falling (rms and held-out rms per step)."""
     import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
+
     fits, unit = result.fits, result.final.unit
     fig, axes = plt.subplots(1, 3, figsize=(12, 4))
     ax = axes[0]
@@ -383,7 +487,11 @@ def loop_figure(result: LoopResult):
     ax.legend(fontsize=9)
     for i, f in enumerate(fits):
         axes[1].plot(f.residuals, ".", ms=2, label=f"step {i}")
-    axes[1].set(xlabel="observation (file order)", ylabel=f"residual ({unit})", title="residuals at each step")
+    axes[1].set(
+        xlabel="observation (file order)",
+        ylabel=f"residual ({unit})",
+        title="residuals at each step",
+    )
     axes[1].legend(fontsize=9)
     k = np.arange(len(fits))
     axes[2].semilogy(k, [f.rms for f in fits], "ko-", label="rms")
@@ -408,18 +516,24 @@ def check_report_folder(folder) -> tuple[Path, Path]:
     png, md = folder / "loop.png", folder / "loop.md"
     for p in (png, md):
         if p.exists() or p.is_symlink():
-            raise InputError(f"{p}: already exists; not overwritten (choose another --report folder)")
+            raise InputError(
+                f"{p}: already exists; not overwritten (choose another --report folder)"
+            )
     base = folder
     while not base.exists() and base != base.parent:
         base = base.parent
     if not base.is_dir():
-        raise InputError(f"{folder}: cannot be created, '{base}' is a file (choose another --report folder)")
+        raise InputError(
+            f"{folder}: cannot be created, '{base}' is a file (choose another --report folder)"
+        )
     try:
         with tempfile.TemporaryFile(dir=base):
             pass
     except OSError as err:
-        raise InputError(f"{folder}: cannot write the report there (creating a file in {base} failed: "
-                         f"{err.strerror or type(err).__name__}); choose another --report folder") from None
+        raise InputError(
+            f"{folder}: cannot write the report there (creating a file in {base} failed: "
+            f"{err.strerror or type(err).__name__}); choose another --report folder"
+        ) from None
     return png, md
 
 
@@ -431,30 +545,50 @@ def write_report(result: LoopResult, folder, source: str = "") -> tuple[Path, Pa
     png, md = check_report_folder(folder)
     folder.mkdir(parents=True, exist_ok=True)
     import matplotlib.pyplot as plt  # noqa: PLC0415  # lazy: matplotlib only for figures; the CLI's loop runs without it
+
     fig = report_figure(result)
     fig.savefig(png, dpi=DPI)
     plt.close(fig)
     unit = result.final.unit
-    lines = [f"# Workbench loop: {result.final.system}" + (f" on `{source}`" if source else ""), "",
-             f"| step | model | rms ({unit}) | held-out rms ({unit}) | named |", "|---|---|---|---|---|"]
+    lines = [
+        f"# Workbench loop: {result.final.system}" + (f" on `{source}`" if source else ""),
+        "",
+        f"| step | model | rms ({unit}) | held-out rms ({unit}) | named |",
+        "|---|---|---|---|---|",
+    ]
     for i, (f, d) in enumerate(zip(result.fits, result.diagnoses)):
-        lines.append(f"| {i} | {' + '.join(f.effects) or '(none)'} | {f.rms:.4g} | {f.loo_rms:.4g} | "
-                     f"{d.missing or '-'} |")
+        lines.append(
+            f"| {i} | {' + '.join(f.effects) or '(none)'} | {f.rms:.4g} | {f.loo_rms:.4g} | "
+            f"{d.missing or '-'} |"
+        )
     lines += [""] + [f"Not tested: {u['effect']} ({u['why']})." for u in result.untested]
     sc = result.screening
     if sc is not None and sc.outliers:
         lines += ["", f"**Outliers:** {sc.outlier_line(unit)}."]
     if sc is not None and sc.noise.series is not None:
         lines += ["", f"**Noise:** {sc.noise.describe()}."]
-    lines += ["", f"**Outcome:** {result.outcome()}.", "", result.final_diagnosis.message.split("\n")[-1]]
+    lines += [
+        "",
+        f"**Outcome:** {result.outcome()}.",
+        "",
+        result.final_diagnosis.message.split("\n")[-1],
+    ]
     rem = result.remaining()
     if rem is not None and not rem[0].empty:
-        lines += ["", "**What remains** (a description, not a test; the factors overlap: a pause is a cell of time, "
-                  f"turn rate and acceleration at once): {rem[1]}.", "",
-                  f"| invariant | factor | cells | share of variance | rms of cell means ({unit}) | largest cell | "
-                  f"its mean ({unit}) |", "|---|---|---|---|---|---|---|"]
-        lines += [f"| {r.invariant} | {r.factor} | {r.cells} | {100 * r.share:.0f} % | {r.amplitude_ut:.3g} | "
-                  f"{r.largest_cell} | {r.largest_mean_ut:+.3g} |" for r in rem[0].itertuples()]
+        lines += [
+            "",
+            "**What remains** (a description, not a test; the factors overlap: a pause is a cell of time, "
+            f"turn rate and acceleration at once): {rem[1]}.",
+            "",
+            f"| invariant | factor | cells | share of variance | rms of cell means ({unit}) | largest cell | "
+            f"its mean ({unit}) |",
+            "|---|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r.invariant} | {r.factor} | {r.cells} | {100 * r.share:.0f} % | {r.amplitude_ut:.3g} | "
+            f"{r.largest_cell} | {r.largest_mean_ut:+.3g} |"
+            for r in rem[0].itertuples()
+        ]
     lines += ["", f"![the loop]({png.name})", ""]
     md.write_text("\n".join(lines))
     return png, md

@@ -25,6 +25,7 @@ Files: ``mag_x_ut, mag_y_ut, mag_z_ut`` and the reference attitude quaternion ``
 (``../shared/realdata/broad/3d``).  :func:`load_magnetometer` reports bad input in one line naming file,
 column and row.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -46,28 +47,41 @@ QUAT = ("q_w", "q_x", "q_y", "q_z")
 GYR = ("gyr_x_dps", "gyr_y_dps", "gyr_z_dps")
 POS = ("pos_n_m", "pos_e_m", "pos_d_m")
 FIELD = ("field_n_ut", "field_e_ut", "field_d_ut")
-QUAT_TOL = 0.01          # |q| must be within 1 +- this
-MIN_ORIENTATIONS = 12    # distinct 30-deg attitude cells needed to separate the effects
-MIN_TILT_DEG = 10.0      # the down axis must leave the body z axis by at least this much somewhere
+QUAT_TOL = 0.01  # |q| must be within 1 +- this
+MIN_ORIENTATIONS = 12  # distinct 30-deg attitude cells needed to separate the effects
+MIN_TILT_DEG = 10.0  # the down axis must leave the body z axis by at least this much somewhere
 
 MAGNETOMETER_EFFECTS = {
     "hard_iron": Effect(
-        "hard_iron", ("hard_x_ut", "hard_y_ut", "hard_z_ut"), ("uT", "uT", "uT"),
+        "hard_iron",
+        ("hard_x_ut", "hard_y_ut", "hard_z_ut"),
+        ("uT", "uT", "uT"),
         "A field fixed to the body (a magnet or magnetised steel on the board, sensor offsets) adds the same "
-        "vector in every attitude. Missing, the residual is a constant vector in the body frame."),
+        "vector in every attitude. Missing, the residual is a constant vector in the body frame.",
+    ),
     "soft_iron": Effect(
-        "soft_iron", ("soft_xx", "soft_yy", "soft_xy", "soft_xz", "soft_yz"), ("-",) * 5,
+        "soft_iron",
+        ("soft_xx", "soft_yy", "soft_xy", "soft_xz", "soft_yz"),
+        ("-",) * 5,
         "Soft iron magnetised by the Earth field and per-axis scale mismatch scale the field differently "
         "along different body axes (symmetric, trace-free). Missing, the residual is quadratic in the "
-        "attitude: the measured field traces an ellipsoid, not a sphere."),
+        "attitude: the measured field traces an ellipsoid, not a sphere.",
+    ),
     "misalignment": Effect(
-        "misalignment", ("mis_x_deg", "mis_y_deg", "mis_z_deg"), ("deg", "deg", "deg"),
+        "misalignment",
+        ("mis_x_deg", "mis_y_deg", "mis_z_deg"),
+        ("deg", "deg", "deg"),
         "The magnetometer's axes are turned against the body frame the reference attitude describes. "
-        "Missing, the residual is the field rotated by a small fixed angle: perpendicular to the field."),
+        "Missing, the residual is the field rotated by a small fixed angle: perpendicular to the field.",
+    ),
     "time_lag": Effect(
-        "time_lag", ("time_lag_s",), ("s",),
+        "time_lag",
+        ("time_lag_s",),
+        ("s",),
         "The magnetometer and the attitude reference are sampled with a time offset. Missing, the residual "
-        "grows with the angular rate (omega x field).", GYR),
+        "grows with the angular rate (omega x field).",
+        GYR,
+    ),
 }
 
 _PARAMS = [p for e in MAGNETOMETER_EFFECTS.values() for p in e.params]
@@ -99,29 +113,73 @@ AXES = {"x": "x forward", "y": "y right", "z": "z down"}
 # The file schema of the ``magnetometer`` system (what :func:`load_magnetometer` reads; the data
 # dictionary of :func:`navlib.data.tables.schema_table`).
 MAGNETOMETER_COLUMNS = tuple(
-    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]} (FRD)")
-     for c in MAG]
-    + [Column(c, "", lo=-1.5, hi=1.5,
-              meaning=("reference attitude, unit quaternion, scalar first, body FRD to NED"
-                       if c == "q_w" else "reference attitude quaternion, vector part"))
-       for c in QUAT]
-    + [Column(c, "deg/s", required=False, lo=-1e5, hi=1e5,
-              meaning=f"angular rate, {AXES[c[4]]} (the time_lag effect needs all three)") for c in GYR]
-    + [Column(c, "m", required=False, lo=-1e7, hi=1e7,
-              meaning=f"position, {d} (a field that changes with position)")
-       for c, d in zip(POS, ("north", "east", "down"))]
-    + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10,
-              meaning="time of the sample (a field that changes in time)")]
-    + [Column(c, u, required=False, checked=False, meaning=m)
-       for c, u, m in (("moving", "0/1", "1 while the sensor moves (information only)"),
-                       ("magnet_attached", "-1/0/1", "BROAD's magnet flag (information only)"),
-                       ("att_blur", "-", "attitude blur of a block mean (information only)"),
-                       ("acc_x_ms2", "m/s^2", "specific force, x forward (information only)"),
-                       ("acc_y_ms2", "m/s^2", "specific force, y right (information only)"),
-                       ("acc_z_ms2", "m/s^2", "specific force, z down (information only)"),
-                       ("ref_roll_deg", "deg", "reference roll (information only)"),
-                       ("ref_pitch_deg", "deg", "reference pitch (information only)"),
-                       ("ref_heading_deg", "deg", "reference heading (information only)"))])
+    [
+        Column(
+            c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]} (FRD)"
+        )
+        for c in MAG
+    ]
+    + [
+        Column(
+            c,
+            "",
+            lo=-1.5,
+            hi=1.5,
+            meaning=(
+                "reference attitude, unit quaternion, scalar first, body FRD to NED"
+                if c == "q_w"
+                else "reference attitude quaternion, vector part"
+            ),
+        )
+        for c in QUAT
+    ]
+    + [
+        Column(
+            c,
+            "deg/s",
+            required=False,
+            lo=-1e5,
+            hi=1e5,
+            meaning=f"angular rate, {AXES[c[4]]} (the time_lag effect needs all three)",
+        )
+        for c in GYR
+    ]
+    + [
+        Column(
+            c,
+            "m",
+            required=False,
+            lo=-1e7,
+            hi=1e7,
+            meaning=f"position, {d} (a field that changes with position)",
+        )
+        for c, d in zip(POS, ("north", "east", "down"))
+    ]
+    + [
+        Column(
+            "time_s",
+            "s",
+            required=False,
+            lo=-1e10,
+            hi=1e10,
+            meaning="time of the sample (a field that changes in time)",
+        )
+    ]
+    + [
+        Column(c, u, required=False, checked=False, meaning=m)
+        for c, u, m in (
+            ("moving", "0/1", "1 while the sensor moves (information only)"),
+            ("magnet_attached", "-1/0/1", "BROAD's magnet flag (information only)"),
+            ("att_blur", "-", "attitude blur of a block mean (information only)"),
+            ("acc_x_ms2", "m/s^2", "specific force, x forward (information only)"),
+            ("acc_y_ms2", "m/s^2", "specific force, y right (information only)"),
+            ("acc_z_ms2", "m/s^2", "specific force, z down (information only)"),
+            ("ref_roll_deg", "deg", "reference roll (information only)"),
+            ("ref_pitch_deg", "deg", "reference pitch (information only)"),
+            ("ref_heading_deg", "deg", "reference heading (information only)"),
+        )
+    ]
+)
 
 
 def quaternion_columns() -> list[Column]:
@@ -146,8 +204,10 @@ def load_magnetometer(path, *, min_rows: int = 30) -> pd.DataFrame:
     bad = np.flatnonzero(np.abs(norm - 1.0) > QUAT_TOL)
     if bad.size:
         r = int(bad[0])
-        raise InputError(f"{where(path, 'q_w..q_z', r, frame)}: quaternion norm "
-                         f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})")
+        raise InputError(
+            f"{where(path, 'q_w..q_z', r, frame)}: quaternion norm "
+            f"{norm[r]:.4f}; a unit quaternion is needed (within {QUAT_TOL:g})"
+        )
     check_orientations(frame, Path(path).name)
     check_field(frame, Path(path).name)
     check_rates(frame, Path(path).name)
@@ -184,11 +244,16 @@ def check_rates(frame: pd.DataFrame, name: str = "data") -> None:
     if 0.5 <= ratio <= 2.0:
         return
     near = [(u, f) for u, f in RATE_UNITS if 0.5 <= ratio * f <= 2.0]
-    look = (f"these look like {near[0][0]} (multiply by {near[0][1]:.6g} for deg/s)" if near else
-            "the gyro and the reference attitude disagree")
-    raise InputError(f"{name}: columns {', '.join(GYR)}: |omega| is {ratio:.3g} times the rate at which the "
-                     f"reference attitude turns (median over {int(turning.sum())} turning rows; 0.5..2 accepted): "
-                     f"{look}")
+    look = (
+        f"these look like {near[0][0]} (multiply by {near[0][1]:.6g} for deg/s)"
+        if near
+        else "the gyro and the reference attitude disagree"
+    )
+    raise InputError(
+        f"{name}: columns {', '.join(GYR)}: |omega| is {ratio:.3g} times the rate at which the "
+        f"reference attitude turns (median over {int(turning.sum())} turning rows; 0.5..2 accepted): "
+        f"{look}"
+    )
 
 
 _AXES = ("x", "y", "z")
@@ -231,8 +296,8 @@ def check_field(frame: pd.DataFrame, name: str = "data") -> None:
     cols = "columns mag_x_ut, mag_y_ut, mag_z_ut"
     X = np.column_stack([C.reshape(len(m), 9), np.ones(len(m))])
     keep = np.ones(len(m), bool)
-    for _ in range(4):                               # set wild rows aside (a spike must not pass for a unit)
-        W = np.column_stack([lstsq(X[keep], m[keep, j]) for j in range(3)])          # (10, 3)
+    for _ in range(4):  # set wild rows aside (a spike must not pass for a unit)
+        W = np.column_stack([lstsq(X[keep], m[keep, j]) for j in range(3)])  # (10, 3)
         e = np.linalg.norm(m - X @ W, axis=1)
         inside = e <= TRIM * np.median(e[keep])
         if np.array_equal(inside, keep) or inside.sum() < len(m) // 2:
@@ -241,10 +306,12 @@ def check_field(frame: pd.DataFrame, name: str = "data") -> None:
     m, C, X = m[keep], C[keep], X[keep]
     explained = 1.0 - float(np.sum((m - X @ W) ** 2)) / float(np.sum((m - m.mean(axis=0)) ** 2))
     if explained < MIN_EXPLAINED:
-        raise InputError(f"{name}: {cols}: the reference attitude explains only {100 * max(explained, 0.0):.0f} "
-                         f"% of the field's variation (a magnetometer turned with it: more than "
-                         f"{100 * MIN_EXPLAINED:.0f} %); a stuck or disconnected sensor, or the attitude of "
-                         f"another body or time?")
+        raise InputError(
+            f"{name}: {cols}: the reference attitude explains only {100 * max(explained, 0.0):.0f} "
+            f"% of the field's variation (a magnetometer turned with it: more than "
+            f"{100 * MIN_EXPLAINED:.0f} %); a stuck or disconnected sensor, or the attitude of "
+            f"another body or time?"
+        )
     # W[k*3 + l, j] = M_jk n_l: rows (j, k), columns l
     G = W[:9].T.reshape(3, 3, 3).reshape(9, 3)
     u, s, vt = np.linalg.svd(G, full_matrices=False)
@@ -252,27 +319,46 @@ def check_field(frame: pd.DataFrame, name: str = "data") -> None:
     if n[0] < 0:
         M, n = -M, -n
     P = _signed_permutation(M)
-    if (P is not None and not np.array_equal(P, np.eye(3)) and np.linalg.norm(M - P) < 0.5
-            and n[0] > 0.2 * np.linalg.norm(n)):
+    if (
+        P is not None
+        and not np.array_equal(P, np.eye(3))
+        and np.linalg.norm(M - P) < 0.5
+        and n[0] > 0.2 * np.linalg.norm(n)
+    ):
         k = np.argmax(np.abs(P), axis=1)
-        said = " and ".join(f"{MAG[j]} holds {'-' if P[j, k[j]] < 0 else ''}{_AXES[k[j]]}" for j in range(3)
-                            if not (k[j] == j and P[j, k[j]] > 0))
-        hint = (" (FLU: y left, z up; multiply y and z by -1)"
-                if np.array_equal(P, np.diag([1.0, -1.0, -1.0])) else "")
-        raise InputError(f"{name}: {cols}: the axes are not FRD (x forward, y right, z down): the field "
-                         f"follows the attitude only if {said}{hint}; convert the axes to FRD")
-    Xf = np.column_stack([C[:, :, j].reshape(-1) for j in range(3)]
-                         + [np.tile(np.eye(3)[j], len(m)) for j in range(3)])
+        said = " and ".join(
+            f"{MAG[j]} holds {'-' if P[j, k[j]] < 0 else ''}{_AXES[k[j]]}"
+            for j in range(3)
+            if not (k[j] == j and P[j, k[j]] > 0)
+        )
+        hint = (
+            " (FLU: y left, z up; multiply y and z by -1)"
+            if np.array_equal(P, np.diag([1.0, -1.0, -1.0]))
+            else ""
+        )
+        raise InputError(
+            f"{name}: {cols}: the axes are not FRD (x forward, y right, z down): the field "
+            f"follows the attitude only if {said}{hint}; convert the axes to FRD"
+        )
+    Xf = np.column_stack(
+        [C[:, :, j].reshape(-1) for j in range(3)]
+        + [np.tile(np.eye(3)[j], len(m)) for j in range(3)]
+    )
     intensity = float(np.linalg.norm(lstsq(Xf, m.ravel())[:3]))
     lo, hi = FIELD_BAND_UT
     if not lo <= intensity <= hi:
         median = float(np.median(np.linalg.norm(m, axis=1)))
         units = [(unit, f) for unit, f in FIELD_UNITS if lo <= intensity * f <= hi]
-        look = (f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)" if units
-                else "this is not a field in uT")
-        raise InputError(f"{name}: {cols}: the field that follows the attitude has an intensity of "
-                         f"{intensity:.4g} (median |m| {median:.4g}), where the Earth's field is 22-67 uT "
-                         f"and {lo:g}-{hi:g} uT is accepted: {look}")
+        look = (
+            f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)"
+            if units
+            else "this is not a field in uT"
+        )
+        raise InputError(
+            f"{name}: {cols}: the field that follows the attitude has an intensity of "
+            f"{intensity:.4g} (median |m| {median:.4g}), where the Earth's field is 22-67 uT "
+            f"and {lo:g}-{hi:g} uT is accepted: {look}"
+        )
 
 
 def body_from_nav(frame: pd.DataFrame) -> np.ndarray:
@@ -285,20 +371,26 @@ def body_from_nav(frame: pd.DataFrame) -> np.ndarray:
 def check_orientations(frame: pd.DataFrame, name: str = "data") -> None:
     """Enough distinct orientations to separate the effects (see :func:`load_magnetometer`)."""
     C = body_from_nav(frame)
-    down = C[:, :, 2]                                  # NED down in body axes
+    down = C[:, :, 2]  # NED down in body axes
     north = C[:, :, 0]
     cells = {tuple(v) for v in np.round(np.column_stack([down, north]) * 2).astype(int)}
     tilt = np.degrees(np.arccos(np.clip(down[:, 2], -1, 1)))
     failed = []
     if len(cells) < MIN_ORIENTATIONS:
-        failed.append(f"only {len(cells)} distinct orientations (30-deg cells; at least {MIN_ORIENTATIONS} "
-                      f"are needed)")
+        failed.append(
+            f"only {len(cells)} distinct orientations (30-deg cells; at least {MIN_ORIENTATIONS} "
+            f"are needed)"
+        )
     if np.max(np.abs(tilt - np.median(tilt))) < MIN_TILT_DEG:
-        failed.append(f"a tilt of at most {np.max(np.abs(tilt - np.median(tilt))):.1f} deg from the median "
-                      f"(at least {MIN_TILT_DEG:g} deg is needed)")
+        failed.append(
+            f"a tilt of at most {np.max(np.abs(tilt - np.median(tilt))):.1f} deg from the median "
+            f"(at least {MIN_TILT_DEG:g} deg is needed)"
+        )
     if failed:
-        raise InputError(f"{name}: columns q_w..q_z, rows 1..{len(frame)}: {' and '.join(failed)}, to separate "
-                         f"hard iron from the local field")
+        raise InputError(
+            f"{name}: columns q_w..q_z, rows 1..{len(frame)}: {' and '.join(failed)}, to separate "
+            f"hard iron from the local field"
+        )
 
 
 def _rotation(theta_deg) -> np.ndarray:
@@ -307,9 +399,13 @@ def _rotation(theta_deg) -> np.ndarray:
 
 def _matrix(p: dict) -> np.ndarray:
     """A = R(theta) (I + S)."""
-    S = np.array([[p["soft_xx"], p["soft_xy"], p["soft_xz"]],
-                  [p["soft_xy"], p["soft_yy"], p["soft_yz"]],
-                  [p["soft_xz"], p["soft_yz"], -p["soft_xx"] - p["soft_yy"]]])
+    S = np.array(
+        [
+            [p["soft_xx"], p["soft_xy"], p["soft_xz"]],
+            [p["soft_xy"], p["soft_yy"], p["soft_yz"]],
+            [p["soft_xz"], p["soft_yz"], -p["soft_xx"] - p["soft_yy"]],
+        ]
+    )
     return _rotation([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]]) @ (np.eye(3) + S)
 
 
@@ -319,8 +415,9 @@ def full_params(params: dict) -> dict:
     return p
 
 
-def predict_field(params: dict, frame: pd.DataFrame, C: np.ndarray | None = None,
-                  w: np.ndarray | None = None) -> np.ndarray:
+def predict_field(
+    params: dict, frame: pd.DataFrame, C: np.ndarray | None = None, w: np.ndarray | None = None
+) -> np.ndarray:
     """Model field (n, 3) in body axes for catalogued parameters ``params`` (absent = 0); ``C`` and the body
     rate ``w`` (rad/s) may be given precomputed from ``frame``."""
     p = full_params(params)
@@ -335,18 +432,26 @@ def predict_field(params: dict, frame: pd.DataFrame, C: np.ndarray | None = None
 def correct_field(params: dict, frame: pd.DataFrame) -> np.ndarray:
     """Invert the body-fixed part: ``A^-1 (m - b)``, (n, 3) uT."""
     p = full_params(params)
-    m = frame[list(MAG)].to_numpy(float) - np.array([p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]])
+    m = frame[list(MAG)].to_numpy(float) - np.array(
+        [p["hard_x_ut"], p["hard_y_ut"], p["hard_z_ut"]]
+    )
     return m @ np.linalg.inv(_matrix(p)).T
 
 
 def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     cat = tuple(e.name for e in effects if e.contribution is None)
     users = tuple(e for e in effects if e.contribution is not None)
-    names = list(FIELD) + [p for e in cat for p in MAGNETOMETER_EFFECTS[e].params] + [p for e in users for p in e.params]
+    names = (
+        list(FIELD)
+        + [p for e in cat for p in MAGNETOMETER_EFFECTS[e].params]
+        + [p for e in users for p in e.params]
+    )
     clash = sorted({n for n in names if names.count(n) > 1})
     if clash:
-        raise InputError(f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
-                         f"not be named like the local field {', '.join(FIELD)})")
+        raise InputError(
+            f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
+            f"not be named like the local field {', '.join(FIELD)})"
+        )
     m = data[list(MAG)].to_numpy(float)
     C = body_from_nav(data)
     shape = m.shape
@@ -360,7 +465,7 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
         return predict_field(p, data, C, rate).ravel() + user_columns(users, p, data, shape)
 
     # start 2 (linearised): m = C m_n + b (+ linear user terms), all else zero -- linear least squares
-    lin = [C[:, :, j].reshape(-1) for j in range(3)]          # d m / d m_n
+    lin = [C[:, :, j].reshape(-1) for j in range(3)]  # d m / d m_n
     hard = "hard_iron" in cat
     if hard:
         lin += [np.tile(np.eye(3)[j], len(m)) for j in range(3)]
@@ -369,7 +474,7 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
     x2 = np.zeros(len(names))
     x2[:3] = beta[:3]
     if hard:
-        x2[names.index("hard_x_ut"):names.index("hard_x_ut") + 3] = beta[3:6]
+        x2[names.index("hard_x_ut") : names.index("hard_x_ut") + 3] = beta[3:6]
     if users:
         k = len([p for e in users for p in e.params])
         x2[-k:] = beta[-k:]
@@ -385,16 +490,28 @@ def _fit_magnetometer(data: pd.DataFrame, effects: tuple[Effect, ...], start) ->
     params = dict(zip(names, map(float, sol.x)))
 
     def predict(frame):
-        return predict_field(params, frame) + user_columns(users, params, frame, (len(frame), 3)).reshape(-1, 3)
+        return predict_field(params, frame) + user_columns(
+            users, params, frame, (len(frame), 3)
+        ).reshape(-1, 3)
 
-    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, m.ravel() - model(sol.x),
-               np.asarray(sol.jac), predict)
+    return Fit(
+        SYSTEM,
+        tuple(e.name for e in effects),
+        params,
+        data,
+        m.ravel() - model(sol.x),
+        np.asarray(sol.jac),
+        predict,
+    )
 
 
-_SOFT_BASIS = {"soft_xx": np.diag([1.0, 0.0, -1.0]), "soft_yy": np.diag([0.0, 1.0, -1.0]),
-               "soft_xy": np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 0]]),
-               "soft_xz": np.array([[0, 0, 1.0], [0, 0, 0], [1.0, 0, 0]]),
-               "soft_yz": np.array([[0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])}
+_SOFT_BASIS = {
+    "soft_xx": np.diag([1.0, 0.0, -1.0]),
+    "soft_yy": np.diag([0.0, 1.0, -1.0]),
+    "soft_xy": np.array([[0, 1.0, 0], [1.0, 0, 0], [0, 0, 0]]),
+    "soft_xz": np.array([[0, 0, 1.0], [0, 0, 0], [1.0, 0, 0]]),
+    "soft_yz": np.array([[0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]]),
+}
 
 
 def _jacobian(params: dict, names, C, w, users, data) -> np.ndarray:
@@ -469,15 +586,22 @@ def magnetometer_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
     d = fit.data
     out = []
     if "time_s" in d and np.ptp(d["time_s"].to_numpy(float)) > 0:
-        out.append(("field changing in time (per axis)", _cell_offsets(_cells(d["time_s"].to_numpy(float), 10)),
-                    2.0))
+        out.append(
+            (
+                "field changing in time (per axis)",
+                _cell_offsets(_cells(d["time_s"].to_numpy(float), 10)),
+                2.0,
+            )
+        )
     if all(c in d for c in POS):
         P = d[list(POS)].to_numpy(float)
         cell = _cells(P[:, 0], 2) * 4 + _cells(P[:, 1], 2) * 2 + _cells(P[:, 2], 2)
         out.append(("field changing with position (per axis)", _cell_offsets(cell), 2.0))
     if all(c in d for c in GYR):
         w = np.linalg.norm(d[list(GYR)].to_numpy(float), axis=1)
-        out.append(("dependence on angular rate |omega| (per axis)", _per_axis(w - w.mean()), np.sqrt(3.0)))
+        out.append(
+            ("dependence on angular rate |omega| (per axis)", _per_axis(w - w.mean()), np.sqrt(3.0))
+        )
     return out
 
 
@@ -493,15 +617,23 @@ def field_summary(fit: Fit) -> dict:
     """The estimated local field: north, east, down (uT), horizontal, intensity (uT), dip (deg)."""
     n, e, dn = (fit.params[k] for k in FIELD)
     h = float(np.hypot(n, e))
-    return {"north (uT)": n, "east (uT)": e, "down (uT)": dn, "horizontal (uT)": h,
-            "intensity (uT)": float(np.sqrt(h * h + dn * dn)), "dip (deg)": float(np.degrees(np.arctan2(dn, h)))}
+    return {
+        "north (uT)": n,
+        "east (uT)": e,
+        "down (uT)": dn,
+        "horizontal (uT)": h,
+        "intensity (uT)": float(np.sqrt(h * h + dn * dn)),
+        "dip (deg)": float(np.degrees(np.arctan2(dn, h))),
+    }
 
 
-def heading_error_deg(body_field: np.ndarray, frame: pd.DataFrame, north_deg: float | None = None) -> np.ndarray:
+def heading_error_deg(
+    body_field: np.ndarray, frame: pd.DataFrame, north_deg: float | None = None
+) -> np.ndarray:
     """Heading error (deg) of a calibrated body-frame field, levelled with the reference attitude: the
     field's declination in NED minus ``north_deg`` (default: its circular mean), with the sign of a heading
     error (a field seen turned anticlockwise reads as a heading too high)."""
-    f = np.einsum("nji,nj->ni", body_from_nav(frame), body_field)      # C_b^n m = (C_n^b)^T m
+    f = np.einsum("nji,nj->ni", body_from_nav(frame), body_field)  # C_b^n m = (C_n^b)^T m
     dec = np.degrees(np.arctan2(f[:, 1], f[:, 0]))
     if north_deg is None:
         north_deg = float(np.degrees(np.angle(np.mean(np.exp(1j * np.radians(dec))))))
@@ -525,19 +657,29 @@ def ellipsoid_fit(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
 
 
 MEASURED["magnetometer"] = (MAG, False)
-SYSTEM = register_system(System(
-    "magnetometer", "uT", MAGNETOMETER_EFFECTS, load_magnetometer, _fit_magnetometer, magnetometer_structure,
-    "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT",
-    columns=MAGNETOMETER_COLUMNS))
+SYSTEM = register_system(
+    System(
+        "magnetometer",
+        "uT",
+        MAGNETOMETER_EFFECTS,
+        load_magnetometer,
+        _fit_magnetometer,
+        magnetometer_structure,
+        "3-D magnetometer with reference attitude; residual = measured - model field, 3 values per row, uT",
+        columns=MAGNETOMETER_COLUMNS,
+    )
+)
 
 
-def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, seed=0) -> pd.DataFrame:
+def simulate_magnetometer(
+    params: dict, *, n: int = 400, noise_ut: float = 0.1, seed=0
+) -> pd.DataFrame:
     """3-D samples from the model (eq. in the module docstring) at ``n`` random attitudes (uniform over
     rotations), a body rate of up to 60 deg/s per axis, 0.1 s apart; ``params`` as in the catalogue plus
     the local field ``field_*_ut`` (default: BROAD's room, (15.2, -0.3, 40.8) uT); white noise ``noise_ut``."""
     rng = np.random.default_rng(seed)
     p = {"field_n_ut": 15.2, "field_e_ut": -0.3, "field_d_ut": 40.8, **params}
-    rot = Rotation.random(n, random_state=rng)               # body -> NED
+    rot = Rotation.random(n, random_state=rng)  # body -> NED
     q = rot.as_quat()[:, [3, 0, 1, 2]]
     frame = pd.DataFrame(q, columns=list(QUAT))
     frame[list(GYR)] = rng.uniform(-60, 60, (n, 3))
@@ -547,9 +689,17 @@ def simulate_magnetometer(params: dict, *, n: int = 400, noise_ut: float = 0.1, 
     return frame
 
 
-def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: float = 10.0,
-                         noise_ut: float = 0.1, noise_correlation: float = 0.0, turn_rate_dps: float = 45.0,
-                         turn_time_s: float = 1.0, seed=0) -> pd.DataFrame:
+def simulate_hand_turned(
+    params: dict,
+    *,
+    duration_s: float = 60.0,
+    rate_hz: float = 10.0,
+    noise_ut: float = 0.1,
+    noise_correlation: float = 0.0,
+    turn_rate_dps: float = 45.0,
+    turn_time_s: float = 1.0,
+    seed=0,
+) -> pd.DataFrame:
     """A magnetometer turned by hand and sampled at ``rate_hz``: the body rate of each axis is an
     Ornstein-Uhlenbeck process (standard deviation ``turn_rate_dps``, correlation time ``turn_time_s``),
     integrated from a random attitude into the reference quaternion (so the attitude, and every effect's
@@ -558,8 +708,12 @@ def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: flo
     noise of marginal standard deviation ``noise_ut`` and lag-1 correlation ``noise_correlation``
     (:func:`navlib.workbench.serial.ar1_noise`, the same process on each axis, independent between axes).  Columns as a BROAD
     3-D file: ``time_s``, quaternion, gyro, field."""
-    for name, value, lo in (("duration_s", duration_s, 0.0), ("rate_hz", rate_hz, 0.0),
-                            ("turn_rate_dps", turn_rate_dps, 0.0), ("turn_time_s", turn_time_s, 0.0)):
+    for name, value, lo in (
+        ("duration_s", duration_s, 0.0),
+        ("rate_hz", rate_hz, 0.0),
+        ("turn_rate_dps", turn_rate_dps, 0.0),
+        ("turn_time_s", turn_time_s, 0.0),
+    ):
         if not (np.isfinite(value) and value > lo):
             raise InputError(f"parameter {name}={value!r}: must be > {lo:g}")
     if not (np.isfinite(noise_ut) and noise_ut >= 0):
@@ -571,15 +725,19 @@ def simulate_hand_turned(params: dict, *, duration_s: float = 60.0, rate_hz: flo
     if n < 30:
         raise InputError(f"duration_s x rate_hz = {n} samples; at least 30 are needed")
     dt = 1.0 / rate_hz
-    w = ar1_noise(rng, (n, 3), turn_rate_dps, float(np.exp(-dt / turn_time_s)))   # body rate, deg/s
+    w = ar1_noise(rng, (n, 3), turn_rate_dps, float(np.exp(-dt / turn_time_s)))  # body rate, deg/s
     steps = Rotation.from_rotvec(np.radians(w[:-1]) * dt).as_quat()[:, [3, 0, 1, 2]]
     q = np.empty((n, 4))
-    q[0] = Rotation.random(random_state=rng).as_quat()[[3, 0, 1, 2]]           # body -> NED
-    for k in range(n - 1):                      # q_(k+1) = q_k (x) dq_k: the body-frame increment
+    q[0] = Rotation.random(random_state=rng).as_quat()[[3, 0, 1, 2]]  # body -> NED
+    for k in range(n - 1):  # q_(k+1) = q_k (x) dq_k: the body-frame increment
         a0, a1, a2, a3 = q[k]
         b0, b1, b2, b3 = steps[k]
-        q[k + 1] = (a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-                    a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0)
+        q[k + 1] = (
+            a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+            a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+            a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+            a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+        )
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     q = q * np.where(q[:, :1] < 0, -1.0, 1.0)
     frame = pd.DataFrame({"time_s": dt * np.arange(n)})
@@ -594,7 +752,9 @@ def effect_rms(data: pd.DataFrame, params: dict, effect: str) -> float:
     """RMS (uT, over rows and axes) of what ``effect`` adds to the noiseless model on ``data`` (the local
     field from ``params``, default :data:`BROAD_FIELD`)."""
     if effect not in MAGNETOMETER_EFFECTS:
-        raise InputError(f"unknown magnetometer effect '{effect}'; known: {', '.join(MAGNETOMETER_EFFECTS)}")
+        raise InputError(
+            f"unknown magnetometer effect '{effect}'; known: {', '.join(MAGNETOMETER_EFFECTS)}"
+        )
     p = {**BROAD_FIELD, **params}
     without = {k: v for k, v in p.items() if k not in MAGNETOMETER_EFFECTS[effect].params}
     return float(np.sqrt(np.mean((predict_field(p, data) - predict_field(without, data)) ** 2)))

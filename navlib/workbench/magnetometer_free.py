@@ -58,6 +58,7 @@ Files: ``mag_x_ut, mag_y_ut, mag_z_ut``; optional ``acc_x_ms2, acc_y_ms2, acc_z_
 ``height_m``, ``date``; :func:`site_of`), which the loop's field check and ``calibrate`` use for the IGRF
 field; other columns ignored.  :func:`load_free` refuses bad input in one line.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -77,7 +78,16 @@ from .fit import MEASURED, Fit, best_least_squares, fit_model, user_columns, use
 from . import free_breakdown
 from .free_kernel import FreeKernel
 from .local_field import field_check, field_lines
-from .magnetometer import AXES, FIELD_BAND_UT, FIELD_UNITS, GYR, MAG, MAG_LIMIT_UT, simulate_hand_turned, body_from_nav
+from .magnetometer import (
+    AXES,
+    FIELD_BAND_UT,
+    FIELD_UNITS,
+    GYR,
+    MAG,
+    MAG_LIMIT_UT,
+    simulate_hand_turned,
+    body_from_nav,
+)
 from .serial import ar1_noise
 from .trials import SYSTEM_KEYS, _seed_label, run_trials, trial_seed
 
@@ -94,25 +104,42 @@ MIN_SPREAD = 0.02
 
 FREE_EFFECTS = {
     "hard_iron": Effect(
-        "hard_iron", ("hard_x_ut", "hard_y_ut", "hard_z_ut"), ("uT", "uT", "uT"),
+        "hard_iron",
+        ("hard_x_ut", "hard_y_ut", "hard_z_ut"),
+        ("uT", "uT", "uT"),
         "A field fixed to the body (magnet, magnetised steel, sensor offsets): the raw field traces a sphere "
-        "whose centre is off the origin. Missing, the magnitude varies as one cycle over the sphere."),
+        "whose centre is off the origin. Missing, the magnitude varies as one cycle over the sphere.",
+    ),
     "scale": Effect(
-        "scale", ("scale_x", "scale_y"), ("-", "-"),
+        "scale",
+        ("scale_x", "scale_y"),
+        ("-", "-"),
         "Per-axis scale mismatch (z = -x - y; the mean scale is in the field strength): an ellipsoid with "
-        "its axes along the sensor's. Missing, the magnitude varies as two cycles, aligned with the axes."),
+        "its axes along the sensor's. Missing, the magnitude varies as two cycles, aligned with the axes.",
+    ),
     "soft_iron": Effect(
-        "soft_iron", ("soft_xy", "soft_xz", "soft_yz"), ("-", "-", "-"),
+        "soft_iron",
+        ("soft_xy", "soft_xz", "soft_yz"),
+        ("-", "-", "-"),
         "Cross-axis soft iron (induced magnetisation): the ellipsoid's axes are turned against the sensor's. "
-        "Missing, the magnitude varies as two cycles along the diagonals."),
+        "Missing, the magnitude varies as two cycles along the diagonals.",
+    ),
     "misalignment": Effect(
-        "misalignment", ("mis_x_deg", "mis_y_deg", "mis_z_deg"), ("deg", "deg", "deg"),
+        "misalignment",
+        ("mis_x_deg", "mis_y_deg", "mis_z_deg"),
+        ("deg", "deg", "deg"),
         "The magnetometer's axes are turned against the accelerometer's. Missing, the angle between field and "
-        "gravity (the dip) seems to change with orientation while the magnitude stays constant.", ACC),
+        "gravity (the dip) seems to change with orientation while the magnitude stays constant.",
+        ACC,
+    ),
     "temperature": Effect(
-        "temperature", ("temp_x_ut_c", "temp_y_ut_c", "temp_z_ut_c"), ("uT/degC",) * 3,
+        "temperature",
+        ("temp_x_ut_c", "temp_y_ut_c", "temp_z_ut_c"),
+        ("uT/degC",) * 3,
         "The offset (hard iron, sensor bias) drifts with temperature. Missing, the ellipsoid's centre moves "
-        "as the sensor warms.", ("temperature_c",)),
+        "as the sensor warms.",
+        ("temperature_c",),
+    ),
 }
 _PARAMS = [p for e in FREE_EFFECTS.values() for p in e.params]
 #: The simulators' local field: BROAD's room (:data:`navlib.workbench.magnetometer.BROAD_FIELD`), intensity
@@ -135,19 +162,52 @@ DATE_TOL_DAYS = 366
 # The file schema of the ``magnetometer_free`` system (what :func:`load_free` reads; the data dictionary
 # of :func:`navlib.data.tables.schema_table`).
 FREE_COLUMNS = tuple(
-    [Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]}") for c in MAG]
-    + [Column(c, "m/s^2", required=False, lo=-1e4, hi=1e4,
-              meaning=f"specific force, {AXES[c[4]]} (all three or none; misalignment needs them)")
-       for c in ACC]
-    + [Column("time_s", "s", required=False, lo=-1e10, hi=1e10, meaning="time of the sample"),
-       Column("temperature_c", "degC", required=False, lo=-80.0, hi=200.0,
-              meaning="sensor temperature (the temperature effect needs it)")]
-    + [Column(c, "deg/s", required=False, checked=False, meaning="angular rate (information only)")
-       for c in GYR]
-    + [Column("lat_deg", "deg", required=False, lo=-90.0, hi=90.0, meaning="site latitude (WGS84)"),
-       Column("lon_deg", "deg", required=False, lo=-180.0, hi=360.0, meaning="site longitude"),
-       Column("height_m", "m", required=False, lo=-1e4, hi=1e6, meaning="site height above the ellipsoid"),
-       Column("date", required=False, text=True, meaning="date of the recording (ISO 8601)")])
+    [
+        Column(c, "uT", lo=-MAG_LIMIT_UT, hi=MAG_LIMIT_UT, meaning=f"magnetometer, {AXES[c[4]]}")
+        for c in MAG
+    ]
+    + [
+        Column(
+            c,
+            "m/s^2",
+            required=False,
+            lo=-1e4,
+            hi=1e4,
+            meaning=f"specific force, {AXES[c[4]]} (all three or none; misalignment needs them)",
+        )
+        for c in ACC
+    ]
+    + [
+        Column("time_s", "s", required=False, lo=-1e10, hi=1e10, meaning="time of the sample"),
+        Column(
+            "temperature_c",
+            "degC",
+            required=False,
+            lo=-80.0,
+            hi=200.0,
+            meaning="sensor temperature (the temperature effect needs it)",
+        ),
+    ]
+    + [
+        Column(c, "deg/s", required=False, checked=False, meaning="angular rate (information only)")
+        for c in GYR
+    ]
+    + [
+        Column(
+            "lat_deg", "deg", required=False, lo=-90.0, hi=90.0, meaning="site latitude (WGS84)"
+        ),
+        Column("lon_deg", "deg", required=False, lo=-180.0, hi=360.0, meaning="site longitude"),
+        Column(
+            "height_m",
+            "m",
+            required=False,
+            lo=-1e4,
+            hi=1e6,
+            meaning="site height above the ellipsoid",
+        ),
+        Column("date", required=False, text=True, meaning="date of the recording (ISO 8601)"),
+    ]
+)
 
 
 def free_columns() -> list[Column]:
@@ -155,7 +215,9 @@ def free_columns() -> list[Column]:
     return list(FREE_COLUMNS)
 
 
-def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str, circle: bool = False) -> float:
+def _one_value(
+    frame: pd.DataFrame, col: str, tol: float, unit: str, name: str, circle: bool = False
+) -> float:
     """The column's one value (its median), refused when it spreads by more than ``tol``.  ``circle``: a
     longitude, compared on the circle (179.99 and -179.99 deg are 0.02 deg apart, and so are 359.99 and
     0.01): the spread and the median of the differences from the first value, wrapped into [-180, 180)."""
@@ -169,8 +231,10 @@ def _one_value(frame: pd.DataFrame, col: str, tol: float, unit: str, name: str, 
         spread = float(np.ptp(v)) if len(v) else 0.0
         value = float(np.median(v)) if len(v) else float("nan")
     if spread > tol:
-        raise InputError(f"{name}: column '{col}' varies by {spread:.4g} {unit} within the file (more than "
-                         f"{tol:g} {unit}): one site per file")
+        raise InputError(
+            f"{name}: column '{col}' varies by {spread:.4g} {unit} within the file (more than "
+            f"{tol:g} {unit}): one site per file"
+        )
     return value
 
 
@@ -179,18 +243,24 @@ def _date_of(frame: pd.DataFrame, name: str) -> str:
     when = pd.to_datetime(text, utc=True, format="ISO8601", errors="coerce")
     bad = np.flatnonzero(when.isna().to_numpy() | ~text.str.match(r"\d{4}-\d{2}-\d{2}").to_numpy())
     if bad.size:
-        raise InputError(f"{name}: column 'date', row {bad[0] + 1}: {str(frame['date'].iloc[bad[0]])[:40]!r} is not an "
-                         f"ISO 8601 date (YYYY-MM-DD or YYYY-MM-DDTHH:MM:SSZ)")
+        raise InputError(
+            f"{name}: column 'date', row {bad[0] + 1}: {str(frame['date'].iloc[bad[0]])[:40]!r} is not an "
+            f"ISO 8601 date (YYYY-MM-DD or YYYY-MM-DDTHH:MM:SSZ)"
+        )
     for row in (int(np.argmin(when.to_numpy())), int(np.argmax(when.to_numpy()))):
         try:
-            Site(0.0, 0.0, 0.0, when.iloc[row].date().isoformat())          # the years IGRF-14 covers
+            Site(0.0, 0.0, 0.0, when.iloc[row].date().isoformat())  # the years IGRF-14 covers
         except InputError as err:
-            raise InputError(f"{name}: column 'date', row {row + 1}: {str(frame['date'].iloc[row])[:40]!r} is "
-                             f"outside the model's years ({str(err).split(': ', 1)[-1]})") from None
+            raise InputError(
+                f"{name}: column 'date', row {row + 1}: {str(frame['date'].iloc[row])[:40]!r} is "
+                f"outside the model's years ({str(err).split(': ', 1)[-1]})"
+            ) from None
     days = (when.max() - when.min()).total_seconds() / 86400.0
     if days > DATE_TOL_DAYS:
-        raise InputError(f"{name}: column 'date' spans {days:.0f} days (more than {DATE_TOL_DAYS}): one recording per "
-                         f"file")
+        raise InputError(
+            f"{name}: column 'date' spans {days:.0f} days (more than {DATE_TOL_DAYS}): one recording per "
+            f"file"
+        )
     return (when.min() + (when.max() - when.min()) / 2).date().isoformat()
 
 
@@ -211,26 +281,36 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
     if site is None:
         have = [c for c in ("lat_deg", "lon_deg") if c in frame]
         if len(have) == 1:
-            raise InputError(f"{name}: column '{have[0]}' without "
-                             f"'{({'lat_deg', 'lon_deg'} - set(have)).pop()}': give both, or --site")
+            raise InputError(
+                f"{name}: column '{have[0]}' without "
+                f"'{({'lat_deg', 'lon_deg'} - set(have)).pop()}': give both, or --site"
+            )
         if have:
-            site = (_one_value(frame, "lat_deg", SITE_TOL_DEG, "deg", name),
-                    _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name, circle=True))
+            site = (
+                _one_value(frame, "lat_deg", SITE_TOL_DEG, "deg", name),
+                _one_value(frame, "lon_deg", SITE_TOL_DEG, "deg", name, circle=True),
+            )
             if "height_m" in frame:
                 site += (_one_value(frame, "height_m", HEIGHT_TOL_M, "m", name),)
     if date is None and "date" in frame:
         date = _date_of(frame, name)
     if site is None:
         if date_given:
-            raise InputError("parameter --date: a date without a site: give --site LAT,LON[,HEIGHT_M] or the "
-                             "columns lat_deg, lon_deg")
+            raise InputError(
+                "parameter --date: a date without a site: give --site LAT,LON[,HEIGHT_M] or the "
+                "columns lat_deg, lon_deg"
+            )
         if date is not None:
-            raise InputError(f"{name}: column 'date' without a site (no columns lat_deg, lon_deg, no --site): the "
-                             f"field check needs where as well as when; add the columns or give --site "
-                             f"LAT,LON[,HEIGHT_M]")
+            raise InputError(
+                f"{name}: column 'date' without a site (no columns lat_deg, lon_deg, no --site): the "
+                f"field check needs where as well as when; add the columns or give --site "
+                f"LAT,LON[,HEIGHT_M]"
+            )
         return None
     site = tuple(float(v) for v in site)
-    return Site(site[0], site[1], site[2] if len(site) > 2 else 0.0, *((date,) if date is not None else ()))
+    return Site(
+        site[0], site[1], site[2] if len(site) > 2 else 0.0, *((date,) if date is not None else ())
+    )
 
 
 def has_acc(frame: pd.DataFrame) -> bool:
@@ -256,10 +336,12 @@ def accelerometer_motion(frame: pd.DataFrame) -> str | None:
     if p95 <= ACC_STILL_TOL_MS2:
         return None
     share = float(np.mean(dev > ACC_STILL_TOL_MS2))
-    return (f"columns {', '.join(ACC)}: |a| departs from gravity by more than {ACC_STILL_TOL_MS2:g} m/s^2 on "
-            f"{100 * share:.0f} % of the rows (95th percentile {p95:.2g} m/s^2): the sensor was accelerated, "
-            f"so the dip constraint, which takes a/|a| for the vertical, is biased; calibrate without the "
-            f"acceleration columns, or on the still or slowly turned part of the recording")
+    return (
+        f"columns {', '.join(ACC)}: |a| departs from gravity by more than {ACC_STILL_TOL_MS2:g} m/s^2 on "
+        f"{100 * share:.0f} % of the rows (95th percentile {p95:.2g} m/s^2): the sensor was accelerated, "
+        f"so the dip constraint, which takes a/|a| for the vertical, is biased; calibrate without the "
+        f"acceleration columns, or on the still or slowly turned part of the recording"
+    )
 
 
 def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
@@ -270,7 +352,7 @@ def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
     out["field_norm_ut"] = np.linalg.norm(m, axis=1)
     if has_acc(out):
         a = out[list(ACC)].to_numpy(float)
-        out["field_gravity_ut"] = field_gravity_dot(m, a) / np.linalg.norm(a, axis=1)     # a/|a| . m
+        out["field_gravity_ut"] = field_gravity_dot(m, a) / np.linalg.norm(a, axis=1)  # a/|a| . m
     return out
 
 
@@ -297,14 +379,20 @@ def check_orientations(frame: pd.DataFrame, name: str, needed: int = MIN_ORIENTA
     cells, spread = orientation_cells(frame), orientation_spread(frame)
     failed = []
     if cells < needed:
-        failed.append(f"only {cells} distinct orientations (30-deg cells of the field's direction; the model "
-                      f"needs at least {needed})")
+        failed.append(
+            f"only {cells} distinct orientations (30-deg cells of the field's direction; the model "
+            f"needs at least {needed})"
+        )
     if spread < MIN_SPREAD:
-        failed.append(f"a smallest spread of the field's directions of {spread:.3f} (the model needs at least "
-                      f"{MIN_SPREAD:g}: the directions lie near a plane or a line)")
+        failed.append(
+            f"a smallest spread of the field's directions of {spread:.3f} (the model needs at least "
+            f"{MIN_SPREAD:g}: the directions lie near a plane or a line)"
+        )
     if failed:
-        raise InputError(f"{name}: columns mag_x_ut..mag_z_ut: {' and '.join(failed)}; turn the sensor through "
-                         f"all directions, not about one axis")
+        raise InputError(
+            f"{name}: columns mag_x_ut..mag_z_ut: {' and '.join(failed)}; turn the sensor through "
+            f"all directions, not about one axis"
+        )
 
 
 def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
@@ -320,7 +408,7 @@ def load_free(path, *, min_rows: int = 30) -> pd.DataFrame:
     require_variation(frame, MAG, name, "a magnetometer turned through many orientations")
     check_units(frame, name)
     check_orientations(frame, name)
-    if "lat_deg" in frame or "lon_deg" in frame:        # the site columns, checked at load
+    if "lat_deg" in frame or "lon_deg" in frame:  # the site columns, checked at load
         site_of(frame, name=name)
     elif "date" in frame:
         _date_of(frame, name)
@@ -333,20 +421,30 @@ def check_units(frame: pd.DataFrame, name: str = "data") -> None:
     lo, hi = FIELD_BAND_UT
     if not lo <= med <= hi:
         units = [(u, f) for u, f in FIELD_UNITS if lo <= med * f <= hi]
-        look = (f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)" if units
-                else "this is not a field in uT")
-        raise InputError(f"{name}: columns mag_x_ut, mag_y_ut, mag_z_ut: median |m| is {med:.4g}, where the Earth's "
-                         f"field is 22-67 uT and {lo:g}-{hi:g} uT is accepted: {look}")
+        look = (
+            f"these look like {units[0][0]} (multiply by {units[0][1]:g} for uT)"
+            if units
+            else "this is not a field in uT"
+        )
+        raise InputError(
+            f"{name}: columns mag_x_ut, mag_y_ut, mag_z_ut: median |m| is {med:.4g}, where the Earth's "
+            f"field is 22-67 uT and {lo:g}-{hi:g} uT is accepted: {look}"
+        )
     if any(c in frame for c in ACC) and not has_acc(frame):
         raise InputError(f"{name}: give all three of {', '.join(ACC)} or none")
     if has_acc(frame):
         g = float(np.median(np.linalg.norm(frame[list(ACC)].to_numpy(float), axis=1)))
         glo, ghi = GRAVITY_BAND
         if not glo <= g <= ghi:
-            look = ("these look like g (multiply by 9.80665 for m/s^2)" if glo <= g * G0 <= ghi else
-                    "this is not a still or slowly turned accelerometer in m/s^2")
-            raise InputError(f"{name}: columns {', '.join(ACC)}: median |a| is {g:.4g}, where gravity is 9.81 m/s^2 "
-                             f"and {glo:g}-{ghi:g} is accepted: {look}")
+            look = (
+                "these look like g (multiply by 9.80665 for m/s^2)"
+                if glo <= g * G0 <= ghi
+                else "this is not a still or slowly turned accelerometer in m/s^2"
+            )
+            raise InputError(
+                f"{name}: columns {', '.join(ACC)}: median |a| is {g:.4g}, where gravity is 9.81 m/s^2 "
+                f"and {glo:g}-{ghi:g} is accepted: {look}"
+            )
 
 
 # ------------------------------------------------------------------------------------------- the model
@@ -360,9 +458,13 @@ def correction_matrix(params: dict) -> np.ndarray:
     """``M = I + K`` (symmetric; K trace-free) from the scale and soft-iron parameters (absent = 0)."""
     p = full_params(params)
     sx, sy = p["scale_x"], p["scale_y"]
-    return np.eye(3) + np.array([[sx, p["soft_xy"], p["soft_xz"]],
-                                 [p["soft_xy"], sy, p["soft_yz"]],
-                                 [p["soft_xz"], p["soft_yz"], -sx - sy]])
+    return np.eye(3) + np.array(
+        [
+            [sx, p["soft_xy"], p["soft_xz"]],
+            [p["soft_xy"], sy, p["soft_yz"]],
+            [p["soft_xz"], p["soft_yz"], -sx - sy],
+        ]
+    )
 
 
 def offset(params: dict, frame: pd.DataFrame, t_c: float) -> np.ndarray:
@@ -377,7 +479,9 @@ def offset(params: dict, frame: pd.DataFrame, t_c: float) -> np.ndarray:
 
 def corrected(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
     """The corrected field ``u = M (m - b - k (T - T_c))``, (n, 3) uT, in the magnetometer's axes."""
-    return (frame[list(MAG)].to_numpy(float) - offset(params, frame, t_c)) @ correction_matrix(params).T
+    return (frame[list(MAG)].to_numpy(float) - offset(params, frame, t_c)) @ correction_matrix(
+        params
+    ).T
 
 
 def invariant_residuals(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
@@ -395,17 +499,23 @@ def kernel_of(frame: pd.DataFrame, names, t_c: float = 0.0) -> FreeKernel:
 
 
 def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
-    if not all(c in data for c in DERIVED[:1 + has_acc(data)]):
+    if not all(c in data for c in DERIVED[: 1 + has_acc(data)]):
         data = with_invariants(data)
     cat = tuple(e.name for e in effects if e.contribution is None)
     users = tuple(e for e in effects if e.contribution is not None)
     acc = has_acc(data)
     base = ["field_ut"] + (["field_down_ut"] if acc else [])
-    names = base + [p for e in cat for p in FREE_EFFECTS[e].params] + [p for e in users for p in e.params]
+    names = (
+        base
+        + [p for e in cat for p in FREE_EFFECTS[e].params]
+        + [p for e in users for p in e.params]
+    )
     clash = sorted({n for n in names if names.count(n) > 1})
     if clash:
-        raise InputError(f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
-                         f"not be named like the field strength {', '.join(base)})")
+        raise InputError(
+            f"parameter '{clash[0]}' is named twice in the model (a user effect's parameter must "
+            f"not be named like the field strength {', '.join(base)})"
+        )
     k = 2 if acc else 1
     if len(data) * k < len(names) + 1:
         raise InputError(f"{len(data)} rows cannot determine {len(names)} model parameters")
@@ -439,18 +549,33 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
     x2v = np.array([x2[n] for n in names])
     x1v = np.array([(start or {}).get(n, x2[n]) for n in names])
     inf = np.full(len(names), np.inf)
-    sol = best_least_squares(resid, [x1v, x2v], -inf, inf, jac="2-point" if users else kern.jacobian,
-                             tr_solver=None if users else "exact")
+    sol = best_least_squares(
+        resid,
+        [x1v, x2v],
+        -inf,
+        inf,
+        jac="2-point" if users else kern.jacobian,
+        tr_solver=None if users else "exact",
+    )
     params = dict(zip(names, map(float, sol.x)))
 
     def predict(frame):
-        r = invariant_residuals(params, frame, t_c) - user_columns(users, params, frame,
-                                                                   (len(frame), k)).reshape(len(frame), k)
+        r = invariant_residuals(params, frame, t_c) - user_columns(
+            users, params, frame, (len(frame), k)
+        ).reshape(len(frame), k)
         return frame[list(DERIVED[:k])].to_numpy(float) - r
 
     # residual = measured - model = -(model - measured): the invariants' residual with the sign of a misfit
-    return Fit(SYSTEM, tuple(e.name for e in effects), params, data, (obs - predict(data)).ravel(),
-               -np.asarray(sol.jac), predict, {"temperature_centre_c": t_c})
+    return Fit(
+        SYSTEM,
+        tuple(e.name for e in effects),
+        params,
+        data,
+        (obs - predict(data)).ravel(),
+        -np.asarray(sol.jac),
+        predict,
+        {"temperature_centre_c": t_c},
+    )
 
 
 def _per_column(x: np.ndarray, k: int, cols=None) -> np.ndarray:
@@ -458,15 +583,24 @@ def _per_column(x: np.ndarray, k: int, cols=None) -> np.ndarray:
     cols = range(k) if cols is None else cols
     out = np.zeros((k * n, len(cols) * x.shape[1]))
     for i, j in enumerate(cols):
-        out[j::k, i * x.shape[1]:(i + 1) * x.shape[1]] = x
+        out[j::k, i * x.shape[1] : (i + 1) * x.shape[1]] = x
     return out
 
 
 def _cubic_harmonics(u: np.ndarray) -> np.ndarray:
     """The seven real third-degree harmonics of unit vectors ``u`` (unnormalised)."""
     x, y, z = u.T
-    return np.column_stack([x * (x * x - 3 * y * y), y * (3 * x * x - y * y), z * (x * x - y * y), x * y * z,
-                            x * (5 * z * z - 1), y * (5 * z * z - 1), z * (5 * z * z - 3)])
+    return np.column_stack(
+        [
+            x * (x * x - 3 * y * y),
+            y * (3 * x * x - y * y),
+            z * (x * x - y * y),
+            x * y * z,
+            x * (5 * z * z - 1),
+            y * (5 * z * z - 1),
+            z * (5 * z * z - 3),
+        ]
+    )
 
 
 def free_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
@@ -479,13 +613,20 @@ def free_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
         t = d["time_s"].to_numpy(float)
         edges = np.quantile(t, np.linspace(0, 1, 11)[1:-1])
         cell = np.searchsorted(edges, t, side="right")
-        X = np.column_stack([(cell == i).astype(float) - np.mean(cell == i) for i in np.unique(cell)[1:]])
+        X = np.column_stack(
+            [(cell == i).astype(float) - np.mean(cell == i) for i in np.unique(cell)[1:]]
+        )
         out.append(("field changing in time (per invariant)", _per_column(X, k), 2.0))
     m = d[list(MAG)].to_numpy(float)
     u = m / np.linalg.norm(m, axis=1, keepdims=True)
     H = _cubic_harmonics(u)
-    out.append(("magnitude depending on direction beyond an ellipsoid (3rd-degree harmonics)",
-                _per_column(H - H.mean(axis=0), k, [0]), np.sqrt(2.0)))
+    out.append(
+        (
+            "magnitude depending on direction beyond an ellipsoid (3rd-degree harmonics)",
+            _per_column(H - H.mean(axis=0), k, [0]),
+            np.sqrt(2.0),
+        )
+    )
     return out
 
 
@@ -503,8 +644,12 @@ def noise_directions(fit: Fit) -> np.ndarray:
     cols = [uh @ M]
     if has_acc(d):
         a = d[list(ACC)].to_numpy(float)
-        R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
-        c = float(np.clip(p.get("field_down_ut", 0.0) / max(p.get("field_ut", 0.0), 1e-9), -0.99, 0.99))
+        R = Rotation.from_rotvec(
+            np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])
+        ).as_matrix()
+        c = float(
+            np.clip(p.get("field_down_ut", 0.0) / max(p.get("field_ut", 0.0), 1e-9), -0.99, 0.99)
+        )
         ga = (a / np.linalg.norm(a, axis=1, keepdims=True)) @ R @ M
         cols.append((ga - c * cols[0]) / np.sqrt(1.0 - c * c))
     return np.stack(cols, axis=1).reshape(-1, 3)
@@ -514,8 +659,11 @@ def loop_field_check(result, site=None, date: str | None = None) -> tuple[dict, 
     """The system's ``final_check`` hook: the local field the loop's final model estimates, beside the
     IGRF-14 field at the recording's site (:func:`site_of`: ``site``/``date`` or the data's columns;
     :func:`navlib.workbench.local_field.field_check`), as a dict and report lines."""
-    check = field_check(result.final, site_of(result.final.data, site, date),
-                        result.screening.noise if result.screening is not None else None)
+    check = field_check(
+        result.final,
+        site_of(result.final.data, site, date),
+        result.screening.noise if result.screening is not None else None,
+    )
     return check, field_lines(check)
 
 
@@ -527,18 +675,35 @@ def remaining_structure(fit: Fit) -> tuple[pd.DataFrame, str]:
     u = corrected(full_params(fit.params), d, fit.model.get("temperature_centre_c", 0.0))
     gyr = d[list(GYR)].to_numpy(float) if all(c in d for c in GYR) else None
     rate = np.linalg.norm(gyr, axis=1) if gyr is not None and np.all(np.isfinite(gyr)) else None
-    cells = free_breakdown.factors(d["time_s"].to_numpy(float) if "time_s" in d else None, rate, u,
-                                   d[list(ACC)].to_numpy(float) if has_acc(d) else None)
-    table = free_breakdown.breakdown(fit.residuals.reshape(len(d), k), ["magnitude", "dip"][:k], cells)
+    cells = free_breakdown.factors(
+        d["time_s"].to_numpy(float) if "time_s" in d else None,
+        rate,
+        u,
+        d[list(ACC)].to_numpy(float) if has_acc(d) else None,
+    )
+    table = free_breakdown.breakdown(
+        fit.residuals.reshape(len(d), k), ["magnitude", "dip"][:k], cells
+    )
     return table, free_breakdown.reading(table)
 
 
 MEASURED["magnetometer_free"] = (DERIVED, False)
-SYSTEM = register_system(System(
-    "magnetometer_free", "uT", FREE_EFFECTS, load_free, _fit_free, free_structure,
-    "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
-    "and (with an accelerometer) its component along gravity - D, uT", noise_directions=noise_directions,
-    final_check=loop_field_check, columns=FREE_COLUMNS, remaining=remaining_structure))
+SYSTEM = register_system(
+    System(
+        "magnetometer_free",
+        "uT",
+        FREE_EFFECTS,
+        load_free,
+        _fit_free,
+        free_structure,
+        "3-D magnetometer without reference attitude; residual = the invariants' misfit: |corrected field| - F "
+        "and (with an accelerometer) its component along gravity - D, uT",
+        noise_directions=noise_directions,
+        final_check=loop_field_check,
+        columns=FREE_COLUMNS,
+        remaining=remaining_structure,
+    )
+)
 
 
 def field_summary(fit: Fit) -> dict:
@@ -547,14 +712,26 @@ def field_summary(fit: Fit) -> dict:
     F = fit.params["field_ut"]
     out = {"intensity (uT)": F}
     if "field_down_ut" in fit.params:
-        out["dip (deg)"] = float(np.degrees(np.arcsin(np.clip(-fit.params["field_down_ut"] / F, -1, 1))))
+        out["dip (deg)"] = float(
+            np.degrees(np.arcsin(np.clip(-fit.params["field_down_ut"] / F, -1, 1)))
+        )
     return out
 
 
 # ------------------------------------------------------------------------------------------- simulation
-def simulate_free(params: dict, *, duration_s: float = 40.0, rate_hz: float = 10.0, noise_ut: float = 0.3,
-                  noise_correlation: float = 0.0, field_ut: float = SIM_FIELD_UT, dip_deg: float = SIM_DIP_DEG,
-                  acc_noise_ms2: float = 0.0, temperatures_c: tuple = (20.0, 35.0), seed=0) -> pd.DataFrame:
+def simulate_free(
+    params: dict,
+    *,
+    duration_s: float = 40.0,
+    rate_hz: float = 10.0,
+    noise_ut: float = 0.3,
+    noise_correlation: float = 0.0,
+    field_ut: float = SIM_FIELD_UT,
+    dip_deg: float = SIM_DIP_DEG,
+    acc_noise_ms2: float = 0.0,
+    temperatures_c: tuple = (20.0, 35.0),
+    seed=0,
+) -> pd.DataFrame:
     """A magnetometer (and accelerometer) turned by hand without reference: the attitude of
     :func:`navlib.workbench.magnetometer.simulate_hand_turned`; the true field of intensity ``field_ut`` and
     dip ``dip_deg``; the sensor's raw field ``m = M^-1 R^T v + b + k (T - T_c)`` plus AR(1) noise (marginal
@@ -573,7 +750,9 @@ def simulate_free(params: dict, *, duration_s: float = 40.0, rate_hz: float = 10
     v = C @ (field_ut * np.array([np.cos(dip), 0.0, np.sin(dip)]))
     f = C @ np.array([0.0, 0.0, -G0])
     p = full_params(params)
-    R = Rotation.from_rotvec(np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])).as_matrix()
+    R = Rotation.from_rotvec(
+        np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])
+    ).as_matrix()
     t0, t1 = temperatures_c
     temp = np.linspace(t0, t1, n)
     frame["temperature_c"] = temp
@@ -585,24 +764,45 @@ def simulate_free(params: dict, *, duration_s: float = 40.0, rate_hz: float = 10
 
 
 #: Half-widths of the uniform draws of each effect's parameters in the trials.
-PARAM_HALF = {"hard_iron": 10.0, "scale": 0.03, "soft_iron": 0.03, "misalignment": 2.0, "temperature": 0.1}
+PARAM_HALF = {
+    "hard_iron": 10.0,
+    "scale": 0.03,
+    "soft_iron": 0.03,
+    "misalignment": 2.0,
+    "temperature": 0.1,
+}
 
 
-def effect_rms(data: pd.DataFrame, params: dict, effect: str, field_ut: float = SIM_FIELD_UT,
-               dip_deg: float = SIM_DIP_DEG) -> float:
+def effect_rms(
+    data: pd.DataFrame,
+    params: dict,
+    effect: str,
+    field_ut: float = SIM_FIELD_UT,
+    dip_deg: float = SIM_DIP_DEG,
+) -> float:
     """RMS (uT) of what ``effect`` does to the invariants' residual on the noiseless ``data``: the true
     parameters fitted with ``effect`` left out (its parameters at zero, field strength kept)."""
-    p = {**params, "field_ut": field_ut,
-         "field_down_ut": -field_ut * np.sin(np.radians(dip_deg))}
+    p = {**params, "field_ut": field_ut, "field_down_ut": -field_ut * np.sin(np.radians(dip_deg))}
     t_c = float(data["temperature_c"].mean())
     without = {k: v for k, v in p.items() if k not in FREE_EFFECTS[effect].params}
-    return float(np.sqrt(np.mean((invariant_residuals(without, data, t_c)
-                                  - invariant_residuals(p, data, t_c)) ** 2)))
+    return float(
+        np.sqrt(
+            np.mean(
+                (invariant_residuals(without, data, t_c) - invariant_residuals(p, data, t_c)) ** 2
+            )
+        )
+    )
 
 
 # ------------------------------------------------------------------------------------------------ trials
-def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed, correlation: float = 0.0,
-                        duration_s: float = 40.0) -> dict:
+def hidden_effect_trial(
+    hidden: str | None,
+    ratio: float,
+    noise_ut: float,
+    seed,
+    correlation: float = 0.0,
+    duration_s: float = 40.0,
+) -> dict:
     """One trial (as :func:`navlib.workbench.trials.hidden_effect_trial`): with ``hidden`` set the data
     hold every effect (uniform draws within :data:`PARAM_HALF`), ``hidden`` rescaled so that its
     :func:`effect_rms` is ``ratio`` x ``noise_ut``, and the model is the catalogue without it; with ``None``
@@ -624,8 +824,12 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
         present = cat
     base = {}
     for e in present:
-        base.update(zip(FREE_EFFECTS[e].params, rng.uniform(-PARAM_HALF[e], PARAM_HALF[e],
-                                                             len(FREE_EFFECTS[e].params))))
+        base.update(
+            zip(
+                FREE_EFFECTS[e].params,
+                rng.uniform(-PARAM_HALF[e], PARAM_HALF[e], len(FREE_EFFECTS[e].params)),
+            )
+        )
     model = tuple(e for e in cat if e != hidden) if hidden is not None else present
     # the recording: the first hand-turned motion (stream child 1, then 1/1, 1/2, ...) whose data turn the
     # sensor through enough directions for the whole catalogue (:func:`check_orientations`; a file that
@@ -635,8 +839,14 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
         stream = child(seed, 1) if redraw == 0 else child(seed, 1, redraw)
 
         def draw(p, noise):
-            return simulate_free(p, duration_s=duration_s, noise_ut=noise, noise_correlation=correlation,
-                                 seed=np.random.default_rng(stream))
+            return simulate_free(
+                p,
+                duration_s=duration_s,
+                noise_ut=noise,
+                noise_correlation=correlation,
+                seed=np.random.default_rng(stream),
+            )
+
         params = dict(base)
         if hidden is not None:
             probe = draw(params, 0.0)
@@ -651,15 +861,29 @@ def hidden_effect_trial(hidden: str | None, ratio: float, noise_ut: float, seed,
         except InputError:
             continue
     d = diagnose(fit_model(SYSTEM, data, model))
-    return {"hidden": hidden or "(none)", "ratio": ratio if hidden else 0.0, "noise": noise_ut,
-            "correlation": correlation, "seed": _seed_label(seed), "redraws": redraw, "named": d.missing or "(none)",
-            "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
-            "consistent_with_noise": d.consistent_with_noise}
+    return {
+        "hidden": hidden or "(none)",
+        "ratio": ratio if hidden else 0.0,
+        "noise": noise_ut,
+        "correlation": correlation,
+        "seed": _seed_label(seed),
+        "redraws": redraw,
+        "named": d.missing or "(none)",
+        "correct": (d.missing == hidden) if hidden else d.consistent_with_noise,
+        "consistent_with_noise": d.consistent_with_noise,
+    }
 
 
-def hidden_effect_study(ratios=(3.0, 10.0), noises=(0.3,), seeds=range(10), none_seeds=None,
-                        correlation: float = 0.0, duration_s: float = 40.0, workers: int = 1,
-                        scheduler: str | None = None) -> pd.DataFrame:
+def hidden_effect_study(
+    ratios=(3.0, 10.0),
+    noises=(0.3,),
+    seeds=range(10),
+    none_seeds=None,
+    correlation: float = 0.0,
+    duration_s: float = 40.0,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame:
     """Detection and false-alarm trials for the reference-free system over hidden effects, sizes, noise
     levels and seeds (nothing-hidden: twice as many seeds by default); each trial's seed is
     :func:`navlib.workbench.trials.trial_seed` of its coordinates (study "hidden effect", or "correlated
@@ -673,8 +897,30 @@ def hidden_effect_study(ratios=(3.0, 10.0), noises=(0.3,), seeds=range(10), none
     base = (SYSTEM_KEYS[SYSTEM.name], int(round(duration_s)))
     args = []
     for j, noise in enumerate(noises):
-        args += [(h, r, float(noise), trial_seed(study, *base, j, i, k, s), correlation, float(duration_s))
-                 for i, h in enumerate(FREE_EFFECTS, start=1) for k, r in enumerate(ratios) for s in seeds]
-        args += [(None, 0.0, float(noise), trial_seed(study, *base, j, 0, 0, s), correlation, float(duration_s))
-                 for s in none_seeds]
-    return pd.DataFrame(run_trials(hidden_effect_trial, args, workers, scheduler, "magnetometer_free trials"))
+        args += [
+            (
+                h,
+                r,
+                float(noise),
+                trial_seed(study, *base, j, i, k, s),
+                correlation,
+                float(duration_s),
+            )
+            for i, h in enumerate(FREE_EFFECTS, start=1)
+            for k, r in enumerate(ratios)
+            for s in seeds
+        ]
+        args += [
+            (
+                None,
+                0.0,
+                float(noise),
+                trial_seed(study, *base, j, 0, 0, s),
+                correlation,
+                float(duration_s),
+            )
+            for s in none_seeds
+        ]
+    return pd.DataFrame(
+        run_trials(hidden_effect_trial, args, workers, scheduler, "magnetometer_free trials")
+    )

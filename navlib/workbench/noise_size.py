@@ -27,6 +27,7 @@ For AR(1) noise of lag-1 correlation ``phi``, ``var(d) = 2 sigma^2 (1 - phi)`` a
 
 Tables shorter than :data:`MIN_ROWS` are not checked (too few differences for a robust spread).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -63,10 +64,15 @@ class NoiseSize:
     problem: str
 
     def to_dict(self) -> dict:
-        return {"sample_to_sample_noise": self.short, "rms": self.rms, "ratio": self.ratio,
-                "ratio_low": self.ratio_low,
-                "largest_candidate": self.biggest, "largest_explained_rms": self.explained,
-                "problem": self.problem}
+        return {
+            "sample_to_sample_noise": self.short,
+            "rms": self.rms,
+            "ratio": self.ratio,
+            "ratio_low": self.ratio_low,
+            "largest_candidate": self.biggest,
+            "largest_explained_rms": self.explained,
+            "problem": self.problem,
+        }
 
 
 def short_lag_noise(residuals: np.ndarray, data: pd.DataFrame) -> float:
@@ -78,10 +84,12 @@ def short_lag_noise(residuals: np.ndarray, data: pd.DataFrame) -> float:
         r = r[np.argsort(data["time_s"].to_numpy(float), kind="stable")]
     d = np.diff(r, axis=0)
     s = MAD_SD * np.median(np.abs(d - np.median(d, axis=0)), axis=0) / np.sqrt(2.0)
-    return float(np.sqrt(np.mean(s ** 2)))
+    return float(np.sqrt(np.mean(s**2)))
 
 
-def noise_size(fit, candidates: dict, unit: str, effective: float | None = None) -> NoiseSize | None:
+def noise_size(
+    fit, candidates: dict, unit: str, effective: float | None = None
+) -> NoiseSize | None:
     """The check of the module docstring on the residuals of ``fit`` (a :class:`navlib.workbench.fit.Fit`),
     ``candidates``: ``{effect: fit with it added}``, ``effective``: the noise model's effective samples
     (default: every observation); None for a table under :data:`MIN_ROWS` rows or residuals whose
@@ -102,11 +110,15 @@ def noise_size(fit, candidates: dict, unit: str, effective: float | None = None)
             biggest, explained = name, e
     problem = ""
     if explained > EXPLAINED_MAX * short:
-        problem = (f"'{biggest}' would take out {explained:.3g} {unit} rms, {explained / short:.1f} times the "
-                   f"sample-to-sample noise ({short:.3g} {unit}), though the correlated-noise test leaves it "
-                   f"undecided")
+        problem = (
+            f"'{biggest}' would take out {explained:.3g} {unit} rms, {explained / short:.1f} times the "
+            f"sample-to-sample noise ({short:.3g} {unit}), though the correlated-noise test leaves it "
+            f"undecided"
+        )
     elif ratio_low > RATIO_MAX:
-        problem = (f"slow variation of {rms:.3g} {unit} rms, {ratio:.1f} times the sample-to-sample noise "
-                   f"({short:.3g} {unit}; at least {ratio_low:.1f} times at 95 %, where noise is called noise up "
-                   f"to {RATIO_MAX:g} times)")
+        problem = (
+            f"slow variation of {rms:.3g} {unit} rms, {ratio:.1f} times the sample-to-sample noise "
+            f"({short:.3g} {unit}; at least {ratio_low:.1f} times at 95 %, where noise is called noise up "
+            f"to {RATIO_MAX:g} times)"
+        )
     return NoiseSize(short, rms, ratio, ratio_low, biggest, explained, problem)

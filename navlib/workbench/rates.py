@@ -16,6 +16,7 @@ interval (:func:`navlib.verdicts.wilson`, scipy's ``binomtest``):
 The trials run on :mod:`navlib.engine` (``workers`` local processes or the cluster at ``scheduler``); the
 rates do not depend on where they ran.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -32,8 +33,13 @@ from .trials import TRIAL_SYSTEMS, hidden_effect_study, out_of_catalogue_study
 #: Systems whose simulated data the rate trials draw.
 RATE_SYSTEMS = TRIAL_SYSTEMS + ("accelerometer", "magnetometer_free")
 #: Default noise (1 sigma, in the system's unit): the book's chapters' levels.
-DEFAULT_NOISE = {"compass": 0.1, "drift": 1e-4, "magnetometer": 0.3, "accelerometer": 0.003,
-                 "magnetometer_free": 0.3}
+DEFAULT_NOISE = {
+    "compass": 0.1,
+    "drift": 1e-4,
+    "magnetometer": 0.3,
+    "accelerometer": 0.003,
+    "magnetometer_free": 0.3,
+}
 #: Default effect sizes, as multiples of the noise.
 DEFAULT_RATIOS = (3.0, 10.0)
 #: Trials a command may ask for per case (a guard against a typo of a few zeros).
@@ -58,30 +64,66 @@ class Rates:
 
     def to_dict(self) -> dict:
         """Plain JSON-ready dictionary (the CLI's ``--json``)."""
+
         def records(df):
-            return None if df is None else [{str(k).replace(" ", "_"): (v.item() if isinstance(v, np.generic) else v)
-                                             for k, v in r.items()} for r in df.to_dict("records")]
-        return {"system": self.system, "unit": self.unit, "noise": list(self.noises), "ratios": list(self.ratios),
-                "trials_per_case": self.trials, "null_trials_per_noise": self.null_trials,
-                "interval": "95 % Wilson (scipy.stats.binomtest)",
-                "detection": records(self.detection), "false_alarms": records(self.false_alarms),
-                "out_of_catalogue": records(self.out_of_catalogue)}
+            return (
+                None
+                if df is None
+                else [
+                    {
+                        str(k).replace(" ", "_"): (v.item() if isinstance(v, np.generic) else v)
+                        for k, v in r.items()
+                    }
+                    for r in df.to_dict("records")
+                ]
+            )
+
+        return {
+            "system": self.system,
+            "unit": self.unit,
+            "noise": list(self.noises),
+            "ratios": list(self.ratios),
+            "trials_per_case": self.trials,
+            "null_trials_per_noise": self.null_trials,
+            "interval": "95 % Wilson (scipy.stats.binomtest)",
+            "detection": records(self.detection),
+            "false_alarms": records(self.false_alarms),
+            "out_of_catalogue": records(self.out_of_catalogue),
+        }
 
     def text(self) -> str:
         """The rates as plain-text tables."""
-        fmt = {"noise": "{:g}".format, "ratio": "{:g}".format, "rate": "{:.3f}".format,
-               "low": "{:.3f}".format, "high": "{:.3f}".format}
-        parts = [f"{self.system}: noise {', '.join(f'{n:g}' for n in self.noises)} {self.unit} (1 sigma); "
-                 f"effect sizes {', '.join(f'{r:g}' for r in self.ratios)} x noise; 95 % Wilson intervals",
-                 "", "hidden effect named (detection):",
-                 self.detection.to_string(index=False, formatters=fmt),
-                 "", "false alarms (nothing hidden; anything but 'consistent with noise'):",
-                 self.false_alarms.to_string(index=False, formatters=fmt)]
+        fmt = {
+            "noise": "{:g}".format,
+            "ratio": "{:g}".format,
+            "rate": "{:.3f}".format,
+            "low": "{:.3f}".format,
+            "high": "{:.3f}".format,
+        }
+        parts = [
+            f"{self.system}: noise {', '.join(f'{n:g}' for n in self.noises)} {self.unit} (1 sigma); "
+            f"effect sizes {', '.join(f'{r:g}' for r in self.ratios)} x noise; 95 % Wilson intervals",
+            "",
+            "hidden effect named (detection):",
+            self.detection.to_string(index=False, formatters=fmt),
+            "",
+            "false alarms (nothing hidden; anything but 'consistent with noise'):",
+            self.false_alarms.to_string(index=False, formatters=fmt),
+        ]
         if self.out_of_catalogue is not None:
-            f2 = dict(fmt, **{c: "{:.3f}".format for c in self.out_of_catalogue.columns
-                              if c.endswith(("rate", "low", "high"))})
-            parts += ["", "errors outside the catalogue (quiet: no catalogued effect named; detected: not noise):",
-                      self.out_of_catalogue.to_string(index=False, formatters=f2)]
+            f2 = dict(
+                fmt,
+                **{
+                    c: "{:.3f}".format
+                    for c in self.out_of_catalogue.columns
+                    if c.endswith(("rate", "low", "high"))
+                },
+            )
+            parts += [
+                "",
+                "errors outside the catalogue (quiet: no catalogued effect named; detected: not noise):",
+                self.out_of_catalogue.to_string(index=False, formatters=f2),
+            ]
         return "\n".join(parts)
 
 
@@ -90,8 +132,15 @@ def _rate(k: int, n: int) -> dict:
     return {"rate": e.value, "low": e.lo, "high": e.hi}
 
 
-def rates(system: str, trials: int = 20, noises=None, ratios=DEFAULT_RATIOS, null_trials: int | None = None,
-          workers: int = 1, scheduler: str | None = None) -> Rates:
+def rates(
+    system: str,
+    trials: int = 20,
+    noises=None,
+    ratios=DEFAULT_RATIOS,
+    null_trials: int | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> Rates:
     """Detection, false-alarm and out-of-catalogue rates of the workbench for ``system``.
 
     Parameters
@@ -132,33 +181,78 @@ def rates(system: str, trials: int = 20, noises=None, ratios=DEFAULT_RATIOS, nul
         raise InputError("rates: a noise level or effect size is given twice")
     seeds, none_seeds = range(trials), range(int(null_trials))
     if system == "accelerometer":
-        study = accelerometer.hidden_effect_study(ratios, tuple(1000.0 * v for v in noises), seeds, none_seeds,
-                                                  workers=workers, scheduler=scheduler)
+        study = accelerometer.hidden_effect_study(
+            ratios,
+            tuple(1000.0 * v for v in noises),
+            seeds,
+            none_seeds,
+            workers=workers,
+            scheduler=scheduler,
+        )
         study["noise"] = study.pop("noise_ug") / 1000.0
     elif system == "magnetometer_free":
-        study = magnetometer_free.hidden_effect_study(ratios, noises, seeds, none_seeds, workers=workers,
-                                                      scheduler=scheduler)
+        study = magnetometer_free.hidden_effect_study(
+            ratios, noises, seeds, none_seeds, workers=workers, scheduler=scheduler
+        )
     else:
-        study = hidden_effect_study(system, ratios=ratios, noises=noises, seeds=seeds, none_seeds=none_seeds,
-                                    workers=workers, scheduler=scheduler)
+        study = hidden_effect_study(
+            system,
+            ratios=ratios,
+            noises=noises,
+            seeds=seeds,
+            none_seeds=none_seeds,
+            workers=workers,
+            scheduler=scheduler,
+        )
     det, fa = [], []
     hidden = study[study.hidden != "(none)"]
     for (h, r, n), g in hidden.groupby(["hidden", "ratio", "noise"], sort=False):
-        det.append({"effect": h, "ratio": float(r), "noise": float(n), "trials": len(g),
-                    "named": int(g.correct.astype(bool).sum()), **_rate(g.correct.astype(bool).sum(), len(g))})
+        det.append(
+            {
+                "effect": h,
+                "ratio": float(r),
+                "noise": float(n),
+                "trials": len(g),
+                "named": int(g.correct.astype(bool).sum()),
+                **_rate(g.correct.astype(bool).sum(), len(g)),
+            }
+        )
     for n, g in study[study.hidden == "(none)"].groupby("noise", sort=False):
         alarms = int((~g.correct.astype(bool)).sum())
         fa.append({"noise": float(n), "trials": len(g), "alarms": alarms, **_rate(alarms, len(g))})
     ooc = None
     if system == "compass":
-        o = out_of_catalogue_study(ratios=ratios, noises=noises, seeds=seeds, workers=workers, scheduler=scheduler)
+        o = out_of_catalogue_study(
+            ratios=ratios, noises=noises, seeds=seeds, workers=workers, scheduler=scheduler
+        )
         rows = []
         for (kind, r, n), g in o.groupby(["kind", "ratio", "noise"], sort=False):
             q, d = _rate(g.quiet.sum(), len(g)), _rate(g.detected.sum(), len(g))
-            rows.append({"kind": kind, "ratio": float(r), "noise": float(n), "trials": len(g),
-                         "quiet rate": q["rate"], "quiet low": q["low"], "quiet high": q["high"],
-                         "detected rate": d["rate"], "detected low": d["low"], "detected high": d["high"]})
+            rows.append(
+                {
+                    "kind": kind,
+                    "ratio": float(r),
+                    "noise": float(n),
+                    "trials": len(g),
+                    "quiet rate": q["rate"],
+                    "quiet low": q["low"],
+                    "quiet high": q["high"],
+                    "detected rate": d["rate"],
+                    "detected low": d["low"],
+                    "detected high": d["high"],
+                }
+            )
         ooc = pd.DataFrame(rows)
-    return Rates(system, get_system(system).unit, noises, ratios, trials, int(null_trials),
-                 pd.DataFrame(det, columns=["effect", "ratio", "noise", "trials", "named", "rate", "low", "high"]),
-                 pd.DataFrame(fa, columns=["noise", "trials", "alarms", "rate", "low", "high"]), ooc)
+    return Rates(
+        system,
+        get_system(system).unit,
+        noises,
+        ratios,
+        trials,
+        int(null_trials),
+        pd.DataFrame(
+            det, columns=["effect", "ratio", "noise", "trials", "named", "rate", "low", "high"]
+        ),
+        pd.DataFrame(fa, columns=["noise", "trials", "alarms", "rate", "low", "high"]),
+        ooc,
+    )

@@ -10,6 +10,7 @@ of whitened columns is a weighted sum of lagged cross-products of the columns, c
 :mod:`~navlib.workbench.serial` (which imports it); the ``series``
 argument (a :class:`~navlib.workbench.serial.Series`) is used only through its ``order`` and ``pos``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,7 +27,7 @@ def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
     v = np.ones(p + 1)
     for m in range(1, p + 1):
         phi[m, m] = kappa[m - 1]
-        phi[m, 1:m] = phi[m - 1, 1:m] - kappa[m - 1] * phi[m - 1, m - 1:0:-1]
+        phi[m, 1:m] = phi[m - 1, 1:m] - kappa[m - 1] * phi[m - 1, m - 1 : 0 : -1]
         v[m] = v[m - 1] * (1.0 - kappa[m - 1] ** 2)
     return phi, v
 
@@ -41,7 +42,7 @@ def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
                         - [l = m] phi[m-1, m-1:0:-1]
         d v[m]        = (1 - kappa_m^2) d v[m-1] - [l = m] 2 kappa_m v[m-1]
     """
-    kappa = [float(k) for k in kappa]                   # plain floats: p is a few, numpy calls cost more
+    kappa = [float(k) for k in kappa]  # plain floats: p is a few, numpy calls cost more
     p = len(kappa)
     phi = [[0.0] * (p + 1) for _ in range(p + 1)]
     v = [1.0] * (p + 1)
@@ -56,9 +57,9 @@ def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
             dphi[m - 1][m][j] -= phi[m - 1][m - j]
         phi[m][m] = km
         dphi[m - 1][m][m] = 1.0
-        v[m] = v[m - 1] * (1.0 - km ** 2)
+        v[m] = v[m - 1] * (1.0 - km**2)
         for d in dv:
-            d[m] = d[m - 1] * (1.0 - km ** 2)
+            d[m] = d[m - 1] * (1.0 - km**2)
         dv[m - 1][m] -= 2.0 * km * v[m - 1]
     dphi, dv = np.array(dphi).reshape(p, p + 1, p + 1), np.array(dv).reshape(p, p + 1)
     phi, v = np.array(phi), np.array(v)
@@ -88,13 +89,20 @@ class _Prepared:
         #: samples per group
         self.count = np.bincount(group, minlength=P + 1)
         #: each group's lagged samples: ``idx[g][j]`` = the group's samples, j steps back (in their segment)
-        self.idx = [np.flatnonzero(group == g)[None, :] - np.arange(g + 1)[:, None] for g in range(P + 1)]
+        self.idx = [
+            np.flatnonzero(group == g)[None, :] - np.arange(g + 1)[:, None] for g in range(P + 1)
+        ]
         #: the regressors' lags: ``lag_q[g][j]`` = ``Q[idx[g][j]]`` (n_g, k)
         self.lag_q = [Zq[ix] for ix in self.idx]
         #: ordered pairs ``(g, i, j)`` and unordered ones (``i <= j``), group by group
-        self.pairs = np.array([(g, i, j) for g in range(P + 1) for i in range(g + 1) for j in range(g + 1)])
+        self.pairs = np.array(
+            [(g, i, j) for g in range(P + 1) for i in range(g + 1) for j in range(g + 1)]
+        )
         self.sym = self.pairs[self.pairs[:, 1] <= self.pairs[:, 2]]
-        self._flat = [(x[:, 0] * (P + 1) + x[:, 1], x[:, 0] * (P + 1) + x[:, 2]) for x in (self.pairs, self.sym)]
+        self._flat = [
+            (x[:, 0] * (P + 1) + x[:, 1], x[:, 0] * (P + 1) + x[:, 2])
+            for x in (self.pairs, self.sym)
+        ]
         Gq = np.empty((len(self.sym), k, k))
         for s, (g, i, j) in enumerate(self.sym):
             c = self.lag_q[g][i].T @ self.lag_q[g][j]
@@ -109,11 +117,13 @@ class _Prepared:
         Cqr, Crr = [], []
         B, k = Ze.shape[1], self.k
         for g, ix in enumerate(self.idx):
-            R = Ze[ix]                                          # (g + 1, n_g, B): the group's lags
+            R = Ze[ix]  # (g + 1, n_g, B): the group's lags
             # one product per regressors' lag i for every (j, b): the residuals' lags side by side
             Rj = R.transpose(1, 0, 2).reshape(ix.shape[1], (g + 1) * B)
-            C = np.stack([lag.T @ Rj for lag in self.lag_q[g]])   # (i, q, (j, b))
-            Cqr.append(C.reshape(g + 1, k, g + 1, B).transpose(0, 2, 1, 3).reshape((g + 1) ** 2, k, B))
+            C = np.stack([lag.T @ Rj for lag in self.lag_q[g]])  # (i, q, (j, b))
+            Cqr.append(
+                C.reshape(g + 1, k, g + 1, B).transpose(0, 2, 1, 3).reshape((g + 1) ** 2, k, B)
+            )
             i, j = np.triu_indices(g + 1)
             Crr.append(np.where((i < j)[:, None], 2.0, 1.0) * np.einsum("snb,snb->sb", R[i], R[j]))
         return np.concatenate(Cqr), np.concatenate(Crr)
@@ -128,22 +138,24 @@ class _Prepared:
         p = len(kappa)
         if p > self.P:
             raise ValueError("order above the cache's")
-        phi, v, dphi, dv = levinson_derivatives(kappa) if gradient else levinson(kappa) + (None, None)
+        phi, v, dphi, dv = (
+            levinson_derivatives(kappa) if gradient else levinson(kappa) + (None, None)
+        )
         m = np.minimum(np.arange(self.P + 1), p)
         vm = v[m]
         scale = 1.0 / np.sqrt(vm)
         A = np.zeros((self.P + 1, self.P + 1))
         A[:, 0] = 1.0
-        A[:, 1:p + 1] = -phi[m, 1:]
+        A[:, 1 : p + 1] = -phi[m, 1:]
         A *= scale[:, None]
-        A = A.ravel()                                           # A[g * (P + 1) + i]: the pairs' flat indices
+        A = A.ravel()  # A[g * (P + 1) + i]: the pairs' flat indices
         (oi, oj), (si, sj) = self._flat
         out = (A[oi] * A[oj], A[si] * A[sj], float(self.count @ np.log(vm)))
         if not gradient:
             return out
-        rel = dv[:, m] / vm                                     # d log v_(m_g) / d kappa_l: (p, P + 1)
+        rel = dv[:, m] / vm  # d log v_(m_g) / d kappa_l: (p, P + 1)
         dA = np.zeros((p, self.P + 1, self.P + 1))
-        dA[:, :, 1:p + 1] = -dphi[:, m, 1:] * scale[None, :, None]
+        dA[:, :, 1 : p + 1] = -dphi[:, m, 1:] * scale[None, :, None]
         dA = dA.reshape(p, A.size) - 0.5 * np.repeat(rel, self.P + 1, axis=1) * A
         dw = dA[:, oi] * A[oj] + A[oi] * dA[:, oj]
         dws = dA[:, si] * A[sj] + A[si] * dA[:, sj]
@@ -162,8 +174,15 @@ class _Restricted:
     with the lagged cross-products ``C_gij`` computed once; then ``G = M_QQ`` (``X' R^-1 X`` for
     orthonormal ``X``), ``b = M_Qr``, ``RSS_W = M_rr - b' G^-1 b`` (Cholesky factor of ``G``)."""
 
-    def __init__(self, r: np.ndarray, Q: np.ndarray, series, max_order: int,
-                 prepared: "_Prepared | None" = None, cross: tuple | None = None):
+    def __init__(
+        self,
+        r: np.ndarray,
+        Q: np.ndarray,
+        series,
+        max_order: int,
+        prepared: "_Prepared | None" = None,
+        cross: tuple | None = None,
+    ):
         """``cross``: ``r``'s cross-products ``(Cqr, Crr)`` with ``prepared`` (``_Prepared.cross`` of one
         column), when computed for many residual vectors at once."""
         usable = prepared is not None and prepared.P >= int(max_order)
@@ -204,10 +223,10 @@ class _Restricted:
             b = w @ self.Cqr
             L, info = dpotrf(G, lower=1, clean=1)
             Li, info = dtrtri(L, lower=1) if info == 0 else (None, 1)
-            if info == 0:                               # Cholesky: G = L L' is positive definite
+            if info == 0:  # Cholesky: G = L L' is positive definite
                 Gi = Li.T @ Li
                 logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-            else:                                       # numerically singular: the eigenvalues, floored
+            else:  # numerically singular: the eigenvalues, floored
                 ev, U = np.linalg.eigh(G)
                 ev = np.maximum(ev, 1e-300)
                 Gi = (U / ev) @ U.T
@@ -234,12 +253,12 @@ class _Restricted:
             return c, logdet_r, 0.0
         G = (ws @ self.pre.Gq).reshape(k, k)
         b = w @ self.Cqr
-        try:                                            # Cholesky: G is positive definite
+        try:  # Cholesky: G is positive definite
             L = np.linalg.cholesky(G)
             z = dtrtrs(L, b, lower=1)[0]
             rss = c - float(z @ z)
             logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-        except np.linalg.LinAlgError:                   # numerically singular: the eigenvalues, floored
+        except np.linalg.LinAlgError:  # numerically singular: the eigenvalues, floored
             ev, U = np.linalg.eigh(G)
             ev = np.maximum(ev, 1e-300)
             rss = c - float(np.sum((U.T @ b) ** 2 / ev))

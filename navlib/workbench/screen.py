@@ -53,6 +53,7 @@ as well when they fit the data better by BIC -- so a slow structure outside the 
 for correlated noise and stays testable, while on data without one the correlation keeps the precision
 that the slow shapes would take from it.
 """
+
 from __future__ import annotations
 
 import math
@@ -91,7 +92,7 @@ SMALL_TABLE = 60
 #: In a time series an outlier stands out from the median of the samples within this many of it, and no
 #: other sample that near is outlying too.
 ISOLATION = 2
-MAD_SD = 1.482602218505602          # 1 / Phi^-1(3/4)
+MAD_SD = 1.482602218505602  # 1 / Phi^-1(3/4)
 #: Asymptotic efficiency of the MAD at the normal (Rousseeuw and Croux 1993).
 MAD_EFFICIENCY = 0.367
 
@@ -109,7 +110,12 @@ class Outlier:
 
     def to_dict(self) -> dict:
         """``{"row", "column", "residual", "robust_z"}``."""
-        return {"row": self.row, "column": self.column, "residual": self.residual, "robust_z": self.z}
+        return {
+            "row": self.row,
+            "column": self.column,
+            "residual": self.residual,
+            "robust_z": self.z,
+        }
 
 
 @dataclass
@@ -154,21 +160,31 @@ class Screening:
         if not self.outliers:
             return ""
         rows = self.rows_set_aside
-        shown = "; ".join(f"row {o.row} {o.column} {o.residual:+.4g} {unit} (z {o.z:.3g})"
-                          for o in self.outliers[:5])
+        shown = "; ".join(
+            f"row {o.row} {o.column} {o.residual:+.4g} {unit} (z {o.z:.3g})"
+            for o in self.outliers[:5]
+        )
         more = f"; and {len(self.outliers) - 5} more" if len(self.outliers) > 5 else ""
-        return (f"set aside {len(rows)} outlying row{'s' if len(rows) > 1 else ''} of {self.n_rows} "
-                f"(robust |z| > {self.cutoff:.3g} against {' + '.join(self.model) or 'the model'}): "
-                f"{shown}{more}")
+        return (
+            f"set aside {len(rows)} outlying row{'s' if len(rows) > 1 else ''} of {self.n_rows} "
+            f"(robust |z| > {self.cutoff:.3g} against {' + '.join(self.model) or 'the model'}): "
+            f"{shown}{more}"
+        )
 
     def to_dict(self) -> dict:
         """The screen in ``--json``: ``rows`` (given), ``rows_used``, ``outliers``, ``outlier_cutoff`` (None if
         the screen did not run), ``screening_model``, ``numerical_floor``, ``noise``
         (:meth:`navlib.workbench.serial.NoiseModel.to_dict`), ``screen_note``."""
-        return {"rows": self.n_rows, "rows_used": int(len(self.kept)),
-                "outliers": [o.to_dict() for o in self.outliers], "outlier_cutoff": self.cutoff,
-                "screening_model": list(self.model), "numerical_floor": self.floor,
-                "noise": self.noise.to_dict(), "screen_note": self.note}
+        return {
+            "rows": self.n_rows,
+            "rows_used": int(len(self.kept)),
+            "outliers": [o.to_dict() for o in self.outliers],
+            "outlier_cutoff": self.cutoff,
+            "screening_model": list(self.model),
+            "numerical_floor": self.floor,
+            "noise": self.noise.to_dict(),
+            "screen_note": self.note,
+        }
 
 
 def cutoff(n_obs: int, dof: int) -> float:
@@ -185,7 +201,7 @@ def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
         v = frame[[c for c in MEASURED[fit.system][0] if c in frame]].to_numpy(float)
     else:
         v = np.asarray(fit.predict(frame), float).ravel() + fit.residuals
-    return float(np.sqrt(np.mean(v ** 2)))
+    return float(np.sqrt(np.mean(v**2)))
 
 
 def _robust_z(u: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
@@ -284,21 +300,35 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     regressors = None
     if serial and rich is not None and rich.rms > floor:
         ser = series_of(rich.data, rich.n, rich.system)
-        if ser is not None and rich.spec.noise_directions is not None:     # residuals see axis-wise noise
+        if (
+            ser is not None and rich.spec.noise_directions is not None
+        ):  # residuals see axis-wise noise
             ser = with_projection(ser, rich.data, rich.spec.noise_directions(rich))
         if ser is not None:
-            if zk is not None:                         # the noise model describes the bulk of the data
+            if zk is not None:  # the noise model describes the bulk of the data
                 ser = ser.without(np.abs(zk.ravel()) > Z_NOISE)
             shapes = [np.asarray(X, float) for _, X, _ in rich.spec.structure(rich)]
             regressors = (rich.jacobian, np.column_stack(shapes) if shapes else None)
             noise = select(rich.residuals, *regressors, ser)
-    return Screening(data, kept, n, found, c, rich.effects if rich is not None else tuple(fit.effects), noise,
-                     scale, floor, note, rich, regressors)
+    return Screening(
+        data,
+        kept,
+        n,
+        found,
+        c,
+        rich.effects if rich is not None else tuple(fit.effects),
+        noise,
+        scale,
+        floor,
+        note,
+        rich,
+        regressors,
+    )
 
 
 def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
     """The system's structure shapes evaluated on the rows of ``frame`` (columns side by side)."""
-    probe = replace(rich, data=frame)                # the structure functions read only the data
+    probe = replace(rich, data=frame)  # the structure functions read only the data
     cols = [np.asarray(X, float) for _, X, _ in rich.spec.structure(probe)]
     return np.column_stack(cols) if cols else np.zeros((len(frame) * (rich.n // len(rich.data)), 0))
 
@@ -312,7 +342,7 @@ def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system:
     if ser is None:
         return np.ones(len(data), bool)
     n = len(data)
-    rows, pos = ser.order[:n] // axes, ser.pos[:n]   # axis 0: rows in time order
+    rows, pos = ser.order[:n] // axes, ser.pos[:n]  # axis 0: rows in time order
     z = size[rows]
     bar = np.maximum(c, z / DOMINANCE)
     seg = np.cumsum(pos == 0)
@@ -343,10 +373,10 @@ def _deletion_z(fit: Fit, data: pd.DataFrame, rich: Fit, floor: float) -> np.nda
     e = rich.residuals
     h = np.clip(np.diag(H), 0.0, 0.99)
     z = np.zeros((n, axes))
-    if axes == 1:                                    # every deletion at once: row i of U is the fit without i
+    if axes == 1:  # every deletion at once: row i of U is the fit without i
         g = e / (1.0 - h)
         U = e[None, :] + H * g[:, None]
-        hU = np.clip(h[None, :] + H ** 2 / (1.0 - h)[:, None], 0.0, 0.99)
+        hU = np.clip(h[None, :] + H**2 / (1.0 - h)[:, None], 0.0, 0.99)
         U = U / np.sqrt(1.0 - hU)
         U[np.arange(n), np.arange(n)] = np.nan
         med = np.nanmedian(U, axis=1)
@@ -376,7 +406,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
     shapes_all = _shapes_on(rich, data)
     dof = rich.n - rich.n_params
     if n <= SMALL_TABLE or dof - shapes_all.shape[1] < max(MIN_DOF, dof / 2):
-        shapes_all = shapes_all[:, :0]               # too few rows to take the structure out as well
+        shapes_all = shapes_all[:, :0]  # too few rows to take the structure out as well
 
     def judge(rich, aside):
         """Robust z of every observation against ``rich`` (fitted to the rows not ``aside``) and the
@@ -396,7 +426,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
             r = r - (shapes_all @ coef).reshape(n, axes)
         else:
             q = orth_basis(rich.jacobian)
-        lev = np.sum(q ** 2, axis=1)
+        lev = np.sum(q**2, axis=1)
         h = np.zeros((n, axes))
         h[kept] = np.clip(lev, 0.0, 0.99).reshape(len(kept), axes)
         u = r / np.sqrt(1.0 - h)
@@ -411,7 +441,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
 
     for k in range(MAX_ROUNDS):
         r, z, flagged = judge(rich, aside)
-        if k == 0 and n <= SMALL_TABLE:             # a short table: deletion residuals against masking
+        if k == 0 and n <= SMALL_TABLE:  # a short table: deletion residuals against masking
             zd = _deletion_z(fit, data, rich, floor)
             flagged = flagged | (np.abs(zd) > c)
             z = np.where(np.abs(zd) > np.abs(z), zd, z)
@@ -423,8 +453,13 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         if np.array_equal(nxt, aside) or nxt.all():
             break
         aside = nxt
-        rich = fit_model(fit.spec, data.iloc[np.flatnonzero(~aside)], rich.effects, start=rich.params,
-                         user_effects=fit.user_effects)
+        rich = fit_model(
+            fit.spec,
+            data.iloc[np.flatnonzero(~aside)],
+            rich.effects,
+            start=rich.params,
+            user_effects=fit.user_effects,
+        )
     else:
         r, z, flagged = judge(rich, aside)
     bad = np.flatnonzero(aside | flagged.any(axis=1))
@@ -435,7 +470,8 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
             f"{' + '.join(rich.effects) or '(none)'}; e.g. column '{cols[j]}', rows "
             f"{', '.join(str(int(b) + 1) for b in bad[:6])}{', ...' if len(bad) > 6 else ''}): more than "
             f"{limit} ({100 * MAX_OUTLIER_SHARE:g} % of the rows, at least 1) that the screen sets aside; a "
-            f"least-squares model does not describe these data -- check the file")
+            f"least-squares model does not describe these data -- check the file"
+        )
     kept = np.flatnonzero(~aside)
     found = []
     for i in np.flatnonzero(aside):

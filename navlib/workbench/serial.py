@@ -69,6 +69,7 @@ removes most of that bias for AR errors in regression (Cheang and Reinsel 2000, 
 regressors and the residual, computed once, and maximised over ``atanh(kappa)`` by L-BFGS-B with its
 analytic gradient (:mod:`navlib.workbench.reml`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -138,11 +139,13 @@ class Series:
         if not gone.any():
             return self
         start = self.pos == 0
-        start[1:] |= gone[:-1]                   # after a removed sample a new segment starts
+        start[1:] |= gone[:-1]  # after a removed sample a new segment starts
         start = start[~gone]
         seg = np.cumsum(start) - 1
         first = np.flatnonzero(start)
-        return Series(self.order[~gone], np.arange(len(seg)) - first[seg], self.source, self.projection)
+        return Series(
+            self.order[~gone], np.arange(len(seg)) - first[seg], self.source, self.projection
+        )
 
 
 def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
@@ -174,7 +177,9 @@ def series_of(data: pd.DataFrame, n_obs: int, system: str) -> Series | None:
     return Series(order, pos, source)
 
 
-def with_projection(series: Series | None, data: pd.DataFrame, directions: np.ndarray) -> Series | None:
+def with_projection(
+    series: Series | None, data: pd.DataFrame, directions: np.ndarray
+) -> Series | None:
     """``series`` with the :class:`Projection` of residuals that see axis-wise noise along ``directions``
     ((n_obs, 3), observation order, rows flattened as the systems do): each observation's clock is its
     row's ``time_s`` over the median time step (a series in file order: the row number).  The series is
@@ -195,9 +200,9 @@ def with_projection(series: Series | None, data: pd.DataFrame, directions: np.nd
     clock = np.repeat(t, axes)
     old = series.order
     starts = np.zeros(n * axes, bool)
-    starts[old[series.pos == 0]] = True               # observations that started a segment
+    starts[old[series.pos == 0]] = True  # observations that started a segment
     row = old // axes
-    first = np.full(n, len(old))                      # each row's place in time: its first in ``old``
+    first = np.full(n, len(old))  # each row's place in time: its first in ``old``
     np.minimum.at(first, row, np.arange(len(old)))
     order = old[np.lexsort((old % axes, first[row]))]
     row = order // axes
@@ -231,10 +236,14 @@ def _projected_gains(kappa, series: Series) -> innovations.Gains:
     if hit is not None and hit[0] is series:
         return hit[1]
     inputs = _INPUTS.get(id(series))
-    if inputs is None or inputs[0] is not series:       # the clock and directions in series order, once
+    if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
         pr = series.projection
-        inputs = (series, pr.clock[series.order], np.ascontiguousarray(pr.directions[series.order], float),
-                  regular_clock(series))
+        inputs = (
+            series,
+            pr.clock[series.order],
+            np.ascontiguousarray(pr.directions[series.order], float),
+            regular_clock(series),
+        )
         _INPUTS.clear()
         _INPUTS[id(series)] = inputs
     _, clock, d, regular = inputs
@@ -255,7 +264,7 @@ def ar1_noise(rng: np.random.Generator, shape, sd: float, correlation: float) ->
     u = rng.standard_normal(shape)
     e = np.empty(shape)
     e[0] = sd * u[0]
-    s = sd * np.sqrt(1.0 - correlation ** 2)
+    s = sd * np.sqrt(1.0 - correlation**2)
     for t in range(1, shape[0]):
         e[t] = correlation * e[t - 1] + s * u[t]
     return e
@@ -276,10 +285,10 @@ def whiten(x: np.ndarray, kappa, series: Series, *, ordered: bool = False) -> np
     phi, v = levinson(kappa)
     m = len(xo)
     out = xo.copy()
-    for j in range(1, p + 1):                   # the full-order filter on every sample from the p-th on
-        out[p:] -= phi[p, j] * xo[p - j:m - j]
+    for j in range(1, p + 1):  # the full-order filter on every sample from the p-th on
+        out[p:] -= phi[p, j] * xo[p - j : m - j]
     out[p:] /= np.sqrt(v[p])
-    early = np.flatnonzero(series.pos < p)       # near a segment start: the filter of a lower order
+    early = np.flatnonzero(series.pos < p)  # near a segment start: the filter of a lower order
     order = series.pos[early]
     acc = xo[early].copy()
     for j in range(1, p):
@@ -308,12 +317,14 @@ def whiten_transpose(y: np.ndarray, kappa, series: Series) -> np.ndarray:
     z = y * (scale[:, None] if y.ndim == 2 else scale)
     out = z.copy()
     for j in range(1, p + 1):
-        c = phi[m[j:], j]                                 # 0 where pos_t < j (phi[m, j] = 0 for j > m)
+        c = phi[m[j:], j]  # 0 where pos_t < j (phi[m, j] = 0 for j > m)
         out[:-j] -= (c[:, None] if y.ndim == 2 else c) * z[j:]
     return out
 
 
-def whiten_each(x: np.ndarray, kappas: list, series: Series, *, transpose: bool = False) -> np.ndarray:
+def whiten_each(
+    x: np.ndarray, kappas: list, series: Series, *, transpose: bool = False
+) -> np.ndarray:
     """Each column of ``x`` (N, B; series order) under its own partial autocorrelations ``kappas[b]`` (all
     of one order, no :class:`Projection`): ``W_b x_b`` (:func:`whiten`), or ``W_b' x_b`` with ``transpose``
     (:func:`whiten_transpose`); series order out.  Sample ``t`` of order ``m = min(pos_t, p)`` and column ``b``
@@ -327,9 +338,12 @@ def whiten_each(x: np.ndarray, kappas: list, series: Series, *, transpose: bool 
     if series.projection is not None:
         raise ValueError("whiten_each: a projected series is whitened by its filter")
     lev = [levinson(k) for k in kappas]
-    phi, v = np.stack([f for f, _ in lev]), np.stack([w for _, w in lev])     # (B, p + 1, p + 1), (B, p + 1)
+    phi, v = (
+        np.stack([f for f, _ in lev]),
+        np.stack([w for _, w in lev]),
+    )  # (B, p + 1, p + 1), (B, p + 1)
     m = np.minimum(series.pos, p)
-    scale = 1.0 / np.sqrt(v[:, m].T)                                           # (N, B)
+    scale = 1.0 / np.sqrt(v[:, m].T)  # (N, B)
     if transpose:
         z = x * scale
         out = z.copy()
@@ -350,6 +364,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     Durbin-Levinson coefficients of their own order, the rest by the recursion of order p
     (``scipy.signal.lfilter``, its state carried over from the start-up)."""
     from scipy.signal import lfilter  # noqa: PLC0415  # lazy: scipy.signal costs 0.3 s at the CLI's start
+
     u = np.asarray(u, float)
     p = len(kappa)
     out = np.zeros((n_obs,) + u.shape[1:])
@@ -362,20 +377,19 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     phi, v = levinson(kappa)
     x = np.empty_like(u)
     starts = np.flatnonzero(series.pos == 0).tolist() + [len(u)]
-    a = np.r_[1.0, -phi[p, 1:p + 1]]
+    a = np.r_[1.0, -phi[p, 1 : p + 1]]
     for a0, b0 in zip(starts[:-1], starts[1:]):
         head = min(p, b0 - a0)
-        for t in range(head):                       # start-up: order t predicts sample t exactly
+        for t in range(head):  # start-up: order t predicts sample t exactly
             x[a0 + t] = np.sqrt(v[t]) * u[a0 + t]
             for j in range(1, t + 1):
                 x[a0 + t] += phi[t, j] * x[a0 + t - j]
         if b0 - a0 > p:
             # x_t = sum_j phi_pj x_(t-j) + sqrt(v_p) u_t for t >= p; the filter's state holds the start-up
-            past = x[a0:a0 + p][::-1]               # x_(p-1), ..., x_0
+            past = x[a0 : a0 + p][::-1]  # x_(p-1), ..., x_0
             # (transposed direct form: z_k = -sum_(m>k) a_m x_(t-1-(m-k-1)))
-            zi = np.array([-np.tensordot(a[k + 1:], past[:p - k], axes=(0, 0)) for k in range(p)])
-            x[a0 + p:b0], _ = lfilter([1.0], a, np.sqrt(v[p]) * u[a0 + p:b0], axis=0,
-                                      zi=zi)
+            zi = np.array([-np.tensordot(a[k + 1 :], past[: p - k], axes=(0, 0)) for k in range(p)])
+            x[a0 + p : b0], _ = lfilter([1.0], a, np.sqrt(v[p]) * u[a0 + p : b0], axis=0, zi=zi)
     out[series.order] = x
     return out
 
@@ -427,17 +441,27 @@ class NoiseModel:
     def whiten(self, x: np.ndarray, ordered: bool = False) -> np.ndarray:
         """``W x`` (rows reordered into series order), or ``x`` unchanged if the samples are independent;
         ``ordered``: ``x`` is already in series order (:func:`whiten`)."""
-        return whiten(x, self.kappa, self.series, ordered=ordered) if self.correlated else np.asarray(x, float)
+        return (
+            whiten(x, self.kappa, self.series, ordered=ordered)
+            if self.correlated
+            else np.asarray(x, float)
+        )
 
     def to_dict(self) -> dict:
         """The noise model in ``--json``: what ordered the series (``time_s``, ``file order`` or None), AR
         order, partial autocorrelations, lag-1 correlation and its interval, the variance inflation of a
         slow shape, the effective number of samples and the regressors it was estimated around
         (:func:`select`)."""
-        return {"series": self.series.source if self.series is not None else None, "ar_order": self.order,
-                "partial_autocorrelations": [float(k) for k in self.kappa], "lag1_correlation": self.lag1,
-                "lag1_interval": [float(k) for k in self.bounds], "variance_inflation": self.inflation,
-                "effective_samples": self.effective_samples, "estimated_around": self.around or None}
+        return {
+            "series": self.series.source if self.series is not None else None,
+            "ar_order": self.order,
+            "partial_autocorrelations": [float(k) for k in self.kappa],
+            "lag1_correlation": self.lag1,
+            "lag1_interval": [float(k) for k in self.bounds],
+            "variance_inflation": self.inflation,
+            "effective_samples": self.effective_samples,
+            "estimated_around": self.around or None,
+        }
 
     def describe(self) -> str:
         """One phrase for a report."""
@@ -446,14 +470,24 @@ class NoiseModel:
         if self.note:
             return f"samples taken as independent ({self.note})"
         if not self.correlated:
-            return f"no serial correlation found (AR order 0 by AIC; series in {self.series.source})"
-        slow = (f"a slow shape sees about {self.effective_samples:.0f} independent samples of {self.n_obs}"
-                if self.inflation > 1 else "neighbouring samples anti-correlated")
-        seen = (" on the sensor's axes, seen along the residuals' turning directions"
-                if self.series.projection is not None else "")
-        return (f"serially correlated, AR({self.order}){seen} with lag-1 correlation {self.lag1:.2f} "
-                f"(interval {self.bounds[0]:.2f}..{self.bounds[1]:.2f}; series in {self.series.source}): tests "
-                f"on whitened residuals, {slow}")
+            return (
+                f"no serial correlation found (AR order 0 by AIC; series in {self.series.source})"
+            )
+        slow = (
+            f"a slow shape sees about {self.effective_samples:.0f} independent samples of {self.n_obs}"
+            if self.inflation > 1
+            else "neighbouring samples anti-correlated"
+        )
+        seen = (
+            " on the sensor's axes, seen along the residuals' turning directions"
+            if self.series.projection is not None
+            else ""
+        )
+        return (
+            f"serially correlated, AR({self.order}){seen} with lag-1 correlation {self.lag1:.2f} "
+            f"(interval {self.bounds[0]:.2f}..{self.bounds[1]:.2f}; series in {self.series.source}): tests "
+            f"on whitened residuals, {slow}"
+        )
 
 
 class _ProjectedLik:
@@ -462,7 +496,9 @@ class _ProjectedLik:
     sum of the log innovation variances."""
 
     def __init__(self, r: np.ndarray, Q: np.ndarray, series: Series):
-        self.Z = np.column_stack([np.asarray(Q, float), np.asarray(r, float)])[series.order]   # [Q, r]
+        self.Z = np.column_stack([np.asarray(Q, float), np.asarray(r, float)])[
+            series.order
+        ]  # [Q, r]
         self.series = series
         self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
 
@@ -546,13 +582,23 @@ def _objective(loglik) -> tuple:
         kappa = np.tanh(a)
         value, grad = loglik.value_and_gradient(kappa)
         return -value, -grad * (1.0 - kappa * kappa)
+
     return fun, True
 
 
-def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | None,
-             max_order: int = MAX_ORDER, *, order: int | None = None, interval: bool = True,
-             basis: np.ndarray | None = None, prepared: _Prepared | None = None,
-             start_at: tuple | None = None, cross: tuple | None = None) -> NoiseModel:
+def estimate(
+    residuals: np.ndarray,
+    regressors: np.ndarray,
+    series: Series | None,
+    max_order: int = MAX_ORDER,
+    *,
+    order: int | None = None,
+    interval: bool = True,
+    basis: np.ndarray | None = None,
+    prepared: _Prepared | None = None,
+    start_at: tuple | None = None,
+    cross: tuple | None = None,
+) -> NoiseModel:
     """REML estimate of the AR noise model of ``residuals`` given the ``regressors`` a fit took out of
     them (module docstring), the order chosen by AIC over ``0..max_order``, or fixed at ``order``.
     ``interval``: also the profile-likelihood interval of ``kappa_1`` (``bounds``).  No series:
@@ -567,10 +613,12 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
     inc = series.order
     Q = basis_on(regressors, series, len(r)) if basis is None else basis
     if len(inc) - Q.shape[1] < MIN_SAMPLES:
-        return NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation")
+        return NoiseModel(
+            (), series, len(r), note="too few samples to estimate a serial correlation"
+        )
     if order is not None:
         max_order = int(order)
-    if series.projection is not None:                   # the sensor's AR(1), seen through the directions
+    if series.projection is not None:  # the sensor's AR(1), seen through the directions
         max_order = min(max_order, 1)
         loglik = _ProjectedLik(r, Q, series)
     else:
@@ -584,28 +632,47 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
         lim = np.arctanh(KAPPA_MAX)
         x0 = np.arctanh(np.clip(np.asarray(start_at, float)[:order], -KAPPA_MAX, KAPPA_MAX))
         fun, jac = _objective(loglik)
-        sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * order,
-                       options={"maxiter": 60})
+        sol = minimize(
+            fun,
+            x0,
+            jac=jac,
+            method="L-BFGS-B",
+            bounds=[(-lim, lim)] * order,
+            options={"maxiter": 60},
+        )
         best = (tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun))
         logliks.append(best[1])
-        max_order = 0                                  # skip the forward search
+        max_order = 0  # skip the forward search
     # the lowest kappa_1: -KAPPA_MAX, or 0 for a projected series on an irregular clock
-    low = 0.0 if series.projection is not None and not regular_clock(series) else -np.arctanh(KAPPA_MAX)
+    low = (
+        0.0
+        if series.projection is not None and not regular_clock(series)
+        else -np.arctanh(KAPPA_MAX)
+    )
     for p in range(1, max_order + 1):
         if p == 1:
-            sol = minimize_scalar(lambda a: -loglik((np.tanh(a),)),
-                                  bounds=(low, np.arctanh(KAPPA_MAX)), method="bounded",
-                                  options={"xatol": 1e-4})
+            sol = minimize_scalar(
+                lambda a: -loglik((np.tanh(a),)),
+                bounds=(low, np.arctanh(KAPPA_MAX)),
+                method="bounded",
+                options={"xatol": 1e-4},
+            )
             kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
         else:
             x0 = np.arctanh(np.clip(np.r_[start, 0.0], -KAPPA_MAX, KAPPA_MAX))
             lim = np.arctanh(KAPPA_MAX)
             fun, jac = _objective(loglik)
-            sol = minimize(fun, x0, jac=jac, method="L-BFGS-B", bounds=[(-lim, lim)] * p,
-                           options={"maxiter": 60})
+            sol = minimize(
+                fun,
+                x0,
+                jac=jac,
+                method="L-BFGS-B",
+                bounds=[(-lim, lim)] * p,
+                options={"maxiter": 60},
+            )
             kappa, ll = tuple(float(k) for k in np.tanh(sol.x)), -float(sol.fun)
             ll0 = loglik(np.r_[start, 0.0])
-            if ll0 > ll:                                # never worse than the previous order
+            if ll0 > ll:  # never worse than the previous order
                 kappa, ll = tuple(float(k) for k in np.r_[start, 0.0]), ll0
         logliks.append(ll)
         start = kappa
@@ -614,12 +681,12 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
             best = (kappa, ll)
             continue
         if aic >= aic_best:
-            break                                       # forward selection: stop at the first order that
-        best, aic_best = (kappa, ll), aic              # does not lower the AIC
+            break  # forward selection: stop at the first order that
+        best, aic_best = (kappa, ll), aic  # does not lower the AIC
     kappa, ll = best
     bounds = ()
     if kappa and interval:
-        drop = special.gammaincinv(0.5, KAPPA_LEVEL)     # chi2.ppf(KAPPA_LEVEL, 1) / 2
+        drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
         lim = np.arctanh(KAPPA_MAX)
         a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
 
@@ -633,13 +700,29 @@ def estimate(residuals: np.ndarray, regressors: np.ndarray, series: Series | Non
             else:
                 ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
         bounds = tuple(ends)
-    return NoiseModel(tuple(kappa), series, len(r), tuple(logliks), bounds=bounds, ml=loglik.ml(kappa),
-                      regressors=Q.shape[1])
+    return NoiseModel(
+        tuple(kappa),
+        series,
+        len(r),
+        tuple(logliks),
+        bounds=bounds,
+        ml=loglik.ml(kappa),
+        regressors=Q.shape[1],
+    )
 
 
-def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series | None, *,
-           order: int | None = None, interval: bool = True, bases: Bases | None = None,
-           start_at: tuple | None = None, cross: tuple = (None, None)) -> NoiseModel:
+def select(
+    residuals: np.ndarray,
+    base: np.ndarray,
+    extra: np.ndarray | None,
+    series: Series | None,
+    *,
+    order: int | None = None,
+    interval: bool = True,
+    bases: Bases | None = None,
+    start_at: tuple | None = None,
+    cross: tuple = (None, None),
+) -> NoiseModel:
     """The noise model around the better of two sets of regressors: ``base`` (the model's Jacobian) or
     ``base`` and ``extra`` (the structure shapes).  Each set gets its REML estimate (:func:`estimate`);
     the set with the lower BIC of the plain likelihood (:func:`criterion`) is used.
@@ -653,30 +736,73 @@ def select(residuals: np.ndarray, base: np.ndarray, extra: np.ndarray | None, se
     if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
     cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
-    mb = estimate(residuals, base, series, order=order, interval=interval, basis=qb, prepared=pb, start_at=start_at,
-                  cross=cross[0])
+    mb = estimate(
+        residuals,
+        base,
+        series,
+        order=order,
+        interval=interval,
+        basis=qb,
+        prepared=pb,
+        start_at=start_at,
+        cross=cross[0],
+    )
     if extra is None or not np.size(extra) or series is None:
         return replace(mb, around="model")
-    me = estimate(residuals, None if qe is not None else np.column_stack([base, extra]), series, order=order,
-                  interval=interval, basis=qe, prepared=pe, start_at=start_at, cross=cross[1])
+    me = estimate(
+        residuals,
+        None if qe is not None else np.column_stack([base, extra]),
+        series,
+        order=order,
+        interval=interval,
+        basis=qe,
+        prepared=pe,
+        start_at=start_at,
+        cross=cross[1],
+    )
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
         return replace(me, around="model and structure shapes")
     n = len(series.order)
-    better = criterion(me.ml, me.regressors + me.order, n) < criterion(mb.ml, mb.regressors + mb.order, n)
-    return replace(me, around="model and structure shapes") if better else replace(mb, around="model")
+    better = criterion(me.ml, me.regressors + me.order, n) < criterion(
+        mb.ml, mb.regressors + mb.order, n
+    )
+    return (
+        replace(me, around="model and structure shapes") if better else replace(mb, around="model")
+    )
 
 
-def select_many(E: np.ndarray, base: np.ndarray, extra: np.ndarray | None, series: Series, bases: Bases, *,
-                order: int, start_at: tuple | None = None) -> list[NoiseModel]:
+def select_many(
+    E: np.ndarray,
+    base: np.ndarray,
+    extra: np.ndarray | None,
+    series: Series,
+    bases: Bases,
+    *,
+    order: int,
+    start_at: tuple | None = None,
+) -> list[NoiseModel]:
     """:func:`select` (no interval) on each column of ``E`` (residual vectors in observation order: a
     bootstrap's replicates), the columns' cross-products with both regressor sets' likelihood parts
     (``bases`` of that ``order``: :func:`select_bases`) computed in one product per set."""
     Ze = np.asarray(E, float)[series.order]
-    parts = [pre.cross(Ze) if pre is not None and pre.P >= max(order, 1) else None
-             for pre in (bases.prepared_base, bases.prepared_extra)]
-    return [select(E[:, b], base, extra, series, order=order, interval=False, bases=bases, start_at=start_at,
-                   cross=tuple(None if c is None else (c[0][:, :, b], c[1][:, b]) for c in parts))
-            for b in range(E.shape[1])]
+    parts = [
+        pre.cross(Ze) if pre is not None and pre.P >= max(order, 1) else None
+        for pre in (bases.prepared_base, bases.prepared_extra)
+    ]
+    return [
+        select(
+            E[:, b],
+            base,
+            extra,
+            series,
+            order=order,
+            interval=False,
+            bases=bases,
+            start_at=start_at,
+            cross=tuple(None if c is None else (c[0][:, :, b], c[1][:, b]) for c in parts),
+        )
+        for b in range(E.shape[1])
+    ]
 
 
 def criterion(ml, parameters: int, n: int):
@@ -696,16 +822,23 @@ class Bases(NamedTuple):
     prepared_extra: "_Prepared | None" = None
 
 
-def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_obs: int,
-                 order: int | None = None) -> Bases:
+def select_bases(
+    base: np.ndarray, extra: np.ndarray | None, series: Series, n_obs: int, order: int | None = None
+) -> Bases:
     """The :class:`Bases` of :func:`select`'s regressors on ``series``; with ``order``, also their
     likelihood parts for that AR order."""
     qb = basis_on(base, series, n_obs)
-    qe = basis_on(np.column_stack([base, extra]), series, n_obs) if extra is not None and np.size(extra) else None
+    qe = (
+        basis_on(np.column_stack([base, extra]), series, n_obs)
+        if extra is not None and np.size(extra)
+        else None
+    )
     if order is None or series.projection is not None:
         return Bases(qb, qe)
     P = max(int(order), 1)
-    return Bases(qb, qe, _Prepared(qb, series, P), _Prepared(qe, series, P) if qe is not None else None)
+    return Bases(
+        qb, qe, _Prepared(qb, series, P), _Prepared(qe, series, P) if qe is not None else None
+    )
 
 
 #: The grid of lag-1 correlations on which :func:`ar1_grid` evaluates the likelihoods: uniform in
@@ -713,8 +846,13 @@ def select_bases(base: np.ndarray, extra: np.ndarray | None, series: Series, n_o
 AR1_GRID = np.tanh(np.linspace(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX), 241))
 
 
-def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray = AR1_GRID,
-             prepared: _Prepared | None = None) -> tuple:
+def ar1_grid(
+    E: np.ndarray,
+    basis: np.ndarray,
+    series: Series,
+    grid: np.ndarray = AR1_GRID,
+    prepared: _Prepared | None = None,
+) -> tuple:
     """REML and plain log likelihoods of AR(1) noise (module docstring) for many residual vectors at once,
     on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
     (:func:`basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
@@ -743,7 +881,9 @@ def ar1_grid(E: np.ndarray, basis: np.ndarray, series: Series, grid: np.ndarray 
     return reml, ml
 
 
-def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarray = AR1_GRID) -> np.ndarray:
+def select_ar1_many(
+    E: np.ndarray, bases: Bases, series: Series, grid: np.ndarray = AR1_GRID
+) -> np.ndarray:
     """:func:`select` at AR order 1 for many residual vectors at once (the columns of ``E``), the
     correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
     correlation of each vector."""
@@ -763,7 +903,9 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
         re_, me = ar1_grid(E, qe, series, grid, bases.prepared_extra)
     ie = np.argmax(re_, axis=0)
     n = len(series.order)
-    better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(mb[ib, cols], qb.shape[1] + 1, n)
+    better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(
+        mb[ib, cols], qb.shape[1] + 1, n
+    )
     return np.where(better, grid[ie], grid[ib])
 
 
@@ -773,7 +915,9 @@ def select_ar1_many(E: np.ndarray, bases: Bases, series: Series, grid: np.ndarra
 PROJECTED_GRID = AR1_GRID[::4]
 
 
-def projected_grid(E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID) -> list:
+def projected_grid(
+    E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID
+) -> list:
     """:func:`ar1_grid` for a series with a :class:`Projection`: for each regressor basis of ``bases``,
     ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one filter per grid point, shared."""
     Ze = np.asarray(E, float)[series.order]

@@ -12,7 +12,9 @@ from navbook.html_checks import check_html
 def test_check_html_flags_remote_assets(tmp_path):
     (tmp_path / "ok.html").write_text('<script src="_static/mathjax/tex-chtml.js"></script>')
     assert check_html(tmp_path) == 0
-    (tmp_path / "bad.html").write_text('<script src="https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex.js"></script>')
+    (tmp_path / "bad.html").write_text(
+        '<script src="https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex.js"></script>'
+    )
     assert check_html(tmp_path) == 1
 
 
@@ -31,7 +33,7 @@ def test_strip_metadata_removes_timings():
     nb.cells.append(cell)
     strip_metadata(nb)
     assert "papermill" not in nb.metadata and cell.metadata == {}
-    assert cell.execution_count == 3          # nbval needs execution counts to compare outputs
+    assert cell.execution_count == 3  # nbval needs execution counts to compare outputs
 
 
 def test_missing_figures_detects_plot_cells_without_images():
@@ -54,7 +56,7 @@ def test_execute_fails_loudly_on_a_failing_notebook(tmp_path, capsys):
     out = tmp_path / "out"
     assert execute([path], out, in_place=False) == 1
     assert "FAILED bad.ipynb" in capsys.readouterr().err
-    assert not (out / "bad.ipynb").exists()          # no half-executed notebook lands in the book
+    assert not (out / "bad.ipynb").exists()  # no half-executed notebook lands in the book
 
 
 # ------------------------------------------------------------------ the presentation checks of check-html
@@ -71,15 +73,19 @@ def page(body, heading="Results"):
 
 
 def test_check_page_accepts_a_clean_page():
-    body = (OUT.format(PRE.format("x" * MAX_PRE_CHARS)) +
-            '<figure id="fig-a"><div class="cell_output docutils container"><img alt="errors" src="a.png"/></div>'
-            '<figcaption><p>Caption.</p></figcaption></figure>'
-            '<div class="cell tag_nbval-ignore-output">3.2 s</div>')
+    body = (
+        OUT.format(PRE.format("x" * MAX_PRE_CHARS))
+        + '<figure id="fig-a"><div class="cell_output docutils container"><img alt="errors" src="a.png"/></div>'
+        "<figcaption><p>Caption.</p></figcaption></figure>"
+        '<div class="cell tag_nbval-ignore-output">3.2 s</div>'
+    )
     assert check_page(page(body)) == []
 
 
 def test_check_page_flags_a_wide_output_line_and_says_where():
-    problems = check_page(page(OUT.format(PRE.format("short\n" + "y" * (MAX_PRE_CHARS + 1))), "Table 3"))
+    problems = check_page(
+        page(OUT.format(PRE.format("short\n" + "y" * (MAX_PRE_CHARS + 1))), "Table 3")
+    )
     assert len(problems) == 1
     assert f"{MAX_PRE_CHARS + 1} characters" in problems[0] and "Table 3" in problems[0]
 
@@ -126,16 +132,35 @@ def _claim(text, reproduced, reading="as printed", source="paper"):
     interval = {True: [0.2, 0.5], False: [1.5, 2.0], None: [0.5, 1.5]}[reproduced]
     from navbook import report
     from navlib import verdicts
-    c = report.Claim(text, "-0.22..0.20 deg", reading=reading, source=source, statistic="rms, deg",
-                     estimate=verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20),
-                     boundary=1.0, holds_when="below", unit="deg")
+
+    c = report.Claim(
+        text,
+        "-0.22..0.20 deg",
+        reading=reading,
+        source=source,
+        statistic="rms, deg",
+        estimate=verdicts.Estimate(sum(interval) / 2, *interval, "median over runs", 20),
+        boundary=1.0,
+        holds_when="below",
+        unit="deg",
+    )
     return c.record()
 
 
 def test_api_markdown_lists_every_navlib_module():
     mods = navlib_modules()
-    assert {"navlib.angles", "navlib.claims", "navbook.report", "navbook.landing", "navlib.studies.compass"} <= set(mods)
-    assert not [m for m in mods if m in ("navlib.report", "navlib.booktools", "navlib.grid", "navbook.booktools")]
+    assert {
+        "navlib.angles",
+        "navlib.claims",
+        "navbook.report",
+        "navbook.landing",
+        "navlib.studies.compass",
+    } <= set(mods)
+    assert not [
+        m
+        for m in mods
+        if m in ("navlib.report", "navlib.booktools", "navlib.grid", "navbook.booktools")
+    ]
     assert "navlib.__main__" not in mods
     md = api_markdown(mods)
     assert md.count(".. automodule:: ") == len(mods)
@@ -143,10 +168,21 @@ def test_api_markdown_lists_every_navlib_module():
 
 # ------------------------------------------------------------------ results check
 def _results(rms=4.2, verdict=False):
-    return {"chapter": "compass", "unit": "deg",
-            "methods": {"ADE-BP": {"median_rms_deg": rms, "p10_rms_deg": 3.0, "p90_rms_deg": 5.0,
-                                   "median_min_deg": -9.0, "median_max_deg": 8.0, "n_seeds": 20}},
-            "claims": [_claim("ADE-BP beats DE-BP", verdict)]}
+    return {
+        "chapter": "compass",
+        "unit": "deg",
+        "methods": {
+            "ADE-BP": {
+                "median_rms_deg": rms,
+                "p10_rms_deg": 3.0,
+                "p90_rms_deg": 5.0,
+                "median_min_deg": -9.0,
+                "median_max_deg": 8.0,
+                "n_seeds": 20,
+            }
+        },
+        "claims": [_claim("ADE-BP beats DE-BP", verdict)],
+    }
 
 
 def test_validate_results_checks_the_schema():
@@ -160,11 +196,21 @@ def test_validate_results_checks_the_schema():
     assert validate_results({"chapter": "compass", "claims": []}, "compass.json")
 
 
-@pytest.mark.parametrize("field,value,message", [
-    ("source", "ours", "source"), ("rule", "eyeball", "rule"), ("interval", [2.0, 1.0], "interval"),
-    ("holds_when", "left", "holds_when"), ("boundary", None, "boundary"), ("statistic", "", "statistic"),
-    ("estimate", 9.0, "outside its interval"), ("decided_by", "noise", "decided_by"),
-    ("floor", {"value": 0.1}, "floor"), ("ours", "", "ours")])
+@pytest.mark.parametrize(
+    "field,value,message",
+    [
+        ("source", "ours", "source"),
+        ("rule", "eyeball", "rule"),
+        ("interval", [2.0, 1.0], "interval"),
+        ("holds_when", "left", "holds_when"),
+        ("boundary", None, "boundary"),
+        ("statistic", "", "statistic"),
+        ("estimate", 9.0, "outside its interval"),
+        ("decided_by", "noise", "decided_by"),
+        ("floor", {"value": 0.1}, "floor"),
+        ("ours", "", "ours"),
+    ],
+)
 def test_validate_results_names_each_bad_claim_field(field, value, message):
     res = _results()
     res["claims"][0][field] = value
@@ -180,22 +226,31 @@ def test_a_hand_edited_verdict_is_rejected(verdict):
     for other in {True, False, None} - {verdict}:
         edited = json.loads(json.dumps(res))
         edited["claims"][0]["reproduced"] = other
-        edited["claims"][0]["verdict"] = {True: "reproduced", False: "not reproduced",
-                                          None: "cannot be judged"}[other]
+        edited["claims"][0]["verdict"] = {
+            True: "reproduced",
+            False: "not reproduced",
+            None: "cannot be judged",
+        }[other]
         edited["claims"][0]["why"] = "edited by hand"
         assert any("does not follow" in p for p in validate_results(edited, "compass.json"))
 
 
 def test_a_floor_on_the_wrong_side_makes_a_stored_claim_undecidable():
-    res = _results(verdict=False)                       # interval beyond the boundary
+    res = _results(verdict=False)  # interval beyond the boundary
     c = res["claims"][0]
-    c.update(estimate=1.1, interval=[1.05, 1.15])       # ... but within the floor 1.2
+    c.update(estimate=1.1, interval=[1.05, 1.15])  # ... but within the floor 1.2
     c["floor"] = {"value": 1.2, "assumption": "sensor noise 3 ug", "needs": "noise below 2.5 ug"}
     assert any("does not follow" in p for p in validate_results(res, "compass.json"))
     c["floor"]["interval"] = [1.3, 1.1]
     assert any("floor interval" in p for p in validate_results(res, "compass.json"))
     c["floor"]["interval"] = [1.1, 1.3]
-    c.update(reproduced=None, verdict="cannot be judged", basis="noise floor", reason="noise floor", why="floor")
+    c.update(
+        reproduced=None,
+        verdict="cannot be judged",
+        basis="noise floor",
+        reason="noise floor",
+        why="floor",
+    )
     assert validate_results(res, "compass.json") == []
     c["why"] = ""
     assert any("without a why" in p for p in validate_results(res, "compass.json"))
@@ -221,7 +276,7 @@ def test_check_results_fails_without_reference_and_passes_with_it(tmp_path, caps
     assert "missing reference" in capsys.readouterr().err
     (ref / "compass.json").write_text(json.dumps(_results()))
     assert check_results(fresh, ref, [nb]) == 0
-    (fresh / "compass.json").unlink()                      # a stale fresh folder cannot pass
+    (fresh / "compass.json").unlink()  # a stale fresh folder cannot pass
     assert check_results(fresh, ref, [nb]) == 1
 
 
@@ -240,30 +295,37 @@ def test_execute_in_place_stores_the_results_file_beside_the_notebook(tmp_path, 
 
     monkeypatch.delenv(RESULTS_ENV, raising=False)
     nb = nbformat.v4.new_notebook()
-    nb.cells.append(nbformat.v4.new_code_cell(
-        "import os\n"
-        "from navbook import report\n"
-        "from navlib import verdicts\n"
-        "p = report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
-        "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])\n"
-        f"print(os.environ.get({RESULTS_ENV!r}))\n"
-        "print(p.resolve())"))
+    nb.cells.append(
+        nbformat.v4.new_code_cell(
+            "import os\n"
+            "from navbook import report\n"
+            "from navlib import verdicts\n"
+            "p = report.write_results('demo_chapter', claims=[report.Claim('c', 'p', statistic='x, deg', "
+            "estimate=verdicts.exact(0.5), boundary=1.0, holds_when='below')])\n"
+            f"print(os.environ.get({RESULTS_ENV!r}))\n"
+            "print(p.resolve())"
+        )
+    )
     path = tmp_path / "demo.ipynb"
     nbformat.write(nb, path)
     assert execute([path], None, in_place=True) == 0
     stored = json.loads((tmp_path / "results" / "demo_chapter.json").read_text())
     assert stored["claims"][0]["reproduced"] is True
     told, wrote = nbformat.read(path, as_version=4).cells[0].outputs[0]["text"].split()
-    assert told != "None" and Path(wrote) == Path(told).resolve() / "demo_chapter.json"   # where it was told
-    assert Path(told).resolve() != (tmp_path / "results").resolve()                       # not its ./results
-    assert not Path(told).exists()                                                        # a temporary folder
-    assert RESULTS_ENV not in os.environ                                                  # restored
+    assert (
+        told != "None" and Path(wrote) == Path(told).resolve() / "demo_chapter.json"
+    )  # where it was told
+    assert Path(told).resolve() != (tmp_path / "results").resolve()  # not its ./results
+    assert not Path(told).exists()  # a temporary folder
+    assert RESULTS_ENV not in os.environ  # restored
 
 
 def test_check_html_reads_source_listings_only_for_network_assets(tmp_path):
     listing = tmp_path / "_modules" / "navbook"
     listing.mkdir(parents=True)
-    (listing / "html_checks.html").write_text('<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>')
+    (listing / "html_checks.html").write_text(
+        '<pre>if "Traceback (most recent call last)" in text: # NBVAL_</pre>'
+    )
     assert check_html(tmp_path) == 0
     (listing / "cli.html").write_text('<script src="https://cdn.example/x.js"></script>')
     assert check_html(tmp_path) == 1
@@ -290,11 +352,15 @@ def test_chapter_pages_must_close_with_what_the_chapter_showed():
     from navbook.html_checks import check_chapter_closing
 
     def box(title, paper, book=None):
-        tallies = f"<p>The paper's claims: {paper[0]} of {sum(paper)} reproduced, {paper[1]} not reproduced, " \
-                  f"{paper[2]} cannot be judged</p>"
+        tallies = (
+            f"<p>The paper's claims: {paper[0]} of {sum(paper)} reproduced, {paper[1]} not reproduced, "
+            f"{paper[2]} cannot be judged</p>"
+        )
         if book:
-            tallies += f"<p>The book's own claims: {book[0]} of {sum(book)} reproduced, {book[1]} not " \
-                       f"reproduced, {book[2]} cannot be judged</p>"
+            tallies += (
+                f"<p>The book's own claims: {book[0]} of {sum(book)} reproduced, {book[1]} not "
+                f"reproduced, {book[2]} cannot be judged</p>"
+            )
         return f'<div class="admonition"><p class="admonition-title">{title}</p>{tallies}</div>'
 
     cell = '<div class="cell docutils container"><pre>x = 1</pre></div>'
@@ -317,11 +383,15 @@ def test_compare_results_checks_intervals_except_for_a_volatile_timing():
     assert any("interval" in p for p in compare_results(moved, ref, "c"))
     vol_ref, vol = json.loads(json.dumps(ref)), json.loads(json.dumps(moved))
     vol_ref["claims"][0]["volatile"] = vol["claims"][0]["volatile"] = True
-    assert compare_results(vol, vol_ref, "c") == []                 # a timing's numbers may move
+    assert compare_results(vol, vol_ref, "c") == []  # a timing's numbers may move
     flipped = json.loads(json.dumps(vol))
-    flipped["claims"][0].update(_claim("ADE-BP beats DE-BP", True, reading=ref["claims"][0]["reading"]))
+    flipped["claims"][0].update(
+        _claim("ADE-BP beats DE-BP", True, reading=ref["claims"][0]["reading"])
+    )
     flipped["claims"][0]["volatile"] = True
-    assert any("verdict" in p for p in compare_results(flipped, vol_ref, "c"))    # its verdict may not
+    assert any(
+        "verdict" in p for p in compare_results(flipped, vol_ref, "c")
+    )  # its verdict may not
     assert any("volatile" in p for p in compare_results(vol, ref, "c"))
 
 
@@ -329,10 +399,20 @@ def test_compare_results_compares_tables_of_records_exactly(tmp_path):
     """write_results(tables=...) writes top-level lists (the compass chapter's "robustness"); a changed or
     missing record is a difference from the reference."""
     from navbook import report
-    claim = report.Claim("c", "p", statistic="x, deg", estimate=None, boundary=0.0, holds_when="above",
-                         why="no statistic")
+
+    claim = report.Claim(
+        "c",
+        "p",
+        statistic="x, deg",
+        estimate=None,
+        boundary=0.0,
+        holds_when="above",
+        why="no statistic",
+    )
     rows = [{"compass": "C1", "claim": "c", "reading": "r", "verdict": "reproduced"}]
-    path = report.write_results("demo", claims=[claim], folder=tmp_path, tables={"robustness": rows})
+    path = report.write_results(
+        "demo", claims=[claim], folder=tmp_path, tables={"robustness": rows}
+    )
     res = json.loads(path.read_text())
     assert res["robustness"] == rows
     other = json.loads(path.read_text())
@@ -345,8 +425,11 @@ def test_compare_results_compares_tables_of_records_exactly(tmp_path):
 
 def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run():
     from navbook.html_checks import check_api_page
-    ok = ("<dl><dt>loop SYSTEM FILE.csv --model START [--json] [--report DIR]</dt>"
-          "<dd><p>the whole loop</p></dd><dt>field --site LAT,LON [--date YYYY-MM-DD] [--json]</dt></dl>")
+
+    ok = (
+        "<dl><dt>loop SYSTEM FILE.csv --model START [--json] [--report DIR]</dt>"
+        "<dd><p>the whole loop</p></dd><dt>field --site LAT,LON [--date YYYY-MM-DD] [--json]</dt></dl>"
+    )
     assert check_api_page(ok, cli_page=True) == []
     dash = ok.replace("[--json] [--report", "[\u2013json] [--report")
     assert any("typographic" in p for p in check_api_page(dash, cli_page=True))
@@ -356,15 +439,17 @@ def test_api_page_check_finds_split_descriptions_and_commands_that_would_not_run
     assert any("no option --reprot" in p for p in check_api_page(unknown, cli_page=True))
     split = '<dt class="field-odd">Type<span class="colon">:</span></dt><dd>The output must</dd>'
     assert check_api_page(split) == ["1 description(s) split into a 'Type:' field"]
-    assert check_api_page(ok) == []                       # commands are checked on the CLI page only
+    assert check_api_page(ok) == []  # commands are checked on the CLI page only
 
 
 def test_commands_on_the_cli_page_are_run_with_help():
     """Each command the page shows runs ``python -m navlib COMMAND --help`` in a new process: a command
     that fails, or whose help lacks an option the page shows, is a problem."""
     from navbook.html_checks import _help_problems
+
     assert _help_problems({"loop": {"--json", "--report"}, "field": {"--site"}}) == []
     assert _help_problems({"loop": {"--json", "--jsonl"}}) == [
-        "'navlib loop --help' does not show --jsonl, which the page shows"]
+        "'navlib loop --help' does not show --jsonl, which the page shows"
+    ]
     bad = _help_problems({"no-such-command": {"--json"}})
     assert len(bad) == 1 and "failed (exit 2)" in bad[0]

@@ -1,5 +1,6 @@
 """The book's figure style: the layout decision, legends outside the data, the loop staircase and its step
 labels, the shrunk-figure check of the screenshots, readable table labels."""
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -14,7 +15,14 @@ from navlib import plotstyle as rs  # noqa: E402
 from navbook.screenshots import shrunk_figures  # noqa: E402
 from navlib.errors import InputError  # noqa: E402
 from navlib.workbench.fit import fit_model, simulate  # noqa: E402
-from navlib.workbench.loop import LoopResult, loop, loop_figure, noise_band, staircase_figure, step_labels  # noqa: E402
+from navlib.workbench.loop import (
+    LoopResult,
+    loop,
+    loop_figure,
+    noise_band,
+    staircase_figure,
+    step_labels,
+)  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -23,9 +31,18 @@ def _close_figures():
     plt.close("all")
 
 
-@pytest.mark.parametrize("n, width, expected", [
-    (1, 7.5, (1, 1)), (2, 7.5, (1, 2)), (3, 7.5, (3, 1)), (4, 7.5, (2, 2)), (5, 7.5, (5, 1)),
-    (3, 10.2, (1, 3)), (2, 6.0, (2, 1))])
+@pytest.mark.parametrize(
+    "n, width, expected",
+    [
+        (1, 7.5, (1, 1)),
+        (2, 7.5, (1, 2)),
+        (3, 7.5, (3, 1)),
+        (4, 7.5, (2, 2)),
+        (5, 7.5, (5, 1)),
+        (3, 10.2, (1, 3)),
+        (2, 6.0, (2, 1)),
+    ],
+)
 def test_panels_are_stacked_when_side_by_side_they_would_be_too_narrow(n, width, expected):
     rows, cols = rs.panel_grid(n, width)
     assert (rows, cols) == expected
@@ -40,10 +57,12 @@ def test_panel_grid_rejects_bad_input_naming_the_parameter():
 
 
 def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
-    monkeypatch.setattr(tables, "READABLE_TABLES", False)          # restored after the test
+    monkeypatch.setattr(tables, "READABLE_TABLES", False)  # restored after the test
     with plt.rc_context():
         report.use_style()
-        assert plt.rcParams["font.size"] >= 11 and plt.rcParams["figure.figsize"][0] <= rs.MAX_WIDTH_IN
+        assert (
+            plt.rcParams["font.size"] >= 11 and plt.rcParams["figure.figsize"][0] <= rs.MAX_WIDTH_IN
+        )
         assert rs.MAX_WIDTH_IN * rs.DPI <= rs.COLUMN_PX
         fig, axes = rs.panels(2)
         for ax in axes:
@@ -55,9 +74,9 @@ def test_style_fits_the_column_and_the_legend_sits_below_the_data(monkeypatch):
         r = fig.canvas.get_renderer()
         box, ticks = leg.get_window_extent(r), axes[0].get_tightbbox(r)
         label = axes[0].xaxis.label.get_window_extent(r)
-        assert box.y1 < axes[0].get_window_extent(r).y0 and box.y1 <= label.y0   # under the x label
+        assert box.y1 < axes[0].get_window_extent(r).y0 and box.y1 <= label.y0  # under the x label
         assert fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN and ticks.y0 >= 0
-    assert tables.READABLE_TABLES                                  # use_style turned readable tables on
+    assert tables.READABLE_TABLES  # use_style turned readable tables on
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +86,7 @@ def out_of_order():
     f0 = fit_model("compass", data, ["misalignment"])
     f1 = f0.add("soft_iron")
     f2 = f1.add("hard_iron")
-    assert f2.effects[-1] == "soft_iron"          # the trap the old labels fell into
+    assert f2.effects[-1] == "soft_iron"  # the trap the old labels fell into
     return LoopResult([f0, f1, f2], [None, None, None])
 
 
@@ -82,25 +101,30 @@ def test_the_staircase_shows_every_step_on_a_log_axis_with_the_noise_band():
     res = loop("compass", data, ["misalignment"])
     lo, hi = noise_band(res)
     rich = res.screening.rich
-    assert lo < np.sqrt(rich.rss / (rich.n - rich.n_params)) < hi < 1.3 * lo    # 95 %, 240 readings
-    assert lo < res.final.loo_rms < hi                         # the loop ends at the noise floor
+    assert lo < np.sqrt(rich.rss / (rich.n - rich.n_params)) < hi < 1.3 * lo  # 95 %, 240 readings
+    assert lo < res.final.loo_rms < hi  # the loop ends at the noise floor
     fig = staircase_figure(res)
     ax = fig.axes[0]
     assert ax.get_yscale() == "log" and fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN
     assert [t.get_text() for t in ax.get_xticklabels()] == step_labels(res)
     assert ax.get_legend() is not None and {"rms", "held-out rms", "noise floor (95 %)"} <= {
-        t.get_text() for t in ax.get_legend().get_texts()}
-    heights = ax.patches[0].get_data().values                 # the stairs
+        t.get_text() for t in ax.get_legend().get_texts()
+    }
+    heights = ax.patches[0].get_data().values  # the stairs
     assert np.allclose(heights, [f.rms for f in res.fits])
-    assert all(t.get_rotation() == 0 for t in ax.get_xticklabels())      # three steps: labels fit
+    assert all(t.get_rotation() == 0 for t in ax.get_xticklabels())  # three steps: labels fit
     long = staircase_figure(res, title="compass: unexplained structure: heading harmonic 3; " * 3)
-    lines = long.axes[0].get_title().splitlines()      # a long outcome wraps: the figure stays in the column
+    lines = (
+        long.axes[0].get_title().splitlines()
+    )  # a long outcome wraps: the figure stays in the column
     assert len(lines) > 1 and max(map(len, lines)) <= 70
 
 
 def test_staircase_slants_labels_that_do_not_fit_their_step():
     fig, ax = rs.panels(1)
-    rs.staircase(ax, ["start: bias"] + [f"+ effect_number_{i}" for i in range(9)], np.geomspace(1, 0.1, 10))
+    rs.staircase(
+        ax, ["start: bias"] + [f"+ effect_number_{i}" for i in range(9)], np.geomspace(1, 0.1, 10)
+    )
     assert {t.get_rotation() for t in ax.get_xticklabels()} == {30.0}
     assert ax.get_xticklabels()[1].get_text() == "+ effect_number_0"
 
@@ -115,8 +139,12 @@ def test_staircase_rejects_what_a_log_axis_cannot_show():
 
 @pytest.mark.parametrize("shown, flagged", [(750, False), (563, False), (562, True), (300, True)])
 def test_a_figure_shown_below_three_quarters_of_its_width_is_flagged(shown, flagged):
-    found = shrunk_figures([{"src": "a.png", "natural_px": 750, "shown_px": shown, "heading": "Fig"},
-                            {"src": "logo.png", "natural_px": 0, "shown_px": 0}])
+    found = shrunk_figures(
+        [
+            {"src": "a.png", "natural_px": 750, "shown_px": shown, "heading": "Fig"},
+            {"src": "logo.png", "natural_px": 0, "shown_px": 0},
+        ]
+    )
     assert [f["src"] for f in found] == (["a.png"] if flagged else [])
     if flagged:
         assert found[0]["share"] == round(shown / 750, 3) and found[0]["heading"] == "Fig"
@@ -126,18 +154,29 @@ def test_readable_labels_units_flat_rows_no_index_name_no_negative_zero():
     assert report.label("median_rms_deg") == "median RMS (deg)"
     assert report.label("drift_deg_h") == "drift (deg/h)"
     assert report.label("temperature_c") == "temperature (degC)"
-    assert report.label("RMS (deg/h)") == "RMS (deg/h)" and report.label(("a", "b_ug")) == "a b (ug)"
+    assert (
+        report.label("RMS (deg/h)") == "RMS (deg/h)" and report.label(("a", "b_ug")) == "a b (ug)"
+    )
     assert [report.no_negative_zero(t) for t in ("-0.000", "-0", "+0.00", "-0.001", "-10")] == [
-        "0.000", "0", "+0.00", "-0.001", "-10"]
-    df = pd.DataFrame({"rms_ug": [1.0, -0.0001]},
-                      index=pd.MultiIndex.from_tuples([("compass", "a"), ("compass", "b")]))
+        "0.000",
+        "0",
+        "+0.00",
+        "-0.001",
+        "-10",
+    ]
+    df = pd.DataFrame(
+        {"rms_ug": [1.0, -0.0001]},
+        index=pd.MultiIndex.from_tuples([("compass", "a"), ("compass", "b")]),
+    )
     text = repr(report.table(df, {"rms_ug": "{:.2f}"}, readable=True))
     assert "RMS (ug)" in text and "compass: a" in text and "-0.00" not in text and "0.00" in text
     named = pd.DataFrame({"value": [1.0]}, index=pd.Index(["k"], name="quantity"))
     lines = repr(report.table(named, readable=True)).splitlines()
-    assert len(lines) == 2 and lines[0].split() == ["quantity", "value"]      # no index-name row
-    assert len(repr(report.table(named)).splitlines()) == 3                    # the old table had one
-    steps = pd.DataFrame({"rms_deg": [0.5]}, index=pd.Index([0], name="step"))  # a numeric index level
+    assert len(lines) == 2 and lines[0].split() == ["quantity", "value"]  # no index-name row
+    assert len(repr(report.table(named)).splitlines()) == 3  # the old table had one
+    steps = pd.DataFrame(
+        {"rms_deg": [0.5]}, index=pd.Index([0], name="step")
+    )  # a numeric index level
     assert repr(report.table(steps, readable=True)).splitlines()[1].split() == ["0", "0.5"]
     with pytest.raises(InputError, match="RMS"):
         report.readable(pd.DataFrame({"rms_deg": [1], "RMS (deg)": [2]}))
@@ -145,7 +184,7 @@ def test_readable_labels_units_flat_rows_no_index_name_no_negative_zero():
 
 def test_step_labels_wrap_after_spaces_and_underscores_only():
     assert rs.wrap_label("+ scale_factor_temperature", 13) == "+ scale_\nfactor_\ntemperature"
-    assert rs.wrap_label("misalignment", 5) == "misalignment"                  # a word stays whole
+    assert rs.wrap_label("misalignment", 5) == "misalignment"  # a word stays whole
     assert rs.wrap_label("start: bias", 20) == "start: bias"
 
 
@@ -156,9 +195,11 @@ def test_known_noise_band_holds_95_percent_of_correct_models_rms():
     n, p, sigma = 60, 4, 0.3
     X = rng.normal(size=(n, p))
     lo, hi = known_noise_band(sigma, n, p)
-    y = (X @ rng.normal(size=p))[:, None] + sigma * rng.normal(size=(n, 2000))   # 2000 noisy data sets
+    y = (X @ rng.normal(size=p))[:, None] + sigma * rng.normal(
+        size=(n, 2000)
+    )  # 2000 noisy data sets
     resid = y - X @ np.linalg.lstsq(X, y, rcond=None)[0]
-    rms = np.sqrt(np.mean(resid ** 2, axis=0))
+    rms = np.sqrt(np.mean(resid**2, axis=0))
     share = np.mean((rms >= lo) & (rms <= hi))
     assert 0.93 < share < 0.97
     with pytest.raises(InputError, match="n_params"):
@@ -187,17 +228,22 @@ def test_a_staircase_summary_draws_the_same_picture_and_pickles():
     assert st.outcome == res.outcome() and st.floor_label == "noise floor (95 %)"
     a, b = staircase_figure(res).axes[0], staircase_figure(st).axes[0]
     assert np.allclose(a.patches[0].get_data().values, b.patches[0].get_data().values)
-    assert [t.get_text() for t in a.get_xticklabels()] == [t.get_text() for t in b.get_xticklabels()]
-    assert len(b.lines) == 1                                               # the held-out markers
+    assert [t.get_text() for t in a.get_xticklabels()] == [
+        t.get_text() for t in b.get_xticklabels()
+    ]
+    assert len(b.lines) == 1  # the held-out markers
     bare = Staircase(st.labels, st.rms, None, None, "", st.unit, "no held-out set")
     ax = staircase_figure(bare).axes[0]
     assert len(ax.lines) == 0 and {t.get_text() for t in ax.get_legend().get_texts()} == {"rms"}
     grid = staircase_grid({"trial one": res, "trial two": st, "trial three": bare})
     axes = [x for x in grid.axes if x.get_visible() and x.axison]
     assert len(axes) == 3 and grid.get_size_inches()[0] <= rs.MAX_WIDTH_IN
-    assert grid.get_size_inches()[1] <= 2 * 2.6 + 0.5 + 1e-9           # two rows: panels do not grow it
+    assert grid.get_size_inches()[1] <= 2 * 2.6 + 0.5 + 1e-9  # two rows: panels do not grow it
     assert all(x.get_legend() is None for x in axes) and len(grid.legends) == 1
-    assert axes[0].get_title().startswith("trial one") and "+" not in axes[0].get_xticklabels()[1].get_text()
+    assert (
+        axes[0].get_title().startswith("trial one")
+        and "+" not in axes[0].get_xticklabels()[1].get_text()
+    )
     with pytest.raises(InputError, match="no loop"):
         staircase_grid({})
 
@@ -213,6 +259,6 @@ def test_report_figure_panels_span_the_column():
     fig.draw_without_rendering()
     boxes = [ax.get_position() for ax in fig.axes]
     assert len(boxes) == 3 and fig.get_size_inches()[0] <= rs.MAX_WIDTH_IN
-    assert all(b.width > 0.8 for b in boxes)                                # stacked, not side by side
+    assert all(b.width > 0.8 for b in boxes)  # stacked, not side by side
     labels = [t.get_text() for ax in fig.axes[1:] for t in ax.get_legend().get_texts()]
     assert max(map(len, labels)) <= 22 and "step 0" in labels

@@ -49,18 +49,57 @@ The modules, each importing only those listed before it:
 Every name the chapter and the tests use is re-exported here: ``from navlib.studies import accelerometer as
 D; D.run_chapter(...)``.
 """
+
 # re-exported: the names the chapter and the tests use (ruff: F401 would call them unused)
-from .parameters import (BATCH_SPREADS, METHODS, MIN_SEEDS_FOR_CLAIMS, NEARLY_TWO_ORDERS, NOTEBOOK_KEYS,  # noqa: F401
-                         ORDER_OF_MAGNITUDE, PAPER_FILE, SIM_ENTROPY, SIM_PARTS, SPLIT_MODES, TUNERS, PaperDParams,
-                         _paper_value, paper_numbers)
+from .parameters import (
+    BATCH_SPREADS,
+    METHODS,
+    MIN_SEEDS_FOR_CLAIMS,
+    NEARLY_TWO_ORDERS,
+    NOTEBOOK_KEYS,  # noqa: F401
+    ORDER_OF_MAGNITUDE,
+    PAPER_FILE,
+    SIM_ENTROPY,
+    SIM_PARTS,
+    SPLIT_MODES,
+    TUNERS,
+    PaperDParams,
+    _paper_value,
+    paper_numbers,
+)
 from .simulation import random_split, samples, sim_seed, simulate, split, unit_b_coefficients  # noqa: F401
 from .models import PolyCompensator, fit_physical, grid_search, oracle, scm_objective  # noqa: F401
 from .runs import Chapter, Run, errors_long, metrics, run_chapter, run_seed, run_study  # noqa: F401
 from .floors import max_error_floor_ug, rmse_floor_ug  # noqa: F401
-from .figures import (drift_by_seed, drift_summary, fig2_output_drift, fig3_bias, fig4_scale_factor,  # noqa: F401
-                      fig8_residuals, fig9_unit_b)
+from .figures import (
+    drift_by_seed,
+    drift_summary,
+    fig2_output_drift,
+    fig3_bias,
+    fig4_scale_factor,  # noqa: F401
+    fig8_residuals,
+    fig9_unit_b,
+)
 from .batch_spread import _units_difference, spread_needed, unit_b_spread  # noqa: F401
-from .tables import (method_summary, noise_floor, noise_permitted, noise_table, per_seed, spread_summary,  # noqa: F401
-                     swarm_choices, table2, tuner_table, unit_b_table)
-from .claims import (claims, drift_claims, noise_claims, reading_claims, tuner_claims, two_orders_claims,  # noqa: F401
-                     unit_b_spread_claims, verdict_grid)
+from .tables import (
+    method_summary,
+    noise_floor,
+    noise_permitted,
+    noise_table,
+    per_seed,
+    spread_summary,  # noqa: F401
+    swarm_choices,
+    table2,
+    tuner_table,
+    unit_b_table,
+)
+from .claims import (
+    claims,
+    drift_claims,
+    noise_claims,
+    reading_claims,
+    tuner_claims,
+    two_orders_claims,  # noqa: F401
+    unit_b_spread_claims,
+    verdict_grid,
+)

@@ -1,6 +1,7 @@
 """Unit B as a function of the batch spread: the chapter's runs' models on unit B drawn at every spread
 (:func:`unit_b_spread`), and over many draws of unit B the spread at which the two units' difference
 alone reaches the paper's 9.3 ug (:func:`spread_needed`)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -13,8 +14,9 @@ from .parameters import BATCH_SPREADS, PaperDParams, _paper_value
 from .simulation import samples, sim_seed, unit_b_coefficients
 
 
-def unit_b_spread(runs: list, params: PaperDParams, spreads=BATCH_SPREADS, method: str = "IAFSA-SCM-ANFIS"
-                  ) -> pd.DataFrame:
+def unit_b_spread(
+    runs: list, params: PaperDParams, spreads=BATCH_SPREADS, method: str = "IAFSA-SCM-ANFIS"
+) -> pd.DataFrame:
     """Unit B as a function of the batch spread: for every run (seed) and spread, unit B drawn by
     :func:`~navlib.studies.accelerometer.simulation.unit_b_coefficients` (the same ``z`` at every spread) with the
     seed's unit-B noise, compensated with the run's ``method`` and unit A's exact model.  Per row: largest
@@ -27,15 +29,22 @@ def unit_b_spread(runs: list, params: PaperDParams, spreads=BATCH_SPREADS, metho
         for sp in spreads:
             coef_b = unit_b_coefficients(params, r.seed, float(sp))
             df = simulate_tumble(coef_b, params.experiment, sim_seed(r.seed, "noise_b"), "B")
-            b = samples(df, "B", ref)                       # the rows of df in order
+            b = samples(df, "B", ref)  # the rows of df in order
             X = b[["temperature_c", "output_mg"]].to_numpy()
             Xt = np.column_stack([b["temperature_c"], df["true_output_mg"]])
-            rows.append({"seed": r.seed, "spread": float(sp),
-                         "max drift before (mg)": float(np.max(np.abs(b["output_mg"] - b["target_mg"]))),
-                         f"{method} max |e| (ug)": 1000 * float(np.max(np.abs(r.models[method](X) - b["target_mg"]))),
-                         "exact model A max |e| (ug)": 1000 * float(np.max(np.abs(r.models["oracle"](X) - b["target_mg"]))),
-                         "units' difference (ug)": 1000 * float(np.max(np.abs(r.models["oracle"](Xt)
-                                                                              - b["target_true_mg"])))})
+            rows.append(
+                {
+                    "seed": r.seed,
+                    "spread": float(sp),
+                    "max drift before (mg)": float(np.max(np.abs(b["output_mg"] - b["target_mg"]))),
+                    f"{method} max |e| (ug)": 1000
+                    * float(np.max(np.abs(r.models[method](X) - b["target_mg"]))),
+                    "exact model A max |e| (ug)": 1000
+                    * float(np.max(np.abs(r.models["oracle"](X) - b["target_mg"]))),
+                    "units' difference (ug)": 1000
+                    * float(np.max(np.abs(r.models["oracle"](Xt) - b["target_true_mg"]))),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -57,8 +66,9 @@ def _units_difference(params: PaperDParams, draw: int, spreads) -> tuple:
     return np.array(drift), np.array(diff)
 
 
-def spread_needed(params: PaperDParams, paper: pd.DataFrame, spreads=BATCH_SPREADS, n_draws: int = 200
-                  ) -> pd.DataFrame:
+def spread_needed(
+    params: PaperDParams, paper: pd.DataFrame, spreads=BATCH_SPREADS, n_draws: int = 200
+) -> pd.DataFrame:
     """Per draw of unit B (draw ``k`` uses :func:`~navlib.studies.accelerometer.simulation.sim_seed` ``(k,
     "batch_b")``; no draw is picked): its largest drift before compensation at every spread (mg), and the spread at
     which the units' difference alone (unit A's exact model on unit B's noise-free outputs) first reaches the
@@ -78,7 +88,15 @@ def spread_needed(params: PaperDParams, paper: pd.DataFrame, spreads=BATCH_SPREA
             need = np.nan
         else:
             i = int(hit[0])
-            need = float(s0[i - 1] + (b - diff0[i - 1]) * (s0[i] - s0[i - 1]) / (diff0[i] - diff0[i - 1]))
-        rows.append({"draw": k, **{f"drift {s:g} (mg)": d for s, d in zip(sp, drift)},
-                     **{f"difference {s:g} (ug)": d for s, d in zip(sp, diff)}, "spread for 9.3 ug": need})
+            need = float(
+                s0[i - 1] + (b - diff0[i - 1]) * (s0[i] - s0[i - 1]) / (diff0[i] - diff0[i - 1])
+            )
+        rows.append(
+            {
+                "draw": k,
+                **{f"drift {s:g} (mg)": d for s, d in zip(sp, drift)},
+                **{f"difference {s:g} (ug)": d for s, d in zip(sp, diff)},
+                "spread for 9.3 ug": need,
+            }
+        )
     return pd.DataFrame(rows)

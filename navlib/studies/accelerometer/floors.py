@@ -1,6 +1,7 @@
 """The noise floors of the chapter's statistics (ug): what the exact model shows against the *measured*
 55 degC target, on held-out and training readings (:func:`rmse_floor_ug`) and as the largest error on a
 tumble data set (:func:`max_error_floor_ug`)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -66,10 +67,10 @@ def max_error_floor_ug(noise_ug: float, n_temperatures: int, n_positions: int) -
     check_param("n_positions", n_positions, lo=1, integer=True)
     if noise_ug == 0:
         return 0.0
-    z, w = np.polynomial.hermite_e.hermegauss(80)       # nodes for E[f(m)], m ~ N(0, 1)
+    z, w = np.polynomial.hermite_e.hermegauss(80)  # nodes for E[f(m)], m ~ N(0, 1)
     w = w / w.sum()
 
-    def cdf(x):       # in units of the noise
+    def cdf(x):  # in units of the noise
         inner = (stats.norm.cdf(x + z) - stats.norm.cdf(z - x)) ** n_temperatures
         return float(np.dot(w, inner)) ** n_positions - 0.5
 
@@ -83,10 +84,13 @@ def _floors(params: PaperDParams) -> dict:
     sigma = exp.noise_ug
     n_sp = exp.set_points_c.size
     n_train = n_sp - len(params.held_out_c) - len(params.check_c)
-    return {"test": rmse_floor_ug(sigma), "train": rmse_floor_ug(sigma, 1.0 / n_train),
-            "train_share": 1.0 / n_train,
-            "unit B max": max_error_floor_ug(sigma, n_sp - 1, exp.positions_deg.size),
-            "unit B shape": (n_sp - 1, exp.positions_deg.size)}
+    return {
+        "test": rmse_floor_ug(sigma),
+        "train": rmse_floor_ug(sigma, 1.0 / n_train),
+        "train_share": 1.0 / n_train,
+        "unit B max": max_error_floor_ug(sigma, n_sp - 1, exp.positions_deg.size),
+        "unit B shape": (n_sp - 1, exp.positions_deg.size),
+    }
 
 
 def _test_floor(params: PaperDParams) -> float:

@@ -2,6 +2,7 @@
 and draws, :class:`PaperDParams` (everything a reader may change, with
 :meth:`PaperDParams.from_notebook` for the chapter's papermill parameters) and paper D's printed numbers
 (:func:`paper_numbers`)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -23,7 +24,7 @@ TUNERS = ("AFSA-SCM-ANFIS", "grid-SCM-ANFIS")
 #: "Nearly two orders of magnitude" better than the single models (section 5.2): two defensible
 #: boundaries on the RMSE ratio, 50x (within a factor 2 of 100) and 10^1.5 = 31.6x (nearer to two
 #: orders than to one on a log scale).
-NEARLY_TWO_ORDERS = (50.0, 10 ** 1.5)
+NEARLY_TWO_ORDERS = (50.0, 10**1.5)
 SPLIT_MODES = ("temperatures", "random")
 #: "1-2 orders of magnitude" more accurate than the neural network and the FIS (section 5.2, conclusion 3):
 #: the claim holds when the RMSE ratio is above one order of magnitude.
@@ -45,22 +46,47 @@ BATCH_SPREADS = (0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.25)
 #: The accelerometer notebook's papermill parameters that build :class:`PaperDParams`, by the part they
 #: feed (notebook name -> field name): the experiment, the first unit's coefficients, the fish swarm,
 #: ANFIS's epochs, and the fields taken as they are (sequences as tuples).
-NOTEBOOK_EXPERIMENT = {"t_start_c": "t_start_c", "t_stop_c": "t_stop_c", "t_step_c": "t_step_c",
-                       "noise_ug": "noise_ug"}
+NOTEBOOK_EXPERIMENT = {
+    "t_start_c": "t_start_c",
+    "t_stop_c": "t_stop_c",
+    "t_step_c": "t_step_c",
+    "noise_ug": "noise_ug",
+}
 NOTEBOOK_COEFFICIENTS = {"bias_step_mg": "bias_step_mg"}
-NOTEBOOK_SWARM = {"n_fish": "n_fish", "generations": "generations", "try_number": "try_number",
-                  "visual": "visual", "step": "step", "crowd_delta": "delta", "improved": "improved"}
+NOTEBOOK_SWARM = {
+    "n_fish": "n_fish",
+    "generations": "generations",
+    "try_number": "try_number",
+    "visual": "visual",
+    "step": "step",
+    "crowd_delta": "delta",
+    "improved": "improved",
+}
 NOTEBOOK_ANFIS = {"anfis_epochs": "epochs"}
 NOTEBOOK_FIELDS = ("batch_spread_rel", "fis_radius", "max_rules")
 NOTEBOOK_TUPLES = ("held_out_c", "check_c", "seeds", "grid_squash")
 #: The notebook's other parameters (the noise study, unit B's sweep, the workbench trials, the workers):
 #: :meth:`PaperDParams.from_notebook` checks the first four as the notebook does and builds nothing from
 #: them.
-NOTEBOOK_OTHER = ("noise_levels", "batch_spreads", "unit_b_draws", "trial_ratios", "trial_seeds", "n_workers",
-                  "scheduler")
+NOTEBOOK_OTHER = (
+    "noise_levels",
+    "batch_spreads",
+    "unit_b_draws",
+    "trial_ratios",
+    "trial_seeds",
+    "n_workers",
+    "scheduler",
+)
 #: Every parameter of the accelerometer notebook's ``parameters`` cell.
-NOTEBOOK_KEYS = (*NOTEBOOK_EXPERIMENT, *NOTEBOOK_COEFFICIENTS, *NOTEBOOK_SWARM, *NOTEBOOK_ANFIS, *NOTEBOOK_FIELDS,
-                 *NOTEBOOK_TUPLES, *NOTEBOOK_OTHER)
+NOTEBOOK_KEYS = (
+    *NOTEBOOK_EXPERIMENT,
+    *NOTEBOOK_COEFFICIENTS,
+    *NOTEBOOK_SWARM,
+    *NOTEBOOK_ANFIS,
+    *NOTEBOOK_FIELDS,
+    *NOTEBOOK_TUPLES,
+    *NOTEBOOK_OTHER,
+)
 
 
 @dataclass(frozen=True)
@@ -87,7 +113,9 @@ class PaperDParams:
 
     def __post_init__(self):
         if self.split_mode not in SPLIT_MODES:
-            raise InputError(f"parameter split_mode={self.split_mode!r}: must be one of {SPLIT_MODES}")
+            raise InputError(
+                f"parameter split_mode={self.split_mode!r}: must be one of {SPLIT_MODES}"
+            )
         if not isinstance(self.tuners, (bool, np.bool_)):
             raise InputError(f"parameter tuners={self.tuners!r}: must be True or False")
         if len(self.grid_squash) < 1:
@@ -99,11 +127,15 @@ class PaperDParams:
             for t in getattr(self, name):
                 check_param(name, t, lo=-60, hi=130)
                 if not np.any(np.isclose(sp, t)):
-                    raise InputError(f"parameter {name}: {t:g} degC is not a set point of the experiment "
-                                     f"({sp[0]:g}..{sp[-1]:g} step {self.experiment.t_step_c:g})")
+                    raise InputError(
+                        f"parameter {name}: {t:g} degC is not a set point of the experiment "
+                        f"({sp[0]:g}..{sp[-1]:g} step {self.experiment.t_step_c:g})"
+                    )
                 if np.isclose(t, self.experiment.reference_c):
-                    raise InputError(f"parameter {name}: {t:g} degC is the reference temperature; keep it "
-                                     "for training")
+                    raise InputError(
+                        f"parameter {name}: {t:g} degC is the reference temperature; keep it "
+                        "for training"
+                    )
         if set(np.round(self.held_out_c, 6)) & set(np.round(self.check_c, 6)):
             raise InputError("parameters held_out_c and check_c share a temperature")
         n_train = sp.size - len(self.held_out_c) - len(self.check_c)
@@ -112,16 +144,22 @@ class PaperDParams:
         check_param("max_rules", self.max_rules, lo=1, hi=500, integer=True)
         check_param("poly_degree", self.poly_degree, lo=0, hi=6, integer=True)
         if n_train < self.poly_degree + 1:
-            raise InputError(f"parameters held_out_c/check_c: {n_train} training temperatures left, the "
-                             f"degree-{self.poly_degree} polynomials need at least {self.poly_degree + 1}")
+            raise InputError(
+                f"parameters held_out_c/check_c: {n_train} training temperatures left, the "
+                f"degree-{self.poly_degree} polynomials need at least {self.poly_degree + 1}"
+            )
         for name in ("radius_bounds", "squash_bounds"):
             lo, hi = getattr(self, name)
             check_param(name, lo, lo=0.01, hi=10)
             check_param(name, hi, lo=0.01, hi=10)
             if hi <= lo:
-                raise InputError(f"parameter {name}={getattr(self, name)!r}: low must be below high")
+                raise InputError(
+                    f"parameter {name}={getattr(self, name)!r}: low must be below high"
+                )
         if self.squash_bounds[0] < 1.0:
-            raise InputError(f"parameter squash_bounds={self.squash_bounds!r}: rb >= ra (squash >= 1)")
+            raise InputError(
+                f"parameter squash_bounds={self.squash_bounds!r}: rb >= ra (squash >= 1)"
+            )
         if len(self.seeds) < 1:
             raise InputError("parameter seeds: give at least one seed")
         for s in self.seeds:
@@ -144,13 +182,17 @@ class PaperDParams:
         """
         unknown = [k for k in cell if k not in NOTEBOOK_KEYS]
         if unknown:
-            raise InputError(f"parameter {unknown[0]!r}: not a parameter of the accelerometer notebook "
-                             f"(those are {', '.join(NOTEBOOK_KEYS)})")
+            raise InputError(
+                f"parameter {unknown[0]!r}: not a parameter of the accelerometer notebook "
+                f"(those are {', '.join(NOTEBOOK_KEYS)})"
+            )
         kw = {}
-        for field_name, make, names in (("coefficients", AccelCoefficients, NOTEBOOK_COEFFICIENTS),
-                                        ("experiment", TumbleExperiment, NOTEBOOK_EXPERIMENT),
-                                        ("anfis", AnfisOptions, NOTEBOOK_ANFIS),
-                                        ("swarm", FishSwarmParams, NOTEBOOK_SWARM)):
+        for field_name, make, names in (
+            ("coefficients", AccelCoefficients, NOTEBOOK_COEFFICIENTS),
+            ("experiment", TumbleExperiment, NOTEBOOK_EXPERIMENT),
+            ("anfis", AnfisOptions, NOTEBOOK_ANFIS),
+            ("swarm", FishSwarmParams, NOTEBOOK_SWARM),
+        ):
             given = {names[k]: cell[k] for k in names if k in cell}
             if given:
                 kw[field_name] = make(**given)
@@ -163,7 +205,7 @@ class PaperDParams:
             check_param("trial_ratios", r, lo=0, lo_open=True, hi=100)
         if "trial_seeds" in cell:
             check_param("trial_seeds", cell["trial_seeds"], lo=1, hi=200, integer=True)
-        if "noise_levels" in cell:        # how many levels: at least one
+        if "noise_levels" in cell:  # how many levels: at least one
             check_param("noise_levels", len(cell["noise_levels"]), lo=1, integer=True)
         for s in cell.get("batch_spreads", ()):
             check_param("batch_spreads", s, lo=0, lo_open=True, hi=1)
@@ -180,5 +222,7 @@ def paper_numbers(path=PAPER_FILE) -> pd.DataFrame:
 def _paper_value(paper: pd.DataFrame, key: str, method: str = "") -> float:
     g = paper[(paper["key"] == key) & (paper["method"].fillna("") == method)]
     if len(g) != 1:
-        raise InputError(f"{PAPER_FILE.name}: expected one row key={key!r} method={method!r}, found {len(g)}")
+        raise InputError(
+            f"{PAPER_FILE.name}: expected one row key={key!r} method={method!r}, found {len(g)}"
+        )
     return float(g["value_mg"].iloc[0])

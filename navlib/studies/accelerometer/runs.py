@@ -2,6 +2,7 @@
 engine tasks (:func:`run_study`), the whole chapter as one batch (:func:`run_chapter`: the main study with
 the other tuners, the noise levels and the random split), and the errors of the runs (:func:`metrics`,
 :func:`errors_long`)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
@@ -42,7 +43,9 @@ def run_seed(params: PaperDParams, seed: int, df: pd.DataFrame | None = None) ->
     df = simulate(params, seed) if df is None else df
     ref = params.experiment.reference_c
     a = samples(df, "A", ref)
-    a["set"] = split(a, params) if params.split_mode == "temperatures" else random_split(a, params, seed)
+    a["set"] = (
+        split(a, params) if params.split_mode == "temperatures" else random_split(a, params, seed)
+    )
     b = samples(df, "B", ref) if (df["unit"] == "B").any() else None
     X = a[["temperature_c", "output_mg"]].to_numpy()
     y = a["target_mg"].to_numpy()
@@ -56,20 +59,30 @@ def run_seed(params: PaperDParams, seed: int, df: pd.DataFrame | None = None) ->
     models["ANFIS"] = anfis(X[tr], y[tr], fis, params.anfis, check=(X[ck], y[ck])).fis
     fallback = float(np.sqrt(np.mean((X[ck, 1] - y[ck]) ** 2)))
     obj = scm_objective(X[tr], y[tr], X[ck], y[ck], params.max_rules, fallback)
-    res = minimise(obj, [params.radius_bounds, params.squash_bounds], params.swarm,
-                   seed=int(ss[1].generate_state(1)[0]))
+    res = minimise(
+        obj,
+        [params.radius_bounds, params.squash_bounds],
+        params.swarm,
+        seed=int(ss[1].generate_state(1)[0]),
+    )
     ra, sq = (float(v) for v in res.x)
     init = _genfis2_capped(X[tr], y[tr], ra, sq, params.max_rules)
     models["IAFSA-SCM-ANFIS"] = anfis(X[tr], y[tr], init, params.anfis, check=(X[ck], y[ck])).fis
     tuned = {"IAFSA-SCM-ANFIS": (ra, sq, res.n_evaluations, res.fun, init.n_rules)}
     if params.tuners:
-        plain = minimise(obj, [params.radius_bounds, params.squash_bounds], replace(params.swarm, improved=False),
-                         seed=int(ss[1].generate_state(1)[0]))
+        plain = minimise(
+            obj,
+            [params.radius_bounds, params.squash_bounds],
+            replace(params.swarm, improved=False),
+            seed=int(ss[1].generate_state(1)[0]),
+        )
         grid = grid_search(obj, params.radius_bounds, params.grid_squash, res.n_evaluations)
-        for name, (x, fun, n_ev) in (("AFSA-SCM-ANFIS", (plain.x, plain.fun, plain.n_evaluations)),
-                                     ("grid-SCM-ANFIS", grid)):
+        for name, (x, fun, n_ev) in (
+            ("AFSA-SCM-ANFIS", (plain.x, plain.fun, plain.n_evaluations)),
+            ("grid-SCM-ANFIS", grid),
+        ):
             fis_t = _genfis2_capped(X[tr], y[tr], float(x[0]), float(x[1]), params.max_rules)
-            if fis_t is None:       # every candidate had too many rules: MATLAB's default radius
+            if fis_t is None:  # every candidate had too many rules: MATLAB's default radius
                 fis_t = genfis2(X[tr], y[tr], params.fis_radius)
             models[name] = anfis(X[tr], y[tr], fis_t, params.anfis, check=(X[ck], y[ck])).fis
             tuned[name] = (float(x[0]), float(x[1]), int(n_ev), float(fun), fis_t.n_rules)
@@ -83,6 +96,7 @@ def run_seed(params: PaperDParams, seed: int, df: pd.DataFrame | None = None) ->
             b[f"pred_{name}"] = m(b[["temperature_c", "output_mg"]].to_numpy())
     n_rules = {"FIS": fis.n_rules, "ANFIS": fis.n_rules, **{k: v[4] for k, v in tuned.items()}}
     return Run(seed, a, b, ra, sq, n_rules, res.history, models, tuned)
+
 
 @dataclass
 class Chapter:
@@ -101,8 +115,13 @@ def _chapter_task(kind: str, params: PaperDParams, seed: int):
     return run if kind == "main" else errors_long([run])
 
 
-def run_chapter(params: PaperDParams = PaperDParams(), noise_levels=(), random_reading: bool = True,
-                workers: int = 1, scheduler: str | None = None) -> Chapter:
+def run_chapter(
+    params: PaperDParams = PaperDParams(),
+    noise_levels=(),
+    random_reading: bool = True,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> Chapter:
     """The chapter's runs as one batch of engine tasks (:mod:`navlib.engine`; one task per seed and variant, the
     most expensive first): the main study at ``params`` with the other tuners (``tuners=True``), the same seeds at
     every noise level of ``noise_levels`` (ug per reading; the ``params`` level is taken from the main runs) and, if
@@ -127,8 +146,14 @@ def run_chapter(params: PaperDParams = PaperDParams(), noise_levels=(), random_r
         p = replace(params, split_mode="random")
         tasks += [("random", p, s) for s in params.seeds]
         cost += [1.0] * len(params.seeds)
-    out = engine.run(_chapter_task, tasks, workers=workers, scheduler=scheduler, cost=cost,
-                     label="paper D seeds, noise levels, splits")
+    out = engine.run(
+        _chapter_task,
+        tasks,
+        workers=workers,
+        scheduler=scheduler,
+        cost=cost,
+        label="paper D seeds, noise levels, splits",
+    )
     n = len(params.seeds)
     runs = out[:n]
     err = errors_long(runs)
@@ -138,20 +163,31 @@ def run_chapter(params: PaperDParams = PaperDParams(), noise_levels=(), random_r
             e = err[~err["method"].isin(TUNERS)].copy()
         else:
             i = n + others.index(v) * n
-            e = pd.concat(out[i:i + n], ignore_index=True)
+            e = pd.concat(out[i : i + n], ignore_index=True)
         e.insert(0, "noise_ug", v)
         frames.append(e)
     noise_err = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
-    random_err = pd.concat(out[n + len(others) * n:], ignore_index=True) if random_reading else pd.DataFrame()
+    random_err = (
+        pd.concat(out[n + len(others) * n :], ignore_index=True)
+        if random_reading
+        else pd.DataFrame()
+    )
     return Chapter(runs, err, noise_err, random_err)
 
 
-def run_study(params: PaperDParams = PaperDParams(), workers: int = 1, scheduler: str | None = None) -> list[Run]:
+def run_study(
+    params: PaperDParams = PaperDParams(), workers: int = 1, scheduler: str | None = None
+) -> list[Run]:
     """One :class:`Run` per seed in ``params.seeds``, each a task of :mod:`navlib.engine` (``workers``
     local processes, or the cluster at ``scheduler``); every seed draws its own data and starts, so the
     runs do not depend on where they ran."""
-    return engine.run(run_seed, [(params, s) for s in params.seeds], workers=workers, scheduler=scheduler,
-                      label="paper D seeds")
+    return engine.run(
+        run_seed,
+        [(params, s) for s in params.seeds],
+        workers=workers,
+        scheduler=scheduler,
+        label="paper D seeds",
+    )
 
 
 # ----------------------------------------------------------------------------------------- metrics
@@ -161,8 +197,13 @@ def metrics(err_mg, target_mg) -> dict:
     e = np.asarray(err_mg, float)
     t = np.asarray(target_mg, float)
     rel = np.abs(e / t)
-    return {"ME_mg": float(np.max(np.abs(e))), "AE_mg": float(np.mean(e)), "MAXE": float(np.max(rel)),
-            "MARE": float(np.mean(rel)), "RMSE_mg": float(np.sqrt(np.mean(e ** 2)))}
+    return {
+        "ME_mg": float(np.max(np.abs(e))),
+        "AE_mg": float(np.mean(e)),
+        "MAXE": float(np.max(rel)),
+        "MARE": float(np.mean(rel)),
+        "RMSE_mg": float(np.sqrt(np.mean(e**2))),
+    }
 
 
 def errors_long(runs: list[Run]) -> pd.DataFrame:
@@ -179,5 +220,13 @@ def errors_long(runs: list[Run]) -> pd.DataFrame:
                 pred = g["output_mg"] if name == "uncompensated" else g[f"pred_{name}"]
                 m = metrics(pred - g["target_mg"], g["target_mg"])
                 m_true = np.sqrt(np.mean((pred - g["target_true_mg"]) ** 2))
-                rows.append({"seed": r.seed, "method": name, "set": s, **m, "RMSE_vs_true_mg": float(m_true)})
+                rows.append(
+                    {
+                        "seed": r.seed,
+                        "method": name,
+                        "set": s,
+                        **m,
+                        "RMSE_vs_true_mg": float(m_true),
+                    }
+                )
     return pd.DataFrame(rows)

@@ -17,13 +17,52 @@ navigation, with its tables, figures and claims (notebook ``notebooks/celestial.
 The modules import one way: parameters <- simulation <- scores <- tables <- claims.  Every public name is
 also here: ``from navlib.studies import celestial``, then ``celestial.simulate(spec)``.
 """
-from .parameters import (AXES, CASE_LABEL, CASES, KINDS, LM_NETS, NOTEBOOK_DEFAULTS, PHASES,  # noqa: F401
-                         RUN_KEYS, SEED_PARTS, SWEEP_METHODS, StudySpec, bp_params, seed_of)
+
+from .parameters import (
+    AXES,
+    CASE_LABEL,
+    CASES,
+    KINDS,
+    LM_NETS,
+    NOTEBOOK_DEFAULTS,
+    PHASES,  # noqa: F401
+    RUN_KEYS,
+    SEED_PARTS,
+    SWEEP_METHODS,
+    StudySpec,
+    bp_params,
+    seed_of,
+)
 from .simulation import StudyData, quiet_repeats_flown, simulate  # noqa: F401
 from .scores import per_run, phase_per_run, sweep_per_run  # noqa: F401
-from .tables import (accuracy_table, blind_effect_table, case_label, device_table, error_traces,  # noqa: F401
-                     innovation_test, lm_timing_pairs, loop_runs, loop_table, method_summary, named_effect,
-                     overall, paper_numbers, sweep_table, time_ratio, timing_pairs, trainlm_time, training_time,
-                     yaw_manoeuvre)
-from .claims import (FALSE_NAMING_BOUNDARY, MISSING_EFFECT, NAMED_RATE_BOUNDARY, TURN_CLAIM,  # noqa: F401
-                     claims, improvement_pct, results_extra, sweep_verdicts)
+from .tables import (
+    accuracy_table,
+    blind_effect_table,
+    case_label,
+    device_table,
+    error_traces,  # noqa: F401
+    innovation_test,
+    lm_timing_pairs,
+    loop_runs,
+    loop_table,
+    method_summary,
+    named_effect,
+    overall,
+    paper_numbers,
+    sweep_table,
+    time_ratio,
+    timing_pairs,
+    trainlm_time,
+    training_time,
+    yaw_manoeuvre,
+)
+from .claims import (
+    FALSE_NAMING_BOUNDARY,
+    MISSING_EFFECT,
+    NAMED_RATE_BOUNDARY,
+    TURN_CLAIM,  # noqa: F401
+    claims,
+    improvement_pct,
+    results_extra,
+    sweep_verdicts,
+)

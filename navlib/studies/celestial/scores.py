@@ -2,6 +2,7 @@
 attitude error per held-out run (:func:`per_run`), the same on the scale-factor sweep (:func:`sweep_per_run`)
 and over the turning or steady half of each S-turn run (:func:`phase_per_run`); and the rows of the
 innovation diagnosis with an effect outside the candidates or with nothing missing."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -43,8 +44,14 @@ def _by_angle(s: pd.DataFrame, angle: str) -> pd.Series:
     return out.sort_index()
 
 
-def sweep_per_run(data: StudyData, level_ppm: float, method: str, angle: str = "all",
-                  latency_ms: float | None = None, smear: float | None = None) -> pd.Series:
+def sweep_per_run(
+    data: StudyData,
+    level_ppm: float,
+    method: str,
+    angle: str = "all",
+    latency_ms: float | None = None,
+    smear: float | None = None,
+) -> pd.Series:
     """Like :func:`per_run` for the scale-factor sweep: one method's held-out S-turn error per run at one
     level (arcsec), indexed by (repeat, run); ``latency_ms`` and ``smear`` (arcsec per deg/s) select the
     star sensor's blind effects (default: the study's own)."""
@@ -55,16 +62,28 @@ def sweep_per_run(data: StudyData, level_ppm: float, method: str, angle: str = "
     latency_ms = data.spec.star_latency_ms if latency_ms is None else latency_ms
     smear = data.spec.star_smear_arcsec_per_deg_s if smear is None else smear
     s = data.sweep
-    s = s[(s["level_ppm"] == float(level_ppm)) & (s["latency_ms"] == float(latency_ms))
-          & (_smear(s) == float(smear)) & (s["method"] == method)]
+    s = s[
+        (s["level_ppm"] == float(level_ppm))
+        & (s["latency_ms"] == float(latency_ms))
+        & (_smear(s) == float(smear))
+        & (s["method"] == method)
+    ]
     if s.empty:
-        raise InputError(f"parameter level_ppm={level_ppm!r}, latency_ms={latency_ms!r}, smear={smear!r}: "
-                         "not in the sweep")
+        raise InputError(
+            f"parameter level_ppm={level_ppm!r}, latency_ms={latency_ms!r}, smear={smear!r}: "
+            "not in the sweep"
+        )
     return _by_angle(s, angle)
 
 
-def phase_per_run(data: StudyData, method: str, phase: str, angle: str = "yaw", level_ppm: float | None = None,
-                  repeats: int | None = None) -> pd.Series:
+def phase_per_run(
+    data: StudyData,
+    method: str,
+    phase: str,
+    angle: str = "yaw",
+    level_ppm: float | None = None,
+    repeats: int | None = None,
+) -> pd.Series:
     """One method's held-out S-turn error per run (arcsec) over the ``turning`` or the ``steady`` half of the
     run's scored epochs (:data:`~navlib.studies.celestial.parameters.PHASES`), indexed by (repeat, run):
     ``method`` ``"KF"`` or ``"BPKF 6 QR"``, at the gyro scale factor ``level_ppm`` (default: the study's own,

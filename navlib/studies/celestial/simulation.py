@@ -31,6 +31,7 @@ nothing missing for the tests' false-alarm rates (``_quiet``: filters and tests 
 sweep flies at 0 ppm; None: those alone); and the filter-residual features the paper rejects (case
 ``level_resid3``).
 """
+
 from __future__ import annotations
 
 import functools
@@ -47,11 +48,25 @@ from ...methods.mlp import train_mlp
 from ...seeding import sequence
 from ...sensors.strapdown import InitialError, strapdown
 from ...sensors.trajectory import generate
-from .parameters import (AXES, CASES, KINDS, LM_NETS, PHASES, SEED_PARTS, SWEEP_METHODS, StudySpec, bp_params,
-                         seed_of)
+from .parameters import (
+    AXES,
+    CASES,
+    KINDS,
+    LM_NETS,
+    PHASES,
+    SEED_PARTS,
+    SWEEP_METHODS,
+    StudySpec,
+    bp_params,
+    seed_of,
+)
 
 #: The sweep's BPKF methods and the case of the study's own scores each is taken from at the study's level.
-_SWEEP_CASE = {"BPKF 6 QR": "sturn_qr6", "BPKF 6 QR + 3 rates": "sturn_qr6_rate", "BPKF 45 raw": "sturn_raw45"}
+_SWEEP_CASE = {
+    "BPKF 6 QR": "sturn_qr6",
+    "BPKF 6 QR + 3 rates": "sturn_qr6_rate",
+    "BPKF 45 raw": "sturn_raw45",
+}
 
 
 @dataclass
@@ -60,25 +75,33 @@ class StudyData:
     training times, the innovation test and the settings."""
 
     spec: StudySpec
-    scores: pd.DataFrame                 # repeat, case, mode, method, axis, rms_arcsec (per test run)
-    traces: pd.DataFrame                 # t_s, case, method, axis, err_arcsec (repeat 0, test run 0)
-    timing: pd.DataFrame                 # repeat, case, n_in, seconds_per_pass, seconds_total
-    glr: pd.DataFrame                    # repeat, kind, candidate, chi2, p_bonferroni, significant, named
-    glr_runs: pd.DataFrame               # repeat, kind, runs (train/test), run, named (the test on one run)
-    timings: pd.DataFrame                # timing, n_in, seconds_per_pass (paired repetitions, level repeat 0)
-    rate_corr: pd.DataFrame              # repeat, kind, r, p
-    yaw_profile: pd.DataFrame            # t_s, yaw_deg, rate_deg_s (repeat 0 test path)
+    scores: pd.DataFrame  # repeat, case, mode, method, axis, rms_arcsec (per test run)
+    traces: pd.DataFrame  # t_s, case, method, axis, err_arcsec (repeat 0, test run 0)
+    timing: pd.DataFrame  # repeat, case, n_in, seconds_per_pass, seconds_total
+    glr: pd.DataFrame  # repeat, kind, candidate, chi2, p_bonferroni, significant, named
+    glr_runs: pd.DataFrame  # repeat, kind, runs (train/test), run, named (the test on one run)
+    timings: pd.DataFrame  # timing, n_in, seconds_per_pass (paired repetitions, level repeat 0)
+    rate_corr: pd.DataFrame  # repeat, kind, r, p
+    yaw_profile: pd.DataFrame  # t_s, yaw_deg, rate_deg_s (repeat 0 test path)
     seconds: dict = field(default_factory=dict)
-    lm_timing: pd.DataFrame | None = None  # timing, n_in, n_weights, seconds, epochs, stop (whole trainlm trainings)
-    sweep: pd.DataFrame | None = None      # level_ppm, latency_ms, smear, repeat, run, method, axis, rms_arcsec
-    diagnosis: pd.DataFrame | None = None  # level_ppm, latency_ms, smear, repeat, runs, run, named, flagged,
+    lm_timing: pd.DataFrame | None = (
+        None  # timing, n_in, n_weights, seconds, epochs, stop (whole trainlm trainings)
+    )
+    sweep: pd.DataFrame | None = (
+        None  # level_ppm, latency_ms, smear, repeat, run, method, axis, rms_arcsec
+    )
+    diagnosis: pd.DataFrame | None = (
+        None  # level_ppm, latency_ms, smear, repeat, runs, run, named, flagged,
+    )
     #                                        flagged_aug, tried, flagged_after, decision, remains (per run)
-    phases: pd.DataFrame | None = None     # level_ppm, repeat, run, method, phase, axis, rms_arcsec (held-out
+    phases: pd.DataFrame | None = (
+        None  # level_ppm, repeat, run, method, phase, axis, rms_arcsec (held-out
+    )
     #                                        S-turn runs, turning and steady epochs apart; KF and BPKF 6 QR)
 
 
 def _rms(err, mask):
-    return np.sqrt(np.mean(err[:, mask] ** 2, axis=1))          # (runs, 3)
+    return np.sqrt(np.mean(err[:, mask] ** 2, axis=1))  # (runs, 3)
 
 
 def _phase_rows(level_ppm: float, rep: int, method: str, err, rate_deg_s, mask) -> list[dict]:
@@ -93,8 +116,17 @@ def _phase_rows(level_ppm: float, rep: int, method: str, err, rate_deg_s, mask) 
         for phase, sel in zip(PHASES, (zi >= med, zi < med)):
             r = np.sqrt(np.mean(ei[sel] ** 2, axis=0))
             for a, ax in enumerate(AXES):
-                rows.append({"level_ppm": float(level_ppm), "repeat": rep, "run": i, "method": method,
-                             "phase": phase, "axis": ax, "rms_arcsec": float(r[a])})
+                rows.append(
+                    {
+                        "level_ppm": float(level_ppm),
+                        "repeat": rep,
+                        "run": i,
+                        "method": method,
+                        "phase": phase,
+                        "axis": ax,
+                        "rms_arcsec": float(r[a]),
+                    }
+                )
     return rows
 
 
@@ -102,8 +134,17 @@ def _score_rows(rows, rep, case, mode, method, err, mask, first_run=0):
     r = _rms(err, mask)
     for i in range(r.shape[0]):
         for a, ax in enumerate(AXES):
-            rows.append({"repeat": rep, "case": case, "mode": mode, "method": method, "run": first_run + i,
-                         "axis": ax, "rms_arcsec": float(r[i, a])})
+            rows.append(
+                {
+                    "repeat": rep,
+                    "case": case,
+                    "mode": mode,
+                    "method": method,
+                    "run": first_run + i,
+                    "axis": ax,
+                    "rms_arcsec": float(r[i, a]),
+                }
+            )
 
 
 def _paired_timings(spec: StudySpec, f_train) -> list[dict]:
@@ -112,12 +153,21 @@ def _paired_timings(spec: StudySpec, f_train) -> list[dict]:
     x = {45: km.gain_features(f_train, "raw45"), 6: km.gain_features(f_train, "qr6")}
     y = f_train.att_err_arcsec
     for n_in in (45, 6):
-        train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs), seed=seed_of(spec, 0, "timing", 0))
+        train_mlp(
+            x[n_in],
+            y,
+            bp_params(n_in, spec.n_hidden, spec.timing_epochs),
+            seed=seed_of(spec, 0, "timing", 0),
+        )
     rows = []
     for j in range(spec.n_timings):
-        for n_in in ((45, 6) if j % 2 == 0 else (6, 45)):
-            net = train_mlp(x[n_in], y, bp_params(n_in, spec.n_hidden, spec.timing_epochs),
-                            seed=seed_of(spec, 0, "timing", j))
+        for n_in in (45, 6) if j % 2 == 0 else (6, 45):
+            net = train_mlp(
+                x[n_in],
+                y,
+                bp_params(n_in, spec.n_hidden, spec.timing_epochs),
+                seed=seed_of(spec, 0, "timing", j),
+            )
             rows.append({"timing": j, "n_in": n_in, "seconds_per_pass": net.seconds_per_pass})
     return rows
 
@@ -128,10 +178,17 @@ def _lm_training_set(spec: StudySpec) -> tuple[dict, np.ndarray]:
     inputs per net and the targets, flown and filtered once per process (the timings time the trainings
     only)."""
     seed = seed_of(spec, 0, "noise", KINDS.index("level"), 0)
-    run = strapdown(generate(spec.profile("level", 0)), [seed], spec.imu, spec.star,
-                    InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec))
+    run = strapdown(
+        generate(spec.profile("level", 0)),
+        [seed],
+        spec.imu,
+        spec.star,
+        InitialError(spec.init_level_arcsec, spec.init_azimuth_arcsec),
+    )
     f = km.run_filter(run, spec.filter)
-    return {n_in: km.gain_features(f, feats)[0] for n_in, feats in LM_NETS.items()}, f.att_err_arcsec[0]
+    return {
+        n_in: km.gain_features(f, feats)[0] for n_in, feats in LM_NETS.items()
+    }, f.att_err_arcsec[0]
 
 
 def _lm_timing(spec: StudySpec, j: int) -> list[dict]:
@@ -143,19 +200,28 @@ def _lm_timing(spec: StudySpec, j: int) -> list[dict]:
     :func:`~navlib.studies.celestial.parameters.seed_of` (``trainlm``, ``j``, inputs)."""
     xs, y = _lm_training_set(spec)
     order = list(LM_NETS)
-    order = order[j % 3:] + order[:j % 3]
+    order = order[j % 3 :] + order[: j % 3]
     rows = []
     for n_in in order:
         x = xs[n_in]
         rng = np.random.default_rng(sequence(spec.seed, 0, SEED_PARTS["trainlm"], j, n_in))
         net = train_feedforward(x, y, spec.n_hidden, rng, activation="logsig")
-        rows.append({"timing": j, "n_in": n_in, "n_weights": net.info["n_weights"], "seconds": net.train_time_s,
-                     "epochs": net.info["epochs"], "stop": net.info["stop"]})
+        rows.append(
+            {
+                "timing": j,
+                "n_in": n_in,
+                "n_weights": net.info["n_weights"],
+                "seconds": net.train_time_s,
+                "epochs": net.info["epochs"],
+                "stop": net.info["stop"],
+            }
+        )
     return rows
 
 
-def _diagnose(rep: int, level_ppm: float, latency_ms: float, smear: float, train, f_train, test, f_test,
-              aug) -> list[dict]:
+def _diagnose(
+    rep: int, level_ppm: float, latency_ms: float, smear: float, train, f_train, test, f_test, aug
+) -> list[dict]:
     """The filter's innovations on each S-turn run alone, through the decision rule
     (:func:`navlib.methods.kalman.innovation_loop`): what the candidate test names (``named``), whether the
     generalised test flags structure (``flagged``), the candidate whose state was added (``tried``), whether
@@ -168,17 +234,30 @@ def _diagnose(rep: int, level_ppm: float, latency_ms: float, smear: float, train
         loop = km.innovation_loop(rr, ff)
         gen_aug = km.innovation_structure_per_run(rr, aa) if aa is not None else [None] * len(loop)
         for i, (d, sa) in enumerate(zip(loop, gen_aug)):
-            rows.append({"level_ppm": float(level_ppm), "latency_ms": float(latency_ms), "smear": float(smear),
-                         "repeat": rep, "runs": part, "run": i, "named": d.named_by_test or "none",
-                         "chi2": d.chi2, "flagged": d.flagged,
-                         "flagged_aug": np.nan if sa is None else float(sa.flagged),
-                         "tried": d.tried or "none",
-                         "flagged_after": np.nan if d.flagged_after is None else float(d.flagged_after),
-                         "decision": d.decision, "remains": ", ".join(d.remains)})
+            rows.append(
+                {
+                    "level_ppm": float(level_ppm),
+                    "latency_ms": float(latency_ms),
+                    "smear": float(smear),
+                    "repeat": rep,
+                    "runs": part,
+                    "run": i,
+                    "named": d.named_by_test or "none",
+                    "chi2": d.chi2,
+                    "flagged": d.flagged,
+                    "flagged_aug": np.nan if sa is None else float(sa.flagged),
+                    "tried": d.tried or "none",
+                    "flagged_after": np.nan if d.flagged_after is None else float(d.flagged_after),
+                    "decision": d.decision,
+                    "remains": ", ".join(d.remains),
+                }
+            )
     return rows
 
 
-def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0, smear: float = 0.0) -> dict:
+def _sweep(
+    spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0, smear: float = 0.0
+) -> dict:
     """One repeat of the S-turn simulation with the gyro scale factor set to ``level_ppm`` (a task of
     :func:`simulate`): the held-out scores of the KF, the three BPKF and the augmented KF.  The draws are
     those of the study's repeat ``rep`` (:func:`~navlib.studies.celestial.parameters.seed_of` does not depend
@@ -188,8 +267,12 @@ def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0,
     trained); ``smear``: the star sensor's rate-proportional error (arcsec per deg/s; a second effect outside
     the candidates, treated like the time offset).  Returns the score rows and the innovation diagnosis
     (``_diagnose``)."""
-    sp = replace(spec, gyro_scale_ppm=float(level_ppm), star_latency_ms=float(latency_ms),
-                 star_smear_arcsec_per_deg_s=float(smear))
+    sp = replace(
+        spec,
+        gyro_scale_ppm=float(level_ppm),
+        star_latency_ms=float(latency_ms),
+        star_smear_arcsec_per_deg_s=float(smear),
+    )
     train, test, _ = _runs(sp, "s_turns", rep)
     f_train, f_test = km.run_filter(train, spec.filter), km.run_filter(test, spec.filter)
     mask = f_test.t_s >= spec.settle_s
@@ -197,20 +280,39 @@ def _sweep(spec: StudySpec, rep: int, level_ppm: float, latency_ms: float = 0.0,
     errs = {"KF": f_test.att_err_arcsec, "augmented KF": aug.att_err_arcsec}
     net_seed = seed_of(spec, rep, "network")
     for method, feats in SWEEP_METHODS.items():
-        if feats is None or ((latency_ms or smear) and feats != "qr6_rate"):   # blind effects: the rate net only
+        if feats is None or (
+            (latency_ms or smear) and feats != "qr6_rate"
+        ):  # blind effects: the rate net only
             continue
-        net = train_mlp(km.gain_features(f_train, feats), f_train.att_err_arcsec,
-                        bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs), seed=net_seed)
+        net = train_mlp(
+            km.gain_features(f_train, feats),
+            f_train.att_err_arcsec,
+            bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs),
+            seed=net_seed,
+        )
         errs[method] = f_test.att_err_arcsec - net.predict(km.gain_features(f_test, feats))
     rows = []
     for method, err in errs.items():
         one = []
         _score_rows(one, rep, "s_turns", "held-out", method, err, mask)
-        rows += [dict(r, level_ppm=float(level_ppm), latency_ms=float(latency_ms), smear=float(smear)) for r in one]
-    phase = [] if (latency_ms or smear) else [
-        r for m in ("KF", "BPKF 6 QR") for r in _phase_rows(level_ppm, rep, m, errs[m], f_test.rate_deg_s, mask)]
-    return {"scores": rows, "diag": _diagnose(rep, level_ppm, latency_ms, smear, train, f_train, test, f_test, aug),
-            "phase": phase}
+        rows += [
+            dict(r, level_ppm=float(level_ppm), latency_ms=float(latency_ms), smear=float(smear))
+            for r in one
+        ]
+    phase = (
+        []
+        if (latency_ms or smear)
+        else [
+            r
+            for m in ("KF", "BPKF 6 QR")
+            for r in _phase_rows(level_ppm, rep, m, errs[m], f_test.rate_deg_s, mask)
+        ]
+    )
+    return {
+        "scores": rows,
+        "diag": _diagnose(rep, level_ppm, latency_ms, smear, train, f_train, test, f_test, aug),
+        "phase": phase,
+    }
 
 
 def _quiet(spec: StudySpec, rep: int) -> list[dict]:
@@ -245,17 +347,32 @@ def _runs(spec: StudySpec, kind: str, rep: int):
     if kind == "level":
         tr = generate(spec.profile(kind, 0))
         both = strapdown(tr, seeds, spec.imu, spec.star, init)
-        return _subset(both, slice(0, spec.n_train_runs)), _subset(both, slice(spec.n_train_runs, None)), tr
-    train = strapdown([generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 1 + i)))
-                       for i in range(spec.n_train_runs)], seeds[:spec.n_train_runs], spec.imu, spec.star, init)
+        return (
+            _subset(both, slice(0, spec.n_train_runs)),
+            _subset(both, slice(spec.n_train_runs, None)),
+            tr,
+        )
+    train = strapdown(
+        [
+            generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 1 + i)))
+            for i in range(spec.n_train_runs)
+        ],
+        seeds[: spec.n_train_runs],
+        spec.imu,
+        spec.star,
+        init,
+    )
     tr_test = generate(spec.profile(kind, seed_of(spec, rep, "manoeuvre", 0)))
-    test = strapdown(tr_test, seeds[spec.n_train_runs:], spec.imu, spec.star, init)
+    test = strapdown(tr_test, seeds[spec.n_train_runs :], spec.imu, spec.star, init)
     return train, test, tr_test
 
 
 def _subset(run, sl):
-    arrays = {f.name: getattr(run, f.name)[sl] for f in fields(run)
-              if isinstance(getattr(run, f.name), np.ndarray) and getattr(run, f.name).ndim >= 2}
+    arrays = {
+        f.name: getattr(run, f.name)[sl]
+        for f in fields(run)
+        if isinstance(getattr(run, f.name), np.ndarray) and getattr(run, f.name).ndim >= 2
+    }
     return replace(run, **arrays)
 
 
@@ -267,11 +384,19 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
         return {"lm": _lm_timing(spec, rep), "secs": {"trainlm": time.perf_counter() - t0}}
     if kind == "quiet":
         t0 = time.perf_counter()
-        return {"sweep": {"scores": [], "diag": _quiet(spec, rep)}, "secs": {"quiet": time.perf_counter() - t0}}
-    if isinstance(kind, tuple):                 # (scale factor ppm, star-sensor latency ms, smear arcsec per deg/s)
+        return {
+            "sweep": {"scores": [], "diag": _quiet(spec, rep)},
+            "secs": {"quiet": time.perf_counter() - t0},
+        }
+    if isinstance(
+        kind, tuple
+    ):  # (scale factor ppm, star-sensor latency ms, smear arcsec per deg/s)
         t0 = time.perf_counter()
         return {"sweep": _sweep(spec, rep, *kind), "secs": {"sweep": time.perf_counter() - t0}}
-    out = {k: [] for k in ("score", "trace", "time", "glr", "glr_run", "corr", "timing", "diag", "phase")}
+    out = {
+        k: []
+        for k in ("score", "trace", "time", "glr", "glr_run", "corr", "timing", "diag", "phase")
+    }
     out["yaw"] = None
     secs = {"simulate_filter": 0.0, "train": 0.0, "timing": 0.0}
     score_rows, trace_rows, time_rows = out["score"], out["trace"], out["time"]
@@ -285,7 +410,9 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     _score_rows(score_rows, rep, kind, "same run", "KF", f_test.att_err_arcsec, mask)
     own_plain = not (spec.star_latency_ms or spec.star_smear_arcsec_per_deg_s)
     if kind == "s_turns" and own_plain:
-        out["phase"] += _phase_rows(spec.gyro_scale_ppm, rep, "KF", f_test.att_err_arcsec, f_test.rate_deg_s, mask)
+        out["phase"] += _phase_rows(
+            spec.gyro_scale_ppm, rep, "KF", f_test.att_err_arcsec, f_test.rate_deg_s, mask
+        )
     if rep == 0:
         _trace(trace_rows, t, kind, "KF", f_test.att_err_arcsec[0])
     if kind == "s_turns":
@@ -294,19 +421,43 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
         _score_rows(score_rows, rep, kind, "same run", "augmented KF", aug.att_err_arcsec, mask)
         if rep == 0:
             _trace(trace_rows, t, kind, "augmented KF", aug.att_err_arcsec[0])
-            out["yaw"] = pd.DataFrame({"t_s": tr_test.t_s, "yaw_deg": np.degrees(tr_test.att[:, 2]),
-                                       "rate_deg_s": np.degrees(np.r_[tr_test.rate_b[0, 2], tr_test.rate_b[:, 2]])})
+            out["yaw"] = pd.DataFrame(
+                {
+                    "t_s": tr_test.t_s,
+                    "yaw_deg": np.degrees(tr_test.att[:, 2]),
+                    "rate_deg_s": np.degrees(np.r_[tr_test.rate_b[0, 2], tr_test.rate_b[:, 2]]),
+                }
+            )
     g = km.innovation_glr(train, f_train)
     for row in g.table.itertuples():
-        out["glr"].append({"repeat": rep, "kind": kind, "candidate": row.candidate, "chi2": row.chi2,
-                           "p_bonferroni": row.p_bonferroni, "significant": bool(row.significant),
-                           "named": g.named or "none"})
+        out["glr"].append(
+            {
+                "repeat": rep,
+                "kind": kind,
+                "candidate": row.candidate,
+                "chi2": row.chi2,
+                "p_bonferroni": row.p_bonferroni,
+                "significant": bool(row.significant),
+                "named": g.named or "none",
+            }
+        )
     for part, (rr, ff) in (("train", (train, f_train)), ("test", (test, f_test))):
         for i, gi in enumerate(km.innovation_glr_per_run(rr, ff)):
-            out["glr_run"].append({"repeat": rep, "kind": kind, "runs": part, "run": i, "named": gi.named or "none"})
+            out["glr_run"].append(
+                {"repeat": rep, "kind": kind, "runs": part, "run": i, "named": gi.named or "none"}
+            )
     if kind == "s_turns":
-        out["diag"] = _diagnose(rep, spec.gyro_scale_ppm, spec.star_latency_ms, spec.star_smear_arcsec_per_deg_s,
-                                train, f_train, test, f_test, aug)
+        out["diag"] = _diagnose(
+            rep,
+            spec.gyro_scale_ppm,
+            spec.star_latency_ms,
+            spec.star_smear_arcsec_per_deg_s,
+            train,
+            f_train,
+            test,
+            f_test,
+            aug,
+        )
     r, p = km.rate_correlation(f_train)
     out["corr"].append({"repeat": rep, "kind": kind, "r": r, "p": p})
     secs["simulate_filter"] += time.perf_counter() - t0
@@ -321,10 +472,18 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
         bp = f_test.att_err_arcsec - net.predict(x_te)
         _score_rows(score_rows, rep, case, "held-out", "BPKF", bp, mask)
         if case == "sturn_qr6" and own_plain:
-            out["phase"] += _phase_rows(spec.gyro_scale_ppm, rep, "BPKF 6 QR", bp, f_test.rate_deg_s, mask)
-        time_rows.append({"repeat": rep, "case": case, "n_in": mspec.n_in,
-                          "seconds_per_pass": net.seconds_per_pass,
-                          "seconds_total": net.seconds_per_pass * spec.epochs})
+            out["phase"] += _phase_rows(
+                spec.gyro_scale_ppm, rep, "BPKF 6 QR", bp, f_test.rate_deg_s, mask
+            )
+        time_rows.append(
+            {
+                "repeat": rep,
+                "case": case,
+                "n_in": mspec.n_in,
+                "seconds_per_pass": net.seconds_per_pass,
+                "seconds_total": net.seconds_per_pass * spec.epochs,
+            }
+        )
         for i in range(spec.n_test_runs):
             one = slice(i, i + 1)
             same = train_mlp(x_te[one], f_test.att_err_arcsec[one], mspec, seed=net_seed)
@@ -342,7 +501,9 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     return out
 
 
-def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | None = None) -> StudyData:
+def simulate(
+    spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | None = None
+) -> StudyData:
     """Fly, filter and train for every repeat (see the module docstring); returns :class:`StudyData`.
 
     Per repeat and simulation: KF on training and test runs; networks for every case of ``CASES``
@@ -354,39 +515,65 @@ def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | N
     each come from :func:`~navlib.studies.celestial.parameters.seed_of`, so the numbers (not the timings) do not
     depend on where they ran."""
     tasks = [(spec, rep, kind) for rep in range(spec.n_repeats) for kind in KINDS]
-    cost = [(3.0 if kind == "s_turns" else 2.0) + (2.0 * spec.n_timings * spec.timing_epochs / spec.epochs
-                                                     if rep == 0 and kind == "level" else 0.0)
-            for _, rep, kind in tasks]
+    cost = [
+        (3.0 if kind == "s_turns" else 2.0)
+        + (
+            2.0 * spec.n_timings * spec.timing_epochs / spec.epochs
+            if rep == 0 and kind == "level"
+            else 0.0
+        )
+        for _, rep, kind in tasks
+    ]
     tasks += [(spec, j, "trainlm") for j in range(spec.lm_timings)]
     cost += [4.0] * spec.lm_timings
     # the sweep: the study's own level is taken from its repeats (same draws, same filters and nets)
     levels = [float(v) for v in spec.sweep_ppm if float(v) != float(spec.gyro_scale_ppm)]
     own_smear = float(spec.star_smear_arcsec_per_deg_s)
-    tasks += [(spec, rep, (v, float(spec.star_latency_ms), own_smear)) for v in levels
-              for rep in range(spec.sweep_repeats)]
+    tasks += [
+        (spec, rep, (v, float(spec.star_latency_ms), own_smear))
+        for v in levels
+        for rep in range(spec.sweep_repeats)
+    ]
     # the blind effects: star-sensor time offsets, rate-proportional errors, with no scale factor
-    tasks += [(spec, rep, (0.0, float(v), 0.0)) for v in spec.latency_ms_levels for rep in range(spec.sweep_repeats)]
-    tasks += [(spec, rep, (0.0, 0.0, float(v))) for v in spec.smear_levels_arcsec_per_deg_s
-              for rep in range(spec.sweep_repeats)]
-    n_sw = (len(levels) + len(spec.latency_ms_levels) + len(spec.smear_levels_arcsec_per_deg_s)) * spec.sweep_repeats
+    tasks += [
+        (spec, rep, (0.0, float(v), 0.0))
+        for v in spec.latency_ms_levels
+        for rep in range(spec.sweep_repeats)
+    ]
+    tasks += [
+        (spec, rep, (0.0, 0.0, float(v)))
+        for v in spec.smear_levels_arcsec_per_deg_s
+        for rep in range(spec.sweep_repeats)
+    ]
+    n_sw = (
+        len(levels) + len(spec.latency_ms_levels) + len(spec.smear_levels_arcsec_per_deg_s)
+    ) * spec.sweep_repeats
     cost += [2.0] * n_sw
     # more runs with nothing missing for the false-alarm rates (filters and tests only)
     quiet = range(quiet_repeats_flown(spec), spec.quiet_repeats or 0)
     tasks += [(spec, rep, "quiet") for rep in quiet]
     cost += [1.0] * len(quiet)
-    every = engine.run(_repeat, tasks, workers=workers, scheduler=scheduler, cost=cost, label="paper E repeats")
+    every = engine.run(
+        _repeat, tasks, workers=workers, scheduler=scheduler, cost=cost, label="paper E repeats"
+    )
     parts = [p for p in every if "lm" not in p and "sweep" not in p]
     lm_timing = pd.DataFrame([r for p in every if "lm" in p for r in p["lm"]])
     sweep = [r for p in every if "sweep" in p for r in p["sweep"]["scores"]]
-    phases = pd.DataFrame([r for p in every if "sweep" in p for r in p["sweep"].get("phase", [])] +
-                          [r for p in parts for r in p["phase"]])
-    diagnosis = pd.DataFrame([r for p in every if "sweep" in p for r in p["sweep"]["diag"]] +
-                             [r for p in parts for r in p["diag"]])
+    phases = pd.DataFrame(
+        [r for p in every if "sweep" in p for r in p["sweep"].get("phase", [])]
+        + [r for p in parts for r in p["phase"]]
+    )
+    diagnosis = pd.DataFrame(
+        [r for p in every if "sweep" in p for r in p["sweep"]["diag"]]
+        + [r for p in parts for r in p["diag"]]
+    )
 
     def rows(key):
         return [r for part in parts for r in part[key]]
 
-    secs = {k: sum(part["secs"][k] for part in parts) for k in ("simulate_filter", "train", "timing")}
+    secs = {
+        k: sum(part["secs"][k] for part in parts) for k in ("simulate_filter", "train", "timing")
+    }
     secs["trainlm"] = sum(p["secs"]["trainlm"] for p in every if "lm" in p)
     secs["sweep"] = sum(p["secs"].get("sweep", 0.0) for p in every if "sweep" in p)
     secs["quiet"] = sum(p["secs"].get("quiet", 0.0) for p in every if "sweep" in p)
@@ -400,21 +587,51 @@ def simulate(spec: StudySpec = StudySpec(), workers: int = 1, scheduler: str | N
     scores = pd.concat(parts_, ignore_index=True)
     traces = pd.concat(rows("trace"), ignore_index=True)
     if float(spec.gyro_scale_ppm) in [float(v) for v in spec.sweep_ppm]:
-        label = {("sturn_qr6", "KF"): "KF", ("sturn_qr6", "augmented KF"): "augmented KF",
-                 **{(case, "BPKF"): m for m, case in _SWEEP_CASE.items()}}
+        label = {
+            ("sturn_qr6", "KF"): "KF",
+            ("sturn_qr6", "augmented KF"): "augmented KF",
+            **{(case, "BPKF"): m for m, case in _SWEEP_CASE.items()},
+        }
         own = scores[(scores["mode"] == "held-out") & (scores["repeat"] < spec.sweep_repeats)]
         for r in own.itertuples():
             if (r.case, r.method) in label:
-                sweep.append({"repeat": r.repeat, "case": "s_turns", "mode": "held-out",
-                              "method": label[(r.case, r.method)], "run": r.run, "axis": r.axis,
-                              "rms_arcsec": r.rms_arcsec, "level_ppm": float(spec.gyro_scale_ppm),
-                              "latency_ms": float(spec.star_latency_ms), "smear": own_smear})
+                sweep.append(
+                    {
+                        "repeat": r.repeat,
+                        "case": "s_turns",
+                        "mode": "held-out",
+                        "method": label[(r.case, r.method)],
+                        "run": r.run,
+                        "axis": r.axis,
+                        "rms_arcsec": r.rms_arcsec,
+                        "level_ppm": float(spec.gyro_scale_ppm),
+                        "latency_ms": float(spec.star_latency_ms),
+                        "smear": own_smear,
+                    }
+                )
     sweep = pd.DataFrame(sweep)
-    return StudyData(spec, scores, traces, pd.DataFrame(rows("time")), pd.DataFrame(rows("glr")),
-                     pd.DataFrame(rows("glr_run")), pd.DataFrame(rows("timing")), pd.DataFrame(rows("corr")),
-                     yaw_profile, secs, lm_timing, sweep, diagnosis, phases)
+    return StudyData(
+        spec,
+        scores,
+        traces,
+        pd.DataFrame(rows("time")),
+        pd.DataFrame(rows("glr")),
+        pd.DataFrame(rows("glr_run")),
+        pd.DataFrame(rows("timing")),
+        pd.DataFrame(rows("corr")),
+        yaw_profile,
+        secs,
+        lm_timing,
+        sweep,
+        diagnosis,
+        phases,
+    )
 
 
 def _trace(rows, t, case, method, err):
     for a, ax in enumerate(AXES):
-        rows.append(pd.DataFrame({"t_s": t, "case": case, "method": method, "axis": ax, "err_arcsec": err[:, a]}))
+        rows.append(
+            pd.DataFrame(
+                {"t_s": t, "case": case, "method": method, "axis": ax, "err_arcsec": err[:, a]}
+            )
+        )

@@ -23,25 +23,113 @@ Paper A's study and the pieces both studies share are read here as one namespace
 The methods themselves (ids, labels, readings, settings) are registered in
 :mod:`navlib.methods.compass_methods`; their public names are re-exported here.
 """
-from ...methods.compass_methods import (ADE_DEFAULT_RULES, ADE_RULE_READINGS, ELM_METHODS, LEGACY_NAMES,  # noqa: F401
-                                        LS_MODELS, METHODS, R1, R2, R2V, R3, R3V, R4, R4V, RA, READINGS,
-                                        RULE_READINGS, RUN_COST_S, EightPosition, MethodParams, MethodSpec,
-                                        NetworkMethod, PlanarFit, Uncompensated, elm_trainer, fit_family,
-                                        fit_method, fitting_units, label, method_id, unit_cost)
+
+from ...methods.compass_methods import (
+    ADE_DEFAULT_RULES,
+    ADE_RULE_READINGS,
+    ELM_METHODS,
+    LEGACY_NAMES,  # noqa: F401
+    LS_MODELS,
+    METHODS,
+    R1,
+    R2,
+    R2V,
+    R3,
+    R3V,
+    R4,
+    R4V,
+    RA,
+    READINGS,
+    RULE_READINGS,
+    RUN_COST_S,
+    EightPosition,
+    MethodParams,
+    MethodSpec,
+    NetworkMethod,
+    PlanarFit,
+    Uncompensated,
+    elm_trainer,
+    fit_family,
+    fit_method,
+    fitting_units,
+    label,
+    method_id,
+    unit_cost,
+)
 from . import elm_patent, real  # noqa: F401  (document B and the real compass: sub-namespaces)
-from .parameters import (BASE_READINGS, BOX_BOUNDS, BP_VARIANTS, CONVERGENCE_AT_FRACTIONS,  # noqa: F401
-                         CONVERGENCE_RMS_DEG, FLOOR_GRID_UT, LS_POSITIONS, LS_REF_POSITIONS, LS_TOLERANCE_MAX_DEG,
-                         MAIN_METHODS, NOISE_METHODS, NOTEBOOK_DEFAULTS, R_ANY, ROBUST_METHODS, ChapterParams,
-                         CompassDrawRule, StudyParams, params_from_notebook)
-from .robustness import (draw_compass, draw_compasses, robustness_flips, robustness_study,  # noqa: F401
-                         robustness_table)
-from .sweeps import (TRAINING_ONLY, Sweeps, error_stats, ls_assumption, ordering_probability,  # noqa: F401
-                     ordering_rate, paired_by_seed, paired_rms_difference, paired_seed_difference, per_seed,
-                     rms_deg, test_errors, width_estimate)
-from .tables import (fig4_panels, noise_summary, ordering_table, reach_summary, results_methods,  # noqa: F401
-                     side_by_side, summarize)
-from .turntable import (MAX_TASK_S, SEED_BATCH, choices_study, compensate, convergence_curves,  # noqa: F401
-                        convergence_generations, floor_curve, generations_to_reach, implied_noise_ut,
-                        largest_noise, ls_positions_rms, noise_study, seed_studies, seed_study)
-from .turntable_claims import (READING_KEYS, claims, convergence_claims, headline_claims,  # noqa: F401
-                               rule_reading_table, sweep_claims, verdict_table)
+from .parameters import (
+    BASE_READINGS,
+    BOX_BOUNDS,
+    BP_VARIANTS,
+    CONVERGENCE_AT_FRACTIONS,  # noqa: F401
+    CONVERGENCE_RMS_DEG,
+    FLOOR_GRID_UT,
+    LS_POSITIONS,
+    LS_REF_POSITIONS,
+    LS_TOLERANCE_MAX_DEG,
+    MAIN_METHODS,
+    NOISE_METHODS,
+    NOTEBOOK_DEFAULTS,
+    R_ANY,
+    ROBUST_METHODS,
+    ChapterParams,
+    CompassDrawRule,
+    StudyParams,
+    params_from_notebook,
+)
+from .robustness import (
+    draw_compass,
+    draw_compasses,
+    robustness_flips,
+    robustness_study,  # noqa: F401
+    robustness_table,
+)
+from .sweeps import (
+    TRAINING_ONLY,
+    Sweeps,
+    error_stats,
+    ls_assumption,
+    ordering_probability,  # noqa: F401
+    ordering_rate,
+    paired_by_seed,
+    paired_rms_difference,
+    paired_seed_difference,
+    per_seed,
+    rms_deg,
+    test_errors,
+    width_estimate,
+)
+from .tables import (
+    fig4_panels,
+    noise_summary,
+    ordering_table,
+    reach_summary,
+    results_methods,  # noqa: F401
+    side_by_side,
+    summarize,
+)
+from .turntable import (
+    MAX_TASK_S,
+    SEED_BATCH,
+    choices_study,
+    compensate,
+    convergence_curves,  # noqa: F401
+    convergence_generations,
+    floor_curve,
+    generations_to_reach,
+    implied_noise_ut,
+    largest_noise,
+    ls_positions_rms,
+    noise_study,
+    seed_studies,
+    seed_study,
+)
+from .turntable_claims import (
+    READING_KEYS,
+    claims,
+    convergence_claims,
+    headline_claims,  # noqa: F401
+    rule_reading_table,
+    sweep_claims,
+    verdict_table,
+)

@@ -3,6 +3,7 @@ filter, field-gravity screen, min-max, random 90/10 split) on sweeps with glitch
 and document B's claims.  The ELM rows of paper A's comparison are in
 :mod:`navlib.studies.compass.turntable`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -30,8 +31,15 @@ from .sweeps import TRAINING_ONLY, Sweeps, ls_assumption, paired_seed_difference
 # ----------------------------------------------------------------------------------------------------------
 # Patent B: test error against hidden-node count
 
-def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20),
-                     max_nodes: int = 40, workers: int = 1, scheduler: str | None = None) -> pd.DataFrame:
+
+def node_count_curve(
+    sw: Sweeps,
+    params: StudyParams = StudyParams(),
+    seeds=range(20),
+    max_nodes: int = 40,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame:
     """Test-sweep RMS error (deg) against the hidden-node count, one row per (method, seed, n_nodes):
 
     - ``ELM``: a plain ELM fitted afresh with n = 1..max_nodes random nodes (seed ``seed``);
@@ -49,23 +57,36 @@ def node_count_curve(sw: Sweeps, params: StudyParams = StudyParams(), seeds=rang
     xn, tn = xs.transform(sw.x_train), ts.transform(target)
     xv, tv = xs.transform(sw.x_test), ts.transform(t_val)
     span = float(ts.span[0])
-    parts = engine.run(_node_count_seed, [(xn, tn, xv, tv, span, params, int(seed), int(max_nodes)) for seed in seeds],
-                       workers=workers, scheduler=scheduler, label="ELM node counts")
+    parts = engine.run(
+        _node_count_seed,
+        [(xn, tn, xv, tv, span, params, int(seed), int(max_nodes)) for seed in seeds],
+        workers=workers,
+        scheduler=scheduler,
+        label="ELM node counts",
+    )
     rows = [r for part in parts for r in part]
-    return pd.DataFrame(rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg"])
+    return pd.DataFrame(
+        rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg"]
+    )
 
 
 def _node_count_seed(xn, tn, xv, tv, span, params, seed, max_nodes) -> list[tuple]:
     """The rows of :func:`node_count_curve` for one seed (a task)."""
     rows = []
-    for n in range(1, max_nodes + 1):      # the same stream for every n: run `seed`'s generator
+    for n in range(1, max_nodes + 1):  # the same stream for every n: run `seed`'s generator
         model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=generators([seed])[0])
-        rows.append(("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)), span * np.sqrt(model.loss(xv, tv))))
-    ip = replace(params.incremental_params(span), loss_goal=0.0, max_nodes=max_nodes, max_iter=2 * max_nodes)
+        rows.append(
+            ("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)), span * np.sqrt(model.loss(xv, tv)))
+        )
+    ip = replace(
+        params.incremental_params(span), loss_goal=0.0, max_nodes=max_nodes, max_iter=2 * max_nodes
+    )
     _, hist = fit_incremental_elm(xn, tn, ip, rng=generators([seed])[0], x_val=xv, t_val=tv)
     tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
     for n, row in tuned.iterrows():
-        rows.append(("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss)))
+        rows.append(
+            ("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss))
+        )
     return rows
 
 
@@ -101,9 +122,17 @@ class PatentData:
         return int(self.keep.size - np.count_nonzero(self.keep))
 
 
-def prepare_patent_data(frame: pd.DataFrame, *, window: int = 3, threshold: float = 4.0,
-                        frac: float = 0.9, rng=None, median: bool = True, screen: bool = True,
-                        mode: str = "closed") -> PatentData:
+def prepare_patent_data(
+    frame: pd.DataFrame,
+    *,
+    window: int = 3,
+    threshold: float = 4.0,
+    frac: float = 0.9,
+    rng=None,
+    median: bool = True,
+    screen: bool = True,
+    mode: str = "closed",
+) -> PatentData:
     """Patent B's data preparation of one sweep (``frame`` with true and measured heading, the field
     ``mag_*_ut`` and the accelerometer ``acc_*_ms2`` columns):
 
@@ -117,11 +146,16 @@ def prepare_patent_data(frame: pd.DataFrame, *, window: int = 3, threshold: floa
        (:func:`navlib.methods.preprocess.train_test_split`, ``rng`` a seed or Generator).
 
     The patent prescribes the order (filter, then screen) but no window, threshold or split seed."""
-    missing = [c for c in ("true_heading_deg", "measured_heading_deg", *MAG_COLUMNS, *ACC_COLUMNS)
-               if c not in frame]
+    missing = [
+        c
+        for c in ("true_heading_deg", "measured_heading_deg", *MAG_COLUMNS, *ACC_COLUMNS)
+        if c not in frame
+    ]
     if missing:
-        raise InputError(f"patent data preparation needs column '{missing[0]}' (field and accelerometer "
-                         f"columns: {', '.join(MAG_COLUMNS + ACC_COLUMNS)})")
+        raise InputError(
+            f"patent data preparation needs column '{missing[0]}' (field and accelerometer "
+            f"columns: {', '.join(MAG_COLUMNS + ACC_COLUMNS)})"
+        )
     mag = frame[list(MAG_COLUMNS)].to_numpy(float)
     acc = frame[list(ACC_COLUMNS)].to_numpy(float)
     true = frame["true_heading_deg"].to_numpy(float)
@@ -132,14 +166,24 @@ def prepare_patent_data(frame: pd.DataFrame, *, window: int = 3, threshold: floa
     scr = dot_product_screen(mag, acc, threshold=threshold) if screen else None
     keep = scr.keep.copy() if scr is not None else np.ones(len(frame), dtype=bool)
     if keep.sum() < 4:
-        raise InputError(f"patent data preparation: only {int(keep.sum())} readings left after the "
-                         f"dot-product screen; need at least 4")
+        raise InputError(
+            f"patent data preparation: only {int(keep.sum())} readings left after the "
+            f"dot-product screen; need at least 4"
+        )
     t, m = true[keep], measured[keep]
     x = unwrap_measured(t, m)
     train_idx, test_idx = train_test_split(int(keep.sum()), frac, rng)
-    return PatentData(keep=keep, screen=scr, true_deg=t, measured_deg=m, x=x,
-                      x_scale=MinMax.fit(x, name="network input"),
-                      t_scale=MinMax.fit(t, name="network target"), train_idx=train_idx, test_idx=test_idx)
+    return PatentData(
+        keep=keep,
+        screen=scr,
+        true_deg=t,
+        measured_deg=m,
+        x=x,
+        x_scale=MinMax.fit(x, name="network input"),
+        t_scale=MinMax.fit(t, name="network target"),
+        train_idx=train_idx,
+        test_idx=test_idx,
+    )
 
 
 GLITCH_VARIANTS = {
@@ -156,9 +200,18 @@ def _check_elm(method: str) -> None:
         raise InputError(f"glitch study method {method!r}: one of {', '.join(ELM_METHODS)}")
 
 
-def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: StudyParams = StudyParams(),
-               seed: int = 0, *, method: str = "elm_backtuned", window: int = 3, threshold: float = 4.0,
-               frac: float = 0.9):
+def glitch_run(
+    train: pd.DataFrame,
+    test: pd.DataFrame,
+    variant: str,
+    params: StudyParams = StudyParams(),
+    seed: int = 0,
+    *,
+    method: str = "elm_backtuned",
+    window: int = 3,
+    threshold: float = 4.0,
+    frac: float = 0.9,
+):
     """One run of :func:`glitch_study`: prepare ``train`` as ``variant`` (a key of ``GLITCH_VARIANTS``;
     split seed = ``seed``), train ``method`` (an ELM method, seed ``seed``) on the training part, and
     compensate every reading of ``test``.  Returns ``(test_errors_deg, clean, data, info)``: the wrapped
@@ -168,8 +221,14 @@ def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: St
     if variant not in GLITCH_VARIANTS:
         raise InputError(f"unknown preparation {variant!r}; known: {', '.join(GLITCH_VARIANTS)}")
     _check_elm(method)
-    d = prepare_patent_data(train, window=window, threshold=threshold, frac=frac,
-                            rng=generators([seed], base=1)[0], **GLITCH_VARIANTS[variant])
+    d = prepare_patent_data(
+        train,
+        window=window,
+        threshold=threshold,
+        frac=frac,
+        rng=generators([seed], base=1)[0],
+        **GLITCH_VARIANTS[variant],
+    )
     tr, ck = d.train_idx, d.test_idx
     comp = fit_method(method, d.x[tr], d.true_deg[tr], params, [seed])[0]
     t_test = test["true_heading_deg"].to_numpy(float)
@@ -180,10 +239,19 @@ def glitch_run(train: pd.DataFrame, test: pd.DataFrame, variant: str, params: St
     return err, clean, d, info
 
 
-def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = StudyParams(),
-                 seeds=range(20), *, method: str = "elm_backtuned", window: int = 3,
-                 threshold: float = 4.0, frac: float = 0.9, workers: int = 1,
-                 scheduler: str | None = None) -> pd.DataFrame:
+def glitch_study(
+    train: pd.DataFrame,
+    test: pd.DataFrame,
+    params: StudyParams = StudyParams(),
+    seeds=range(20),
+    *,
+    method: str = "elm_backtuned",
+    window: int = 3,
+    threshold: float = 4.0,
+    frac: float = 0.9,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame:
     """What patent B's data preparation buys on a training sweep with glitches: for each variant of
     ``GLITCH_VARIANTS`` and seed, :func:`glitch_run`, scored on the glitch-free readings of the test
     sweep (a compensation cannot repair a reading hit by a spike).
@@ -193,10 +261,21 @@ def glitch_study(train: pd.DataFrame, test: pd.DataFrame, params: StudyParams = 
     were glitches, from the training sweep's ``glitch`` column), ``n_nodes``.  The runs are tasks of
     :mod:`navlib.engine` (``workers``, ``scheduler``; every run has its own seeds)."""
     _check_elm(method)
-    items = [(train, test, variant, params, int(seed), method, window, threshold, frac)
-             for variant in GLITCH_VARIANTS for seed in seeds]
-    return pd.DataFrame(engine.run_batches(_glitch_row, items, GLITCH_BATCH, workers=workers, scheduler=scheduler,
-                                           label="glitch study"))
+    items = [
+        (train, test, variant, params, int(seed), method, window, threshold, frac)
+        for variant in GLITCH_VARIANTS
+        for seed in seeds
+    ]
+    return pd.DataFrame(
+        engine.run_batches(
+            _glitch_row,
+            items,
+            GLITCH_BATCH,
+            workers=workers,
+            scheduler=scheduler,
+            label="glitch study",
+        )
+    )
 
 
 #: Runs of :func:`glitch_study` per engine task.
@@ -206,15 +285,31 @@ GLITCH_BATCH = 5
 def _glitch_row(train, test, variant, params, seed, method, window, threshold, frac) -> dict:
     """One row of :func:`glitch_study` (a task)."""
     glitch = train["glitch"].to_numpy(bool) if "glitch" in train else np.zeros(len(train), bool)
-    err, clean, d, info = glitch_run(train, test, variant, params, seed, method=method, window=window,
-                                     threshold=threshold, frac=frac)
-    return {"variant": variant, "seed": seed, "test_rms_deg": float(np.sqrt(np.mean(err[clean] ** 2))),
-            "check_rms_deg": info["check_rms_deg"], "n_rejected": d.n_rejected,
-            "glitches_rejected": int(np.sum(glitch & ~d.keep)), "n_nodes": info["n_nodes"]}
+    err, clean, d, info = glitch_run(
+        train,
+        test,
+        variant,
+        params,
+        seed,
+        method=method,
+        window=window,
+        threshold=threshold,
+        frac=frac,
+    )
+    return {
+        "variant": variant,
+        "seed": seed,
+        "test_rms_deg": float(np.sqrt(np.mean(err[clean] ** 2))),
+        "check_rms_deg": info["check_rms_deg"],
+        "n_rejected": d.n_rejected,
+        "glitches_rejected": int(np.sum(glitch & ~d.keep)),
+        "n_nodes": info["n_nodes"],
+    }
 
 
 # ----------------------------------------------------------------------------------------------------------
 # Patent B: small samples
+
 
 def even_indices(n_total: int, n: int) -> np.ndarray:
     """``n`` readings spread evenly over a sweep of ``n_total`` (first and last included): a turntable
@@ -228,9 +323,15 @@ def big_net_labels(big_hidden: int) -> tuple[str, str]:
     return f"BP 1-{int(big_hidden)}-1 (Adam)", f"BP 1-{int(big_hidden)}-1 (trainlm)"
 
 
-def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = StudyParams(),
-                       seeds=range(20), big_hidden: int = 50, workers: int = 1,
-                       scheduler: str | None = None) -> pd.DataFrame:
+def small_sample_study(
+    sw: Sweeps,
+    sizes=(8, 15, 30, 60),
+    params: StudyParams = StudyParams(),
+    seeds=range(20),
+    big_hidden: int = 50,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame:
     """Patent B's claim that its ELM overfits less than a large network on small samples: train on ``n``
     evenly spread readings of the training sweep (:func:`even_indices`) and score on the whole test sweep.
 
@@ -254,12 +355,20 @@ def small_sample_study(sw: Sweeps, sizes=(8, 15, 30, 60), params: StudyParams = 
     seeds = [int(s) for s in seeds]
     for n in sizes:
         check_param("n", n, lo=2, hi=sw.t_train.size, integer=True)
-    parts = engine.run(_small_sample_size, [(sw, int(n), params, seeds, int(big_hidden)) for n in sizes],
-                       workers=workers, scheduler=scheduler, cost=[float(n) for n in sizes], label="small samples")
+    parts = engine.run(
+        _small_sample_size,
+        [(sw, int(n), params, seeds, int(big_hidden)) for n in sizes],
+        workers=workers,
+        scheduler=scheduler,
+        cost=[float(n) for n in sizes],
+        label="small samples",
+    )
     return pd.DataFrame([r for part in parts for r in part])
 
 
-def _small_sample_size(sw: Sweeps, n: int, params: StudyParams, seeds: list, big_hidden: int) -> list[dict]:
+def _small_sample_size(
+    sw: Sweeps, n: int, params: StudyParams, seeds: list, big_hidden: int
+) -> list[dict]:
     """The rows of :func:`small_sample_study` for one training size (a task)."""
     adam, lm = big_net_labels(big_hidden)
     tg = params.target
@@ -268,45 +377,75 @@ def _small_sample_size(sw: Sweeps, n: int, params: StudyParams, seeds: list, big
     xtr, ttr, xte = sub.x_train, sub.t_train, sub.x_test
 
     def add(method, seed, comp, n_nodes):
-        rows.append({"n_train": int(n), "method": method, "seed": seed,
-                     "train_rms_deg": rms_deg(comp.correct(xtr), ttr),
-                     "test_rms_deg": rms_deg(comp.correct(xte), sub.t_test), "n_nodes": n_nodes})
+        rows.append(
+            {
+                "n_train": int(n),
+                "method": method,
+                "seed": seed,
+                "train_rms_deg": rms_deg(comp.correct(xtr), ttr),
+                "test_rms_deg": rms_deg(comp.correct(xte), sub.t_test),
+                "n_nodes": n_nodes,
+            }
+        )
 
     for method in ELM_METHODS[::-1]:
         for seed, comp in zip(seeds, fit_method(method, xtr, ttr, params, seeds)):
             add(METHODS[method].label, seed, comp, comp.info["n_nodes"])
     target = tg.target(xtr, ttr)
-    for label, nets in ((adam, train_adam_many(xtr, target, big_hidden, params.adam, generators(seeds))),
-                        (lm, train_matlab_bp_many(xtr, target, big_hidden, generators(seeds), params.lm))):
+    for label, nets in (
+        (adam, train_adam_many(xtr, target, big_hidden, params.adam, generators(seeds))),
+        (lm, train_matlab_bp_many(xtr, target, big_hidden, generators(seeds), params.lm)),
+    ):
         for seed, net in zip(seeds, nets):
             add(label, seed, NetworkCompensator(net, tg), big_hidden)
     phys = fit_planar_model(sub.t_train, sub.m_train)
-    rows.append({"n_train": int(n), "method": "physical model", "seed": -1,
-                 "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
-                 "test_rms_deg": rms_deg(phys.correct(sub.m_test), sub.t_test), "n_nodes": np.nan})
+    rows.append(
+        {
+            "n_train": int(n),
+            "method": "physical model",
+            "seed": -1,
+            "train_rms_deg": rms_deg(phys.correct(sub.m_train), ttr),
+            "test_rms_deg": rms_deg(phys.correct(sub.m_test), sub.t_test),
+            "n_nodes": np.nan,
+        }
+    )
     return rows
 
 
 # ----------------------------------------------------------------------------------------------------------
 # Summaries and claims
 
+
 def glitch_summary(g_runs: pd.DataFrame) -> pd.DataFrame:
     """Per preparation variant of :func:`glitch_study`: median test RMS with its 10th..90th percentiles,
     median check RMS, readings rejected, glitches among them, hidden nodes."""
     g = g_runs.groupby("variant", sort=False)
-    return pd.DataFrame({"test rms (deg)": g.test_rms_deg.median(),
-                         "p10 (deg)": g.test_rms_deg.quantile(0.1), "p90 (deg)": g.test_rms_deg.quantile(0.9),
-                         "check rms (deg)": g.check_rms_deg.median(), "rejected": g.n_rejected.median(),
-                         "glitches rejected": g.glitches_rejected.median(), "nodes": g.n_nodes.median()})
+    return pd.DataFrame(
+        {
+            "test rms (deg)": g.test_rms_deg.median(),
+            "p10 (deg)": g.test_rms_deg.quantile(0.1),
+            "p90 (deg)": g.test_rms_deg.quantile(0.9),
+            "check rms (deg)": g.check_rms_deg.median(),
+            "rejected": g.n_rejected.median(),
+            "glitches rejected": g.glitches_rejected.median(),
+            "nodes": g.n_nodes.median(),
+        }
+    )
 
 
 def small_sample_summary(small: pd.DataFrame) -> pd.DataFrame:
     """Per (n_train, method) of :func:`small_sample_study`: median training and test RMS, the test RMS's
     10th..90th percentiles, median hidden nodes."""
     g = small.groupby(["n_train", "method"], sort=False)
-    return pd.DataFrame({"train rms (deg)": g.train_rms_deg.median(), "test rms (deg)": g.test_rms_deg.median(),
-                         "test p10 (deg)": g.test_rms_deg.quantile(0.1),
-                         "test p90 (deg)": g.test_rms_deg.quantile(0.9), "nodes": g.n_nodes.median()})
+    return pd.DataFrame(
+        {
+            "train rms (deg)": g.train_rms_deg.median(),
+            "test rms (deg)": g.test_rms_deg.median(),
+            "test p10 (deg)": g.test_rms_deg.quantile(0.1),
+            "test p90 (deg)": g.test_rms_deg.quantile(0.9),
+            "nodes": g.n_nodes.median(),
+        }
+    )
 
 
 def nodes_to_goal_runs(curve: pd.DataFrame, goal_deg: float) -> pd.DataFrame:
@@ -340,12 +479,20 @@ def _paired(worse: pd.Series, better: pd.Series, name: str) -> tuple[verdicts.Es
     """The paired difference ``worse - better`` over the same seeds
     (:func:`navlib.studies.compass.sweeps.paired_seed_difference`), or None and the reason when there is no 95 %
     interval."""
-    return verdicts.attempt(paired_seed_difference, worse.rename(f"{name} (first)"),
-                            better.rename(f"{name} (second)"))
+    return verdicts.attempt(
+        paired_seed_difference, worse.rename(f"{name} (first)"), better.rename(f"{name} (second)")
+    )
 
 
-def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, small: pd.DataFrame,
-           params: StudyParams, big_hidden: int, bp_rows=("bp_matlab", "ade_bp_hybrid_trainlm")) -> list[Claim]:
+def claims(
+    runs: pd.DataFrame,
+    node_runs: pd.DataFrame,
+    g_runs: pd.DataFrame,
+    small: pd.DataFrame,
+    params: StudyParams,
+    big_hidden: int,
+    bp_rows=("bp_matlab", "ade_bp_hybrid_trainlm"),
+) -> list[Claim]:
     """Document B's claims (reading ``'document B'``), each judged by the one rule of
     :mod:`navlib.verdicts` on a paired difference over the same seeds (boundary 0, holds above):
 
@@ -372,91 +519,201 @@ def claims(runs: pd.DataFrame, node_runs: pd.DataFrame, g_runs: pd.DataFrame, sm
     r = "document B"
     rms = {m: per_seed(runs, m) for m in set(runs.method)}
     bt = rms["elm_backtuned"]
-    elm_set = (f"our a-priori ELM settings ({params.elm_nodes} nodes plain; back-tuned: goal "
-               f"{params.elm_goal_deg:g} deg, at most {params.elm_max_nodes} nodes; weights "
-               f"U(-{params.elm_range:g}, {params.elm_range:g}))")
+    elm_set = (
+        f"our a-priori ELM settings ({params.elm_nodes} nodes plain; back-tuned: goal "
+        f"{params.elm_goal_deg:g} deg, at most {params.elm_max_nodes} nodes; weights "
+        f"U(-{params.elm_range:g}, {params.elm_range:g}))"
+    )
 
     def beats(claim, paper, source, worse_id, key, extra=(), why="", by_construction=False):
         est, short = _paired(rms[worse_id], bt, claim)
-        return Claim(claim, paper, reading=r, source=source,
-                     statistic=f"RMS {METHODS[worse_id].label} - RMS ELM back-tuned, paired by seed, deg",
-                     estimate=est, by_construction=by_construction, boundary=0.0, holds_when="above", unit="deg",
-                     decided_by=(elm_set, TRAINING_ONLY) + tuple(extra),
-                     ours=f"{bt.median():.3f} vs {rms[worse_id].median():.3f} deg rms", key=key,
-                     why="; ".join(t for t in (short, why) if t))
+        return Claim(
+            claim,
+            paper,
+            reading=r,
+            source=source,
+            statistic=f"RMS {METHODS[worse_id].label} - RMS ELM back-tuned, paired by seed, deg",
+            estimate=est,
+            by_construction=by_construction,
+            boundary=0.0,
+            holds_when="above",
+            unit="deg",
+            decided_by=(elm_set, TRAINING_ONLY) + tuple(extra),
+            ours=f"{bt.median():.3f} vs {rms[worse_id].median():.3f} deg rms",
+            key=key,
+            why="; ".join(t for t in (short, why) if t),
+        )
 
     out = []
     if "uncompensated" in rms:
         # The invention's own result (its headline): the back-tuned ELM against no compensation at all.  B
         # states no amount, so "improves" is any reduction of the test RMS (boundary 0).
-        out.append(beats("the back-tuned ELM improves the uncompensated heading", "compensates the nonlinear "
-                         "error and improves the heading accuracy (no numbers)", "paper", "uncompensated",
-                         "b_bt_uncompensated",
-                         why="boundary 0: document B states no amount of improvement, so any reduction of "
-                             "the test RMS counts"))
-    out += [beats(f"ELM back-tuned beats 8-position LS [{name}]", "implicit beats explicit models (no numbers)",
-                 "paper", ls, "b_bt_ls" if ls == "ls8" else f"b_bt_ls_{ls.split('_')[-1]}", (ls_assumption(ls),))
-           for ls, name in LS_MODELS.items() if ls in rms]
-    out += [beats("ELM back-tuned beats ADE-BP (pure DE)", "(not in the paper)", "book", "ade_bp_pure",
-                 "b_bt_ade_bp_pure", ("paper A's pure DE with its budget",))]
+        out.append(
+            beats(
+                "the back-tuned ELM improves the uncompensated heading",
+                "compensates the nonlinear error and improves the heading accuracy (no numbers)",
+                "paper",
+                "uncompensated",
+                "b_bt_uncompensated",
+                why="boundary 0: document B states no amount of improvement, so any reduction of "
+                "the test RMS counts",
+            )
+        )
+    out += [
+        beats(
+            f"ELM back-tuned beats 8-position LS [{name}]",
+            "implicit beats explicit models (no numbers)",
+            "paper",
+            ls,
+            "b_bt_ls" if ls == "ls8" else f"b_bt_ls_{ls.split('_')[-1]}",
+            (ls_assumption(ls),),
+        )
+        for ls, name in LS_MODELS.items()
+        if ls in rms
+    ]
+    out += [
+        beats(
+            "ELM back-tuned beats ADE-BP (pure DE)",
+            "(not in the paper)",
+            "book",
+            "ade_bp_pure",
+            "b_bt_ade_bp_pure",
+            ("paper A's pure DE with its budget",),
+        )
+    ]
     for b in bp_rows:
         if b in rms:
             paper_side = b in RANDOM_START
-            out.append(beats(f"ELM back-tuned beats {METHODS[b].label}",
-                             "fewer local minima than random starting weights (no numbers)" if paper_side
-                             else "(not in the paper)", "paper" if paper_side else "book", b, f"b_bt_{b}"))
-    out.append(beats("the implicit ELM beats the exact physical model", "implicit beats explicit models",
-                     "paper", "physical", "b_bt_physical", by_construction=True,
-                     why="our simulator is the exact five-parameter model that the physical model fits: on "
-                         "our sweeps only the noise draw can favour another model; real data must decide"))
+            out.append(
+                beats(
+                    f"ELM back-tuned beats {METHODS[b].label}",
+                    "fewer local minima than random starting weights (no numbers)"
+                    if paper_side
+                    else "(not in the paper)",
+                    "paper" if paper_side else "book",
+                    b,
+                    f"b_bt_{b}",
+                )
+            )
+    out.append(
+        beats(
+            "the implicit ELM beats the exact physical model",
+            "implicit beats explicit models",
+            "paper",
+            "physical",
+            "b_bt_physical",
+            by_construction=True,
+            why="our simulator is the exact five-parameter model that the physical model fits: on "
+            "our sweeps only the noise draw can favour another model; real data must decide",
+        )
+    )
     est, short = _paired(rms["elm"], bt, "plain ELM")
-    out.append(Claim(f"back-tuning beats a plain ELM of {params.elm_nodes} nodes", "higher accuracy", reading=r,
-                     statistic="RMS plain ELM - RMS ELM back-tuned, paired by seed, deg", estimate=est,
-                     boundary=0.0, holds_when="above", unit="deg", decided_by=(elm_set, TRAINING_ONLY), why=short,
-                     ours=f"{bt.median():.3f} vs {rms['elm'].median():.3f} deg rms", key="b_plain_elm"))
+    out.append(
+        Claim(
+            f"back-tuning beats a plain ELM of {params.elm_nodes} nodes",
+            "higher accuracy",
+            reading=r,
+            statistic="RMS plain ELM - RMS ELM back-tuned, paired by seed, deg",
+            estimate=est,
+            boundary=0.0,
+            holds_when="above",
+            unit="deg",
+            decided_by=(elm_set, TRAINING_ONLY),
+            why=short,
+            ours=f"{bt.median():.3f} vs {rms['elm'].median():.3f} deg rms",
+            key="b_plain_elm",
+        )
+    )
     plain = node_runs[node_runs.method == "ELM"]
     nodes_bt = runs[runs.method == "elm_backtuned"]
     est, short = _paired(_series(plain, "n_nodes"), _series(nodes_bt, "n_nodes"), "nodes")
     unreached = int((~plain.reached.astype(bool)).sum())
-    out.append(Claim("back-tuning needs fewer nodes for the same training goal", "solves the node-count choice",
-                     reading=r, statistic="nodes a plain ELM needs for the training goal - nodes the back-tuned "
-                                          "ELM stops at, paired by seed",
-                     estimate=est, boundary=0.0, holds_when="above", unit="nodes", spec="{:.3g}",
-                     decided_by=(elm_set, TRAINING_ONLY),
-                     why="; ".join(t for t in (short, f"{unreached} plain-ELM runs never reached the goal "
-                                                              f"(counted at the curve's cap + 1)" if unreached
-                                               else "") if t),
-                     ours=f"{nodes_bt.n_nodes.median():.1f} vs {plain.n_nodes.median():.1f} nodes (medians)",
-                     key="b_nodes"))
+    out.append(
+        Claim(
+            "back-tuning needs fewer nodes for the same training goal",
+            "solves the node-count choice",
+            reading=r,
+            statistic="nodes a plain ELM needs for the training goal - nodes the back-tuned "
+            "ELM stops at, paired by seed",
+            estimate=est,
+            boundary=0.0,
+            holds_when="above",
+            unit="nodes",
+            spec="{:.3g}",
+            decided_by=(elm_set, TRAINING_ONLY),
+            why="; ".join(
+                t
+                for t in (
+                    short,
+                    f"{unreached} plain-ELM runs never reached the goal "
+                    f"(counted at the curve's cap + 1)"
+                    if unreached
+                    else "",
+                )
+                if t
+            ),
+            ours=f"{nodes_bt.n_nodes.median():.1f} vs {plain.n_nodes.median():.1f} nodes (medians)",
+            key="b_nodes",
+        )
+    )
     prep = g_runs[g_runs.variant == "median filter + screen (patent)"]
     raw = g_runs[g_runs.variant == "no preparation"]
     est, short = _paired(_series(raw, "test_rms_deg"), _series(prep, "test_rms_deg"), "glitches")
-    out.append(Claim("the data preparation lowers the error on sweeps with glitches", "rejects abnormal data",
-                     reading=r, statistic="test RMS without preparation - with the patent's, paired by seed, "
-                                          "deg (glitch-free test readings)",
-                     estimate=est, boundary=0.0, holds_when="above", unit="deg",
-                     decided_by=("our glitch model: field spikes in random directions", elm_set, TRAINING_ONLY),
-                     why=short,
-                     ours=f"{prep.test_rms_deg.median():.2f} vs {raw.test_rms_deg.median():.2f} deg rms",
-                     key="b_glitch"))
+    out.append(
+        Claim(
+            "the data preparation lowers the error on sweeps with glitches",
+            "rejects abnormal data",
+            reading=r,
+            statistic="test RMS without preparation - with the patent's, paired by seed, "
+            "deg (glitch-free test readings)",
+            estimate=est,
+            boundary=0.0,
+            holds_when="above",
+            unit="deg",
+            decided_by=(
+                "our glitch model: field spikes in random directions",
+                elm_set,
+                TRAINING_ONLY,
+            ),
+            why=short,
+            ours=f"{prep.test_rms_deg.median():.2f} vs {raw.test_rms_deg.median():.2f} deg rms",
+            key="b_glitch",
+        )
+    )
     n0 = int(small.n_train.min())
     s0 = small[small.n_train == n0].assign(gap=lambda f: f.test_rms_deg - f.train_rms_deg)
     elm_gap = _series(s0[s0.method == "ELM back-tuned"], "gap")
     adam, lm = big_net_labels(big_hidden)
     # The patent does not say how its "BP network" is trained: one verdict per plausible trainer.
-    for big, how, key in ((lm, "MATLAB trainlm, Nguyen-Widrow", "b_small_trainlm"),
-                          (adam, "Adam from U(-1, 1)", "b_small_adam")):
+    for big, how, key in (
+        (lm, "MATLAB trainlm, Nguyen-Widrow", "b_small_trainlm"),
+        (adam, "Adam from U(-1, 1)", "b_small_adam"),
+    ):
         part = s0[s0.method == big]
         if part.empty or elm_gap.empty:
             continue
         big_gap = _series(part, "gap")
         est, short = _paired(big_gap, elm_gap, "gap")
-        out.append(Claim(f"on {n0} readings the ELM overfits less than an over-sized net ({how})",
-                         "less overfitting on small samples", reading=r,
-                         statistic=f"overfitting gap (test - training RMS) of the 1-{int(big_hidden)}-1 net - "
-                                   f"the back-tuned ELM's, paired by seed, deg",
-                         estimate=est, boundary=0.0, holds_when="above", unit="deg",
-                         decided_by=(f"the over-sized net's trainer: {how} (the patent does not say)",
-                                     f"{n0} evenly spread training readings", elm_set, TRAINING_ONLY), why=short,
-                         ours=f"gap {elm_gap.median():.2f} vs {big_gap.median():.2f} deg (medians)", key=key))
+        out.append(
+            Claim(
+                f"on {n0} readings the ELM overfits less than an over-sized net ({how})",
+                "less overfitting on small samples",
+                reading=r,
+                statistic=f"overfitting gap (test - training RMS) of the 1-{int(big_hidden)}-1 net - "
+                f"the back-tuned ELM's, paired by seed, deg",
+                estimate=est,
+                boundary=0.0,
+                holds_when="above",
+                unit="deg",
+                decided_by=(
+                    f"the over-sized net's trainer: {how} (the patent does not say)",
+                    f"{n0} evenly spread training readings",
+                    elm_set,
+                    TRAINING_ONLY,
+                ),
+                why=short,
+                ours=f"gap {elm_gap.median():.2f} vs {big_gap.median():.2f} deg (medians)",
+                key=key,
+            )
+        )
     return out

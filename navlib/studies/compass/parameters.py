@@ -5,6 +5,7 @@ constants of its studies, how the robustness study draws its compasses (:class:`
 The methods, their ids, labels, readings and settings are registered in
 :mod:`navlib.methods.compass_methods` (``METHODS``, ``READINGS``, ``MethodParams``).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -14,8 +15,18 @@ import numpy as np
 
 from ...errors import InputError, check_param
 from ...methods.bpnet import AdamParams
-from ...methods.compass_methods import (ADE_RULE_READINGS, LS_MODELS, R1, R2, R2V, R4, R4V, READINGS, RULE_READINGS,
-                                        MethodParams)
+from ...methods.compass_methods import (
+    ADE_RULE_READINGS,
+    LS_MODELS,
+    R1,
+    R2,
+    R2V,
+    R4,
+    R4V,
+    READINGS,
+    RULE_READINGS,
+    MethodParams,
+)
 from ...methods.de import DEParams
 from ...methods.lm import LMParams
 from ...sensors.compass import CompassErrors
@@ -24,14 +35,32 @@ from ...sensors.compass import CompassErrors
 StudyParams = MethodParams
 
 
-
 #: The methods of the chapter's main table, in display order.
-MAIN_METHODS = ("uncompensated", "ls8", "ls8_planar", "ls8_h3", "bp_matlab", "bp_matlab_val", "bp_adam",
-                "de_bp_pure", "ade_bp_pure", "de_bp_hybrid_trainlm", "ade_bp_hybrid_trainlm",
-                "de_bp_hybrid_trainlm_val", "ade_bp_hybrid_trainlm_val", "de_bp_full_trainlm",
-                "ade_bp_full_trainlm", "de_bp_full_trainlm_val", "ade_bp_full_trainlm_val") + tuple(
-    f"ade_bp_{v}_{sfx}" for _, _, sfx, _ in ADE_RULE_READINGS for v in ("pure", "full_trainlm")) + (
-    "elm", "elm_backtuned", "physical")
+MAIN_METHODS = (
+    (
+        "uncompensated",
+        "ls8",
+        "ls8_planar",
+        "ls8_h3",
+        "bp_matlab",
+        "bp_matlab_val",
+        "bp_adam",
+        "de_bp_pure",
+        "ade_bp_pure",
+        "de_bp_hybrid_trainlm",
+        "ade_bp_hybrid_trainlm",
+        "de_bp_hybrid_trainlm_val",
+        "ade_bp_hybrid_trainlm_val",
+        "de_bp_full_trainlm",
+        "ade_bp_full_trainlm",
+        "de_bp_full_trainlm_val",
+        "ade_bp_full_trainlm_val",
+    )
+    + tuple(
+        f"ade_bp_{v}_{sfx}" for _, _, sfx, _ in ADE_RULE_READINGS for v in ("pure", "full_trainlm")
+    )
+    + ("elm", "elm_backtuned", "physical")
+)
 #: The same with the Adam extra as the "BP" (for the ordering probabilities).
 BP_VARIANTS = ("bp_matlab", "bp_matlab_val", "bp_adam")
 
@@ -56,7 +85,9 @@ LS_REF_POSITIONS = 24
 BASE_READINGS = (R1, R2, R2V, R4, R4V)
 #: The methods of the noise study: the base readings' methods, the LS models, the extras and the floor
 #: (ADE's rule readings are judged at the default noise only).
-NOISE_METHODS = tuple(m for m in MAIN_METHODS if not any(m == ade for ade in RULE_READINGS.values()))
+NOISE_METHODS = tuple(
+    m for m in MAIN_METHODS if not any(m == ade for ade in RULE_READINGS.values())
+)
 
 
 #: Training-error levels (RMS over the training sweep, deg) whose fitness J = N rms^2 the convergence study
@@ -114,8 +145,9 @@ class CompassDrawRule:
 
 #: The methods of the robustness study: every reading's methods (ADE's rule readings included), the LS
 #: models and the floor.
-ROBUST_METHODS = tuple(dict.fromkeys([i for ids in READINGS.values() for i in ids] + list(LS_MODELS)
-                                     + ["physical"]))
+ROBUST_METHODS = tuple(
+    dict.fromkeys([i for ids in READINGS.values() for i in ids] + list(LS_MODELS) + ["physical"])
+)
 
 
 # ------------------------------------------------------------------------------------- the notebook's parameters
@@ -126,16 +158,55 @@ LS_TOLERANCE_MAX_DEG = 22.5
 #: The compass notebook's papermill parameters (its ``parameters`` cell) and their defaults: the keys
 #: :func:`params_from_notebook` takes.
 NOTEBOOK_DEFAULTS = {
-    "sweep_csv": "../data/compass_sweeps.csv", "simulate": False, "noise_ut": 0.04, "error_scale": 1.0,
-    "sim_seed": 2024, "headline_seed": 0, "n_seeds": 20, "n_hidden": 6, "pop_size": 95, "max_generations": 3000,
-    "target_fitness": 0.2, "pure_target": "deg2", "hybrid_target": "normalised", "de_f": 0.5, "de_cr": 0.6,
-    "ade_f_min": 0.3, "ade_f_max": 0.9, "ade_cr_min": 0.1, "ade_cr_max": 0.9, "weight_bound": 10.0,
-    "lm_epochs": 1000, "lm_max_fail": 6, "bp_epochs": 3000, "bp_lr": 0.01, "noise_levels_ut": [0.005, 0.02, 0.1],
-    "n_noise_seeds": 4, "n_implied_seeds": 8, "n_robust_seeds": 6, "n_box_seeds": 4, "n_budget_seeds": 3,
-    "n_target_seeds": 5, "n_compasses": 5, "robust_tolerance_deg": 2.0, "robust_seed": 7, "n_workers": 2,
-    "scheduler": None, "elm_nodes": 19, "elm_range": 5.0, "elm_max_nodes": 30, "elm_goal_deg": 0.1,
-    "elm_max_iter": 200, "glitch_prob": 0.05, "glitch_ut": 15.0, "median_window": 3, "dot_threshold": 4.0,
-    "small_sizes": [8, 15, 30, 60], "big_hidden": 50, "n_real_seeds": 10, "real_ls_tolerance_deg": 22.5,
+    "sweep_csv": "../data/compass_sweeps.csv",
+    "simulate": False,
+    "noise_ut": 0.04,
+    "error_scale": 1.0,
+    "sim_seed": 2024,
+    "headline_seed": 0,
+    "n_seeds": 20,
+    "n_hidden": 6,
+    "pop_size": 95,
+    "max_generations": 3000,
+    "target_fitness": 0.2,
+    "pure_target": "deg2",
+    "hybrid_target": "normalised",
+    "de_f": 0.5,
+    "de_cr": 0.6,
+    "ade_f_min": 0.3,
+    "ade_f_max": 0.9,
+    "ade_cr_min": 0.1,
+    "ade_cr_max": 0.9,
+    "weight_bound": 10.0,
+    "lm_epochs": 1000,
+    "lm_max_fail": 6,
+    "bp_epochs": 3000,
+    "bp_lr": 0.01,
+    "noise_levels_ut": [0.005, 0.02, 0.1],
+    "n_noise_seeds": 4,
+    "n_implied_seeds": 8,
+    "n_robust_seeds": 6,
+    "n_box_seeds": 4,
+    "n_budget_seeds": 3,
+    "n_target_seeds": 5,
+    "n_compasses": 5,
+    "robust_tolerance_deg": 2.0,
+    "robust_seed": 7,
+    "n_workers": 2,
+    "scheduler": None,
+    "elm_nodes": 19,
+    "elm_range": 5.0,
+    "elm_max_nodes": 30,
+    "elm_goal_deg": 0.1,
+    "elm_max_iter": 200,
+    "glitch_prob": 0.05,
+    "glitch_ut": 15.0,
+    "median_window": 3,
+    "dot_threshold": 4.0,
+    "small_sizes": [8, 15, 30, 60],
+    "big_hidden": 50,
+    "n_real_seeds": 10,
+    "real_ls_tolerance_deg": 22.5,
 }
 
 
@@ -162,8 +233,10 @@ def params_from_notebook(**cell) -> ChapterParams:
     """
     unknown = [k for k in cell if k not in NOTEBOOK_DEFAULTS]
     if unknown:
-        raise InputError(f"compass notebook: unknown parameter {unknown[0]!r} (not in the notebook's parameters "
-                         f"cell)")
+        raise InputError(
+            f"compass notebook: unknown parameter {unknown[0]!r} (not in the notebook's parameters "
+            f"cell)"
+        )
     p = {**NOTEBOOK_DEFAULTS, **cell}
     check_param("n_seeds", p["n_seeds"], lo=2, integer=True)
     check_param("n_noise_seeds", p["n_noise_seeds"], lo=1, integer=True)
@@ -179,14 +252,29 @@ def params_from_notebook(**cell) -> ChapterParams:
     errors = replace(CompassErrors().scaled(p["error_scale"]), noise_ut=p["noise_ut"])
     params = StudyParams(
         n_hidden=p["n_hidden"],
-        de=DEParams(pop_size=p["pop_size"], max_generations=p["max_generations"],
-                    target_fitness=p["target_fitness"], f=p["de_f"], cr=p["de_cr"], f_min=p["ade_f_min"],
-                    f_max=p["ade_f_max"], cr_min=p["ade_cr_min"], cr_max=p["ade_cr_max"], bound=p["weight_bound"]),
-        pure_target=p["pure_target"], hybrid_target=p["hybrid_target"],
+        de=DEParams(
+            pop_size=p["pop_size"],
+            max_generations=p["max_generations"],
+            target_fitness=p["target_fitness"],
+            f=p["de_f"],
+            cr=p["de_cr"],
+            f_min=p["ade_f_min"],
+            f_max=p["ade_f_max"],
+            cr_min=p["ade_cr_min"],
+            cr_max=p["ade_cr_max"],
+            bound=p["weight_bound"],
+        ),
+        pure_target=p["pure_target"],
+        hybrid_target=p["hybrid_target"],
         lm=LMParams(epochs=p["lm_epochs"], max_fail=p["lm_max_fail"]),
         adam=AdamParams(epochs=p["bp_epochs"], lr=p["bp_lr"]),
-        elm_nodes=p["elm_nodes"], elm_range=p["elm_range"], elm_max_nodes=p["elm_max_nodes"],
-        elm_goal_deg=p["elm_goal_deg"], elm_max_iter=p["elm_max_iter"])
-    draw_rule = CompassDrawRule(n_compasses=p["n_compasses"], tolerance_deg=p["robust_tolerance_deg"],
-                                seed=p["robust_seed"])
+        elm_nodes=p["elm_nodes"],
+        elm_range=p["elm_range"],
+        elm_max_nodes=p["elm_max_nodes"],
+        elm_goal_deg=p["elm_goal_deg"],
+        elm_max_iter=p["elm_max_iter"],
+    )
+    draw_rule = CompassDrawRule(
+        n_compasses=p["n_compasses"], tolerance_deg=p["robust_tolerance_deg"], seed=p["robust_seed"]
+    )
     return ChapterParams(errors, params, draw_rule)

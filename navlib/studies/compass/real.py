@@ -37,6 +37,7 @@ every claim is a paired difference of held-out RMS over the same seeds (a determ
 one value with every seed), judged by :func:`navlib.verdicts.decide`.  The intervals cover the training
 randomness, not another recording of the compass.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -75,10 +76,20 @@ class Recording:
 
 #: The recordings and what their sweep split asks (module docstring).
 RECORDINGS = (
-    Recording("trial05", "broad_trial05_level.csv", "BROAD trial 05",
-              "one session: fitted on one sweep, scored on the other, both ways", True),
-    Recording("sessions", "broad_trials_level_by_trial.csv", "BROAD trials 2, 3, 5, 7",
-              "another session (each trial held out once, fitted on the other three)", False),
+    Recording(
+        "trial05",
+        "broad_trial05_level.csv",
+        "BROAD trial 05",
+        "one session: fitted on one sweep, scored on the other, both ways",
+        True,
+    ),
+    Recording(
+        "sessions",
+        "broad_trials_level_by_trial.csv",
+        "BROAD trials 2, 3, 5, 7",
+        "another session (each trial held out once, fitted on the other three)",
+        False,
+    ),
 )
 
 
@@ -104,9 +115,16 @@ def available(folder=None) -> bool:
     return all((folder / r.file).is_file() for r in RECORDINGS)
 
 
-def real_compass_study(seeds: int = 10, seed: int = 0, ls_tolerance_deg: float = LS_TOLERANCE_MAX_DEG,
-                       params: MethodParams | None = None, methods=None, folder=None, workers: int = 1,
-                       scheduler: str | None = None) -> RealCompass | None:
+def real_compass_study(
+    seeds: int = 10,
+    seed: int = 0,
+    ls_tolerance_deg: float = LS_TOLERANCE_MAX_DEG,
+    params: MethodParams | None = None,
+    methods=None,
+    folder=None,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> RealCompass | None:
     """Run the comparison (:func:`navlib.workbench.compare.compare`, split by sweep) on each recording of
     :data:`RECORDINGS`.
 
@@ -141,10 +159,21 @@ def real_compass_study(seeds: int = 10, seed: int = 0, ls_tolerance_deg: float =
     if not available(folder):
         return None
     params = params or MethodParams()
-    results = {r.key: compare("compass", folder / r.file, methods=methods, split="sweep", seeds=seeds,
-                              seed=seed, workers=workers, scheduler=scheduler,
-                              ls_tolerance_deg=ls_tolerance_deg, params=params)
-               for r in RECORDINGS}
+    results = {
+        r.key: compare(
+            "compass",
+            folder / r.file,
+            methods=methods,
+            split="sweep",
+            seeds=seeds,
+            seed=seed,
+            workers=workers,
+            scheduler=scheduler,
+            ls_tolerance_deg=ls_tolerance_deg,
+            params=params,
+        )
+        for r in RECORDINGS
+    }
     return RealCompass(results, int(seeds), int(seed), float(ls_tolerance_deg), params)
 
 
@@ -169,12 +198,17 @@ def method_table(real: RealCompass, key: str = "trial05") -> pd.DataFrame:
     cannot occur)."""
     res = real.results[key]
     t = res.table()
-    return pd.DataFrame({
-        "method": t["label"],
-        "held-out RMS (deg)": [_iv(*v, "{:.3f}") for v in zip(t.rms, t.rms_lo, t.rms_hi)],
-        "minus best (deg)": ["–" if m == res.best else _iv(*v, "{:+.3f}")
-                                    for m, *v in zip(t.method, t.vs_best, t.vs_best_lo, t.vs_best_hi)],
-        "against the best": [FINDINGS.get(f, f) for f in t["finding"]]})
+    return pd.DataFrame(
+        {
+            "method": t["label"],
+            "held-out RMS (deg)": [_iv(*v, "{:.3f}") for v in zip(t.rms, t.rms_lo, t.rms_hi)],
+            "minus best (deg)": [
+                "–" if m == res.best else _iv(*v, "{:+.3f}")
+                for m, *v in zip(t.method, t.vs_best, t.vs_best_lo, t.vs_best_hi)
+            ],
+            "against the best": [FINDINGS.get(f, f) for f in t["finding"]],
+        }
+    )
 
 
 def folds_table(real: RealCompass) -> pd.DataFrame:
@@ -183,16 +217,25 @@ def folds_table(real: RealCompass) -> pd.DataFrame:
     for r in RECORDINGS:
         res = real.results[r.key]
         for k, f in enumerate(res.folds):
-            rows.append({"recording": r.label, "fold": k + 1, "fitted on": f"{f.train_what} ({f.train.size} rows)",
-                         "scored on": f"{f.test_what} ({f.test.size} rows)"})
+            rows.append(
+                {
+                    "recording": r.label,
+                    "fold": k + 1,
+                    "fitted on": f"{f.train_what} ({f.train.size} rows)",
+                    "scored on": f"{f.test_what} ({f.test.size} rows)",
+                }
+            )
     return pd.DataFrame(rows)
 
 
 def not_run(real: RealCompass) -> pd.DataFrame:
     """The default methods left out of each recording's comparison and why (the 8-position LS without a
     reading near each of its positions)."""
-    rows = [{"recording": r.label, "methods": ", ".join(METHODS[m].label for m in ms), "why": why}
-            for r in RECORDINGS for why, ms in _not_run_by_reason(real.results[r.key]).items()]
+    rows = [
+        {"recording": r.label, "methods": ", ".join(METHODS[m].label for m in ms), "why": why}
+        for r in RECORDINGS
+        for why, ms in _not_run_by_reason(real.results[r.key]).items()
+    ]
     return pd.DataFrame(rows, columns=["recording", "methods", "why"])
 
 
@@ -214,8 +257,15 @@ def runs_frame(res: CompareResult) -> pd.DataFrame:
         e = res.errors[mid]
         seeds = range(e.shape[0]) if res.stochastic[mid] else [-1]
         for k, run, rms in zip(seeds, e, res.rms(mid)):
-            rows.append({"method": mid, "seed": int(k), "rms_deg": float(rms), "min_deg": float(run.min()),
-                         "max_deg": float(run.max())})
+            rows.append(
+                {
+                    "method": mid,
+                    "seed": int(k),
+                    "rms_deg": float(rms),
+                    "min_deg": float(run.min()),
+                    "max_deg": float(run.max()),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -251,26 +301,74 @@ def real_claim_specs(params: MethodParams | None = None) -> list[RealClaim]:
     sample-size claim (A18), the patent's glitch, node-count and small-sample claims (B02-B04: other
     experiments) and the ELM against paper A's DE-initialised BP (B06: reading 2, not in the comparison)."""
     p = params or MethodParams()
-    out = [RealClaim("ADE-BP beats DE-BP", "beats", ("ade_bp_full_trainlm", "de_bp_full_trainlm"), "real_a_ade_de"),
-           RealClaim("DE-BP beats BP", "beats", ("de_bp_full_trainlm", "bp_matlab"), "real_a_de_bp")]
+    out = [
+        RealClaim(
+            "ADE-BP beats DE-BP",
+            "beats",
+            ("ade_bp_full_trainlm", "de_bp_full_trainlm"),
+            "real_a_ade_de",
+        ),
+        RealClaim("DE-BP beats BP", "beats", ("de_bp_full_trainlm", "bp_matlab"), "real_a_de_bp"),
+    ]
     for ls, name in LS_MODELS.items():
         short = "" if ls == "ls8" else "_" + ls.split("_")[-1]
-        out += [RealClaim(f"ADE-BP beats 8-position LS [{name}]", "beats", ("ade_bp_full_trainlm", ls),
-                          f"real_a_ade_ls{short}"),
-                RealClaim(f"BP beats 8-position LS [{name}]", "beats", ("bp_matlab", ls), f"real_a_bp_ls{short}"),
-                RealClaim(f"one run shows LS > BP > DE-BP > ADE-BP [{name}]", "order",
-                          (ls, "bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm"), f"real_a_order{short}")]
-    out += [RealClaim("the back-tuned ELM improves the uncompensated heading", "beats",
-                      ("elm_backtuned", "uncompensated"), "real_b_bt_uncompensated")]
-    out += [RealClaim(f"ELM back-tuned beats 8-position LS [{name}]", "beats", ("elm_backtuned", ls),
-                      "real_b_bt_ls" + ("" if ls == "ls8" else "_" + ls.split("_")[-1]))
-            for ls, name in LS_MODELS.items()]
-    out += [RealClaim("ELM back-tuned beats BP MATLAB (trainlm)", "beats", ("elm_backtuned", "bp_matlab"),
-                      "real_b_bt_bp_matlab"),
-            RealClaim("the implicit ELM beats the exact physical model", "beats", ("elm_backtuned", "physical"),
-                      "real_b_bt_physical"),
-            RealClaim(f"back-tuning beats a plain ELM of {p.elm_nodes} nodes", "beats", ("elm_backtuned", "elm"),
-                      "real_b_plain_elm")]
+        out += [
+            RealClaim(
+                f"ADE-BP beats 8-position LS [{name}]",
+                "beats",
+                ("ade_bp_full_trainlm", ls),
+                f"real_a_ade_ls{short}",
+            ),
+            RealClaim(
+                f"BP beats 8-position LS [{name}]",
+                "beats",
+                ("bp_matlab", ls),
+                f"real_a_bp_ls{short}",
+            ),
+            RealClaim(
+                f"one run shows LS > BP > DE-BP > ADE-BP [{name}]",
+                "order",
+                (ls, "bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm"),
+                f"real_a_order{short}",
+            ),
+        ]
+    out += [
+        RealClaim(
+            "the back-tuned ELM improves the uncompensated heading",
+            "beats",
+            ("elm_backtuned", "uncompensated"),
+            "real_b_bt_uncompensated",
+        )
+    ]
+    out += [
+        RealClaim(
+            f"ELM back-tuned beats 8-position LS [{name}]",
+            "beats",
+            ("elm_backtuned", ls),
+            "real_b_bt_ls" + ("" if ls == "ls8" else "_" + ls.split("_")[-1]),
+        )
+        for ls, name in LS_MODELS.items()
+    ]
+    out += [
+        RealClaim(
+            "ELM back-tuned beats BP MATLAB (trainlm)",
+            "beats",
+            ("elm_backtuned", "bp_matlab"),
+            "real_b_bt_bp_matlab",
+        ),
+        RealClaim(
+            "the implicit ELM beats the exact physical model",
+            "beats",
+            ("elm_backtuned", "physical"),
+            "real_b_bt_physical",
+        ),
+        RealClaim(
+            f"back-tuning beats a plain ELM of {p.elm_nodes} nodes",
+            "beats",
+            ("elm_backtuned", "elm"),
+            "real_b_plain_elm",
+        ),
+    ]
     return out
 
 
@@ -292,10 +390,13 @@ def _paper_text(entry: registry.Entry, spec: RealClaim, paper: pd.DataFrame) -> 
     if entry.register == "paper_a":
         better, worse = (METHODS[m].paper_row for m in spec.methods)
         return f"{rng(better)} vs {rng(worse)} deg"
-    return {"B01": "compensates the nonlinear error and improves the heading accuracy (no numbers)",
-            "B05": "implicit beats explicit models (no numbers)",
-            "B07": "fewer local minima than random starting weights (no numbers)",
-            "B08": "implicit beats explicit models", "B09": "higher accuracy"}[entry.id]
+    return {
+        "B01": "compensates the nonlinear error and improves the heading accuracy (no numbers)",
+        "B05": "implicit beats explicit models (no numbers)",
+        "B07": "fewer local minima than random starting weights (no numbers)",
+        "B08": "implicit beats explicit models",
+        "B09": "higher accuracy",
+    }[entry.id]
 
 
 def _reading(entry: registry.Entry, rec: Recording) -> str:
@@ -324,40 +425,77 @@ def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
         res = real.results[rec.key]
         runs = runs_frame(res)
         skipped = {x["method"]: x["why"] for x in res.not_run}
-        decided = (f"{rec.label}, real measurements (BROAD, Laidig et al. 2021): {rec.question}",
-                   "the interval covers training randomness (seeds), not another recording of the compass")
+        decided = (
+            f"{rec.label}, real measurements (BROAD, Laidig et al. 2021): {rec.question}",
+            "the interval covers training randomness (seeds), not another recording of the compass",
+        )
         for spec in real_claim_specs(real.params):
             e = entries[spec.claim]
             missing = [m for m in spec.methods if m not in res.methods]
             if any(m not in skipped for m in missing):
-                continue                       # not asked for: not judged
+                continue  # not asked for: not judged
             reading = _reading(e, rec)
-            how = ((f"{e.primary_reading}: the full DE stage, then MATLAB trainlm",) if e.register == "paper_a"
-                   else ("our a-priori ELM settings (the chapter's)",))
-            common = dict(paper=_paper_text(e, spec, paper), reading=reading, source=e.origin, data="real",
-                          key=spec.key + ("" if rec.primary else f"_{rec.key}"))
-            if missing:                        # left out (the LS without its 8 headings): one row per entry
+            how = (
+                (f"{e.primary_reading}: the full DE stage, then MATLAB trainlm",)
+                if e.register == "paper_a"
+                else ("our a-priori ELM settings (the chapter's)",)
+            )
+            common = dict(
+                paper=_paper_text(e, spec, paper),
+                reading=reading,
+                source=e.origin,
+                data="real",
+                key=spec.key + ("" if rec.primary else f"_{rec.key}"),
+            )
+            if missing:  # left out (the LS without its 8 headings): one row per entry
                 if spec.claim != e.primary_claim:
                     continue
                 why = skipped[missing[0]]
-                out.append(Claim(spec.claim, statistic=e.statistic, decided_by=decided,
-                                 why=f"not run: {METHODS[missing[0]].label} {why}", **common))
+                out.append(
+                    Claim(
+                        spec.claim,
+                        statistic=e.statistic,
+                        decided_by=decided,
+                        why=f"not run: {METHODS[missing[0]].label} {why}",
+                        **common,
+                    )
+                )
                 continue
             if spec.kind == "order":
                 est = ordering_rate(runs, *spec.methods)
-                out.append(Claim(spec.claim, statistic="share of seeds whose runs show the ordering by held-out "
-                                                       "RMS", estimate=est, boundary=0.5, holds_when="above",
-                                 decided_by=decided + how, spec="{:.2f}",
-                                 why="boundary 0.5: the paper shows one run per method as typical",
-                                 ours=f"{round(est.value * est.n)} of {est.n} seeds", **common))
+                out.append(
+                    Claim(
+                        spec.claim,
+                        statistic="share of seeds whose runs show the ordering by held-out RMS",
+                        estimate=est,
+                        boundary=0.5,
+                        holds_when="above",
+                        decided_by=decided + how,
+                        spec="{:.2f}",
+                        why="boundary 0.5: the paper shows one run per method as typical",
+                        ours=f"{round(est.value * est.n)} of {est.n} seeds",
+                        **common,
+                    )
+                )
                 continue
             better, worse = spec.methods
             est, short = verdicts.attempt(paired_rms_difference, runs, worse, better)
             rb, rw = per_seed(runs, better), per_seed(runs, worse)
-            out.append(Claim(spec.claim, statistic=f"held-out RMS {METHODS[worse].label} - held-out RMS "
-                                                   f"{METHODS[better].label}, paired by seed, deg",
-                             estimate=est, boundary=0.0, holds_when="above", unit="deg", decided_by=decided + how,
-                             why=short, ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms", **common))
+            out.append(
+                Claim(
+                    spec.claim,
+                    statistic=f"held-out RMS {METHODS[worse].label} - held-out RMS "
+                    f"{METHODS[better].label}, paired by seed, deg",
+                    estimate=est,
+                    boundary=0.0,
+                    holds_when="above",
+                    unit="deg",
+                    decided_by=decided + how,
+                    why=short,
+                    ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms",
+                    **common,
+                )
+            )
     return out
 
 
@@ -365,9 +503,26 @@ def real_claims(real: RealCompass, paper: pd.DataFrame) -> list[Claim]:
 #: What the section glues when the recordings are absent.
 ABSENT = "not computed (BROAD data absent)"
 #: The texts :func:`answer` returns (the section's prose glues each as ``real_<key>``).
-ANSWER_KEYS = ("best", "best_rms", "runner_up", "by", "by_verdict", "uncompensated", "ranking_holds",
-               "de_bp", "ade_de", "ls", "b_uncompensated", "b_physical", "b_plain", "physical",
-               "sessions_best", "sessions_best_rms", "sessions_uncompensated", "sessions_networks")
+ANSWER_KEYS = (
+    "best",
+    "best_rms",
+    "runner_up",
+    "by",
+    "by_verdict",
+    "uncompensated",
+    "ranking_holds",
+    "de_bp",
+    "ade_de",
+    "ls",
+    "b_uncompensated",
+    "b_physical",
+    "b_plain",
+    "physical",
+    "sessions_best",
+    "sessions_best_rms",
+    "sessions_uncompensated",
+    "sessions_networks",
+)
 
 
 def answer(real: RealCompass | None, claims: list[Claim]) -> dict[str, str]:
@@ -388,14 +543,22 @@ def answer(real: RealCompass | None, claims: list[Claim]) -> dict[str, str]:
     t = res.table()
     best, second = t.iloc[0], t.iloc[1]
     entries = _entries()
-    mine = {c.claim: c for c in claims if c.data == "real" and c.reading == _reading(entries[c.claim], RECORDINGS[0])}
+    mine = {
+        c.claim: c
+        for c in claims
+        if c.data == "real" and c.reading == _reading(entries[c.claim], RECORDINGS[0])
+    }
 
     def said(text):
         c = mine.get(text)
         return "not judged" if c is None else c.verdict_label
 
     def rms_of(table, mid):
-        return f"{float(table.loc[table.method == mid, 'rms'].iloc[0]):.2f}" if mid in set(table.method) else "–"
+        return (
+            f"{float(table.loc[table.method == mid, 'rms'].iloc[0]):.2f}"
+            if mid in set(table.method)
+            else "–"
+        )
 
     def row_verdict(table, mid):
         if mid not in set(table.method):
@@ -403,32 +566,53 @@ def answer(real: RealCompass | None, claims: list[Claim]) -> dict[str, str]:
         f = table.loc[table.method == mid, "finding"].iloc[0]
         return FINDINGS.get(f, f)
 
-    ranking = [c for c in mine.values() if entries[c.claim].id in ("A01", "A02", "A03", "A04", "A05")
-               and c.estimate is not None]
+    ranking = [
+        c
+        for c in mine.values()
+        if entries[c.claim].id in ("A01", "A02", "A03", "A04", "A05") and c.estimate is not None
+    ]
     rep = [c.verdict == "reproduced" for c in ranking]
-    holds = ("holds" if rep and all(rep) and len(ranking) == 5 else "does not hold" if not any(rep)
-             else "holds only in part")
+    holds = (
+        "holds"
+        if rep and all(rep) and len(ranking) == 5
+        else "does not hold"
+        if not any(rep)
+        else "holds only in part"
+    )
     why_ls = next((x["why"] for x in res.not_run if x["method"] == "ls8"), None)
-    ls = (f"the 8-position LS cannot be placed on these sweeps: even {real.ls_tolerance_deg:g} deg from its "
-          f"positions, {why_ls.split(' and ', 1)[-1]}" if why_ls else
-          f"the 8-position LS (Smith's terms) ranks {int(t.index[t.method == 'ls8'][0]) + 1} of {len(t)}"
-          if "ls8" in res.methods else "the 8-position LS was not run")
+    ls = (
+        f"the 8-position LS cannot be placed on these sweeps: even {real.ls_tolerance_deg:g} deg from its "
+        f"positions, {why_ls.split(' and ', 1)[-1]}"
+        if why_ls
+        else f"the 8-position LS (Smith's terms) ranks {int(t.index[t.method == 'ls8'][0]) + 1} of {len(t)}"
+        if "ls8" in res.methods
+        else "the 8-position LS was not run"
+    )
     st = real.results["sessions"].table()
-    nets = [m for m in ("bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm") if m in set(st.method)]
-    return {"best": str(best.label), "best_rms": _iv(best.rms, best.rms_lo, best.rms_hi, "{:.2f}"),
-            "runner_up": str(second.label),
-            "by": _iv(second.vs_best, second.vs_best_lo, second.vs_best_hi, "{:.2f}"),
-            "by_verdict": FINDINGS.get(second.finding, second.finding),
-            "uncompensated": rms_of(t, "uncompensated"), "ranking_holds": holds,
-            "de_bp": said("DE-BP beats BP"), "ade_de": said("ADE-BP beats DE-BP"), "ls": ls,
-            "b_uncompensated": said("the back-tuned ELM improves the uncompensated heading"),
-            "b_physical": said("the implicit ELM beats the exact physical model"),
-            "b_plain": said(f"back-tuning beats a plain ELM of {real.params.elm_nodes} nodes"),
-            "physical": row_verdict(t, "physical"),
-            "sessions_best": str(st.iloc[0].label),
-            "sessions_best_rms": _iv(st.iloc[0].rms, st.iloc[0].rms_lo, st.iloc[0].rms_hi, "{:.2f}"),
-            "sessions_uncompensated": rms_of(st, "uncompensated"),
-            "sessions_networks": ", ".join(f"{METHODS[m].label} {row_verdict(st, m)}" for m in nets) or "not run"}
+    nets = [
+        m for m in ("bp_matlab", "de_bp_full_trainlm", "ade_bp_full_trainlm") if m in set(st.method)
+    ]
+    return {
+        "best": str(best.label),
+        "best_rms": _iv(best.rms, best.rms_lo, best.rms_hi, "{:.2f}"),
+        "runner_up": str(second.label),
+        "by": _iv(second.vs_best, second.vs_best_lo, second.vs_best_hi, "{:.2f}"),
+        "by_verdict": FINDINGS.get(second.finding, second.finding),
+        "uncompensated": rms_of(t, "uncompensated"),
+        "ranking_holds": holds,
+        "de_bp": said("DE-BP beats BP"),
+        "ade_de": said("ADE-BP beats DE-BP"),
+        "ls": ls,
+        "b_uncompensated": said("the back-tuned ELM improves the uncompensated heading"),
+        "b_physical": said("the implicit ELM beats the exact physical model"),
+        "b_plain": said(f"back-tuning beats a plain ELM of {real.params.elm_nodes} nodes"),
+        "physical": row_verdict(t, "physical"),
+        "sessions_best": str(st.iloc[0].label),
+        "sessions_best_rms": _iv(st.iloc[0].rms, st.iloc[0].rms_lo, st.iloc[0].rms_hi, "{:.2f}"),
+        "sessions_uncompensated": rms_of(st, "uncompensated"),
+        "sessions_networks": ", ".join(f"{METHODS[m].label} {row_verdict(st, m)}" for m in nets)
+        or "not run",
+    }
 
 
 def verdict_changes(real_claims_: list[Claim], simulated: list[Claim]) -> pd.DataFrame:
@@ -442,11 +626,27 @@ def verdict_changes(real_claims_: list[Claim], simulated: list[Claim]) -> pd.Dat
         base, _, rest = c.reading.partition("; ")
         rec = next((r for r in RECORDINGS if not r.primary and rest == r.label), RECORDINGS[0])
         s = sim.get((c.claim, base), "–")
-        differs = ("not run on real data" if c.estimate is None else "–" if s == "–" else
-                   "yes" if s != c.verdict else "no")
-        rows.append({"claim": c.claim, "recording": rec.label, "simulated compass": s,
-                     "real compass": c.verdict, "differs": differs})
-    return pd.DataFrame(rows, columns=["claim", "recording", "simulated compass", "real compass", "differs"])
+        differs = (
+            "not run on real data"
+            if c.estimate is None
+            else "–"
+            if s == "–"
+            else "yes"
+            if s != c.verdict
+            else "no"
+        )
+        rows.append(
+            {
+                "claim": c.claim,
+                "recording": rec.label,
+                "simulated compass": s,
+                "real compass": c.verdict,
+                "differs": differs,
+            }
+        )
+    return pd.DataFrame(
+        rows, columns=["claim", "recording", "simulated compass", "real compass", "differs"]
+    )
 
 
 # ------------------------------------------------------------------------------------------ the figure
@@ -462,8 +662,14 @@ def real_figure(real: RealCompass, paper: pd.DataFrame, key: str = "trial05"):
     for ax, mid in zip(fig.axes, res.table().method):
         row = METHODS[mid].paper_row
         if row and row != "uncompensated" and row in pr.index:
-            ax.axhspan(pr.loc[row, "error_min_deg"], pr.loc[row, "error_max_deg"], color="tab:red", alpha=0.25,
-                       lw=0, label="paper A's printed range")
+            ax.axhspan(
+                pr.loc[row, "error_min_deg"],
+                pr.loc[row, "error_max_deg"],
+                color="tab:red",
+                alpha=0.25,
+                lw=0,
+                label="paper A's printed range",
+            )
     handles = {}
     for ax in fig.axes:
         for h, lab in zip(*ax.get_legend_handles_labels()):
@@ -472,16 +678,37 @@ def real_figure(real: RealCompass, paper: pd.DataFrame, key: str = "trial05"):
         if ax.get_legend() is not None:
             ax.get_legend().remove()
     spare = [ax for ax in fig.axes if not ax.get_visible()]
-    if spare:                             # an odd number of methods: the key in the empty panel
+    if spare:  # an odd number of methods: the key in the empty panel
         spare[0].set_visible(True)
         spare[0].axis("off")
-        spare[0].legend(list(handles.values()), list(handles), loc="center",
-                        title=f"{real.recording(key).label}, held out:")
+        spare[0].legend(
+            list(handles.values()),
+            list(handles),
+            loc="center",
+            title=f"{real.recording(key).label}, held out:",
+        )
     else:
         legend_below(fig.axes[-1], handles=list(handles.values()), labels=list(handles), ncol=3)
     return fig
 
 
-__all__ = ["ABSENT", "ANSWER_KEYS", "LEVEL_DIR", "RECORDINGS", "RealClaim", "RealCompass", "Recording", "answer",
-           "available", "folds_table", "method_table", "not_run", "real_claim_specs", "real_claims",
-           "real_compass_study", "real_figure", "runs_frame", "verdict_changes"]
+__all__ = [
+    "ABSENT",
+    "ANSWER_KEYS",
+    "LEVEL_DIR",
+    "RECORDINGS",
+    "RealClaim",
+    "RealCompass",
+    "Recording",
+    "answer",
+    "available",
+    "folds_table",
+    "method_table",
+    "not_run",
+    "real_claim_specs",
+    "real_claims",
+    "real_compass_study",
+    "real_figure",
+    "runs_frame",
+    "verdict_changes",
+]

@@ -12,6 +12,7 @@ training seeds on which the claims of paper A, document B and the real compass r
 
 Error = compensated - true heading, wrapped to (-180, 180], on the test sweep.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -23,17 +24,20 @@ from ...data.compass_sweeps import unwrap_measured
 from ...errors import InputError
 
 
-
 def error_stats(err) -> dict:
     """Minimum, maximum and RMS (deg) of an error array."""
     e = np.asarray(err, dtype=float)
-    return {"min_deg": float(e.min()), "max_deg": float(e.max()), "rms_deg": float(np.sqrt(np.mean(e ** 2)))}
+    return {
+        "min_deg": float(e.min()),
+        "max_deg": float(e.max()),
+        "rms_deg": float(np.sqrt(np.mean(e**2))),
+    }
 
 
 def rms_deg(predicted, true) -> float:
     """RMS of the wrapped heading error (deg)."""
     e = wrap_deg(np.asarray(predicted, dtype=float) - np.asarray(true, dtype=float))
-    return float(np.sqrt(np.mean(e ** 2)))
+    return float(np.sqrt(np.mean(e**2)))
 
 
 class Sweeps:
@@ -52,8 +56,10 @@ class Sweeps:
         again over the subset, as if only those readings had been taken)."""
         idx = np.asarray(idx, dtype=int)
         if idx.size < 2 or np.any(np.diff(idx) <= 0) or idx[0] < 0 or idx[-1] >= self.t_train.size:
-            raise InputError(f"training subset: need at least 2 increasing indices within 0.."
-                             f"{self.t_train.size - 1}")
+            raise InputError(
+                f"training subset: need at least 2 increasing indices within 0.."
+                f"{self.t_train.size - 1}"
+            )
         new = object.__new__(Sweeps)
         new.__dict__.update(self.__dict__)
         new.t_train, new.m_train = self.t_train[idx], self.m_train[idx]
@@ -66,7 +72,7 @@ def test_errors(corrected, sw: Sweeps) -> np.ndarray:
     return wrap_deg(np.asarray(corrected) - sw.t_test)
 
 
-test_errors.__test__ = False     # not a pytest test
+test_errors.__test__ = False  # not a pytest test
 
 
 # ------------------------------------------------------------------------------------ statistics over seeds
@@ -90,7 +96,9 @@ def paired_by_seed(a: pd.Series, b: pd.Series) -> tuple[np.ndarray, np.ndarray]:
         b = pd.Series(b.iloc[0], index=a.index)
     common = a.index.intersection(b.index).sort_values()
     if common.empty:
-        raise InputError(f"{a.name} and {b.name} share no seed: a paired comparison needs the same seeds")
+        raise InputError(
+            f"{a.name} and {b.name} share no seed: a paired comparison needs the same seeds"
+        )
     return a.loc[common].to_numpy(float), b.loc[common].to_numpy(float)
 
 
@@ -103,8 +111,10 @@ def paired_seed_difference(worse: pd.Series, better: pd.Series) -> verdicts.Esti
     return verdicts.paired_difference(w, b)
 
 
-def paired_rms_difference(runs: pd.DataFrame, worse: str, better: str, col: str = "rms_deg") -> verdicts.Estimate:
-    """"``better`` beats ``worse``" as a statistic: the median over seeds of ``col(worse) - col(better)``
+def paired_rms_difference(
+    runs: pd.DataFrame, worse: str, better: str, col: str = "rms_deg"
+) -> verdicts.Estimate:
+    """ "``better`` beats ``worse``" as a statistic: the median over seeds of ``col(worse) - col(better)``
     (the RMS by default) with its 95 % interval, paired by seed (:func:`paired_seed_difference`); positive
     when ``better`` has the smaller error."""
     return paired_seed_difference(per_seed(runs, worse, col), per_seed(runs, better, col))
@@ -118,10 +128,16 @@ def ordering_rate(runs: pd.DataFrame, ls: str, bp: str, de: str, ade: str) -> ve
     stochastic = [set(v.index) for v in s.values() if list(v.index) != [-1]]
     seeds = sorted(set.intersection(*stochastic)) if stochastic else [-1]
     if not seeds:
-        raise InputError(f"{bp}, {de} and {ade} share no seed: the ordering needs one run of each per seed")
+        raise InputError(
+            f"{bp}, {de} and {ade} share no seed: the ordering needs one run of each per seed"
+        )
 
     def val(m):
-        return np.full(len(seeds), s[m].iloc[0]) if list(s[m].index) == [-1] else s[m].loc[seeds].to_numpy(float)
+        return (
+            np.full(len(seeds), s[m].iloc[0])
+            if list(s[m].index) == [-1]
+            else s[m].loc[seeds].to_numpy(float)
+        )
 
     ok = (val(ls) > val(bp)) & (val(bp) > val(de)) & (val(de) > val(ade))
     return verdicts.wilson(int(ok.sum()), int(ok.size))
@@ -139,24 +155,27 @@ def ordering_probability(ls: float, bp, de, ade) -> float:
     samples of the error over seeds): the chance that a paper reporting one run per method shows this
     ordering, computed exactly over the empirical distributions (all ``n_bp n_de n_ade`` combinations)."""
     bp, de, ade = (np.asarray(a, dtype=float) for a in (bp, de, ade))
-    n_bp = ((bp[None, :] > de[:, None]) & (bp[None, :] < ls)).sum(axis=1)       # per DE draw
+    n_bp = ((bp[None, :] > de[:, None]) & (bp[None, :] < ls)).sum(axis=1)  # per DE draw
     n_ade = (ade[None, :] < de[:, None]).sum(axis=1)
     return float(np.sum(n_bp * n_ade) / (bp.size * de.size * ade.size))
 
 
 # ------------------------------------------------------------------------------------ what the claims state
 #: What every interval over training seeds covers (shown in each claim's ``decided_by``).
-TRAINING_ONLY = ("one fixed simulated sweep pair: the interval covers training randomness (seeds), not "
-                 "sensor-noise draws")
+TRAINING_ONLY = (
+    "one fixed simulated sweep pair: the interval covers training randomness (seeds), not "
+    "sensor-noise draws"
+)
 
 
 def ls_assumption(ls: str | None) -> str:
     """What judging a claim against the 8-position LS ``ls`` (an id of
     :data:`~navlib.methods.compass_methods.LS_MODELS`) assumes about the model paper A does not print ("" for
     any other id)."""
-    return {"ls8": "8-position LS as Smith's 5-term series: on our compass (hard iron a third of the "
-                   "horizontal field) its missing 3rd harmonic limits it",
-            "ls8_planar": "8-position LS as the exact 5-parameter hard/soft-iron model (our simulator's own "
-                          "model on a level table)",
-            "ls8_h3": "8-position LS as a harmonic series to 3rd order (7 coefficients from 8 readings)"
-            }.get(ls, "")
+    return {
+        "ls8": "8-position LS as Smith's 5-term series: on our compass (hard iron a third of the "
+        "horizontal field) its missing 3rd harmonic limits it",
+        "ls8_planar": "8-position LS as the exact 5-parameter hard/soft-iron model (our simulator's own "
+        "model on a level table)",
+        "ls8_h3": "8-position LS as a harmonic series to 3rd order (7 coefficients from 8 readings)",
+    }.get(ls, "")

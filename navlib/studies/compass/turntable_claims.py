@@ -4,6 +4,7 @@ need no trained network (:func:`sweep_claims`), ADE's convergence and stability 
 the Results-at-a-glance selection (:func:`headline_claims`), claims x readings (:func:`verdict_table`,
 :func:`rule_reading_table`).
 """
+
 from __future__ import annotations
 
 from typing import Mapping
@@ -14,13 +15,32 @@ import pandas as pd
 from ... import verdicts
 from ...claims import Claim
 from ...errors import InputError, check_param
-from ...methods.compass_methods import (ADE_RULE_READINGS, LS_MODELS, METHODS, R1, R2, R2V, R4, R4V, READINGS,
-                                        RULE_READINGS, rule_reading)
+from ...methods.compass_methods import (
+    ADE_RULE_READINGS,
+    LS_MODELS,
+    METHODS,
+    R1,
+    R2,
+    R2V,
+    R4,
+    R4V,
+    READINGS,
+    RULE_READINGS,
+    rule_reading,
+)
 from .parameters import LS_REF_POSITIONS, R_ANY, CompassDrawRule
-from .sweeps import (TRAINING_ONLY, Sweeps, ls_assumption, ordering_probability, ordering_rate, paired_rms_difference,
-                     paired_seed_difference, per_seed, width_estimate)
+from .sweeps import (
+    TRAINING_ONLY,
+    Sweeps,
+    ls_assumption,
+    ordering_probability,
+    ordering_rate,
+    paired_rms_difference,
+    paired_seed_difference,
+    per_seed,
+    width_estimate,
+)
 from .turntable import largest_noise, ls_positions_rms
-
 
 
 #: Glue-key part of each LS model (Smith's keeps the former keys).
@@ -29,8 +49,13 @@ _LS_KEYS = {"ls8": "ls", "ls8_planar": "lsplanar", "ls8_h3": "lsh3"}
 
 #: Short names of the readings, for the claims' glue keys.
 READING_KEYS = {R1: "r1", R2: "r2", R2V: "r2v", R4: "r4", R4V: "r4v"}
-READING_KEYS.update({rule_reading(base, lab): f"{READING_KEYS[base]}_{sfx.replace('_', '')}"
-                     for base in (R1, R4) for _, _, sfx, lab in ADE_RULE_READINGS})
+READING_KEYS.update(
+    {
+        rule_reading(base, lab): f"{READING_KEYS[base]}_{sfx.replace('_', '')}"
+        for base in (R1, R4)
+        for _, _, sfx, lab in ADE_RULE_READINGS
+    }
+)
 
 
 _READING_ASSUMPTIONS = {
@@ -44,17 +69,23 @@ for _f, _c, _sfx, _lab in ADE_RULE_READINGS:
     for _base in (R1, R4):
         _READING_ASSUMPTIONS[rule_reading(_base, _lab)] = (
             f"{_READING_ASSUMPTIONS[_base]}; ADE's F "
-            f"{ {'individual': 'per individual', 'generation': 'by generation'}.get(_f, _f)}, CR by {_c} "
-            f"(the default reads F by generation, CR by value)")
+            f"{ {'individual': 'per individual', 'generation': 'by generation'}.get(_f, _f) }, CR by {_c} "
+            f"(the default reads F by generation, CR by value)"
+        )
 
 
 def _rng(r) -> str:
     return f"{r.error_min_deg:+.2f}..{r.error_max_deg:+.2f}"
 
 
-def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | None = None,
-           implied_ut: float | None = None, default_ut: float | None = None,
-           floor: pd.DataFrame | None = None) -> list[Claim]:
+def claims(
+    runs: pd.DataFrame,
+    paper: pd.DataFrame,
+    noise_runs: pd.DataFrame | None = None,
+    implied_ut: float | None = None,
+    default_ut: float | None = None,
+    floor: pd.DataFrame | None = None,
+) -> list[Claim]:
     """Paper A's claims, one :class:`navlib.claims.Claim` per (claim, reading), judged by the one rule of
     :mod:`navlib.verdicts`:
 
@@ -88,7 +119,7 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
             continue
         rk = READING_KEYS[reading]
         how = _READING_ASSUMPTIONS[reading]
-        ade_only = reading in RULE_READINGS          # a reading of ADE's rules: only ADE-BP changes
+        ade_only = reading in RULE_READINGS  # a reading of ADE's rules: only ADE-BP changes
         pairs = [("ADE-BP beats DE-BP", ade, de, "ADE-BP", "DE-BP", "ade_de", None)]
         if not ade_only:
             pairs.append(("DE-BP beats BP", de, bp, "DE-BP", "BP network", "de_bp", None))
@@ -101,27 +132,54 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
             est, short = verdicts.attempt(paired_rms_difference, runs, worse, better)
             rb, rw = per_seed(runs, better), per_seed(runs, worse)
             dec = (how, TRAINING_ONLY) + ((ls_assumption(ls),) if ls else ())
-            out.append(Claim(_ls_text(text, ls), f"{_rng(pr.loc[pb])} vs {_rng(pr.loc[pw])} deg", reading=reading,
-                             source="paper",
-                             statistic=f"RMS {METHODS[worse].label} - RMS {METHODS[better].label}, paired by "
-                                       f"seed, deg",
-                             estimate=est, boundary=0.0, holds_when="above", unit="deg", decided_by=dec,
-                             why=short, ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms",
-                             key=f"a_{_ls_key(key, ls)}_{rk}"))
+            out.append(
+                Claim(
+                    _ls_text(text, ls),
+                    f"{_rng(pr.loc[pb])} vs {_rng(pr.loc[pw])} deg",
+                    reading=reading,
+                    source="paper",
+                    statistic=f"RMS {METHODS[worse].label} - RMS {METHODS[better].label}, paired by "
+                    f"seed, deg",
+                    estimate=est,
+                    boundary=0.0,
+                    holds_when="above",
+                    unit="deg",
+                    decided_by=dec,
+                    why=short,
+                    ours=f"{rb.median():.3f} vs {rw.median():.3f} deg rms",
+                    key=f"a_{_ls_key(key, ls)}_{rk}",
+                )
+            )
         for ls in ls_models:
             est = ordering_rate(runs, ls, bp, de, ade)
-            p_all = ordering_probability(per_seed(runs, ls).iloc[0], per_seed(runs, bp), per_seed(runs, de),
-                                         per_seed(runs, ade))
-            out.append(Claim(_ls_text("one run shows LS > BP > DE-BP > ADE-BP", ls), "one run per method",
-                             reading=reading, source="paper",
-                             statistic="share of seeds whose runs show the ordering by RMS",
-                             estimate=est, boundary=0.5, holds_when="above",
-                             decided_by=(how, TRAINING_ONLY, ls_assumption(ls)),
-                             why="boundary 0.5: the paper shows one run per method as typical",
-                             ours=f"{round(est.value * est.n)} of {est.n} seeds; P = {p_all:.2f} over all "
-                                  f"combinations", spec="{:.2f}",
-                             key=f"a_order_{rk}" if ls == "ls8" else f"a_order_{_LS_KEYS[ls]}_{rk}"))
-        for level_name, frame, noise in (("default", runs, default_ut), ("implied", None, implied_ut)):
+            p_all = ordering_probability(
+                per_seed(runs, ls).iloc[0],
+                per_seed(runs, bp),
+                per_seed(runs, de),
+                per_seed(runs, ade),
+            )
+            out.append(
+                Claim(
+                    _ls_text("one run shows LS > BP > DE-BP > ADE-BP", ls),
+                    "one run per method",
+                    reading=reading,
+                    source="paper",
+                    statistic="share of seeds whose runs show the ordering by RMS",
+                    estimate=est,
+                    boundary=0.5,
+                    holds_when="above",
+                    decided_by=(how, TRAINING_ONLY, ls_assumption(ls)),
+                    why="boundary 0.5: the paper shows one run per method as typical",
+                    ours=f"{round(est.value * est.n)} of {est.n} seeds; P = {p_all:.2f} over all "
+                    f"combinations",
+                    spec="{:.2f}",
+                    key=f"a_order_{rk}" if ls == "ls8" else f"a_order_{_LS_KEYS[ls]}_{rk}",
+                )
+            )
+        for level_name, frame, noise in (
+            ("default", runs, default_ut),
+            ("implied", None, implied_ut),
+        ):
             if frame is None:
                 if noise_runs is None or implied_ut is None or not np.isfinite(implied_ut):
                     continue
@@ -142,16 +200,31 @@ def claims(runs: pd.DataFrame, paper: pd.DataFrame, noise_runs: pd.DataFrame | N
                 g = frame[frame.method == mid]
                 est, short = verdicts.attempt(width_estimate, frame, mid)
                 fl = _floor(phys, width, noise, floor)
-                out.append(Claim(f"{_ls_text(name, ls)} error within the paper's range, {level_name} noise{nz}",
-                                 _rng(p_) + " deg", reading=reading, source="paper",
-                                 statistic="width of the test-sweep error band (max - min) per run, deg",
-                                 estimate=est, boundary=width, holds_when="below", unit="deg", floor=fl,
-                                 decided_by=(f"sensor noise {noise:.3g} uT (our simulator)" if noise is not None
-                                             else "our simulator's sensor noise", how, TRAINING_ONLY)
-                                 + ((ls_assumption(ls),) if ls else ()),
-                                 why=short,
-                                 ours=f"band {g.min_deg.median():+.2f}..{g.max_deg.median():+.2f} deg (medians)",
-                                 key=f"a_range_{_ls_key(name.lower().replace('-', ''), ls)}_{level_name}_{rk}"))
+                out.append(
+                    Claim(
+                        f"{_ls_text(name, ls)} error within the paper's range, {level_name} noise{nz}",
+                        _rng(p_) + " deg",
+                        reading=reading,
+                        source="paper",
+                        statistic="width of the test-sweep error band (max - min) per run, deg",
+                        estimate=est,
+                        boundary=width,
+                        holds_when="below",
+                        unit="deg",
+                        floor=fl,
+                        decided_by=(
+                            f"sensor noise {noise:.3g} uT (our simulator)"
+                            if noise is not None
+                            else "our simulator's sensor noise",
+                            how,
+                            TRAINING_ONLY,
+                        )
+                        + ((ls_assumption(ls),) if ls else ()),
+                        why=short,
+                        ours=f"band {g.min_deg.median():+.2f}..{g.max_deg.median():+.2f} deg (medians)",
+                        key=f"a_range_{_ls_key(name.lower().replace('-', ''), ls)}_{level_name}_{rk}",
+                    )
+                )
     return out
 
 
@@ -173,23 +246,38 @@ def _ls_key(key: str, ls: str | None) -> str:
     return key.replace("ls", _LS_KEYS[ls], 1)
 
 
-def _floor(phys_width: float, width: float, noise: float | None, curve: pd.DataFrame | None) -> verdicts.Floor:
+def _floor(
+    phys_width: float, width: float, noise: float | None, curve: pd.DataFrame | None
+) -> verdicts.Floor:
     """The noise floor of a range claim: the physical model's width at that noise, the noise that sets it
     and the noise the paper's width ``width`` would need (from
     :func:`~navlib.studies.compass.turntable.floor_curve`)."""
-    at = f"sensor noise {noise:.3g} uT (our simulator)" if noise is not None else "our simulator's noise"
+    at = (
+        f"sensor noise {noise:.3g} uT (our simulator)"
+        if noise is not None
+        else "our simulator's noise"
+    )
     if curve is not None:
         need = largest_noise(curve, width)
-        needs = (f"noise at most {need:.3g} uT" if np.isfinite(need)
-                 else f"noise below {curve.noise_ut.iloc[0]:.3g} uT")
+        needs = (
+            f"noise at most {need:.3g} uT"
+            if np.isfinite(need)
+            else f"noise below {curve.noise_ut.iloc[0]:.3g} uT"
+        )
     else:
         needs = f"a physical-model error width below {width:.3g} deg"
     return verdicts.Floor(phys_width, at, needs)
 
 
 # ------------------------------------------------------------------------------- claims on the sweeps alone
-def sweep_claims(runs: pd.DataFrame, paper: pd.DataFrame, sw: Sweeps, simulated: bool = True,
-                 tolerance_deg: float | None = None, ls: pd.DataFrame | None = None) -> list[Claim]:
+def sweep_claims(
+    runs: pd.DataFrame,
+    paper: pd.DataFrame,
+    sw: Sweeps,
+    simulated: bool = True,
+    tolerance_deg: float | None = None,
+    ls: pd.DataFrame | None = None,
+) -> list[Claim]:
     """Paper A's claims that need no trained network (reading :data:`~navlib.studies.compass.parameters.R_ANY`), each
     an exact statistic of the chapter's fixed sweep pair (:func:`navlib.verdicts.exact`):
 
@@ -213,20 +301,33 @@ def sweep_claims(runs: pd.DataFrame, paper: pd.DataFrame, sw: Sweeps, simulated:
     if not u.empty:
         lo, hi = float(u.min_deg.iloc[0]), float(u.max_deg.iloc[0])
         gap = max(abs(lo - float(p_.error_min_deg)), abs(hi - float(p_.error_max_deg)))
-        out.append(Claim(
-            "the uncompensated error spans the paper's range", _rng(p_) + " deg", reading=R_ANY, source="paper",
-            statistic="larger distance of the uncompensated test-sweep error band's ends from the paper's "
-                      "(|min - paper min| or |max - paper max|), deg",
-            estimate=verdicts.exact(gap), boundary=tol, holds_when="below", unit="deg",
-            by_construction=bool(simulated),
-            decided_by=("the chapter's sweep pair (one noise draw): the band of sweep 2",),
-            why=("our default compass's error sources (navlib.sensors.compass.CompassErrors: hard iron a "
-                 "third of H, soft iron up to 8 %, a 1.6 deg yaw) were set so that the uncompensated error "
-                 f"spans the paper's {_rng(p_)} deg, and the drawn compasses C1-C5 are kept only within "
-                 f"{tol:g} deg of it: only the paper's real sweeps could test it" if simulated else
-                 f"boundary: the {tol:g} deg within which the robustness study keeps a drawn compass's "
-                 f"envelope"),
-            ours=f"band {lo:+.2f}..{hi:+.2f} deg", key="a_uncomp_range"))
+        out.append(
+            Claim(
+                "the uncompensated error spans the paper's range",
+                _rng(p_) + " deg",
+                reading=R_ANY,
+                source="paper",
+                statistic="larger distance of the uncompensated test-sweep error band's ends from the paper's "
+                "(|min - paper min| or |max - paper max|), deg",
+                estimate=verdicts.exact(gap),
+                boundary=tol,
+                holds_when="below",
+                unit="deg",
+                by_construction=bool(simulated),
+                decided_by=("the chapter's sweep pair (one noise draw): the band of sweep 2",),
+                why=(
+                    "our default compass's error sources (navlib.sensors.compass.CompassErrors: hard iron a "
+                    "third of H, soft iron up to 8 %, a 1.6 deg yaw) were set so that the uncompensated error "
+                    f"spans the paper's {_rng(p_)} deg, and the drawn compasses C1-C5 are kept only within "
+                    f"{tol:g} deg of it: only the paper's real sweeps could test it"
+                    if simulated
+                    else f"boundary: the {tol:g} deg within which the robustness study keeps a drawn compass's "
+                    f"envelope"
+                ),
+                ours=f"band {lo:+.2f}..{hi:+.2f} deg",
+                key="a_uncomp_range",
+            )
+        )
     ls = ls_positions_rms(sw) if ls is None else ls
     for mid, g in ls.groupby("model", sort=False):
         by = g.set_index("n_positions").test_rms_deg
@@ -234,19 +335,32 @@ def sweep_claims(runs: pd.DataFrame, paper: pd.DataFrame, sw: Sweeps, simulated:
             continue
         name, few, many = LS_MODELS[mid], int(by.index.min()), int(by.index.max())
         seq = ", ".join(f"{by[n]:.3f} on {n}" for n in by.index)
-        for n, part, k in ((few, "too few positions compensate poorly", "few"),
-                           (many, "too many positions worsen the fit", "many")):
-            out.append(Claim(
-                f"LS [{name}] on {n} positions is worse than on {LS_REF_POSITIONS}", part, reading=R_ANY,
-                source="paper",
-                statistic=f"test RMS of LS [{name}] fitted on {n} equally spaced positions of sweep 1 - fitted "
-                          f"on {LS_REF_POSITIONS}, deg",
-                estimate=verdicts.exact(by[n] - by[LS_REF_POSITIONS]), boundary=0.0, holds_when="above",
-                unit="deg", spec="{:.4f}",
-                decided_by=(ls_assumption(mid), "the chapter's sweep pair (one noise draw): sweep 1 fits, "
-                                                 "sweep 2 tests; exact for these sweeps"),
-                ours=f"test RMS {seq} positions (deg)",
-                key=f"a_lsn_{k}_{_LS_KEYS[mid]}"))
+        for n, part, k in (
+            (few, "too few positions compensate poorly", "few"),
+            (many, "too many positions worsen the fit", "many"),
+        ):
+            out.append(
+                Claim(
+                    f"LS [{name}] on {n} positions is worse than on {LS_REF_POSITIONS}",
+                    part,
+                    reading=R_ANY,
+                    source="paper",
+                    statistic=f"test RMS of LS [{name}] fitted on {n} equally spaced positions of sweep 1 - fitted "
+                    f"on {LS_REF_POSITIONS}, deg",
+                    estimate=verdicts.exact(by[n] - by[LS_REF_POSITIONS]),
+                    boundary=0.0,
+                    holds_when="above",
+                    unit="deg",
+                    spec="{:.4f}",
+                    decided_by=(
+                        ls_assumption(mid),
+                        "the chapter's sweep pair (one noise draw): sweep 1 fits, "
+                        "sweep 2 tests; exact for these sweeps",
+                    ),
+                    ours=f"test RMS {seq} positions (deg)",
+                    key=f"a_lsn_{k}_{_LS_KEYS[mid]}",
+                )
+            )
     return out
 
 
@@ -256,8 +370,11 @@ def headline_claims(claim_list, readings=None) -> list:
     validation-stop variants and ADE's rule readings, which stay in the verdict table and the results
     file)."""
     keep = set(readings or (R1, R2, R4))
-    return [c for c in claim_list if c.reading in keep
-            and ("error within" not in c.claim or c.claim.startswith("ADE-BP"))]
+    return [
+        c
+        for c in claim_list
+        if c.reading in keep and ("error within" not in c.claim or c.claim.startswith("ADE-BP"))
+    ]
 
 
 # ------------------------------------------------------------------------------------------- verdict tables
@@ -281,8 +398,15 @@ def verdict_table(claim_list, readings=None) -> pd.DataFrame:
     if missing:
         raise InputError(f"verdict_table: a claim record has no {missing[0]!r}")
     # a register record names its claim as the register does and keeps the row's own words in 'row_claim'
-    rows = [{"claim": c.get("row_claim") or c["claim"], "reading": c["reading"], "verdict": c["verdict"]}
-            for c in recs if readings is None or c["reading"] in readings]
+    rows = [
+        {
+            "claim": c.get("row_claim") or c["claim"],
+            "reading": c["reading"],
+            "verdict": c["verdict"],
+        }
+        for c in recs
+        if readings is None or c["reading"] in readings
+    ]
     if not rows:
         raise InputError("verdict_table: no claim under the readings asked for")
     df = pd.DataFrame(rows)
@@ -300,14 +424,21 @@ def rule_reading_table(claim_list, base: str) -> pd.DataFrame:
     if len(cols) == 1:
         raise InputError(f"rule_reading_table: {base!r} has no readings of ADE's rules")
     t = verdict_table(claim_list, cols)
-    t = t[t.drop(columns=base).ne("-").any(axis=1)]        # the claims judged under the rule readings
-    return t.rename(columns={base: "F by generation, CR by value"}
-                    | {r: r[len(base) + len(", ADE "):] for r in cols[1:]})
+    t = t[t.drop(columns=base).ne("-").any(axis=1)]  # the claims judged under the rule readings
+    return t.rename(
+        columns={base: "F by generation, CR by value"}
+        | {r: r[len(base) + len(", ADE ") :] for r in cols[1:]}
+    )
 
 
 # ---------------------------------------------------------------------------------------------- convergence
-def convergence_claims(reach: pd.DataFrame, de: str = "de_bp_pure", ade: str = "ade_bp_pure",
-                       reading: str = R1, seed: int = 20) -> list[Claim]:
+def convergence_claims(
+    reach: pd.DataFrame,
+    de: str = "de_bp_pure",
+    ade: str = "ade_bp_pure",
+    reading: str = R1,
+    seed: int = 20,
+) -> list[Claim]:
     """Paper A's "faster convergence and good stability" of ADE against DE (contribution 3), from
     :func:`~navlib.studies.compass.turntable.generations_to_reach` ``reach`` (pure DE, the same seeds):
 
@@ -324,55 +455,109 @@ def convergence_claims(reach: pd.DataFrame, de: str = "de_bp_pure", ade: str = "
     out = []
     rk = READING_KEYS.get(reading, "r")
     for rms in sorted(set(reach.rms_level_deg), reverse=True):
-        a = reach[(reach.method == ade) & (reach.rms_level_deg == rms)].set_index("seed").generations
+        a = (
+            reach[(reach.method == ade) & (reach.rms_level_deg == rms)]
+            .set_index("seed")
+            .generations
+        )
         d = reach[(reach.method == de) & (reach.rms_level_deg == rms)].set_index("seed").generations
-        est, short = verdicts.attempt(paired_seed_difference, d.astype(float).rename(de),
-                                      a.astype(float).rename(ade))
-        never = int((~reach[(reach.rms_level_deg == rms) & reach.method.isin([de, ade])].reached).sum())
-        out.append(Claim(f"ADE-BP converges faster than DE-BP (training RMS {rms:g} deg)",
-                         "faster convergence (no numbers)", reading=reading, source="paper",
-                         statistic=f"generations DE-BP needs - generations ADE-BP needs to reach J = "
-                                   f"{reach[reach.rms_level_deg == rms].j_level.iloc[0]:.4g} deg^2, paired by "
-                                   f"seed",
-                         estimate=est, boundary=0.0, holds_when="above", unit="generations", spec="{:.0f}",
-                         decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY),
-                         why="; ".join(t for t in (short, f"{never} runs never reached it (counted as G + 1)"
-                                                   if never else "") if t),
-                         ours=f"{a.median():.0f} vs {d.median():.0f} generations (medians)",
-                         key=f"a_conv_{rk}_{str(rms).replace('.', 'p')}"))
+        est, short = verdicts.attempt(
+            paired_seed_difference, d.astype(float).rename(de), a.astype(float).rename(ade)
+        )
+        never = int(
+            (~reach[(reach.rms_level_deg == rms) & reach.method.isin([de, ade])].reached).sum()
+        )
+        out.append(
+            Claim(
+                f"ADE-BP converges faster than DE-BP (training RMS {rms:g} deg)",
+                "faster convergence (no numbers)",
+                reading=reading,
+                source="paper",
+                statistic=f"generations DE-BP needs - generations ADE-BP needs to reach J = "
+                f"{reach[reach.rms_level_deg == rms].j_level.iloc[0]:.4g} deg^2, paired by "
+                f"seed",
+                estimate=est,
+                boundary=0.0,
+                holds_when="above",
+                unit="generations",
+                spec="{:.0f}",
+                decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY),
+                why="; ".join(
+                    t
+                    for t in (
+                        short,
+                        f"{never} runs never reached it (counted as G + 1)" if never else "",
+                    )
+                    if t
+                ),
+                ours=f"{a.median():.0f} vs {d.median():.0f} generations (medians)",
+                key=f"a_conv_{rk}_{str(rms).replace('.', 'p')}",
+            )
+        )
     fin = reach[reach.rms_level_deg == reach.rms_level_deg.iloc[0]]
-    at_cols = sorted((c for c in reach.columns if c.startswith("train_rms_at_")), key=lambda c: int(c[13:]))
+    at_cols = sorted(
+        (c for c in reach.columns if c.startswith("train_rms_at_")), key=lambda c: int(c[13:])
+    )
     for col in at_cols:
         g = int(col[13:])
         a = fin[fin.method == ade].set_index("seed")[col]
         d = fin[fin.method == de].set_index("seed")[col]
         est, short = verdicts.attempt(paired_seed_difference, d.rename(de), a.rename(ade))
-        out.append(Claim(f"ADE-BP converges faster than DE-BP (training RMS at generation {g})",
-                         "faster convergence (no numbers)", reading=reading, source="paper",
-                         statistic=f"training RMS of DE-BP's best individual at generation {g} - ADE-BP's, "
-                                   f"paired by seed, deg",
-                         estimate=est, boundary=0.0, holds_when="above", unit="deg",
-                         decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY,
-                                     "the curves compared at a fixed generation (a fraction of the DE budget "
-                                     "fixed before the runs), which no run can miss"),
-                         why=short, ours=f"{a.median():.3g} vs {d.median():.3g} deg (medians)",
-                         key=f"a_conv_{rk}_g{g}"))
+        out.append(
+            Claim(
+                f"ADE-BP converges faster than DE-BP (training RMS at generation {g})",
+                "faster convergence (no numbers)",
+                reading=reading,
+                source="paper",
+                statistic=f"training RMS of DE-BP's best individual at generation {g} - ADE-BP's, "
+                f"paired by seed, deg",
+                estimate=est,
+                boundary=0.0,
+                holds_when="above",
+                unit="deg",
+                decided_by=(
+                    _READING_ASSUMPTIONS.get(reading, reading),
+                    TRAINING_ONLY,
+                    "the curves compared at a fixed generation (a fraction of the DE budget "
+                    "fixed before the runs), which no run can miss",
+                ),
+                why=short,
+                ours=f"{a.median():.3g} vs {d.median():.3g} deg (medians)",
+                key=f"a_conv_{rk}_g{g}",
+            )
+        )
     fa = np.log10(fin[fin.method == ade].set_index("seed").final_j.sort_index())
     fd = np.log10(fin[fin.method == de].set_index("seed").final_j.sort_index())
     common = fa.index.intersection(fd.index)
 
     def iqr_ratio(x, y):
-        return float(np.subtract(*np.percentile(x, [75, 25])) / max(np.subtract(*np.percentile(y, [75, 25])),
-                                                                  1e-12))
-    est, short = verdicts.attempt(lambda: verdicts.bootstrap([fd.loc[common], fa.loc[common]], iqr_ratio,
-                                                             seed=np.random.SeedSequence(seed)))
-    out.append(Claim("ADE-BP is more stable than DE-BP (spread of the final J over seeds)",
-                     "good stability (no numbers)", reading=reading, source="paper",
-                     statistic="interquartile range of log10 final J over seeds, DE-BP / ADE-BP (paired "
-                               "bootstrap over seeds)",
-                     estimate=est, boundary=1.0, holds_when="above", spec="{:.2f}",
-                     decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY), why=short,
-                     ours=f"IQR of log10 J: ADE-BP {np.subtract(*np.percentile(fa, [75, 25])):.2f}, DE-BP "
-                          f"{np.subtract(*np.percentile(fd, [75, 25])):.2f}",
-                     key=f"a_stab_{rk}"))
+        return float(
+            np.subtract(*np.percentile(x, [75, 25]))
+            / max(np.subtract(*np.percentile(y, [75, 25])), 1e-12)
+        )
+
+    est, short = verdicts.attempt(
+        lambda: verdicts.bootstrap(
+            [fd.loc[common], fa.loc[common]], iqr_ratio, seed=np.random.SeedSequence(seed)
+        )
+    )
+    out.append(
+        Claim(
+            "ADE-BP is more stable than DE-BP (spread of the final J over seeds)",
+            "good stability (no numbers)",
+            reading=reading,
+            source="paper",
+            statistic="interquartile range of log10 final J over seeds, DE-BP / ADE-BP (paired "
+            "bootstrap over seeds)",
+            estimate=est,
+            boundary=1.0,
+            holds_when="above",
+            spec="{:.2f}",
+            decided_by=(_READING_ASSUMPTIONS.get(reading, reading), TRAINING_ONLY),
+            why=short,
+            ours=f"IQR of log10 J: ADE-BP {np.subtract(*np.percentile(fa, [75, 25])):.2f}, DE-BP "
+            f"{np.subtract(*np.percentile(fd, [75, 25])):.2f}",
+            key=f"a_stab_{rk}",
+        )
+    )
     return out

@@ -5,6 +5,7 @@
 - Table 5 and Fig 4 in a simulated world with the drift rate term from Table 4: :func:`table5_simulation`
   (cached per parameter set; treat returned frames as read-only).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -20,7 +21,13 @@ from navlib.methods.rbf import leave_one_out
 from navlib.sensors import ins
 
 from .measured import _hot_xy, _maxabs, _quantities, _rms
-from .networks import _cold_net_inputs, _table2_net, design_cold_net, design_hot_net, rate_coefficient
+from .networks import (
+    _cold_net_inputs,
+    _table2_net,
+    design_cold_net,
+    design_hot_net,
+    rate_coefficient,
+)
 from .parameters import ColdDtColumn, StudyParams, experiment_seeds, fact
 from .simulation import _simulated_hot_tests
 
@@ -44,10 +51,18 @@ def table4_hot_net(params: StudyParams = StudyParams()) -> pd.DataFrame:
     x4, y4 = t4["latitude_error_deg"].to_numpy(float), t4["true_drift_deg_h"].to_numpy(float)
     ours = net.predict(x4)
     paper = t4["paper_hot_rbf_drift_deg_h"].to_numpy(float)
-    return pd.DataFrame({"sample": t4["sample"], "dL (arcmin)": to_arcmin(x4),
-                         "calib dT (C)": t4["calib_temp_change_c"].to_numpy(float), "true": y4,
-                         "paper hot RBF": paper, "our hot RBF": ours, "err paper": y4 - paper,
-                         "err ours": y4 - ours})
+    return pd.DataFrame(
+        {
+            "sample": t4["sample"],
+            "dL (arcmin)": to_arcmin(x4),
+            "calib dT (C)": t4["calib_temp_change_c"].to_numpy(float),
+            "true": y4,
+            "paper hot RBF": paper,
+            "our hot RBF": ours,
+            "err paper": y4 - paper,
+            "err ours": y4 - ours,
+        }
+    )
 
 
 @dataclass(frozen=True)
@@ -91,25 +106,54 @@ def cold_leave_one_out(params: StudyParams = StudyParams()) -> ColdLoo:
     X4 = _cold_net_inputs(t4, params.cold.dt_column)
     cold_loo = leave_one_out(X4, y4, lambda x, y: design_cold_net(x, y, params))
     n = len(y4)
-    rate_loo = np.array([hot4[i] - rate_coefficient(hot4[np.arange(n) != i] - y4[np.arange(n) != i],
-                                                    rate4[np.arange(n) != i]) * rate4[i] for i in range(n)])
+    rate_loo = np.array(
+        [
+            hot4[i]
+            - rate_coefficient(
+                hot4[np.arange(n) != i] - y4[np.arange(n) != i], rate4[np.arange(n) != i]
+            )
+            * rate4[i]
+            for i in range(n)
+        ]
+    )
     pred = dict(zip(COLD_METHODS, (cold_loo, hot4, rate_loo)))
     rows = pd.DataFrame({"sample": t4["sample"], "true": y4})
     for k, p in pred.items():
         rows[k.split(" (")[0]] = p
     for k, p in pred.items():
         rows[f"err {k.split(' (')[0]}"] = y4 - p
-    summary = pd.DataFrame({"method": list(pred), "RMS (deg/h)": [_rms(y4 - p) for p in pred.values()],
-                            "max |err| (deg/h)": [_maxabs(y4 - p) for p in pred.values()]})
+    summary = pd.DataFrame(
+        {
+            "method": list(pred),
+            "RMS (deg/h)": [_rms(y4 - p) for p in pred.values()],
+            "max |err| (deg/h)": [_maxabs(y4 - p) for p in pred.values()],
+        }
+    )
     grid = []
     for col in get_args(ColdDtColumn):
         Xg = _cold_net_inputs(t4, col)
         for sp in (1.0, 2.0, 4.0):
-            p = leave_one_out(Xg, y4, lambda x, y, sp=sp: design_cold_net(x, y, params, spread_sd=sp))
-            grid.append({"temperature change": col, "SPREAD (sd units)": sp, "LOO RMS (deg/h)": _rms(y4 - p),
-                         "LOO max (deg/h)": _maxabs(y4 - p)})
-    q = _quantities([("k_R from Table 4", rate_coefficient(hot4 - y4, rate4), "(deg/h) per (C/h)"),
-                     ("correlation of hot-net error with rate", float(np.corrcoef(rate4, hot4 - y4)[0, 1]), "")])
+            p = leave_one_out(
+                Xg, y4, lambda x, y, sp=sp: design_cold_net(x, y, params, spread_sd=sp)
+            )
+            grid.append(
+                {
+                    "temperature change": col,
+                    "SPREAD (sd units)": sp,
+                    "LOO RMS (deg/h)": _rms(y4 - p),
+                    "LOO max (deg/h)": _maxabs(y4 - p),
+                }
+            )
+    q = _quantities(
+        [
+            ("k_R from Table 4", rate_coefficient(hot4 - y4, rate4), "(deg/h) per (C/h)"),
+            (
+                "correlation of hot-net error with rate",
+                float(np.corrcoef(rate4, hot4 - y4)[0, 1]),
+                "",
+            ),
+        ]
+    )
     return ColdLoo(rows, summary, pd.DataFrame(grid), q)
 
 
@@ -133,9 +177,14 @@ TABLE5_METHODS = ("hot net", "cold net", "hot + rate corr.")
 
 
 def _cold_history(row, k_rate: float, proc: ins.Procedure) -> ins.ColdStart:
-    return ins.ColdStart(align_temp_min_c=row.align_temp_min_c, calib_temp_min_c=row.calib_temp_min_c,
-                         calib_temp_max_c=row.calib_temp_max_c, drift_per_c_h_deg_h=k_rate,
-                         align_h=proc.align_h, identify_h=proc.identify_h)
+    return ins.ColdStart(
+        align_temp_min_c=row.align_temp_min_c,
+        calib_temp_min_c=row.calib_temp_min_c,
+        calib_temp_max_c=row.calib_temp_max_c,
+        drift_per_c_h_deg_h=k_rate,
+        align_h=proc.align_h,
+        identify_h=proc.identify_h,
+    )
 
 
 @lru_cache(maxsize=4)
@@ -166,9 +215,14 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
     k_rate = float(cold_leave_one_out(params).quantities.loc["k_R from Table 4", "value"])
     sim_hot = _simulated_hot_tests(params)
     sim_hot_net = design_hot_net([r.latitude_error_12h_deg for r in sim_hot], y2, params.hot)
-    sim_cold = ins.simulated_tests(y4, seed=experiment_seeds(s.seed, "cold_training", 1)[0],
-                                   cold=[_cold_history(r, k_rate, proc) for r in t4.itertuples()],
-                                   earth=earth, procedure=proc, **s.error_sd())
+    sim_cold = ins.simulated_tests(
+        y4,
+        seed=experiment_seeds(s.seed, "cold_training", 1)[0],
+        cold=[_cold_history(r, k_rate, proc) for r in t4.itertuples()],
+        earth=earth,
+        procedure=proc,
+        **s.error_sd(),
+    )
     t4_sim = t4.copy()
     t4_sim["latitude_error_deg"] = [r.latitude_error_12h_deg for r in sim_cold]
     sim_cold_net = design_cold_net(_cold_net_inputs(t4_sim, params.cold.dt_column), y4, params)
@@ -178,24 +232,49 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
     for j, row in enumerate(t5.itertuples()):
         half = s.cold_drift_half_range_deg_h
         drifts = np.random.default_rng(draw_seeds[j]).uniform(-half, half, s.n_seeds)
-        runs = ins.simulated_tests(drifts, seed=seeds[j], cold=[_cold_history(row, k_rate, proc)] * s.n_seeds,
-                                   earth=earth, procedure=proc, **s.error_sd())
+        runs = ins.simulated_tests(
+            drifts,
+            seed=seeds[j],
+            cold=[_cold_history(row, k_rate, proc)] * s.n_seeds,
+            earth=earth,
+            procedure=proc,
+            **s.error_sd(),
+        )
         lat = np.array([r.latitude_error_12h_deg for r in runs])
-        rows5 = pd.DataFrame({"latitude_error_deg": lat, "calib_temp_max_c": row.calib_temp_max_c,
-                              "calib_temp_change_c": row.calib_temp_change_c,
-                              "align_temp_change_c": row.align_temp_change_c})
+        rows5 = pd.DataFrame(
+            {
+                "latitude_error_deg": lat,
+                "calib_temp_max_c": row.calib_temp_max_c,
+                "calib_temp_change_c": row.calib_temp_change_c,
+                "align_temp_change_c": row.align_temp_change_c,
+            }
+        )
         hot_est = sim_hot_net.predict(lat)
-        est = {"hot net": hot_est,
-               "cold net": sim_cold_net.predict(_cold_net_inputs(rows5, params.cold.dt_column)),
-               "hot + rate corr.": hot_est - k_rate * row.calib_temp_change_c / proc.identify_h}
-        out = {"test": int(row.test), "calib dT (C)": float(row.calib_temp_change_c),
-               "paper hot net": float(row.paper_pos_error_hot_net_nmi_72h),
-               "paper cold net": float(row.paper_pos_error_cold_net_nmi_72h)}
-        worst = {name: np.array([r.position_error_nmi_for(c).max() for r, c in zip(runs, e)])
-                 for name, e in est.items()}
-        per_run.append(pd.DataFrame({"test": int(row.test), "draw": np.arange(1, len(runs) + 1),
-                                     "final drift (deg/h)": drifts}
-                                    | {f"{name} (nmi)": w for name, w in worst.items()}))
+        est = {
+            "hot net": hot_est,
+            "cold net": sim_cold_net.predict(_cold_net_inputs(rows5, params.cold.dt_column)),
+            "hot + rate corr.": hot_est - k_rate * row.calib_temp_change_c / proc.identify_h,
+        }
+        out = {
+            "test": int(row.test),
+            "calib dT (C)": float(row.calib_temp_change_c),
+            "paper hot net": float(row.paper_pos_error_hot_net_nmi_72h),
+            "paper cold net": float(row.paper_pos_error_cold_net_nmi_72h),
+        }
+        worst = {
+            name: np.array([r.position_error_nmi_for(c).max() for r, c in zip(runs, e)])
+            for name, e in est.items()
+        }
+        per_run.append(
+            pd.DataFrame(
+                {
+                    "test": int(row.test),
+                    "draw": np.arange(1, len(runs) + 1),
+                    "final drift (deg/h)": drifts,
+                }
+                | {f"{name} (nmi)": w for name, w in worst.items()}
+            )
+        )
         for name, w in worst.items():
             out[f"ours {name}"] = float(np.mean(w))
         for name, e in est.items():
@@ -204,10 +283,26 @@ def table5_simulation(params: StudyParams = StudyParams()) -> Table5:
         if j == 0:
             r0 = runs[0]
             q_drift = r0.final_drift_deg_h
-            fig4 = pd.concat([pd.DataFrame({"method": name, "compensation_deg_h": float(e[0]), "t_h": r0.after.t_h,
-                                            "position_error_nmi": r0.position_error_nmi_for(float(e[0]))})
-                              for name, e in est.items()], ignore_index=True)
-    q = _quantities([("k_R", k_rate, "(deg/h) per (C/h)"), ("simulated hot net neurons", sim_hot_net.n_neurons, ""),
-                     ("simulated cold net neurons", sim_cold_net.n_neurons, ""),
-                     ("paper Fig 4 run: simulated final drift", q_drift, "deg/h")])
+            fig4 = pd.concat(
+                [
+                    pd.DataFrame(
+                        {
+                            "method": name,
+                            "compensation_deg_h": float(e[0]),
+                            "t_h": r0.after.t_h,
+                            "position_error_nmi": r0.position_error_nmi_for(float(e[0])),
+                        }
+                    )
+                    for name, e in est.items()
+                ],
+                ignore_index=True,
+            )
+    q = _quantities(
+        [
+            ("k_R", k_rate, "(deg/h) per (C/h)"),
+            ("simulated hot net neurons", sim_hot_net.n_neurons, ""),
+            ("simulated cold net neurons", sim_cold_net.n_neurons, ""),
+            ("paper Fig 4 run: simulated final drift", q_drift, "deg/h"),
+        ]
+    )
     return Table5(pd.DataFrame(rows), fig4, q, pd.concat(per_run, ignore_index=True))

@@ -7,6 +7,7 @@
 
 :func:`fig3_position_errors` caches its result per parameter set; treat returned frames as read-only.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -51,11 +52,22 @@ def hot_network(params: StudyParams = StudyParams()) -> HotNet:
     """
     net = _table2_net(params.hot)
     unit = params.hot.input_unit
-    neurons = pd.DataFrame({"neuron": np.arange(1, net.n_neurons + 1), "training sample": net.center_index + 1,
-                            f"centre ({unit})": net.centers[:, 0], "weight (deg/h)": net.weights[:, 0]})
-    q = _quantities([("neurons", net.n_neurons, ""),
-                     ("width b", net.b, f"per {unit}"), ("training RMS", float(np.sqrt(net.perf_mse[-1])), "deg/h"),
-                     ("bias", float(net.bias[0]), "deg/h")])
+    neurons = pd.DataFrame(
+        {
+            "neuron": np.arange(1, net.n_neurons + 1),
+            "training sample": net.center_index + 1,
+            f"centre ({unit})": net.centers[:, 0],
+            "weight (deg/h)": net.weights[:, 0],
+        }
+    )
+    q = _quantities(
+        [
+            ("neurons", net.n_neurons, ""),
+            ("width b", net.b, f"per {unit}"),
+            ("training RMS", float(np.sqrt(net.perf_mse[-1])), "deg/h"),
+            ("bias", float(net.bias[0]), "deg/h"),
+        ]
+    )
     return HotNet(net, neurons, q)
 
 
@@ -91,11 +103,20 @@ def table3_identification(params: StudyParams = StudyParams()) -> Table3:
     x2, y2, x3, y3 = _hot_xy()
     net = _table2_net(params.hot)
     line = np.polyfit(x2, y2, 1)
-    out = pd.DataFrame({"test": t3["test"], "dL (arcmin)": to_arcmin(x3), "true (deg/h)": y3,
-                        "paper RBF": t3["paper_rbf_drift_deg_h"].to_numpy(float), "our RBF": net.predict(x3),
-                        "Table 1 inverse": ins.drift_from_latitude_error(x3, fact("identify_h"), params.earth),
-                        "straight line": np.polyval(line, x3)})
-    err = pd.DataFrame({"test": t3["test"], "paper's printed error": t3["paper_error_deg_h"].to_numpy(float)})
+    out = pd.DataFrame(
+        {
+            "test": t3["test"],
+            "dL (arcmin)": to_arcmin(x3),
+            "true (deg/h)": y3,
+            "paper RBF": t3["paper_rbf_drift_deg_h"].to_numpy(float),
+            "our RBF": net.predict(x3),
+            "Table 1 inverse": ins.drift_from_latitude_error(x3, fact("identify_h"), params.earth),
+            "straight line": np.polyval(line, x3),
+        }
+    )
+    err = pd.DataFrame(
+        {"test": t3["test"], "paper's printed error": t3["paper_error_deg_h"].to_numpy(float)}
+    )
     for m in TABLE3_METHODS:
         err[f"err {m}"] = y3 - out[m].to_numpy()
     return Table3(out, err)
@@ -126,11 +147,17 @@ def fig2_training_path(params: StudyParams = StudyParams()) -> Fig2:
     """
     x2, y2, _, _ = _hot_xy()
     h = params.hot
-    full = design_hot_net(x2, y2, HotNetSettings(spread=h.spread, goal=0.0, goal_kind="mse",
-                                                 input_unit=h.input_unit))
+    full = design_hot_net(
+        x2, y2, HotNetSettings(spread=h.spread, goal=0.0, goal_kind="mse", input_unit=h.input_unit)
+    )
     ours = _table2_net(h)
-    path = pd.DataFrame({"neurons": np.arange(full.perf_mse.size), "MSE ((deg/h)^2)": full.perf_mse,
-                         "SSE ((deg/h)^2)": full.perf_sse})
+    path = pd.DataFrame(
+        {
+            "neurons": np.arange(full.perf_mse.size),
+            "MSE ((deg/h)^2)": full.perf_mse,
+            "SSE ((deg/h)^2)": full.perf_sse,
+        }
+    )
     return Fig2(path, full.n_neurons, full.stop_reason, ours.n_neurons)
 
 
@@ -173,24 +200,59 @@ def fig3_position_errors(params: StudyParams = StudyParams()) -> Fig3:
     for i in range(len(t3)):
         est = float(tab["our RBF"].iloc[i])
         true = float(tab["true (deg/h)"].iloc[i])
-        runs = ins.simulated_tests(np.full(s.n_seeds, true), seed=seeds[i], identify=lambda lat, est=est: est,
-                                   earth=params.earth, procedure=s.procedure(), **s.error_sd())
+        runs = ins.simulated_tests(
+            np.full(s.n_seeds, true),
+            seed=seeds[i],
+            identify=lambda lat, est=est: est,
+            earth=params.earth,
+            procedure=s.procedure(),
+            **s.error_sd(),
+        )
         before = np.array([r.max_error_before_nmi for r in runs])
         after = np.array([r.max_error_after_nmi for r in runs])
         best = np.array([float(r.position_error_nmi_for(r.best_drift_deg_h).max()) for r in runs])
-        per_run.append(pd.DataFrame({"test": int(t3["test"].iloc[i]), "draw": np.arange(1, len(runs) + 1),
-                                     "before_nmi": before, "after_nmi": after, "best_nmi": best}))
-        rows.append({"test": int(t3["test"].iloc[i]), "true drift (deg/h)": true, "our RBF (deg/h)": est,
-                     "paper before": float(t3["paper_pos_error_before_nmi_72h"].iloc[i]),
-                     "ours before": before.mean(), "ours before min": before.min(),
-                     "ours before max": before.max(),
-                     "paper after": float(t3["paper_pos_error_after_nmi_72h"].iloc[i]),
-                     "ours after": after.mean(), "ours after min": after.min(), "ours after max": after.max()})
+        per_run.append(
+            pd.DataFrame(
+                {
+                    "test": int(t3["test"].iloc[i]),
+                    "draw": np.arange(1, len(runs) + 1),
+                    "before_nmi": before,
+                    "after_nmi": after,
+                    "best_nmi": best,
+                }
+            )
+        )
+        rows.append(
+            {
+                "test": int(t3["test"].iloc[i]),
+                "true drift (deg/h)": true,
+                "our RBF (deg/h)": est,
+                "paper before": float(t3["paper_pos_error_before_nmi_72h"].iloc[i]),
+                "ours before": before.mean(),
+                "ours before min": before.min(),
+                "ours before max": before.max(),
+                "paper after": float(t3["paper_pos_error_after_nmi_72h"].iloc[i]),
+                "ours after": after.mean(),
+                "ours after min": after.min(),
+                "ours after max": after.max(),
+            }
+        )
         r0 = runs[0]
-        curves.append(pd.DataFrame({"test": int(t3["test"].iloc[i]), "t_h": r0.after.t_h,
-                                    "before_nmi": r0.before.position_error_nmi,
-                                    "after_nmi": r0.after.position_error_nmi}))
-    return Fig3(pd.DataFrame(rows), pd.concat(curves, ignore_index=True), pd.concat(per_run, ignore_index=True))
+        curves.append(
+            pd.DataFrame(
+                {
+                    "test": int(t3["test"].iloc[i]),
+                    "t_h": r0.after.t_h,
+                    "before_nmi": r0.before.position_error_nmi,
+                    "after_nmi": r0.after.position_error_nmi,
+                }
+            )
+        )
+    return Fig3(
+        pd.DataFrame(rows),
+        pd.concat(curves, ignore_index=True),
+        pd.concat(per_run, ignore_index=True),
+    )
 
 
 # ----------------------------------------------------------------------------------- Table 1 against the data
@@ -223,12 +285,25 @@ def slopes_table() -> Slopes:
     for name, xx, yy in (("Table 2", x2, y2), ("Tables 2+3+4", x_all, y_all)):
         b1, b0 = np.polyfit(xx, yy, 1)
         c1, _ = np.polyfit(yy, xx, 1)
-        rows.append({"rows": name, "n": len(xx), "drift on dL": b1, "1 / (dL on drift)": 1 / c1,
-                     "Table 1": slope_t1, "ratio drift on dL": b1 / slope_t1,
-                     "ratio 1 / (dL on drift)": 1 / c1 / slope_t1, "intercept (deg/h)": b0,
-                     "residual RMS (deg/h)": _rms(yy - np.polyval([b1, b0], xx))})
-    loo = pd.DataFrame({"model": ["straight line", "quadratic"],
-                        "LOO RMS (deg/h)": [_rms(y2 - leave_one_out(x2, y2, _poly_fit(d))) for d in (1, 2)]})
+        rows.append(
+            {
+                "rows": name,
+                "n": len(xx),
+                "drift on dL": b1,
+                "1 / (dL on drift)": 1 / c1,
+                "Table 1": slope_t1,
+                "ratio drift on dL": b1 / slope_t1,
+                "ratio 1 / (dL on drift)": 1 / c1 / slope_t1,
+                "intercept (deg/h)": b0,
+                "residual RMS (deg/h)": _rms(yy - np.polyval([b1, b0], xx)),
+            }
+        )
+    loo = pd.DataFrame(
+        {
+            "model": ["straight line", "quadratic"],
+            "LOO RMS (deg/h)": [_rms(y2 - leave_one_out(x2, y2, _poly_fit(d))) for d in (1, 2)],
+        }
+    )
     return Slopes(pd.DataFrame(rows), loo)
 
 
@@ -256,18 +331,38 @@ def drift_against_latitude(params: StudyParams = StudyParams(), n_grid: int = 30
     check_param("n_grid", n_grid, lo=2, integer=True)
     x2, y2, x3, y3 = _hot_xy()
     t4 = load_cold_train()
-    points = pd.concat([
-        pd.DataFrame({"table": "Table 2 (training)", "dL_arcmin": to_arcmin(x2), "drift_deg_h": y2}),
-        pd.DataFrame({"table": "Table 3 (hot tests)", "dL_arcmin": to_arcmin(x3), "drift_deg_h": y3}),
-        pd.DataFrame({"table": "Table 4 (cold start)", "dL_arcmin": to_arcmin(t4["latitude_error_deg"]),
-                      "drift_deg_h": t4["true_drift_deg_h"].to_numpy(float)})], ignore_index=True)
+    points = pd.concat(
+        [
+            pd.DataFrame(
+                {"table": "Table 2 (training)", "dL_arcmin": to_arcmin(x2), "drift_deg_h": y2}
+            ),
+            pd.DataFrame(
+                {"table": "Table 3 (hot tests)", "dL_arcmin": to_arcmin(x3), "drift_deg_h": y3}
+            ),
+            pd.DataFrame(
+                {
+                    "table": "Table 4 (cold start)",
+                    "dL_arcmin": to_arcmin(t4["latitude_error_deg"]),
+                    "drift_deg_h": t4["true_drift_deg_h"].to_numpy(float),
+                }
+            ),
+        ],
+        ignore_index=True,
+    )
     xs = np.linspace(-0.03, 0.03, int(n_grid))
     net = _table2_net(params.hot)
-    models = {f"our RBF ({net.n_neurons} neurons)": net.predict(xs),
-              "Table 1 inverse": ins.drift_from_latitude_error(xs, fact("identify_h"), params.earth),
-              "straight line fit to Table 2": np.polyval(np.polyfit(x2, y2, 1), xs)}
-    lines = pd.concat([pd.DataFrame({"model": k, "dL_arcmin": to_arcmin(xs), "drift_deg_h": v})
-                       for k, v in models.items()], ignore_index=True)
+    models = {
+        f"our RBF ({net.n_neurons} neurons)": net.predict(xs),
+        "Table 1 inverse": ins.drift_from_latitude_error(xs, fact("identify_h"), params.earth),
+        "straight line fit to Table 2": np.polyval(np.polyfit(x2, y2, 1), xs),
+    }
+    lines = pd.concat(
+        [
+            pd.DataFrame({"model": k, "dL_arcmin": to_arcmin(xs), "drift_deg_h": v})
+            for k, v in models.items()
+        ],
+        ignore_index=True,
+    )
     return DriftLatitude(points, lines)
 
 
@@ -298,15 +393,21 @@ def hot_leave_one_out(params: StudyParams = StudyParams()) -> HotLoo:
     """
     t2 = load_hot_train()
     x2, y2, _, _ = _hot_xy()
-    pred = {HOT_LOO_METHODS[0]: leave_one_out(x2, y2, lambda x, y: design_hot_net(x, y, params.hot)),
-            HOT_LOO_METHODS[1]: leave_one_out(x2, y2, _poly_fit(1)),
-            HOT_LOO_METHODS[2]: ins.drift_from_latitude_error(x2, fact("identify_h"), params.earth)}
+    pred = {
+        HOT_LOO_METHODS[0]: leave_one_out(x2, y2, lambda x, y: design_hot_net(x, y, params.hot)),
+        HOT_LOO_METHODS[1]: leave_one_out(x2, y2, _poly_fit(1)),
+        HOT_LOO_METHODS[2]: ins.drift_from_latitude_error(x2, fact("identify_h"), params.earth),
+    }
     lim = fact("claimed_accuracy")
-    summary = pd.DataFrame({"method": list(pred),
-                            "RMS (deg/h)": [_rms(y2 - p) for p in pred.values()],
-                            "max |err| (deg/h)": [_maxabs(y2 - p) for p in pred.values()],
-                            "rows beyond claim": [int(np.sum(np.abs(y2 - p) > lim)) for p in pred.values()],
-                            "rows": len(y2)})
+    summary = pd.DataFrame(
+        {
+            "method": list(pred),
+            "RMS (deg/h)": [_rms(y2 - p) for p in pred.values()],
+            "max |err| (deg/h)": [_maxabs(y2 - p) for p in pred.values()],
+            "rows beyond claim": [int(np.sum(np.abs(y2 - p) > lim)) for p in pred.values()],
+            "rows": len(y2),
+        }
+    )
     rows = pd.DataFrame({"sample": t2["sample"], "dL (arcmin)": to_arcmin(x2), "drift (deg/h)": y2})
     for k, p in pred.items():
         rows[f"err {k.split(' (')[0]}"] = y2 - p

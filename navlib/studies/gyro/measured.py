@@ -6,6 +6,7 @@
   half a unit of its last digit) and :func:`temperature_spans`;
 - the summaries every experiment uses: RMS, largest ``|error|``, a ``quantity -> value, unit`` table.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -13,7 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from navlib.data.gyro_tables import TABLE_FILES, load_cold_test, load_cold_train, load_hot_test, load_hot_train
+from navlib.data.gyro_tables import (
+    TABLE_FILES,
+    load_cold_test,
+    load_cold_train,
+    load_hot_test,
+    load_hot_train,
+)
 from navlib.errors import InputError
 from navlib.paths import data_path
 
@@ -21,16 +28,28 @@ from navlib.paths import data_path
 # -------------------------------------------------------------------------------------------- measured tables
 #: Short column headers (with units) for showing the measured tables in the book.
 SHORT_HEADERS = {
-    "sample": "sample", "test": "test", "latitude_deg": "latitude (deg)", "latitude_error_deg": "dL (deg)",
-    "temperature_min_c": "T min (C)", "temperature_max_c": "T max (C)", "drift_deg_h": "drift (deg/h)",
-    "paper_rbf_drift_deg_h": "paper RBF (deg/h)", "true_drift_deg_h": "true drift (deg/h)",
-    "paper_error_deg_h": "paper error (deg/h)", "paper_pos_error_before_nmi_72h": "paper before (nmi)",
-    "paper_pos_error_after_nmi_72h": "paper after (nmi)", "align_temp_min_c": "align T min (C)",
-    "align_temp_max_c": "align T max (C)", "align_temp_change_c": "align dT (C)",
-    "calib_temp_min_c": "calib T min (C)", "calib_temp_max_c": "calib T max (C)",
-    "calib_temp_change_c": "calib dT (C)", "paper_hot_rbf_drift_deg_h": "paper hot RBF (deg/h)",
+    "sample": "sample",
+    "test": "test",
+    "latitude_deg": "latitude (deg)",
+    "latitude_error_deg": "dL (deg)",
+    "temperature_min_c": "T min (C)",
+    "temperature_max_c": "T max (C)",
+    "drift_deg_h": "drift (deg/h)",
+    "paper_rbf_drift_deg_h": "paper RBF (deg/h)",
+    "true_drift_deg_h": "true drift (deg/h)",
+    "paper_error_deg_h": "paper error (deg/h)",
+    "paper_pos_error_before_nmi_72h": "paper before (nmi)",
+    "paper_pos_error_after_nmi_72h": "paper after (nmi)",
+    "align_temp_min_c": "align T min (C)",
+    "align_temp_max_c": "align T max (C)",
+    "align_temp_change_c": "align dT (C)",
+    "calib_temp_min_c": "calib T min (C)",
+    "calib_temp_max_c": "calib T max (C)",
+    "calib_temp_change_c": "calib dT (C)",
+    "paper_hot_rbf_drift_deg_h": "paper hot RBF (deg/h)",
     "paper_pos_error_hot_net_nmi_72h": "paper, hot net (nmi)",
-    "paper_pos_error_cold_net_nmi_72h": "paper, cold net (nmi)"}
+    "paper_pos_error_cold_net_nmi_72h": "paper, cold net (nmi)",
+}
 
 
 @dataclass(frozen=True)
@@ -46,7 +65,9 @@ class MeasuredTables:
         """Table ``number`` (2-5) with the short headers of :data:`SHORT_HEADERS` (for display); the
         loader's derived ``latitude_error_deg`` only if ``derived``."""
         if number not in (2, 3, 4, 5):
-            raise InputError(f"parameter number={number!r}: paper C's measured tables are 2, 3, 4 and 5")
+            raise InputError(
+                f"parameter number={number!r}: paper C's measured tables are 2, 3, 4 and 5"
+            )
         t = getattr(self, f"table{number}")
         if not derived:
             t = t.drop(columns=["latitude_error_deg"], errors="ignore")
@@ -67,8 +88,12 @@ def measured_tables() -> MeasuredTables:
 
 def _hot_xy():
     t2, t3 = load_hot_train(), load_hot_test()
-    return (t2["latitude_error_deg"].to_numpy(float), t2["drift_deg_h"].to_numpy(float),
-            t3["latitude_error_deg"].to_numpy(float), t3["true_drift_deg_h"].to_numpy(float))
+    return (
+        t2["latitude_error_deg"].to_numpy(float),
+        t2["drift_deg_h"].to_numpy(float),
+        t3["latitude_error_deg"].to_numpy(float),
+        t3["true_drift_deg_h"].to_numpy(float),
+    )
 
 
 # ----------------------------------------------------------------------------------------------- printed text

@@ -8,6 +8,7 @@
 - other models: a polynomial fit, and :func:`swap_basis` (other basis functions, :data:`BASIS_FUNCTIONS`, at a
   Gaussian net's centres and width).
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -43,11 +44,15 @@ def latitude_scaler(unit: str = "arcmin") -> InputScaler:
     navlib.methods.rbf.InputScaler
     """
     if unit not in LATITUDE_UNITS:
-        raise InputError(f"parameter INPUT_UNIT={unit!r}: must be one of {', '.join(LATITUDE_UNITS)}")
+        raise InputError(
+            f"parameter INPUT_UNIT={unit!r}: must be one of {', '.join(LATITUDE_UNITS)}"
+        )
     return InputScaler.affine(0.0, LATITUDE_UNITS[unit], names=("latitude_error",), units=(unit,))
 
 
-def cold_inputs(df: pd.DataFrame, temperature_change_column: str = "calib_temp_change_c") -> np.ndarray:
+def cold_inputs(
+    df: pd.DataFrame, temperature_change_column: str = "calib_temp_change_c"
+) -> np.ndarray:
     """Cold-state network inputs (paper C Sec. 2.3: latitude error, temperature, temperature change).
 
     From a Table 4-like frame: ``[latitude_error_deg, calib_temp_max_c, <temperature_change_column>]``; the
@@ -66,10 +71,15 @@ def cold_inputs(df: pd.DataFrame, temperature_change_column: str = "calib_temp_c
     """
     allowed = get_args(ColdDtColumn)
     if temperature_change_column not in allowed:
-        raise InputError(f"parameter COLD_DT_COLUMN={temperature_change_column!r}: must be one of "
-                         f"{', '.join(allowed)}")
-    return np.c_[df["latitude_error_deg"].to_numpy(float), df["calib_temp_max_c"].to_numpy(float),
-                 df[temperature_change_column].to_numpy(float)]
+        raise InputError(
+            f"parameter COLD_DT_COLUMN={temperature_change_column!r}: must be one of "
+            f"{', '.join(allowed)}"
+        )
+    return np.c_[
+        df["latitude_error_deg"].to_numpy(float),
+        df["calib_temp_max_c"].to_numpy(float),
+        df[temperature_change_column].to_numpy(float),
+    ]
 
 
 def _cold_net_inputs(df: pd.DataFrame, column: str) -> np.ndarray:
@@ -96,8 +106,14 @@ def design_hot_net(x_deg, drift_deg_h, hot: HotNetSettings) -> RBFNet:
     -------
     navlib.methods.rbf.RBFNet
     """
-    return newrb(x_deg, drift_deg_h, goal=hot.goal, spread=hot.matlab_spread, goal_kind=hot.goal_kind,
-                 scaler=latitude_scaler(hot.input_unit))
+    return newrb(
+        x_deg,
+        drift_deg_h,
+        goal=hot.goal,
+        spread=hot.matlab_spread,
+        goal_kind=hot.goal_kind,
+        scaler=latitude_scaler(hot.input_unit),
+    )
 
 
 @lru_cache(maxsize=16)
@@ -108,7 +124,12 @@ def _table2_net(hot: HotNetSettings) -> RBFNet:
 
 
 #: Readings of the printed goal: name -> (``goal_kind``, whether the printed value is squared first).
-GOAL_READINGS = {"MSE": ("mse", False), "SSE": ("sse", False), "RMS": ("mse", True), "RSS": ("sse", True)}
+GOAL_READINGS = {
+    "MSE": ("mse", False),
+    "SSE": ("sse", False),
+    "RMS": ("mse", True),
+    "RSS": ("sse", True),
+}
 
 
 @lru_cache(maxsize=8)
@@ -160,8 +181,14 @@ def design_cold_net(x, drift_deg_h, params: StudyParams, spread_sd: float | None
     navlib.methods.rbf.RBFNet
     """
     sp = params.cold.spread_sd if spread_sd is None else spread_sd
-    return newrb(x, drift_deg_h, goal=params.hot.goal, spread=sp, goal_kind=params.hot.goal_kind,
-                 scaler=InputScaler.standardize(x))
+    return newrb(
+        x,
+        drift_deg_h,
+        goal=params.hot.goal,
+        spread=sp,
+        goal_kind=params.hot.goal_kind,
+        scaler=InputScaler.standardize(x),
+    )
 
 
 # ----------------------------------------------------------------------------------------------- other models
@@ -169,6 +196,7 @@ def _poly_fit(degree: int):
     def fit(x, y):
         p = np.polyfit(x[:, 0], y, degree)
         return lambda q: np.polyval(p, q[:, 0])
+
     return fit
 
 
@@ -190,7 +218,9 @@ def swap_basis(net: RBFNet, x, y, basis: str):
         raise InputError(f"parameter basis={basis!r}: one of {['gaussian', *BASIS_FUNCTIONS]}")
 
     def design(xx):
-        r = net.b * np.sqrt(((net.scaler.transform(xx)[:, None, :] - net.centers[None, :, :]) ** 2).sum(axis=2))
+        r = net.b * np.sqrt(
+            ((net.scaler.transform(xx)[:, None, :] - net.centers[None, :, :]) ** 2).sum(axis=2)
+        )
         return np.hstack([phi(r), np.ones((r.shape[0], 1))])
 
     sol, *_ = np.linalg.lstsq(design(x), np.asarray(y, dtype=float), rcond=None)

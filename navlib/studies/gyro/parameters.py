@@ -8,6 +8,7 @@
 - the seeds: :func:`experiment_seeds` (one ``SeedSequence`` child per experiment) and :func:`bootstrap_seed`
   (one per bootstrap interval over the rows of a real table, :data:`BOOTSTRAPS`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -32,10 +33,23 @@ ColdDtColumn = Literal["calib_temp_change_c", "align_temp_change_c"]
 
 # ------------------------------------------------------------------------------------------------ paper facts
 FACTS_FILE = "paper_c_facts.csv"
-FACT_KEYS = ("claimed_accuracy", "required_accuracy", "position_goal", "training_goal", "spread",
-             "local_latitude", "align_h", "identify_h", "navigate_h", "hot_state_max_temp_change",
-             "cold_state_min_temp_change", "cold_hot_net_drift_error_min", "cold_hot_net_drift_error_max",
-             "cold_hot_net_pos_error_min", "cold_hot_net_pos_error_max")
+FACT_KEYS = (
+    "claimed_accuracy",
+    "required_accuracy",
+    "position_goal",
+    "training_goal",
+    "spread",
+    "local_latitude",
+    "align_h",
+    "identify_h",
+    "navigate_h",
+    "hot_state_max_temp_change",
+    "cold_state_min_temp_change",
+    "cold_hot_net_drift_error_min",
+    "cold_hot_net_drift_error_max",
+    "cold_hot_net_pos_error_min",
+    "cold_hot_net_pos_error_max",
+)
 
 
 def paper_facts(path=None) -> pd.DataFrame:
@@ -67,7 +81,9 @@ def paper_facts(path=None) -> pd.DataFrame:
         raise InputError(f"{getattr(p, 'name', p)}: no row for key '{missing[0]}'")
     bad = df.loc[~df["kind"].isin(["claim", "setting"]), "kind"]
     if len(bad):
-        raise InputError(f"{getattr(p, 'name', p)}: kind '{bad.iloc[0]}' must be 'claim' or 'setting'")
+        raise InputError(
+            f"{getattr(p, 'name', p)}: kind '{bad.iloc[0]}' must be 'claim' or 'setting'"
+        )
     return df.set_index("key")
 
 
@@ -90,14 +106,18 @@ def fact(key: str) -> float:
         The value in the unit of the facts file.
     """
     if key not in FACT_KEYS:
-        raise InputError(f"parameter key={key!r}: paper C has no such fact; one of {', '.join(FACT_KEYS)}")
+        raise InputError(
+            f"parameter key={key!r}: paper C has no such fact; one of {', '.join(FACT_KEYS)}"
+        )
     return float(_default_facts().loc[key, "value"])
 
 
 # --------------------------------------------------------------------------------------------------- settings
 def _check_choice(name: str, value, options) -> None:
     if value not in options:
-        raise InputError(f"parameter {name}={value!r}: must be one of {', '.join(map(repr, options))}")
+        raise InputError(
+            f"parameter {name}={value!r}: must be one of {', '.join(map(repr, options))}"
+        )
 
 
 @dataclass(frozen=True)
@@ -172,22 +192,37 @@ class SimulationSettings:
         check_param("sim_seed", self.seed, lo=0, integer=True)
         check_param("sim_step_s", self.step_s, lo=1, hi=300)
         if 300 % self.step_s:
-            raise InputError(f"parameter sim_step_s={self.step_s!r}: must divide the 300 s indexing dwell")
-        for name in ("gyro_arw_deg_rt_h", "gyro_bias_sd_deg_h", "accel_bias_sd_ug", "tilt_sd_arcsec",
-                     "azimuth_sd_arcsec"):
+            raise InputError(
+                f"parameter sim_step_s={self.step_s!r}: must divide the 300 s indexing dwell"
+            )
+        for name in (
+            "gyro_arw_deg_rt_h",
+            "gyro_bias_sd_deg_h",
+            "accel_bias_sd_ug",
+            "tilt_sd_arcsec",
+            "azimuth_sd_arcsec",
+        ):
             check_param(f"sim_{name}", getattr(self, name), lo=0)
         check_param("cold_drift_half_range_deg_h", self.cold_drift_half_range_deg_h, lo=0, hi=0.1)
 
     def error_sd(self) -> dict:
         """Keyword arguments of :func:`navlib.sensors.ins.random_test`."""
-        return dict(gyro_arw_deg_rt_h=self.gyro_arw_deg_rt_h, gyro_bias_sd_deg_h=self.gyro_bias_sd_deg_h,
-                    accel_bias_sd_ug=self.accel_bias_sd_ug, tilt_sd_arcsec=self.tilt_sd_arcsec,
-                    azimuth_sd_arcsec=self.azimuth_sd_arcsec)
+        return dict(
+            gyro_arw_deg_rt_h=self.gyro_arw_deg_rt_h,
+            gyro_bias_sd_deg_h=self.gyro_bias_sd_deg_h,
+            accel_bias_sd_ug=self.accel_bias_sd_ug,
+            tilt_sd_arcsec=self.tilt_sd_arcsec,
+            azimuth_sd_arcsec=self.azimuth_sd_arcsec,
+        )
 
     def procedure(self) -> ins.Procedure:
         """Paper C's procedure (alignment, identification and navigation hours from the facts file)."""
-        return ins.Procedure(align_h=fact("align_h"), identify_h=fact("identify_h"),
-                             navigate_h=fact("navigate_h"), step_s=float(self.step_s))
+        return ins.Procedure(
+            align_h=fact("align_h"),
+            identify_h=fact("identify_h"),
+            navigate_h=fact("navigate_h"),
+            step_s=float(self.step_s),
+        )
 
 
 @dataclass(frozen=True)
@@ -205,8 +240,11 @@ class ThermalWorld:
     def __post_init__(self):
         if not str(self.name).strip():
             raise InputError("parameter ThermalWorld.name: must not be empty")
-        for f, lo, hi in (("temp_coeff_deg_h_per_c", -0.01, 0.01), ("rate_coeff_in_k_r", -10.0, 10.0),
-                          ("lag_h", 0.01, 24.0)):
+        for f, lo, hi in (
+            ("temp_coeff_deg_h_per_c", -0.01, 0.01),
+            ("rate_coeff_in_k_r", -10.0, 10.0),
+            ("lag_h", 0.01, 24.0),
+        ):
             v = getattr(self, f)
             if len(v) != 2 or not v[0] <= v[1]:
                 raise InputError(f"parameter {f}={v!r}: a (low, high) range")
@@ -218,8 +256,11 @@ class ThermalWorld:
         kt = rng.uniform(*self.temp_coeff_deg_h_per_c)
         kr = rng.uniform(*self.rate_coeff_in_k_r) * k_r
         tau = rng.uniform(*self.lag_h)
-        return thermal_gyro.ThermalGyro(temp_coeff_deg_h_per_c=float(kt), gradient_coeff_deg_h_per_c=float(kr / tau),
-                                        lag_h=float(tau))
+        return thermal_gyro.ThermalGyro(
+            temp_coeff_deg_h_per_c=float(kt),
+            gradient_coeff_deg_h_per_c=float(kr / tau),
+            lag_h=float(tau),
+        )
 
 
 #: The worlds of :func:`~navlib.studies.gyro.thermal_worlds.cold_thermal_study` (ranges stated in the chapter): the rate
@@ -229,9 +270,17 @@ THERMAL_WORLDS = (
     ThermalWorld("rate limit (tau 0.05 h)", lag_h=(0.05, 0.05)),
     ThermalWorld("gradient, short lag", lag_h=(0.25, 1.0)),
     ThermalWorld("gradient, long lag", lag_h=(2.0, 6.0)),
-    ThermalWorld("temperature coefficient only", temp_coeff_deg_h_per_c=(-2e-4, 2e-4), rate_coeff_in_k_r=(0.0, 0.0),
-                 lag_h=(0.25, 6.0)),
-    ThermalWorld("gradient + temperature coefficient", temp_coeff_deg_h_per_c=(-2e-4, 2e-4), lag_h=(0.25, 6.0)),
+    ThermalWorld(
+        "temperature coefficient only",
+        temp_coeff_deg_h_per_c=(-2e-4, 2e-4),
+        rate_coeff_in_k_r=(0.0, 0.0),
+        lag_h=(0.25, 6.0),
+    ),
+    ThermalWorld(
+        "gradient + temperature coefficient",
+        temp_coeff_deg_h_per_c=(-2e-4, 2e-4),
+        lag_h=(0.25, 6.0),
+    ),
 )
 
 
@@ -265,8 +314,12 @@ class StudyParams:
     thermal: ColdStudySettings = field(default_factory=ColdStudySettings)
 
     def __post_init__(self):
-        for name, cls in (("hot", HotNetSettings), ("cold", ColdNetSettings), ("sim", SimulationSettings),
-                          ("thermal", ColdStudySettings)):
+        for name, cls in (
+            ("hot", HotNetSettings),
+            ("cold", ColdNetSettings),
+            ("sim", SimulationSettings),
+            ("thermal", ColdStudySettings),
+        ):
             if not isinstance(getattr(self, name), cls):
                 raise InputError(f"parameter {name}: must be a {cls.__name__}")
 
@@ -299,16 +352,22 @@ class StudyParams:
         """
         unknown = [k for k in cell if k not in NOTEBOOK_PARAMETERS]
         if unknown:
-            raise InputError(f"parameter {unknown[0]}: the gyro notebook has no such parameter; one of "
-                             f"{', '.join(NOTEBOOK_PARAMETERS)}")
+            raise InputError(
+                f"parameter {unknown[0]}: the gyro notebook has no such parameter; one of "
+                f"{', '.join(NOTEBOOK_PARAMETERS)}"
+            )
         groups: dict[str, dict] = {"hot": {}, "cold": {}, "sim": {}, "thermal": {}}
         for key, value in cell.items():
             target = NOTEBOOK_PARAMETERS[key]
             if target is not None:
                 group, name = target
                 groups[group][name] = value
-        return cls(hot=HotNetSettings(**groups["hot"]), cold=ColdNetSettings(**groups["cold"]),
-                   sim=SimulationSettings(**groups["sim"]), thermal=ColdStudySettings(**groups["thermal"]))
+        return cls(
+            hot=HotNetSettings(**groups["hot"]),
+            cold=ColdNetSettings(**groups["cold"]),
+            sim=SimulationSettings(**groups["sim"]),
+            thermal=ColdStudySettings(**groups["thermal"]),
+        )
 
 
 # ---------------------------------------------------------------------------------- the notebook's parameters
@@ -316,21 +375,38 @@ class StudyParams:
 #: :class:`StudyParams`, field) they set; ``None``: not a study setting (``n_workers``, the engine's worker
 #: processes for the thermal worlds: the results do not depend on it).
 NOTEBOOK_PARAMETERS = {
-    "spread": ("hot", "spread"), "goal": ("hot", "goal"), "goal_kind": ("hot", "goal_kind"),
+    "spread": ("hot", "spread"),
+    "goal": ("hot", "goal"),
+    "goal_kind": ("hot", "goal_kind"),
     "input_unit": ("hot", "input_unit"),
-    "cold_spread": ("cold", "spread_sd"), "cold_dt_column": ("cold", "dt_column"),
-    "n_sim_tests": ("sim", "n_tests"), "n_seeds": ("sim", "n_seeds"), "sim_seed": ("sim", "seed"),
-    "sim_step_s": ("sim", "step_s"), "sim_gyro_arw_deg_rt_h": ("sim", "gyro_arw_deg_rt_h"),
-    "sim_gyro_bias_sd_deg_h": ("sim", "gyro_bias_sd_deg_h"), "sim_accel_bias_sd_ug": ("sim", "accel_bias_sd_ug"),
-    "sim_tilt_sd_arcsec": ("sim", "tilt_sd_arcsec"), "sim_azimuth_sd_arcsec": ("sim", "azimuth_sd_arcsec"),
-    "n_cold_draws": ("thermal", "n_draws"), "cold_raw_spread": ("thermal", "raw_spread"),
+    "cold_spread": ("cold", "spread_sd"),
+    "cold_dt_column": ("cold", "dt_column"),
+    "n_sim_tests": ("sim", "n_tests"),
+    "n_seeds": ("sim", "n_seeds"),
+    "sim_seed": ("sim", "seed"),
+    "sim_step_s": ("sim", "step_s"),
+    "sim_gyro_arw_deg_rt_h": ("sim", "gyro_arw_deg_rt_h"),
+    "sim_gyro_bias_sd_deg_h": ("sim", "gyro_bias_sd_deg_h"),
+    "sim_accel_bias_sd_ug": ("sim", "accel_bias_sd_ug"),
+    "sim_tilt_sd_arcsec": ("sim", "tilt_sd_arcsec"),
+    "sim_azimuth_sd_arcsec": ("sim", "azimuth_sd_arcsec"),
+    "n_cold_draws": ("thermal", "n_draws"),
+    "cold_raw_spread": ("thermal", "raw_spread"),
     "n_workers": None,
 }
 
 
 # ------------------------------------------------------------------------------------------------------ seeds
-_EXPERIMENTS = ("fig1", "hot_reference", "cold_training", "fig3", "table5", "table5_drifts", "rounding",
-                "bootstrap")
+_EXPERIMENTS = (
+    "fig1",
+    "hot_reference",
+    "cold_training",
+    "fig3",
+    "table5",
+    "table5_drifts",
+    "rounding",
+    "bootstrap",
+)
 #: The bootstrap intervals over rows of the real tables, one seed each (:func:`bootstrap_seed`).
 BOOTSTRAPS = ("loo_arcmin", "loo_deg", "table4_range", "table4_cold_vs_hot", "nonlinear")
 
@@ -339,7 +415,9 @@ def _experiment_children(seed: int, experiment: str, n: int) -> list[np.random.S
     if experiment not in _EXPERIMENTS:
         raise InputError(f"parameter experiment={experiment!r}: one of {', '.join(_EXPERIMENTS)}")
     check_param("n", n, lo=1, integer=True)
-    child = np.random.SeedSequence(int(seed)).spawn(len(_EXPERIMENTS))[_EXPERIMENTS.index(experiment)]
+    child = np.random.SeedSequence(int(seed)).spawn(len(_EXPERIMENTS))[
+        _EXPERIMENTS.index(experiment)
+    ]
     return child.spawn(int(n))
 
 

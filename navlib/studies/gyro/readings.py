@@ -7,6 +7,7 @@
 
 :func:`latitude_rounding_effect` caches its result per parameter set.
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -21,10 +22,23 @@ from navlib.errors import check_param
 from navlib.methods.rbf import InputScaler, leave_one_out, newrb
 
 from .measured import _hot_xy, _maxabs, _quantities, _rms, printed_decimals
-from .networks import (BASIS_FUNCTIONS, GOAL_READINGS, _hot_loo_errors, _table2_net, design_hot_net,
-                       swap_basis)
-from .parameters import (HotNetSettings, InputUnit, StudyParams, WidthReading, _check_choice,
-                         _experiment_children, fact)
+from .networks import (
+    BASIS_FUNCTIONS,
+    GOAL_READINGS,
+    _hot_loo_errors,
+    _table2_net,
+    design_hot_net,
+    swap_basis,
+)
+from .parameters import (
+    HotNetSettings,
+    InputUnit,
+    StudyParams,
+    WidthReading,
+    _check_choice,
+    _experiment_children,
+    fact,
+)
 
 
 # ---------------------------------------------------------------------------------------- input unit and goal
@@ -50,16 +64,25 @@ def hot_net_variants(params: StudyParams = StudyParams()) -> pd.DataFrame:
     rows = []
     for unit in ("deg", "arcmin"):
         for reading, (kind, squared) in GOAL_READINGS.items():
-            g = params.hot.goal ** 2 if squared else params.hot.goal
+            g = params.hot.goal**2 if squared else params.hot.goal
             hot = HotNetSettings(spread=params.hot.spread, goal=g, goal_kind=kind, input_unit=unit)
             net = design_hot_net(x2, y2, hot)
             loo = leave_one_out(x2, y2, lambda x, y, hot=hot: design_hot_net(x, y, hot))
             p3 = net.predict(x3)
-            row = {"input": unit, "goal": reading, "neurons": net.n_neurons,
-                   "train RMS (deg/h)": float(np.sqrt(net.perf_mse[-1]))}
+            row = {
+                "input": unit,
+                "goal": reading,
+                "neurons": net.n_neurons,
+                "train RMS (deg/h)": float(np.sqrt(net.perf_mse[-1])),
+            }
             row.update({f"T3 #{i + 1} (deg/h)": float(p3[i]) for i in range(len(p3))})
-            row.update({"max |T3 err| (deg/h)": _maxabs(y3 - p3), "LOO RMS (deg/h)": _rms(y2 - loo),
-                        "LOO max (deg/h)": _maxabs(y2 - loo)})
+            row.update(
+                {
+                    "max |T3 err| (deg/h)": _maxabs(y3 - p3),
+                    "LOO RMS (deg/h)": _rms(y2 - loo),
+                    "LOO max (deg/h)": _maxabs(y2 - loo),
+                }
+            )
             rows.append(row)
     return pd.DataFrame(rows)
 
@@ -74,9 +97,13 @@ def target_spread() -> pd.DataFrame:
         ``quantity`` -> ``value``, ``unit``.
     """
     _, y2, _, _ = _hot_xy()
-    return _quantities([("variance of Table 2 drifts", float(np.var(y2)), "(deg/h)^2"),
-                        ("sum of squares about the mean", float(np.sum((y2 - y2.mean()) ** 2)), "(deg/h)^2"),
-                        ("goal as printed", fact("training_goal"), "as printed")])
+    return _quantities(
+        [
+            ("variance of Table 2 drifts", float(np.var(y2)), "(deg/h)^2"),
+            ("sum of squares about the mean", float(np.sum((y2 - y2.mean()) ** 2)), "(deg/h)^2"),
+            ("goal as printed", fact("training_goal"), "as printed"),
+        ]
+    )
 
 
 def input_scale_scan(params: StudyParams = StudyParams(), n_scales: int = 121) -> pd.DataFrame:
@@ -103,15 +130,28 @@ def input_scale_scan(params: StudyParams = StudyParams(), n_scales: int = 121) -
     scales = np.unique(np.r_[np.geomspace(1.0, ARCSEC_PER_DEG, int(n_scales)), ARCMIN_PER_DEG])
     rows = []
     for w in get_args(WidthReading):
-        hot = HotNetSettings(spread=params.hot.spread, goal=params.hot.goal, goal_kind=params.hot.goal_kind,
-                             width=w)
+        hot = HotNetSettings(
+            spread=params.hot.spread, goal=params.hot.goal, goal_kind=params.hot.goal_kind, width=w
+        )
         for sc in scales:
-            net = newrb(x2, y2, goal=hot.goal, spread=hot.matlab_spread, goal_kind=hot.goal_kind,
-                        scaler=InputScaler.affine(0.0, 1.0 / sc))
+            net = newrb(
+                x2,
+                y2,
+                goal=hot.goal,
+                spread=hot.matlab_spread,
+                goal_kind=hot.goal_kind,
+                scaler=InputScaler.affine(0.0, 1.0 / sc),
+            )
             p3 = net.predict(x3)
-            rows.append({"scale": float(sc), "width": w, "neurons": net.n_neurons,
-                         "max |ours - printed| (deg/h)": _maxabs(p3 - printed),
-                         "max |T3 err| (deg/h)": _maxabs(y3 - p3)})
+            rows.append(
+                {
+                    "scale": float(sc),
+                    "width": w,
+                    "neurons": net.n_neurons,
+                    "max |ours - printed| (deg/h)": _maxabs(p3 - printed),
+                    "max |T3 err| (deg/h)": _maxabs(y3 - p3),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -134,14 +174,23 @@ def scale_band(scan: pd.DataFrame, width: str = "matlab") -> pd.DataFrame:
     _check_choice("width", width, get_args(WidthReading))
     s = scan[scan["width"] == width]
     bound = 0.5 * 10.0 ** -int(printed_decimals(3, "paper_rbf_drift_deg_h").min())
-    conds = {"outputs reproduced to the printed decimal": s["max |ours - printed| (deg/h)"] < bound,
-             f"Table 3 error below {fact('claimed_accuracy'):g} deg/h": s["max |T3 err| (deg/h)"] < fact("claimed_accuracy")}
+    conds = {
+        "outputs reproduced to the printed decimal": s["max |ours - printed| (deg/h)"] < bound,
+        f"Table 3 error below {fact('claimed_accuracy'):g} deg/h": s["max |T3 err| (deg/h)"]
+        < fact("claimed_accuracy"),
+    }
     rows = []
     for name, ok in conds.items():
         sc = s.loc[ok.to_numpy(), "scale"]
-        rows.append({"condition": name, "lowest scale": float(sc.min()) if len(sc) else np.nan,
-                     "highest scale": float(sc.max()) if len(sc) else np.nan, "grid points": int(ok.sum()),
-                     "share of the grid": float(ok.mean())})
+        rows.append(
+            {
+                "condition": name,
+                "lowest scale": float(sc.min()) if len(sc) else np.nan,
+                "highest scale": float(sc.max()) if len(sc) else np.nan,
+                "grid points": int(ok.sum()),
+                "share of the grid": float(ok.mean()),
+            }
+        )
     return pd.DataFrame(rows).set_index("condition")
 
 
@@ -163,18 +212,35 @@ def fig2_goal_readings(params: StudyParams = StudyParams()) -> pd.DataFrame:
     """
     x2, y2, _, _ = _hot_xy()
     h = params.hot
-    full = design_hot_net(x2, y2, HotNetSettings(spread=h.spread, goal=0.0, goal_kind="mse", input_unit=h.input_unit,
-                                                 width=h.width))
+    full = design_hot_net(
+        x2,
+        y2,
+        HotNetSettings(
+            spread=h.spread, goal=0.0, goal_kind="mse", input_unit=h.input_unit, width=h.width
+        ),
+    )
     mse = full.perf_mse
     rows = []
     for reading, (kind, squared) in GOAL_READINGS.items():
-        g = h.goal ** 2 if squared else h.goal
-        net = design_hot_net(x2, y2, HotNetSettings(spread=h.spread, goal=g, goal_kind=kind,
-                                                    input_unit=h.input_unit, width=h.width))
+        g = h.goal**2 if squared else h.goal
+        net = design_hot_net(
+            x2,
+            y2,
+            HotNetSettings(
+                spread=h.spread, goal=g, goal_kind=kind, input_unit=h.input_unit, width=h.width
+            ),
+        )
         stop = float(net.perf_mse[-1])
-        rows.append({"goal": reading, "goal ((deg/h)^2)": g, "neurons at stop": net.n_neurons,
-                     "neurons of the full path": full.n_neurons, "training MSE at stop ((deg/h)^2)": stop,
-                     "share of the fall still to come": float((stop - mse[-1]) / (mse[0] - mse[-1]))})
+        rows.append(
+            {
+                "goal": reading,
+                "goal ((deg/h)^2)": g,
+                "neurons at stop": net.n_neurons,
+                "neurons of the full path": full.n_neurons,
+                "training MSE at stop ((deg/h)^2)": stop,
+                "share of the fall still to come": float((stop - mse[-1]) / (mse[0] - mse[-1])),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -198,14 +264,24 @@ def width_readings(params: StudyParams = StudyParams()) -> pd.DataFrame:
     printed = load_hot_test()["paper_rbf_drift_deg_h"].to_numpy(float)
     rows = []
     for w in get_args(WidthReading):
-        hot = HotNetSettings(spread=params.hot.spread, goal=params.hot.goal, goal_kind=params.hot.goal_kind,
-                             input_unit=params.hot.input_unit, width=w)
+        hot = HotNetSettings(
+            spread=params.hot.spread,
+            goal=params.hot.goal,
+            goal_kind=params.hot.goal_kind,
+            input_unit=params.hot.input_unit,
+            width=w,
+        )
         net = design_hot_net(x2, y2, hot)
         p3 = net.predict(x3)
         row = {"width": w, "neurons": net.n_neurons, "b (per input unit)": net.b}
         row.update({f"T3 #{i + 1} (deg/h)": float(p3[i]) for i in range(len(p3))})
-        row.update({"max |ours - printed| (deg/h)": _maxabs(p3 - printed), "max |T3 err| (deg/h)": _maxabs(y3 - p3),
-                    "LOO RMS (deg/h)": _rms(_hot_loo_errors(hot))})
+        row.update(
+            {
+                "max |ours - printed| (deg/h)": _maxabs(p3 - printed),
+                "max |T3 err| (deg/h)": _maxabs(y3 - p3),
+                "LOO RMS (deg/h)": _rms(_hot_loo_errors(hot)),
+            }
+        )
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -231,19 +307,27 @@ def basis_readings(params: StudyParams = StudyParams()) -> pd.DataFrame:
     rows = []
     for basis in ("gaussian", *BASIS_FUNCTIONS):
         p3 = swap_basis(net, x2, y2, basis)(x3)
-        loo = y2 - leave_one_out(x2, y2, lambda x, y, b=basis: swap_basis(design_hot_net(x, y, params.hot), x, y, b))
+        loo = y2 - leave_one_out(
+            x2, y2, lambda x, y, b=basis: swap_basis(design_hot_net(x, y, params.hot), x, y, b)
+        )
         row = {"basis": basis}
         row.update({f"T3 #{i + 1} (deg/h)": float(p3[i]) for i in range(len(p3))})
-        row.update({"max |output - Gaussian| (deg/h)": _maxabs(p3 - ref), "max |T3 err| (deg/h)": _maxabs(y3 - p3),
-                    "LOO RMS (deg/h)": _rms(loo)})
+        row.update(
+            {
+                "max |output - Gaussian| (deg/h)": _maxabs(p3 - ref),
+                "max |T3 err| (deg/h)": _maxabs(y3 - p3),
+                "LOO RMS (deg/h)": _rms(loo),
+            }
+        )
         rows.append(row)
     return pd.DataFrame(rows)
 
 
 # ------------------------------------------------------------------------------------------ latitude rounding
 @lru_cache(maxsize=8)
-def latitude_rounding_effect(params: StudyParams = StudyParams(), input_unit: InputUnit = "arcmin",
-                             n_draws: int = 200) -> float:
+def latitude_rounding_effect(
+    params: StudyParams = StudyParams(), input_unit: InputUnit = "arcmin", n_draws: int = 200
+) -> float:
     """How far our hot net's Table 3 outputs move when the printed latitudes move within their rounding: the
     resolution of any comparison of our outputs with the paper's printed ones.
 
@@ -265,8 +349,12 @@ def latitude_rounding_effect(params: StudyParams = StudyParams(), input_unit: In
         deg/h.
     """
     check_param("n_draws", n_draws, lo=20, integer=True)
-    hot = HotNetSettings(spread=params.hot.spread, goal=params.hot.goal, goal_kind=params.hot.goal_kind,
-                         input_unit=input_unit)
+    hot = HotNetSettings(
+        spread=params.hot.spread,
+        goal=params.hot.goal,
+        goal_kind=params.hot.goal_kind,
+        input_unit=input_unit,
+    )
     x2, y2, x3, _ = _hot_xy()
     h2 = 0.5 * 10.0 ** -printed_decimals(2, "latitude_deg")
     h3 = 0.5 * 10.0 ** -printed_decimals(3, "latitude_deg")

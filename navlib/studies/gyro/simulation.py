@@ -7,6 +7,7 @@
 - the printed position errors read through the simulator's gain: :func:`implied_drift_error`,
   :func:`table3_other_error`, :func:`before_identification`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -64,17 +65,34 @@ def table1_vs_simulator(duration_h: float = 48.0, step_s: float = 60.0) -> Table
     earth = ins.Earth(latitude_deg=ins.LOCAL_LATITUDE_DEG)
     tilt_for_bias = -20.0 * ins.UG / earth.g / ARCSEC
     cases = [
-        ("axial drift 0.001 deg/h", dict(imu=ins.ImuErrors(axial_drift_deg_h=0.001)),
-         dict(axial_drift_deg_h=0.001)),
-        ("azimuth error 60 arcsec", dict(initial=ins.InitialErrors(azimuth_arcsec=60.0)),
-         dict(azimuth_error_arcsec=60.0)),
-        ("north velocity error 0.1 m/s", dict(initial=ins.InitialErrors(vel_north_m_s=0.1)),
-         dict(north_velocity_error_m_s=0.1)),
-        ("north accel bias 20 ug (level at t=0)", dict(imu=ins.ImuErrors(accel_bias_y_ug=20.0)),
-         dict(north_accel_bias_ug=20.0)),
-        ("north accel bias 20 ug (tilt absorbs it)",
-         dict(imu=ins.ImuErrors(accel_bias_y_ug=20.0), initial=ins.InitialErrors(tilt_east_arcsec=tilt_for_bias)),
-         dict(north_accel_bias_ug=20.0)),
+        (
+            "axial drift 0.001 deg/h",
+            dict(imu=ins.ImuErrors(axial_drift_deg_h=0.001)),
+            dict(axial_drift_deg_h=0.001),
+        ),
+        (
+            "azimuth error 60 arcsec",
+            dict(initial=ins.InitialErrors(azimuth_arcsec=60.0)),
+            dict(azimuth_error_arcsec=60.0),
+        ),
+        (
+            "north velocity error 0.1 m/s",
+            dict(initial=ins.InitialErrors(vel_north_m_s=0.1)),
+            dict(north_velocity_error_m_s=0.1),
+        ),
+        (
+            "north accel bias 20 ug (level at t=0)",
+            dict(imu=ins.ImuErrors(accel_bias_y_ug=20.0)),
+            dict(north_accel_bias_ug=20.0),
+        ),
+        (
+            "north accel bias 20 ug (tilt absorbs it)",
+            dict(
+                imu=ins.ImuErrors(accel_bias_y_ug=20.0),
+                initial=ins.InitialErrors(tilt_east_arcsec=tilt_for_bias),
+            ),
+            dict(north_accel_bias_ug=20.0),
+        ),
     ]
     no_rot = ins.Rotation(kind="none")
     rows, curves = [], []
@@ -82,28 +100,46 @@ def table1_vs_simulator(duration_h: float = 48.0, step_s: float = 60.0) -> Table
         run = ins.simulate(duration_h, earth=earth, rotation=no_rot, step_s=step_s, **sim_kw)
         cf = ins.table1_latitude_error(run.t_h, earth=earth, **t1_kw)
         peak = _maxabs(run.latitude_error_deg)
-        rows.append({"source": label, "simulator at 12 h (arcsec)": run.at(12.0)[5] / ARCSEC,
-                     "Table 1 at 12 h (arcsec)":
-                         float(ins.table1_latitude_error(12.0, earth=earth, **t1_kw)) * ARCSEC_PER_DEG,
-                     "max |sim - Table 1| / peak": _maxabs(run.latitude_error_deg - cf) / peak})
-        curves.append(pd.DataFrame({"case": label, "t_h": run.t_h,
-                                    "simulator_arcsec": run.latitude_error_deg * ARCSEC_PER_DEG,
-                                    "table1_arcsec": cf * ARCSEC_PER_DEG}))
+        rows.append(
+            {
+                "source": label,
+                "simulator at 12 h (arcsec)": run.at(12.0)[5] / ARCSEC,
+                "Table 1 at 12 h (arcsec)": float(
+                    ins.table1_latitude_error(12.0, earth=earth, **t1_kw)
+                )
+                * ARCSEC_PER_DEG,
+                "max |sim - Table 1| / peak": _maxabs(run.latitude_error_deg - cf) / peak,
+            }
+        )
+        curves.append(
+            pd.DataFrame(
+                {
+                    "case": label,
+                    "t_h": run.t_h,
+                    "simulator_arcsec": run.latitude_error_deg * ARCSEC_PER_DEG,
+                    "table1_arcsec": cf * ARCSEC_PER_DEG,
+                }
+            )
+        )
     identify_h = fact("identify_h")
     gain = ins.latitude_error_per_drift(identify_h, earth)
-    tilt_run = ins.simulate(identify_h, earth=earth, initial=ins.InitialErrors(tilt_east_arcsec=1.0), step_s=step_s)
+    tilt_run = ins.simulate(
+        identify_h, earth=earth, initial=ins.InitialErrors(tilt_east_arcsec=1.0), step_s=step_s
+    )
     tilt_lat = float(tilt_run.latitude_error_deg[-1])
     tilt_drift = float(ins.drift_from_latitude_error(tilt_lat, identify_h, earth))
     x2, y2, _, _ = _hot_xy()
     scatter = _rms(y2 - np.polyval(np.polyfit(x2, y2, 1), x2))
-    q = _quantities([
-        ("Table 1 gain at 12 h", gain, "deg per deg/h"),
-        ("Table 1 inverse slope", 1.0 / gain, "(deg/h) per deg"),
-        ("12 h latitude error from 1 arcsec east tilt", tilt_lat * ARCSEC_PER_DEG, "arcsec"),
-        ("the same read as axial drift", tilt_drift, "deg/h"),
-        ("Table 2 scatter about a straight line (RMS)", scatter, "deg/h"),
-        ("Table 2 scatter as east tilt", scatter / abs(tilt_drift), "arcsec"),
-    ])
+    q = _quantities(
+        [
+            ("Table 1 gain at 12 h", gain, "deg per deg/h"),
+            ("Table 1 inverse slope", 1.0 / gain, "(deg/h) per deg"),
+            ("12 h latitude error from 1 arcsec east tilt", tilt_lat * ARCSEC_PER_DEG, "arcsec"),
+            ("the same read as axial drift", tilt_drift, "deg/h"),
+            ("Table 2 scatter about a straight line (RMS)", scatter, "deg/h"),
+            ("Table 2 scatter as east tilt", scatter / abs(tilt_drift), "arcsec"),
+        ]
+    )
     return Table1Comparison(pd.DataFrame(rows), pd.concat(curves, ignore_index=True), q)
 
 
@@ -138,19 +174,36 @@ def fig1_simulated_tests(params: StudyParams = StudyParams()) -> Fig1:
     s = params.sim
     drifts = np.quantile(y2, np.linspace(0, 1, s.n_tests))
     seed = experiment_seeds(s.seed, "fig1", 1)[0]
-    tests = ins.simulated_tests(drifts, seed=seed, earth=params.earth, procedure=s.procedure(), **s.error_sd())
-    curves = pd.concat([pd.DataFrame({
-        "test": i + 1, "axial_drift_deg_h": r.final_drift_deg_h, "t_h": r.identify_run.t_h,
-        "latitude_error_arcmin": to_arcmin(r.identify_run.latitude_error_deg),
-        "longitude_error_arcmin": to_arcmin(r.identify_run.longitude_error_deg)}) for i, r in enumerate(tests)],
-        ignore_index=True)
-    table = pd.DataFrame({
-        "test": np.arange(1, len(tests) + 1),
-        "axial drift (deg/h)": [r.final_drift_deg_h for r in tests],
-        "dL 12 h (arcmin)": [float(to_arcmin(r.latitude_error_12h_deg)) for r in tests],
-        "dlon 12 h (arcmin)": [float(to_arcmin(r.identify_run.longitude_error_deg[-1])) for r in tests],
-        "Table 1 inverse (deg/h)": [r.identified_drift_deg_h for r in tests],
-        "72 h-optimal 'true' drift (deg/h)": [r.best_drift_deg_h for r in tests]})
+    tests = ins.simulated_tests(
+        drifts, seed=seed, earth=params.earth, procedure=s.procedure(), **s.error_sd()
+    )
+    curves = pd.concat(
+        [
+            pd.DataFrame(
+                {
+                    "test": i + 1,
+                    "axial_drift_deg_h": r.final_drift_deg_h,
+                    "t_h": r.identify_run.t_h,
+                    "latitude_error_arcmin": to_arcmin(r.identify_run.latitude_error_deg),
+                    "longitude_error_arcmin": to_arcmin(r.identify_run.longitude_error_deg),
+                }
+            )
+            for i, r in enumerate(tests)
+        ],
+        ignore_index=True,
+    )
+    table = pd.DataFrame(
+        {
+            "test": np.arange(1, len(tests) + 1),
+            "axial drift (deg/h)": [r.final_drift_deg_h for r in tests],
+            "dL 12 h (arcmin)": [float(to_arcmin(r.latitude_error_12h_deg)) for r in tests],
+            "dlon 12 h (arcmin)": [
+                float(to_arcmin(r.identify_run.longitude_error_deg[-1])) for r in tests
+            ],
+            "Table 1 inverse (deg/h)": [r.identified_drift_deg_h for r in tests],
+            "72 h-optimal 'true' drift (deg/h)": [r.best_drift_deg_h for r in tests],
+        }
+    )
     return Fig1(curves, table)
 
 
@@ -161,8 +214,13 @@ def _simulated_hot_tests(params: StudyParams) -> list:
     ``"hot_reference"``)."""
     _, y2, _, _ = _hot_xy()
     s = params.sim
-    return ins.simulated_tests(y2, seed=experiment_seeds(s.seed, "hot_reference", 1)[0], earth=params.earth,
-                               procedure=s.procedure(), **s.error_sd())
+    return ins.simulated_tests(
+        y2,
+        seed=experiment_seeds(s.seed, "hot_reference", 1)[0],
+        earth=params.earth,
+        procedure=s.procedure(),
+        **s.error_sd(),
+    )
 
 
 def reference_gap(params: StudyParams = StudyParams()) -> pd.DataFrame:
@@ -181,10 +239,14 @@ def reference_gap(params: StudyParams = StudyParams()) -> pd.DataFrame:
         test, actual drift, 72 h-optimal drift, gap = optimal - actual (deg/h).
     """
     sim_hot = _simulated_hot_tests(params)
-    return pd.DataFrame({"test": np.arange(1, len(sim_hot) + 1),
-                         "actual drift (deg/h)": [r.final_drift_deg_h for r in sim_hot],
-                         "72 h-optimal drift (deg/h)": [r.best_drift_deg_h for r in sim_hot],
-                         "gap (deg/h)": [r.best_drift_deg_h - r.final_drift_deg_h for r in sim_hot]})
+    return pd.DataFrame(
+        {
+            "test": np.arange(1, len(sim_hot) + 1),
+            "actual drift (deg/h)": [r.final_drift_deg_h for r in sim_hot],
+            "72 h-optimal drift (deg/h)": [r.best_drift_deg_h for r in sim_hot],
+            "gap (deg/h)": [r.best_drift_deg_h - r.final_drift_deg_h for r in sim_hot],
+        }
+    )
 
 
 # --------------------------------------------------------------------------------------- position requirement
@@ -193,9 +255,15 @@ def _unit_position_gain(params: StudyParams) -> float:
     """Worst 72 h position error (nmi) per deg/h of uncompensated axial drift, no other error (the navigation
     stage of :func:`navlib.sensors.ins.run_procedure`)."""
     proc = params.sim.procedure()
-    run = ins.simulate(proc.navigate_h, earth=params.earth, imu=ins.ImuErrors(axial_drift_deg_h=1.0),
-                       initial=np.zeros(7), step_s=proc.step_s, t0_s=(proc.align_h + proc.identify_h) * 3600.0,
-                       seed=None)
+    run = ins.simulate(
+        proc.navigate_h,
+        earth=params.earth,
+        imu=ins.ImuErrors(axial_drift_deg_h=1.0),
+        initial=np.zeros(7),
+        step_s=proc.step_s,
+        t0_s=(proc.align_h + proc.identify_h) * 3600.0,
+        seed=None,
+    )
     return float(run.position_error_nmi.max())
 
 
@@ -218,21 +286,37 @@ def position_requirement(params: StudyParams = StudyParams()) -> pd.DataFrame:
     req, goal = fact("required_accuracy"), fact("position_goal")
     runs = _simulated_hot_tests(params)
     with_res = _residual_required(params)
-    return _quantities([("worst 72 h error per deg/h of axial drift", g, "nmi per deg/h"),
-                        (f"worst 72 h error from {req:g} deg/h alone", g * req, "nmi"),
-                        (f"drift error that alone reaches {goal:g} nmi", goal / g, "deg/h"),
-                        (f"median over {len(runs)} simulated tests, drift error +-{req:g} deg/h",
-                         float(np.median(with_res)), "nmi")])
+    return _quantities(
+        [
+            ("worst 72 h error per deg/h of axial drift", g, "nmi per deg/h"),
+            (f"worst 72 h error from {req:g} deg/h alone", g * req, "nmi"),
+            (f"drift error that alone reaches {goal:g} nmi", goal / g, "deg/h"),
+            (
+                f"median over {len(runs)} simulated tests, drift error +-{req:g} deg/h",
+                float(np.median(with_res)),
+                "nmi",
+            ),
+        ]
+    )
 
 
 def _residual_required(params: StudyParams) -> np.ndarray:
     req = fact("required_accuracy")
-    return np.array([max(float(r.position_error_nmi_for(r.final_drift_deg_h + sg * req).max())
-                         for sg in (-1.0, 1.0)) for r in _simulated_hot_tests(params)])
+    return np.array(
+        [
+            max(
+                float(r.position_error_nmi_for(r.final_drift_deg_h + sg * req).max())
+                for sg in (-1.0, 1.0)
+            )
+            for r in _simulated_hot_tests(params)
+        ]
+    )
 
 
 # ------------------------------------------------------------------------------------ printed position errors
-def implied_drift_error(position_nmi, gain_nmi_per_deg_h: float, other_nmi: float = 0.0) -> np.ndarray:
+def implied_drift_error(
+    position_nmi, gain_nmi_per_deg_h: float, other_nmi: float = 0.0
+) -> np.ndarray:
     """The residual axial drift (deg/h) that alone leaves the worst 72 h position error ``position_nmi``,
     ``(position - other) / gain``: the whole error charged to the drift (``other_nmi`` = 0), or what is left
     after ``other_nmi`` of error from other sources is set aside (clipped at 0).
@@ -262,8 +346,9 @@ def table3_other_error(gain_nmi_per_deg_h: float) -> np.ndarray:
     identification error does not explain: ``after - gain |printed error|`` (nmi), the other error sources
     of the paper's own hot tests."""
     t3 = load_hot_test()
-    return (t3["paper_pos_error_after_nmi_72h"].to_numpy(float)
-            - gain_nmi_per_deg_h * np.abs(t3["paper_error_deg_h"].to_numpy(float)))
+    return t3["paper_pos_error_after_nmi_72h"].to_numpy(float) - gain_nmi_per_deg_h * np.abs(
+        t3["paper_error_deg_h"].to_numpy(float)
+    )
 
 
 def before_identification(gain_nmi_per_deg_h: float) -> pd.DataFrame:
@@ -286,6 +371,12 @@ def before_identification(gain_nmi_per_deg_h: float) -> pd.DataFrame:
     printed = t3["paper_pos_error_before_nmi_72h"].to_numpy(float)
     ours = gain_nmi_per_deg_h * np.abs(t3["true_drift_deg_h"].to_numpy(float))
     half = 0.5 * 10.0 ** -printed_decimals(3, "paper_pos_error_before_nmi_72h")
-    return pd.DataFrame({"test": t3["test"].to_numpy(), "printed (nmi)": printed, "drift alone (nmi)": ours,
-                         "relative gap": np.abs(printed - ours) / printed,
-                         "printed rounding (relative)": half / printed})
+    return pd.DataFrame(
+        {
+            "test": t3["test"].to_numpy(),
+            "printed (nmi)": printed,
+            "drift alone (nmi)": ours,
+            "relative gap": np.abs(printed - ours) / printed,
+            "printed rounding (relative)": half / printed,
+        }
+    )

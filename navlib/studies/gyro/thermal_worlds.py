@@ -6,6 +6,7 @@
 - the worlds' stated ranges: :func:`thermal_worlds_table` (the worlds themselves:
   :data:`navlib.studies.gyro.parameters.THERMAL_WORLDS`).
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -34,8 +35,10 @@ def _k_r_table4() -> float:
     """``k_R`` fitted on the real Table 4 with the paper's hot net (default settings)."""
     t4 = load_cold_train()
     hot4 = _table2_net(HotNetSettings()).predict(t4["latitude_error_deg"].to_numpy(float))
-    return rate_coefficient(hot4 - t4["true_drift_deg_h"].to_numpy(float),
-                            t4["calib_temp_change_c"].to_numpy(float) / fact("identify_h"))
+    return rate_coefficient(
+        hot4 - t4["true_drift_deg_h"].to_numpy(float),
+        t4["calib_temp_change_c"].to_numpy(float) / fact("identify_h"),
+    )
 
 
 @lru_cache(maxsize=4)
@@ -44,7 +47,9 @@ def _cold_fixed(dt_column: str, procedure: ins.Procedure) -> dict:
     t2, t4, t5 = load_hot_train(), load_cold_train(), load_cold_test()
     out = {"y2": t2["drift_deg_h"].to_numpy(float), "y4": t4["true_drift_deg_h"].to_numpy(float)}
     for name, t in (("4", t4), ("5", t5)):
-        out[f"knots{name}"] = [thermal_gyro.cold_start_knots(_cold_history(r, 0.0, procedure)) for r in t.itertuples()]
+        out[f"knots{name}"] = [
+            thermal_gyro.cold_start_knots(_cold_history(r, 0.0, procedure)) for r in t.itertuples()
+        ]
         out[f"rate{name}"] = t["calib_temp_change_c"].to_numpy(float) / procedure.identify_h
         out[f"temp{name}"] = t["calib_temp_max_c"].to_numpy(float)
         out[f"dt{name}"] = t[dt_column].to_numpy(float)
@@ -70,26 +75,45 @@ def _cold_draw(params: StudyParams, world: int, draw: int, k_r: float) -> dict:
     resid = np.array(resid)
     half = s.cold_drift_half_range_deg_h
     y5 = rng.uniform(-half, half, n5)
-    gyro = cs.worlds[world].draw(np.random.default_rng(seeding.sequence(s.seed, 1, world, draw)), k_r)
+    gyro = cs.worlds[world].draw(
+        np.random.default_rng(seeding.sequence(s.seed, 1, world, draw)), k_r
+    )
 
     def cold_lat(knots, finals, res):
-        return np.array([float(m.axial @ gyro.axial_drift_deg_h(m.t_mid_h, kt, kc, float(f))) + r
-                         for (kt, kc), f, r in zip(knots, finals, res)])
+        return np.array(
+            [
+                float(m.axial @ gyro.axial_drift_deg_h(m.t_mid_h, kt, kc, float(f))) + r
+                for (kt, kc), f, r in zip(knots, finals, res)
+            ]
+        )
 
     lat2 = y2 * float(m.axial.sum()) + resid[:n2]
-    lat4 = cold_lat(fx["knots4"], y4, resid[n2:n2 + n4])
-    lat5 = cold_lat(fx["knots5"], y5, resid[n2 + n4:])
+    lat4 = cold_lat(fx["knots4"], y4, resid[n2 : n2 + n4])
+    lat5 = cold_lat(fx["knots5"], y5, resid[n2 + n4 :])
     hot_net = design_hot_net(lat2, y2, params.hot)
     hot5 = hot_net.predict(lat5)
     k_fit = rate_coefficient(hot_net.predict(lat4) - y4, fx["rate4"])
     X4 = np.c_[to_arcmin(lat4), fx["temp4"], fx["dt4"]]
     X5 = np.c_[to_arcmin(lat5), fx["temp5"], fx["dt5"]]
     z = design_cold_net(X4, y4, params)
-    raw = newrb(X4, y4, goal=params.hot.goal, spread=cs.raw_spread, goal_kind=params.hot.goal_kind,
-                scaler=InputScaler.identity(X4.shape[1]))
-    est = dict(zip(COLD_STUDY_METHODS, (hot5, hot5 - k_fit * fx["rate5"], z.predict(X5), raw.predict(X5))))
-    out = {"world": cs.worlds[world].name, "draw": draw, "k_T (deg/h per C)": gyro.temp_coeff_deg_h_per_c,
-           "k_G tau (deg/h per C/h)": gyro.rate_coeff_deg_h_per_c_h, "tau (h)": gyro.lag_h}
+    raw = newrb(
+        X4,
+        y4,
+        goal=params.hot.goal,
+        spread=cs.raw_spread,
+        goal_kind=params.hot.goal_kind,
+        scaler=InputScaler.identity(X4.shape[1]),
+    )
+    est = dict(
+        zip(COLD_STUDY_METHODS, (hot5, hot5 - k_fit * fx["rate5"], z.predict(X5), raw.predict(X5)))
+    )
+    out = {
+        "world": cs.worlds[world].name,
+        "draw": draw,
+        "k_T (deg/h per C)": gyro.temp_coeff_deg_h_per_c,
+        "k_G tau (deg/h per C/h)": gyro.rate_coeff_deg_h_per_c_h,
+        "tau (h)": gyro.lag_h,
+    }
     for name, e in est.items():
         err = y5 - e
         out[f"{name} RMS (deg/h)"] = _rms(err)
@@ -100,8 +124,9 @@ def _cold_draw(params: StudyParams, world: int, draw: int, k_r: float) -> dict:
 _COLD_STUDIES: dict = {}
 
 
-def cold_thermal_study(params: StudyParams = StudyParams(), workers: int = 1, scheduler: str | None = None
-                       ) -> pd.DataFrame:
+def cold_thermal_study(
+    params: StudyParams = StudyParams(), workers: int = 1, scheduler: str | None = None
+) -> pd.DataFrame:
     """Paper C's cold-state protocol in simulated worlds that are not the rate baseline's own.
 
     Per world (:data:`~navlib.studies.gyro.parameters.THERMAL_WORLDS`, ``params.thermal``) and draw: one gyro
@@ -131,12 +156,18 @@ def cold_thermal_study(params: StudyParams = StudyParams(), workers: int = 1, sc
         One row per (world, draw): the gyro's parameters and per method the RMS and largest ``|final drift -
         identified|`` over the 3 test runs (deg/h).
     """
-    if params not in _COLD_STUDIES:            # results do not depend on workers or scheduler (engine)
+    if params not in _COLD_STUDIES:  # results do not depend on workers or scheduler (engine)
         k_r = _k_r_table4()
         cs = params.thermal
         items = [(params, w, d, k_r) for w in range(len(cs.worlds)) for d in range(cs.n_draws)]
-        rows = engine.run_batches(_cold_draw, items, cs.batch_size, workers=workers, scheduler=scheduler,
-                                  label="paper C cold worlds")
+        rows = engine.run_batches(
+            _cold_draw,
+            items,
+            cs.batch_size,
+            workers=workers,
+            scheduler=scheduler,
+            label="paper C cold worlds",
+        )
         _COLD_STUDIES.clear()
         _COLD_STUDIES[params] = pd.DataFrame(rows)
     return _COLD_STUDIES[params]
@@ -169,9 +200,11 @@ def cold_thermal_summary(study: pd.DataFrame) -> pd.DataFrame:
 
 
 def _world_text(w: ThermalWorld, k_r: float) -> str:
-    return (f"k_T {w.temp_coeff_deg_h_per_c[0]:g}..{w.temp_coeff_deg_h_per_c[1]:g} deg/h per C, k_G tau "
-            f"{w.rate_coeff_in_k_r[0] * k_r:.5f}..{w.rate_coeff_in_k_r[1] * k_r:.5f} (deg/h) per (C/h), tau "
-            f"{w.lag_h[0]:g}..{w.lag_h[1]:g} h")
+    return (
+        f"k_T {w.temp_coeff_deg_h_per_c[0]:g}..{w.temp_coeff_deg_h_per_c[1]:g} deg/h per C, k_G tau "
+        f"{w.rate_coeff_in_k_r[0] * k_r:.5f}..{w.rate_coeff_in_k_r[1] * k_r:.5f} (deg/h) per (C/h), tau "
+        f"{w.lag_h[0]:g}..{w.lag_h[1]:g} h"
+    )
 
 
 def thermal_worlds_table(params: StudyParams = StudyParams()) -> pd.DataFrame:
@@ -188,8 +221,17 @@ def thermal_worlds_table(params: StudyParams = StudyParams()) -> pd.DataFrame:
         One row per world.
     """
     k_r = _k_r_table4()
-    return pd.DataFrame([{"world": w.name, "k_T low (deg/h per C)": w.temp_coeff_deg_h_per_c[0],
-                          "k_T high": w.temp_coeff_deg_h_per_c[1],
-                          "k_G tau low ((deg/h)/(C/h))": w.rate_coeff_in_k_r[0] * k_r,
-                          "k_G tau high": w.rate_coeff_in_k_r[1] * k_r,
-                          "tau low (h)": w.lag_h[0], "tau high (h)": w.lag_h[1]} for w in params.thermal.worlds])
+    return pd.DataFrame(
+        [
+            {
+                "world": w.name,
+                "k_T low (deg/h per C)": w.temp_coeff_deg_h_per_c[0],
+                "k_T high": w.temp_coeff_deg_h_per_c[1],
+                "k_G tau low ((deg/h)/(C/h))": w.rate_coeff_in_k_r[0] * k_r,
+                "k_G tau high": w.rate_coeff_in_k_r[1] * k_r,
+                "tau low (h)": w.lag_h[0],
+                "tau high (h)": w.lag_h[1],
+            }
+            for w in params.thermal.worlds
+        ]
+    )

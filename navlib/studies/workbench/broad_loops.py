@@ -2,6 +2,7 @@
 reference (the optical attitude) and without it (field and accelerometer only), trial by trial on
 :mod:`navlib.engine`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -39,11 +40,18 @@ def level_loops(start_model=("misalignment",), alpha: float | None = None) -> Le
         res = loop("compass", load("compass", path), list(start_model), alpha=alpha)
         results[path.name] = res
         amp = max([u["amplitude"] for u in res.unexplained] + [0.0])
-        rows.append({"file": path.name, "rows": len(res.final.data),
-                     "effects added": added(res),
-                     "start rms (deg)": res.fits[0].rms, "final rms (deg)": res.final.rms,
-                     "final held-out rms (deg)": res.final.loo_rms, "outcome": res.outcome(),
-                     "largest structure / rms": amp / res.final.rms})
+        rows.append(
+            {
+                "file": path.name,
+                "rows": len(res.final.data),
+                "effects added": added(res),
+                "start rms (deg)": res.fits[0].rms,
+                "final rms (deg)": res.final.rms,
+                "final held-out rms (deg)": res.final.loo_rms,
+                "outcome": res.outcome(),
+                "largest structure / rms": amp / res.final.rms,
+            }
+        )
     return LevelLoops(results, pd.DataFrame(rows).set_index("file"))
 
 
@@ -59,7 +67,7 @@ def load_trial(name: str, row_step: int = 1, attached_only: bool = False) -> pd.
         keep &= d["magnet_attached"] == 1
     if name in STATIONARY:
         keep &= d["moving"] == 1
-    return d[keep].iloc[::int(row_step)].reset_index(drop=True)
+    return d[keep].iloc[:: int(row_step)].reset_index(drop=True)
 
 
 def undisturbed_trials() -> list[str]:
@@ -76,15 +84,24 @@ def undisturbed_loop(name: str, row_step: int = 3, alpha: float | None = None) -
     res = loop("magnetometer", data, [], alpha=alpha)
     noise = res.screening.noise
     amp = max([u["amplitude"] for u in res.unexplained] + [0.0])
-    return {"trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "), "rows": len(data),
-            "rows set aside": len(res.screening.rows_set_aside),
-            "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
-            "effects added": added(res), "final rms (uT)": res.final.rms,
-            "largest structure (uT)": amp, "outcome": res.outcome(), "staircase": staircase_of(res)}
+    return {
+        "trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "),
+        "rows": len(data),
+        "rows set aside": len(res.screening.rows_set_aside),
+        "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}"
+        if noise.correlated
+        else "independent",
+        "effects added": added(res),
+        "final rms (uT)": res.final.rms,
+        "largest structure (uT)": amp,
+        "outcome": res.outcome(),
+        "staircase": staircase_of(res),
+    }
 
 
-def undisturbed_loops(row_step: int = 3, alpha: float | None = None, workers: int = 1,
-                      scheduler: str | None = None) -> pd.DataFrame | None:
+def undisturbed_loops(
+    row_step: int = 3, alpha: float | None = None, workers: int = 1, scheduler: str | None = None
+) -> pd.DataFrame | None:
     """:func:`undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data are
     absent); ``workers``, ``scheduler``: where they run (:mod:`navlib.engine`, the largest files first; the
     workers read the files, so a remote cluster needs them at the same path)."""
@@ -100,8 +117,14 @@ def _on_undisturbed(fn, row_step, alpha, workers, scheduler, label) -> pd.DataFr
     if not names:
         return None
     check_param("row_step", row_step, lo=1, integer=True)
-    rows = engine.run(fn, [(n, row_step, alpha) for n in names], workers=workers, scheduler=scheduler,
-                      label=label, cost=[float((MAG_DIR / n).stat().st_size) for n in names])
+    rows = engine.run(
+        fn,
+        [(n, row_step, alpha) for n in names],
+        workers=workers,
+        scheduler=scheduler,
+        label=label,
+        cost=[float((MAG_DIR / n).stat().st_size) for n in names],
+    )
     stairs = {r["trial"]: st for r in rows if (st := r.pop("staircase", None)) is not None}
     out = pd.DataFrame(rows).set_index("trial")
     out.attrs["staircases"] = stairs
@@ -113,7 +136,9 @@ def _free_frame(d: pd.DataFrame) -> pd.DataFrame:
     return with_invariants(d[list(MAG) + list(ACC) + ["time_s"]])
 
 
-def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float | None = None) -> dict:
+def free_undisturbed_loop(
+    name: str, row_step: int = FREE_ROW_STEP, alpha: float | None = None
+) -> dict:
     """The reference-free loop (:mod:`navlib.workbench.magnetometer_free`: field and accelerometer only,
     the optical reference ignored) from the local field alone on one undisturbed BROAD trial, every
     ``row_step``-th block: what it ends with -- rows, rows set aside, the noise model, the effects added,
@@ -126,20 +151,40 @@ def free_undisturbed_loop(name: str, row_step: int = FREE_ROW_STEP, alpha: float
     label = name.replace("broad_", "").replace(".csv", "").replace("_", " ")
     try:
         res = loop(FREE, data, [], alpha=alpha)
-    except InputError as err:          # what the CLI would refuse (e.g. too few distinct orientations)
-        return {"trial": label, "rows": len(data), "rows set aside": 0, "noise model": "-", "effects added": "-",
-                "final rms (uT)": float("nan"), "outcome": "refused: " + str(err).split(": ", 1)[-1][:60],
-                "field (uT)": float("nan"), "field 95% (uT)": float("nan"), "dip (deg)": float("nan"),
-                "dip 95% (deg)": float("nan"), "what is left": "-"}
+    except InputError as err:  # what the CLI would refuse (e.g. too few distinct orientations)
+        return {
+            "trial": label,
+            "rows": len(data),
+            "rows set aside": 0,
+            "noise model": "-",
+            "effects added": "-",
+            "final rms (uT)": float("nan"),
+            "outcome": "refused: " + str(err).split(": ", 1)[-1][:60],
+            "field (uT)": float("nan"),
+            "field 95% (uT)": float("nan"),
+            "dip (deg)": float("nan"),
+            "dip 95% (deg)": float("nan"),
+            "what is left": "-",
+        }
     check, _ = FREE.final_check(res, BROAD_SITE, None)
     noise = res.screening.noise
-    return {"trial": label, "rows": len(data),
-            "rows set aside": len(res.screening.rows_set_aside),
-            "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}" if noise.correlated else "independent",
-            "effects added": added(res), "final rms (uT)": res.final.rms, "outcome": res.outcome(),
-            "field (uT)": check["intensity_ut"], "field 95% (uT)": 1.96 * check["intensity_std_ut"],
-            "dip (deg)": check["dip_deg"], "dip 95% (deg)": 1.96 * check["dip_std_deg"],
-            "what is left": "-" if res.consistent_with_noise else _top_factor(res), "staircase": staircase_of(res)}
+    return {
+        "trial": label,
+        "rows": len(data),
+        "rows set aside": len(res.screening.rows_set_aside),
+        "noise model": f"AR({noise.order}), lag-1 {noise.lag1:.2f}"
+        if noise.correlated
+        else "independent",
+        "effects added": added(res),
+        "final rms (uT)": res.final.rms,
+        "outcome": res.outcome(),
+        "field (uT)": check["intensity_ut"],
+        "field 95% (uT)": 1.96 * check["intensity_std_ut"],
+        "dip (deg)": check["dip_deg"],
+        "dip 95% (deg)": 1.96 * check["dip_std_deg"],
+        "what is left": "-" if res.consistent_with_noise else _top_factor(res),
+        "staircase": staircase_of(res),
+    }
 
 
 def _top_factor(res: LoopResult) -> str:
@@ -151,9 +196,14 @@ def _top_factor(res: LoopResult) -> str:
     return f"{top['factor']} ({'|m|' if top['invariant'] == 'magnitude' else 'dip'}) {100 * top['share']:.0f}%"
 
 
-def free_undisturbed_loops(row_step: int = FREE_ROW_STEP, alpha: float | None = None, workers: int = 1,
-                           scheduler: str | None = None) -> pd.DataFrame | None:
+def free_undisturbed_loops(
+    row_step: int = FREE_ROW_STEP,
+    alpha: float | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
+) -> pd.DataFrame | None:
     """:func:`free_undisturbed_loop` on every undisturbed BROAD 3-D trial, one row each (None if the data
     are absent)."""
-    return _on_undisturbed(free_undisturbed_loop, row_step, alpha, workers, scheduler,
-                           "BROAD reference-free loops")
+    return _on_undisturbed(
+        free_undisturbed_loop, row_step, alpha, workers, scheduler, "BROAD reference-free loops"
+    )

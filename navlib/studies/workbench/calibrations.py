@@ -2,6 +2,7 @@
 ellipsoid fit on held-out rows, and the reference-free calibration beside the reference-based one in
 heading.
 """
+
 from __future__ import annotations
 
 import tempfile
@@ -38,12 +39,17 @@ class PeerComparison:
         a = self.accuracy
         cal = a[a["navlib"] != "refused"]
         worse = cal[cal["navlib direction (deg)"] > cal["raw direction (deg)"]]
-        return {"trials": len(a), "calibrated": len(cal), "warned": int((a["navlib"] == "warned").sum()),
-                "peer_failed": int((a["peer"] != "fitted").sum()),
-                "refused": int((a["navlib"] == "refused").sum()), "navlib_worse": len(worse),
-                "navlib_worse_warned": int((worse["navlib"] == "warned").sum()),
-                "peer_worse": int((a["peer direction (deg)"] > a["raw direction (deg)"]).sum()),
-                "time_ratio": float((self.times["navlib (s)"] / self.times["peer (s)"]).median())}
+        return {
+            "trials": len(a),
+            "calibrated": len(cal),
+            "warned": int((a["navlib"] == "warned").sum()),
+            "peer_failed": int((a["peer"] != "fitted").sum()),
+            "refused": int((a["navlib"] == "refused").sum()),
+            "navlib_worse": len(worse),
+            "navlib_worse_warned": int((worse["navlib"] == "warned").sum()),
+            "peer_worse": int((a["peer direction (deg)"] > a["raw direction (deg)"]).sum()),
+            "time_ratio": float((self.times["navlib (s)"] / self.times["peer (s)"]).median()),
+        }
 
 
 def held_out_field_errors(m_corrected: np.ndarray, q: np.ndarray) -> tuple[float, float]:
@@ -55,10 +61,12 @@ def held_out_field_errors(m_corrected: np.ndarray, q: np.ndarray) -> tuple[float
     u = w / np.linalg.norm(w, axis=1, keepdims=True)
     mean = u.mean(axis=0)
     ang = np.degrees(np.arccos(np.clip(u @ (mean / np.linalg.norm(mean)), -1.0, 1.0)))
-    return float(np.sqrt(np.mean(ang ** 2))), 100.0 * float(np.std(mag) / np.mean(mag))
+    return float(np.sqrt(np.mean(ang**2))), 100.0 * float(np.std(mag) / np.mean(mag))
 
 
-def calibration_beside_peer(files=None, train_share: float = PEER_TRAIN_SHARE) -> PeerComparison | None:
+def calibration_beside_peer(
+    files=None, train_share: float = PEER_TRAIN_SHARE
+) -> PeerComparison | None:
     """``navlib calibrate`` (the library call of the CLI: :func:`navlib.workbench.calibration.calibrate` on
     :func:`~navlib.workbench.magnetometer_free.load_free` of the training rows) beside the Levenberg-Marquardt
     ellipsoid fit a dedicated calibrator does (:func:`navlib.methods.ellipsoid.lm_ellipsoid`), on every BROAD
@@ -84,11 +92,13 @@ def calibration_beside_peer(files=None, train_share: float = PEER_TRAIN_SHARE) -
             t0 = time.perf_counter()
             try:
                 b, S, _ = lm_ellipsoid(train[list(MAG)].to_numpy(float))
-            except InputError:                  # the algebraic start is no ellipsoid: the peer has no fit
+            except InputError:  # the algebraic start is no ellipsoid: the peer has no fit
                 row["peer direction (deg)"] = row["peer spread (%)"] = float("nan")
                 row["peer"] = "no ellipsoid"
             else:
-                row["peer direction (deg)"], row["peer spread (%)"] = held_out_field_errors((m - b) @ S, q)
+                row["peer direction (deg)"], row["peer spread (%)"] = held_out_field_errors(
+                    (m - b) @ S, q
+                )
                 row["peer"] = "fitted"
             t_peer = time.perf_counter() - t0
             part = Path(tmp) / path.name
@@ -101,11 +111,17 @@ def calibration_beside_peer(files=None, train_share: float = PEER_TRAIN_SHARE) -
                 row["navlib"] = "refused"
             else:
                 A, bn = np.asarray(cal["magcal"]["A"]), np.asarray(cal["magcal"]["b_ut"])
-                row["navlib direction (deg)"], row["navlib spread (%)"] = held_out_field_errors((m - bn) @ A, q)
+                row["navlib direction (deg)"], row["navlib spread (%)"] = held_out_field_errors(
+                    (m - bn) @ A, q
+                )
                 row["navlib"] = "warned" if cal.get("warnings") else "calibrated"
-            times.append({"trial": label, "navlib (s)": time.perf_counter() - t0, "peer (s)": t_peer})
+            times.append(
+                {"trial": label, "navlib (s)": time.perf_counter() - t0, "peer (s)": t_peer}
+            )
             acc.append(row)
-    return PeerComparison(pd.DataFrame(acc).set_index("trial"), pd.DataFrame(times).set_index("trial"))
+    return PeerComparison(
+        pd.DataFrame(acc).set_index("trial"), pd.DataFrame(times).set_index("trial")
+    )
 
 
 def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.DataFrame | None:
@@ -129,7 +145,9 @@ def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.Data
     def free_frame(d):
         return with_invariants(d[list(MAG) + list(ACC) + ["time_s"]])
 
-    cal = calibrate(free_frame(load_trial(CALIBRATION_TRIAL, row_step)), DEFAULT_MODEL, source=CALIBRATION_TRIAL)
+    cal = calibrate(
+        free_frame(load_trial(CALIBRATION_TRIAL, row_step)), DEFAULT_MODEL, source=CALIBRATION_TRIAL
+    )
     rows = []
     for name in names:
         d = load_trial(name, row_step)
@@ -138,10 +156,15 @@ def reference_free_headings(reference: LoopResult, row_step: int = 3) -> pd.Data
         def rms(field):
             return float(np.sqrt(np.mean(heading_error_deg(field, d) ** 2)))
 
-        rows.append({"trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "), "rows": len(d),
-                     "raw field (deg)": rms(d[list(MAG)].to_numpy(float)),
-                     "reference-free calibration (deg)": rms(free),
-                     "reference-based calibration (deg)": rms(correct_field(reference.final.params, d))})
+        rows.append(
+            {
+                "trial": name.replace("broad_", "").replace(".csv", "").replace("_", " "),
+                "rows": len(d),
+                "raw field (deg)": rms(d[list(MAG)].to_numpy(float)),
+                "reference-free calibration (deg)": rms(free),
+                "reference-based calibration (deg)": rms(correct_field(reference.final.params, d)),
+            }
+        )
     out = pd.DataFrame(rows).set_index("trial")
     out.attrs["field_ut"] = cal["expected_field_strength_ut"]["value"]
     out.attrs["dip_deg"] = cal.get("dip_deg", float("nan"))

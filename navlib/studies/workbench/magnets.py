@@ -2,6 +2,7 @@
 attached- and stationary-magnet trial, the ellipsoid fit beside it, and the law of hard iron against the
 magnet's distance.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -12,8 +13,14 @@ from scipy.optimize import least_squares
 
 from ...errors import InputError
 from ...workbench.loop import LoopResult, loop
-from ...workbench.magnetometer import (MAG, apply_calibration, correct_field, ellipsoid_fit, field_summary,
-                                       heading_error_deg)
+from ...workbench.magnetometer import (
+    MAG,
+    apply_calibration,
+    correct_field,
+    ellipsoid_fit,
+    field_summary,
+    heading_error_deg,
+)
 from .broad_loops import load_trial
 from .parameters import ATTACHED, CALIBRATION_TRIAL, MAG_DIR, MAGNET_STAIRCASES, STATIONARY
 from .tables import added
@@ -25,9 +32,9 @@ class MagnetStudy:
 
     calibration: LoopResult
     field: pd.DataFrame
-    trials: pd.DataFrame          # one row per disturbed trial
-    loops: dict                   # file -> LoopResult (on calibrated data)
-    headings: pd.DataFrame        # heading error of our model and of the ellipsoid fit
+    trials: pd.DataFrame  # one row per disturbed trial
+    loops: dict  # file -> LoopResult (on calibrated data)
+    headings: pd.DataFrame  # heading error of our model and of the ellipsoid fit
 
 
 def magnet_study(row_step: int = 3, alpha: float | None = None) -> MagnetStudy | None:
@@ -52,15 +59,29 @@ def magnet_study(row_step: int = 3, alpha: float | None = None) -> MagnetStudy |
         loops[name] = res
         b = [res.final.params.get(k, 0.0) for k in ("hard_x_ut", "hard_y_ut", "hard_z_ut")]
         short = name.replace("broad_", "").replace(".csv", "").replace("_", " ")
-        rows.append({"trial": short, "magnet": "attached" if name in ATTACHED else "stationary",
-                     "nominal distance (cm)": ATTACHED.get(name, np.nan), "rows": len(data),
-                     "calibrated rms (uT)": res.fits[0].rms, "first effect named": res.diagnoses[0].missing or "-",
-                     "effects added": added(res),
-                     "final rms (uT)": res.final.rms, "|hard iron| (uT)": float(np.linalg.norm(b)),
-                     "outcome": res.outcome()})
+        rows.append(
+            {
+                "trial": short,
+                "magnet": "attached" if name in ATTACHED else "stationary",
+                "nominal distance (cm)": ATTACHED.get(name, np.nan),
+                "rows": len(data),
+                "calibrated rms (uT)": res.fits[0].rms,
+                "first effect named": res.diagnoses[0].missing or "-",
+                "effects added": added(res),
+                "final rms (uT)": res.final.rms,
+                "|hard iron| (uT)": float(np.linalg.norm(b)),
+                "outcome": res.outcome(),
+            }
+        )
         if name in ATTACHED:
             heads.append(_headings(short, raw, None, None, calibrated=cal.final, result=res))
-    return MagnetStudy(cal, field, pd.DataFrame(rows).set_index("trial"), loops, pd.DataFrame(heads).set_index("trial"))
+    return MagnetStudy(
+        cal,
+        field,
+        pd.DataFrame(rows).set_index("trial"),
+        loops,
+        pd.DataFrame(heads).set_index("trial"),
+    )
 
 
 def magnet_staircases(study: MagnetStudy) -> dict:
@@ -70,7 +91,9 @@ def magnet_staircases(study: MagnetStudy) -> dict:
     out = {"05 undisturbed (calibration)": study.calibration}
     for name in MAGNET_STAIRCASES:
         if name in study.loops:
-            out[name.replace("broad_", "").replace(".csv", "").replace("_", " ")] = study.loops[name]
+            out[name.replace("broad_", "").replace(".csv", "").replace("_", " ")] = study.loops[
+                name
+            ]
     return out
 
 
@@ -80,12 +103,17 @@ def _headings(label, raw, params, fit, calibrated=None, result=None) -> dict:
         ours = heading_error_deg(correct_field(params, raw), raw, _declination(fit))
     else:
         data = apply_calibration(calibrated, raw)
-        ours = heading_error_deg(correct_field(result.final.params, data), data, _declination(result.final))
+        ours = heading_error_deg(
+            correct_field(result.final.params, data), data, _declination(result.final)
+        )
     W, c = ellipsoid_fit(raw)
     ell = heading_error_deg((raw[list(MAG)].to_numpy(float) - c) @ W.T, raw)
-    return {"trial": label, "workbench model, heading rms (deg)": float(np.sqrt(np.mean(ours ** 2))),
-            "ellipsoid fit, heading rms (deg)": float(np.sqrt(np.mean(ell ** 2))),
-            "ellipsoid fit, max |error| (deg)": float(np.max(np.abs(ell)))}
+    return {
+        "trial": label,
+        "workbench model, heading rms (deg)": float(np.sqrt(np.mean(ours**2))),
+        "ellipsoid fit, heading rms (deg)": float(np.sqrt(np.mean(ell**2))),
+        "ellipsoid fit, max |error| (deg)": float(np.max(np.abs(ell))),
+    }
 
 
 def _declination(fit) -> float:
@@ -112,11 +140,18 @@ def distance_law(trials: pd.DataFrame) -> DistanceLaw:
     if len(d) < 3 or np.any(b <= 0):
         raise InputError("distance_law: need at least 3 trials with a fitted hard iron")
     slope, icpt = np.polyfit(np.log(d), np.log(b), 1)
-    sol = least_squares(lambda x: x[0] - 3 * np.log(d + x[1]) - np.log(b), [np.log(b[0]) + 3 * np.log(d[0] + 1), 1.0],
-                        bounds=([-np.inf, -0.99 * d.min()], [np.inf, 50.0]))
+    sol = least_squares(
+        lambda x: x[0] - 3 * np.log(d + x[1]) - np.log(b),
+        [np.log(b[0]) + 3 * np.log(d[0] + 1), 1.0],
+        bounds=([-np.inf, -0.99 * d.min()], [np.inf, 50.0]),
+    )
     k_dip, d0 = float(np.exp(sol.x[0])), float(sol.x[1])
-    table = pd.DataFrame({"nominal distance (cm)": d, "|hard iron| (uT)": b,
-                          "power law (uT)": np.exp(icpt) * d ** slope,
-                          "dipole law (uT)": k_dip * (d + d0) ** -3.0}).set_index("nominal distance (cm)")
+    table = pd.DataFrame(
+        {
+            "nominal distance (cm)": d,
+            "|hard iron| (uT)": b,
+            "power law (uT)": np.exp(icpt) * d**slope,
+            "dipole law (uT)": k_dip * (d + d0) ** -3.0,
+        }
+    ).set_index("nominal distance (cm)")
     return DistanceLaw(float(-slope), float(np.exp(icpt)), k_dip, d0, table)
-

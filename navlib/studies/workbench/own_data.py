@@ -1,6 +1,7 @@
 """The chapter's "Bring your own data": per system the columns its loader reads, the first rows of a sample
 file, the one command that runs the loop on it, and the report that command writes.
 """
+
 from __future__ import annotations
 
 import textwrap
@@ -58,8 +59,10 @@ def shell_command(words, width: int = 80) -> str:
 
 def wrap_report(text: str, width: int = 88) -> str:
     """A report's text with lines longer than ``width`` wrapped (tables and short lines as written)."""
-    return "\n".join(textwrap.fill(ln, width) if len(ln) > width and not ln.startswith("|") else ln
-                     for ln in text.splitlines())
+    return "\n".join(
+        textwrap.fill(ln, width) if len(ln) > width and not ln.startswith("|") else ln
+        for ln in text.splitlines()
+    )
 
 
 def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
@@ -79,9 +82,23 @@ def own_data(system: str, rows: int = SAMPLE_ROWS) -> OwnData:
         sample.columns = [f"row {i + 1}" for i in range(len(head))]
         sample.index.name = "column"
     shown = _shown_path(path)
-    return OwnData(system, cols, sample, shown,
-                   shell_command(["navlib", "loop", system, shown, *OWN_DATA_COMMAND_OPTIONS.get(system, []),
-                                  "--report", f"out_{system}/"]))
+    return OwnData(
+        system,
+        cols,
+        sample,
+        shown,
+        shell_command(
+            [
+                "navlib",
+                "loop",
+                system,
+                shown,
+                *OWN_DATA_COMMAND_OPTIONS.get(system, []),
+                "--report",
+                f"out_{system}/",
+            ]
+        ),
+    )
 
 
 def own_data_report(folder, system: str = "compass", start_model=()) -> tuple[Path, Path]:

@@ -7,6 +7,7 @@ Robust Inertial Orientation Estimation", Data 6(7):72, 2021, CC BY 4.0), derived
 ``../shared/realdata/broad`` (never copied into this repository; where the folder is absent the functions
 return None and the chapter says so).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
@@ -21,12 +22,20 @@ LEVEL_DIR = REALDATA / "broad" / "level"
 MAG_DIR = REALDATA / "broad" / "3d"
 CALIBRATION_TRIAL = "broad_05_undisturbed_slow_rotation_with_breaks_B.csv"
 #: Attached-magnet trials (file -> nominal distance of the magnet from the IMU in cm, from BROAD's trial list).
-ATTACHED = {"broad_32_attached_magnet_1cm.csv": 1.0, "broad_33_attached_magnet_2cm.csv": 2.0,
-            "broad_34_attached_magnet_3cm.csv": 3.0, "broad_35_attached_magnet_4cm.csv": 4.0,
-            "broad_36_attached_magnet_5cm.csv": 5.0}
-STATIONARY = ("broad_28_stationary_magnet_A.csv", "broad_29_stationary_magnet_B.csv",
-              "broad_30_stationary_magnet_C.csv", "broad_31_stationary_magnet_D.csv")
-MAX_ATT_BLUR = 0.01      # README: keep the block attitude blur below 0.01 for precise fits
+ATTACHED = {
+    "broad_32_attached_magnet_1cm.csv": 1.0,
+    "broad_33_attached_magnet_2cm.csv": 2.0,
+    "broad_34_attached_magnet_3cm.csv": 3.0,
+    "broad_35_attached_magnet_4cm.csv": 4.0,
+    "broad_36_attached_magnet_5cm.csv": 5.0,
+}
+STATIONARY = (
+    "broad_28_stationary_magnet_A.csv",
+    "broad_29_stationary_magnet_B.csv",
+    "broad_30_stationary_magnet_C.csv",
+    "broad_31_stationary_magnet_D.csv",
+)
+MAX_ATT_BLUR = 0.01  # README: keep the block attitude blur below 0.01 for precise fits
 
 
 def realdata_available() -> bool:
@@ -38,9 +47,13 @@ def realdata_available() -> bool:
 # The file each system's section of "Bring your own data" samples: shipped in ``data/`` or BROAD trial 05
 # in ``../shared/realdata`` (read there, never copied; no doc comment: the API page would print this
 # machine's folders).
-OWN_DATA_FILES = {"compass": data_path("compass_sweeps.csv"), "drift": data_path("gyro_drift_measurements.csv"),
-                  "magnetometer": MAG_DIR / CALIBRATION_TRIAL, "magnetometer_free": MAG_DIR / CALIBRATION_TRIAL,
-                  "accelerometer": data_path("accel_tumble.csv")}
+OWN_DATA_FILES = {
+    "compass": data_path("compass_sweeps.csv"),
+    "drift": data_path("gyro_drift_measurements.csv"),
+    "magnetometer": MAG_DIR / CALIBRATION_TRIAL,
+    "magnetometer_free": MAG_DIR / CALIBRATION_TRIAL,
+    "accelerometer": data_path("accel_tumble.csv"),
+}
 #: Options a system's command needs on its sample file: the workbench fits one accelerometer, and
 #: ``data/accel_tumble.csv`` holds two (units A and B), so the command picks one.
 OWN_DATA_COMMAND_OPTIONS = {"accelerometer": ["--unit", "A"]}
@@ -51,8 +64,11 @@ SAMPLE_ROWS = 5
 # ------------------------------------------------------------------------------------ 3-D magnetometer
 #: The loops of :func:`~navlib.studies.workbench.magnets.magnet_study` drawn as staircases: the calibration,
 #: the nearest and the farthest attached magnet, and the first stationary magnet.
-MAGNET_STAIRCASES = ("broad_32_attached_magnet_1cm.csv", "broad_36_attached_magnet_5cm.csv",
-                     "broad_28_stationary_magnet_A.csv")
+MAGNET_STAIRCASES = (
+    "broad_32_attached_magnet_1cm.csv",
+    "broad_36_attached_magnet_5cm.csv",
+    "broad_28_stationary_magnet_A.csv",
+)
 #: Share of each recording (its first rows, in time) the calibrations are fitted on; the rest judges them.
 PEER_TRAIN_SHARE = 0.7
 #: Where BROAD was recorded, as its README states it: it gives no site or date, so the reference-free
@@ -65,9 +81,9 @@ FREE_ROW_STEP = 9
 
 # ------------------------------------------------------------------------------------ the book's targets
 #: Our users' targets for the loop (the book's own; no paper states them), as shares of trials.
-TARGET_NAMED = 0.95          # a hidden catalogued effect is named in at least 95 % of trials
-TARGET_FALSE_ALARMS = 0.05   # data with nothing missing raise at most 5 % false alarms
-TARGET_QUIET = 0.90          # an error outside the catalogue names no catalogued effect in at least 90 %
+TARGET_NAMED = 0.95  # a hidden catalogued effect is named in at least 95 % of trials
+TARGET_FALSE_ALARMS = 0.05  # data with nothing missing raise at most 5 % false alarms
+TARGET_QUIET = 0.90  # an error outside the catalogue names no catalogued effect in at least 90 %
 #: Our bound on a real sweep: the unexplained structure left at the end, as a multiple of the residual rms.
 STRUCTURE_BOUND = 3.0
 
@@ -111,14 +127,23 @@ class WorkbenchParams:
         check_param("noise_deg", self.noise_deg, lo=0, lo_open=True)
         check_param("alpha", self.alpha, lo=0, lo_open=True, hi=1, hi_open=True)
         check_param("three_cycle_deg", self.three_cycle_deg, lo=0)
-        for name in ("study_seeds", "study_null_trials", "drift_null_trials", "ooc_seeds", "mag_row_step",
-                     "corr_seeds", "n_workers"):
+        for name in (
+            "study_seeds",
+            "study_null_trials",
+            "drift_null_trials",
+            "ooc_seeds",
+            "mag_row_step",
+            "corr_seeds",
+            "n_workers",
+        ):
             check_param(name, getattr(self, name), lo=1, integer=True)
         start = check_effects("compass", self.start_model.split(","))
         check_effects("compass", [self.hidden_effect])
         if self.hidden_effect in start:
-            raise InputError(f"parameter hidden_effect={self.hidden_effect!r} is already in start_model;"
-                             " hide another effect")
+            raise InputError(
+                f"parameter hidden_effect={self.hidden_effect!r} is already in start_model;"
+                " hide another effect"
+            )
         object.__setattr__(self, "start", start)
 
     @classmethod
@@ -129,6 +154,8 @@ class WorkbenchParams:
         known = [f.name for f in fields(cls) if f.init]
         for key in cell:
             if key not in known:
-                raise InputError(f"parameter {key!r}: not a parameter of the workbench notebook "
-                                 f"(one of {', '.join(known)})")
+                raise InputError(
+                    f"parameter {key!r}: not a parameter of the workbench notebook "
+                    f"(one of {', '.join(known)})"
+                )
         return cls(**cell)

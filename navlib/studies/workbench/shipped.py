@@ -1,6 +1,7 @@
 """The loop on the measurements shipped in ``data/``: paper C's drift tables (Tables 2-4) and the
 accelerometer tumble test.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -24,8 +25,8 @@ class DriftStudy:
     cold: pd.DataFrame
     hot_fit: object
     hot_diagnosis: object
-    diagnoses: dict               # "cold tests only" / "hot and cold tests" -> Diagnosis (earth_rate + bias)
-    loo: pd.DataFrame             # held-out rms (1e-4 deg/h) of cold and hot tests per model
+    diagnoses: dict  # "cold tests only" / "hot and cold tests" -> Diagnosis (earth_rate + bias)
+    loo: pd.DataFrame  # held-out rms (1e-4 deg/h) of cold and hot tests per model
     temperature_change_coef: float
     loop: LoopResult | None = None  # the loop on every test (hot and cold) from no effect
 
@@ -38,22 +39,39 @@ def drift_study(alpha: float | None = None) -> DriftStudy:
     allrows = drift_measurements()
     hot, cold = allrows[allrows.state == "hot"], allrows[allrows.state == "cold"]
     hot_fit = fit_model("drift", hot, ["earth_rate"])
-    diags = {name: diagnose(fit_model("drift", frame, ["earth_rate", "bias"]), alpha=alpha)
-             for name, frame in (("cold tests only", cold), ("hot and cold tests", allrows))}
+    diags = {
+        name: diagnose(fit_model("drift", frame, ["earth_rate", "bias"]), alpha=alpha)
+        for name, frame in (("cold tests only", cold), ("hot and cold tests", allrows))
+    }
     is_cold = allrows.state.to_numpy() == "cold"
     loo = {}
-    for effects in (["earth_rate"], ["earth_rate", "bias"], ["earth_rate", "bias", "temperature_change"]):
+    for effects in (
+        ["earth_rate"],
+        ["earth_rate", "bias"],
+        ["earth_rate", "bias", "temperature_change"],
+    ):
         r = fit_model("drift", allrows, effects).loo_residuals
-        loo[" + ".join(effects)] = {"cold tests, held-out rms (1e-4 deg/h)": np.sqrt(np.mean(r[is_cold] ** 2)) * 1e4,
-                                    "hot tests, held-out rms (1e-4 deg/h)": np.sqrt(np.mean(r[~is_cold] ** 2)) * 1e4}
+        loo[" + ".join(effects)] = {
+            "cold tests, held-out rms (1e-4 deg/h)": np.sqrt(np.mean(r[is_cold] ** 2)) * 1e4,
+            "hot tests, held-out rms (1e-4 deg/h)": np.sqrt(np.mean(r[~is_cold] ** 2)) * 1e4,
+        }
     full = fit_model("drift", allrows, ["earth_rate", "bias", "temperature_change"])
-    return DriftStudy(hot, cold, hot_fit, diagnose(hot_fit, alpha=alpha), diags, pd.DataFrame(loo).T,
-                      full.params["temperature_change_coef_deg_h_per_c"],
-                      loop("drift", allrows, [], alpha=alpha))
+    return DriftStudy(
+        hot,
+        cold,
+        hot_fit,
+        diagnose(hot_fit, alpha=alpha),
+        diags,
+        pd.DataFrame(loo).T,
+        full.params["temperature_change_coef_deg_h_per_c"],
+        loop("drift", allrows, [], alpha=alpha),
+    )
 
 
 def accelerometer_loop(unit: str = "A", start=("bias",), alpha: float | None = None) -> LoopResult:
     """The workbench loop on one accelerometer of the shipped tumble file ``data/accel_tumble.csv``
     (:func:`navlib.workbench.accelerometer.load_accelerometer` with ``unit``), from the model ``start``: what
     ``python -m navlib loop accelerometer FILE --unit A --model bias`` does."""
-    return loop("accelerometer", load_accelerometer(TUMBLE_FILE, unit=unit), list(start), alpha=alpha)
+    return loop(
+        "accelerometer", load_accelerometer(TUMBLE_FILE, unit=unit), list(start), alpha=alpha
+    )

@@ -1,5 +1,6 @@
 """The accelerometer chapter's pieces: the physical baseline and the exact model, the metrics, the split by
 whole temperatures and the validation of its parameters."""
+
 import numpy as np
 import pytest
 
@@ -16,7 +17,7 @@ def test_physical_baseline_exact_on_a_polynomial_noise_free_sensor():
     s = D.samples(df, "A")
     model = D.fit_physical(df, degree=3)
     pred = model(s[["temperature_c", "output_mg"]].to_numpy())
-    assert np.max(np.abs(pred - s["target_mg"])) < 1e-3      # < 1 ug; only the small cross terms remain
+    assert np.max(np.abs(pred - s["target_mg"])) < 1e-3  # < 1 ug; only the small cross terms remain
     orc = D.oracle(coef)(s[["temperature_c", "output_mg"]].to_numpy())
     assert np.max(np.abs(orc - s["target_mg"])) < 1e-3
 
@@ -38,11 +39,20 @@ def test_split_is_by_whole_temperatures():
     assert (lab[s["set_point_c"] == 55.0] == "train").all()
 
 
-@pytest.mark.parametrize("kw, word", [
-    (dict(held_out_c=(-32.0,)), "not a set point"), (dict(held_out_c=(55.0,)), "reference"),
-    (dict(held_out_c=(0.0,), check_c=(0.0,)), "share"), (dict(radius_bounds=(0.5, 0.2)), "radius_bounds"),
-    (dict(squash_bounds=(0.5, 2.0)), "squash"), (dict(seeds=()), "seeds"), (dict(fis_radius=0), "fis_radius"),
-    (dict(max_rules=0), "max_rules"), (dict(mlp=MLPParams(n_in=3)), "mlp")])
+@pytest.mark.parametrize(
+    "kw, word",
+    [
+        (dict(held_out_c=(-32.0,)), "not a set point"),
+        (dict(held_out_c=(55.0,)), "reference"),
+        (dict(held_out_c=(0.0,), check_c=(0.0,)), "share"),
+        (dict(radius_bounds=(0.5, 0.2)), "radius_bounds"),
+        (dict(squash_bounds=(0.5, 2.0)), "squash"),
+        (dict(seeds=()), "seeds"),
+        (dict(fis_radius=0), "fis_radius"),
+        (dict(max_rules=0), "max_rules"),
+        (dict(mlp=MLPParams(n_in=3)), "mlp"),
+    ],
+)
 def test_study_bad_params(kw, word):
     with pytest.raises(InputError, match=word):
         D.PaperDParams(**kw)

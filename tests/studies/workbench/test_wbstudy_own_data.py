@@ -1,5 +1,6 @@
 """The workbench chapter's "Bring your own data" (navlib.studies.workbench.own_data): the schema, sample
 rows, a command that fits the column, and the report the command writes."""
+
 import pytest
 
 from navlib.errors import InputError
@@ -15,7 +16,9 @@ def test_own_data_sections_show_the_schema_sample_rows_and_a_command_that_fits(t
         assert set(own.sample.index) <= set(own.columns["column"])
         assert own.command.startswith(f"navlib loop {system} ") and "--report" in own.command
     assert "data/compass_sweeps.csv" in wb.own_data("compass").command
-    long = wb.shell_command(["navlib", "loop", "magnetometer", "x" * 70, "--report", "out/"], width=80)
+    long = wb.shell_command(
+        ["navlib", "loop", "magnetometer", "x" * 70, "--report", "out/"], width=80
+    )
     assert all(len(line) <= 80 + 2 for line in long.splitlines()) and long.count("\\\n") == 2
     png, md = wb.own_data_report(tmp_path / "rep")
     assert png.stat().st_size > 1000 and "| step | model |" in md.read_text()
