@@ -4,7 +4,7 @@
 gradient written out in torch operations and torch's fused Adam step (bit-identical to
 ``torch.optim.Adam(fused=True)``); the former implementation
 built an autograd graph every epoch and stepped torch's default Adam (kept here as ``autograd_trajectories``,
-the same as the reference in ``tests/test_bpnet.py``).  Ours runs single-threaded; the autograd path runs
+the same as the reference in ``tests/methods/test_bpnet.py``).  Ours runs single-threaded; the autograd path runs
 both on torch's default thread count (as the former code did: on a shared machine its threads wait for
 each other) and single-threaded (the part of the gain that is the gradient and the step alone).
 

@@ -1,6 +1,6 @@
 """The names the command line offers, kept apart so that parsing a command line (and ``--help``) loads
 nothing but the standard library: the workbench's systems, ``rates``' and ``calibrate``'s defaults and the
-example files shipped with navlib.  Each list equals the library's own registry (``tests/test_cli_surface.py``
+example files shipped with navlib.  Each list equals the library's own registry (``tests/cli/test_cli_surface.py``
 keeps them equal)."""
 
 from __future__ import annotations

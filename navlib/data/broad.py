@@ -47,7 +47,7 @@ blocks (2002 and 1590) and every 3-D column identical to the last written digit,
 differs by 0.001 s in about 5 % of the blocks (a block mean that falls on a tie of the third decimal, rounded
 the other way); the level sweep of trial 05 has the same 144 bins (70 + 74) and columns identical except
 ``error_sd_deg`` (at most 0.0005 deg) and ``time_median_s`` (0.01 s), the same kind of tie.  The tests
-(``tests/test_broad_convert.py``) use small synthetic trial files in BROAD's layout; the original files are
+(``tests/data/test_broad_convert.py``) use small synthetic trial files in BROAD's layout; the original files are
 not part of this project.
 """
 

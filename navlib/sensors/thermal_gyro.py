@@ -10,7 +10,7 @@ Thermal model (a first-order thermal lag between the case and the sensing elemen
 :class:`navlib.sensors.ins.ColdStart`), ``T_s`` the sensing element's, ``T_end`` the temperature at which the
 system settles (``eps_final`` is the drift there), ``k_T`` (deg/h per C) the temperature coefficient and
 ``k_G`` (deg/h per C) the sensitivity to the case-to-sensor gradient.  Closed forms (checked in
-``tests/test_thermal_gyro.py``): at a constant case temperature ``T_s`` relaxes to it with time constant
+``tests/sensors/test_thermal_gyro.py``): at a constant case temperature ``T_s`` relaxes to it with time constant
 ``tau`` (``T_s(t) = T_c + (T_s0 - T_c) exp(-t / tau)``) and the drift to the steady state
 ``eps_final + k_T (T_c - T_end)``; on a ramp of rate ``r`` the gradient settles to ``r tau``, so for
 ``tau -> 0`` with ``k_G tau = k_R`` the model is the rate term ``eps_final + k_R dT/dt`` of

@@ -3,7 +3,7 @@
 The study runs on the real files (skipped where ``../shared/realdata`` is absent) with the cheap methods
 (uncompensated, the exact planar fit and the two ELMs; the networks of paper A cost a minute and add
 nothing to what is checked here).  That the numbers do not depend on the workers is
-``tests/test_compare.py::test_a_local_cluster_gives_the_numbers_of_one_process`` (the study only calls
+``tests/workbench/test_compare.py::test_a_local_cluster_gives_the_numbers_of_one_process`` (the study only calls
 :func:`navlib.workbench.compare.compare`)."""
 
 import numpy as np

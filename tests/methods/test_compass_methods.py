@@ -1,6 +1,6 @@
 """Tests for navlib.methods.compass_methods: the registry of paper A's and document B's compass methods
 (ids, labels, readings, the DE families), the 8-position least squares and its position tolerance, and the
-runs seeded by generators (moved here with the registry from tests/test_compass_study.py)."""
+runs seeded by generators (moved here with the registry from tests/studies/compass/test_compass_study.py)."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ import pytest
 sphinx = pytest.importorskip("sphinx.application")
 pytest.importorskip("myst_parser")
 
-EXT = Path(__file__).resolve().parents[1] / "book" / "_ext"
+EXT = Path(__file__).resolve().parents[2] / "book" / "_ext"
 
 PAGE = """# Chapter
 

@@ -19,7 +19,7 @@ from navbook import cli as book_cli, grid
 from navlib import cli, commands, engine
 from navlib.errors import InputError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ENV = {
     **{k: v for k, v in os.environ.items() if k != engine.ENV_SCHEDULER},
     "PYTHONPATH": os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p),

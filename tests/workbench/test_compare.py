@@ -26,7 +26,7 @@ from navlib.sensors.compass import PAPER_A_EARTH, CompassErrors, simulate_train_
 from navlib.sensors.planar import PlanarModel
 from navlib.workbench import compare as C
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 #: Small training budgets: the tests check the bookkeeping, not the methods' accuracy.
 FAST = replace(
     cm.MethodParams(),
