@@ -1,7 +1,8 @@
-"""navlib.seeding is the one place seeds are made: the helpers that once built their own SeedSequences (ins's
-``_part`` and its tests' spawn keys, the accelerometer's ``_sequence``, paper D's ``sim_seed``, paper E's
-``seed_of``, the workbench bootstrap's stream, the torch seed of the MLP) now call it, and every one of them
-still gives the stream it gave before: each is compared here with a SeedSequence built the old way."""
+"""navlib.seeding is the one place seeds are made.  The inertial simulator is held to behaviours (a run is a
+function of its seed; its two navigations share one noise stream; each simulated test draws a stream of its
+own); the helpers that once built their own SeedSequences (the accelerometer's ``_sequence``, paper D's
+``sim_seed``, paper E's ``seed_of``, the workbench bootstrap's stream, the torch seed of the MLP) still give
+the stream they gave before: each is compared here with a SeedSequence built the old way."""
 
 import numpy as np
 import pytest
@@ -47,47 +48,45 @@ def test_child_and_sequence_are_the_old_constructions():
 PROCEDURE = ins.Procedure(identify_h=1.0, navigate_h=2.0)
 
 
-def _recorded_simulate(monkeypatch):
-    seeds, real = [], ins.simulate
-
-    def simulate(*args, seed=None, **kw):
-        seeds.append(seed)
-        return real(*args, seed=seed, **kw)
-
-    monkeypatch.setattr(ins, "simulate", simulate)
-    return seeds
+IMU = ins.ImuErrors(gyro_arw_deg_rt_h=0.001)
 
 
-@pytest.mark.parametrize("seed", [4, SS(9, spawn_key=(2, 3))])
-def test_ins_navigation_draws_the_old_part_one(monkeypatch, seed):
-    seeds = _recorded_simulate(monkeypatch)
-    ins.run_procedure(
-        None, procedure=PROCEDURE, seed=seed, imu=ins.ImuErrors(gyro_arw_deg_rt_h=0.001)
+def _track(r: ins.ProcedureResult) -> np.ndarray:
+    return np.concatenate(
+        [r.identify_run.north_m, r.after.north_m, r.after.east_m, r.before.north_m]
     )
-    identify, after, before, unit = seeds
-    assert identify is seed and unit is None
-    old = seed if isinstance(seed, SS) else SS(int(seed))
-    for nav in (after, before):
-        assert same_stream(nav, SS(old.entropy, spawn_key=tuple(old.spawn_key) + (1,)))
 
 
-def test_ins_simulated_tests_draw_the_old_spawn_keys(monkeypatch):
-    drawn, procedure_seeds = [], []
-    real_test = ins.random_test
+@pytest.mark.parametrize("seed", [4, 9])
+def test_ins_procedure_is_a_function_of_its_seed(seed):
+    """An int seed and its SeedSequence give the same run; another seed another run."""
+    run = lambda s: _track(ins.run_procedure(None, procedure=PROCEDURE, seed=s, imu=IMU))  # noqa: E731
+    assert np.array_equal(run(seed), run(SS(seed)))
+    assert not np.array_equal(run(seed), run(seed + 1))
 
-    def random_test(rng, **kw):
-        drawn.append(rng.bit_generator.state)
-        return real_test(rng, **kw)
 
-    def run_procedure(identify, *, seed, **kw):
-        procedure_seeds.append(seed)
+def test_ins_navigations_with_and_without_compensation_share_their_noise():
+    """The two navigations after identification draw one stream: they differ by the identified drift's
+    deterministic response alone (the errors are affine in the axial drift)."""
+    r = ins.run_procedure(None, procedure=PROCEDURE, seed=4, imu=IMU)
+    np.testing.assert_allclose(
+        r.after.north_m,
+        r.before.north_m - r.identified_drift_deg_h * r.unit_response.north_m,
+        rtol=1e-9,
+        atol=1e-6,
+    )
+    assert r.identified_drift_deg_h != 0
 
-    monkeypatch.setattr(ins, "random_test", random_test)
-    monkeypatch.setattr(ins, "run_procedure", run_procedure)
-    ins.simulated_tests([0.01, 0.02, 0.03], seed=6)
-    for i in range(3):
-        assert drawn[i] == np.random.default_rng(SS(6, spawn_key=(i, 0))).bit_generator.state
-        assert same_stream(procedure_seeds[i], SS(6, spawn_key=(i, 1)))
+
+def test_ins_simulated_tests_each_draw_a_stream_of_their_own():
+    """Test i draws from child i of the seed: dropping or changing another test leaves it as it was."""
+    three = ins.simulated_tests([0.01, 0.02, 0.03], seed=6, procedure=PROCEDURE)
+    two = ins.simulated_tests([0.01, 0.02], seed=6, procedure=PROCEDURE)
+    other = ins.simulated_tests([0.05, 0.02], seed=6, procedure=PROCEDURE)
+    for a, b in zip(two, three):
+        assert np.array_equal(_track(a), _track(b))
+    assert np.array_equal(_track(other[1]), _track(two[1]))
+    assert not np.array_equal(_track(other[0]), _track(two[0]))
 
 
 @pytest.mark.parametrize("seed", [3, SS(1000, spawn_key=(2, 1))])
