@@ -748,6 +748,7 @@ def tally(records: Iterable[Mapping]) -> dict[str, int]:
 
 
 __all__ = [
+    "Claim",
     "Entry",
     "REGISTERS",
     "SOURCE_NAMES",
@@ -758,6 +759,7 @@ __all__ = [
     "headlines",
     "inconsistencies",
     "load_register",
+    "method_stats",
     "parse_register",
     "registers",
     "tally",

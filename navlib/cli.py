@@ -42,6 +42,7 @@ Commands:
       is checked key by key first (A 3x3, b_ut 3 finite numbers, A's condition number at most 10, ...), and
       the corrected field's median strength against expected_field_strength_ut: beyond 25 % refused (nothing
       written), beyond 10 % a warning line (navlib.workbench.calibration: COND_LIMIT, FIELD_*_REL).
+
 rates and compare run on dask.distributed (navlib.engine): --workers N local worker processes (default: the
 cores of this machine; 1 runs in this process), or --scheduler tcp://HOST:PORT (or the environment
 variable NAVLIB_SCHEDULER) for a cluster started with `dask scheduler` and `dask worker`.  An address that
