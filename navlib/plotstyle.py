@@ -11,7 +11,7 @@ and figures drawn with::
 
     fig, axes = plotstyle.panels(3)            # one row if three panels fit the column,
                                                # else stacked
-    plotstyle.legend_below(axes[0])            # the legend under the axes, never over the data
+    plotstyle.legend_below(axes[0])   # the legend under the axes, never over the data
 
 **Sizes.**  The book's content column is :data:`COLUMN_PX` = 756 px wide at 1400 px; a figure is shown at
 its natural size when it is at most that wide, so figures are at most :data:`MAX_WIDTH_IN` = 7.5 in at

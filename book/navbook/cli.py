@@ -3,7 +3,8 @@
 Commands::
 
   execute NOTEBOOK... (--out DIR | --in-place)
-      execute chapters with papermill (``--in-place``: the stored notebooks, results to notebooks/results)
+      execute chapters with papermill (``--in-place``: the stored notebooks,
+      results to notebooks/results)
   compile
       compile the numba kernels once (cached on disk)
   status RESULTS_DIR --notebooks DIR --out FILE [--toc FILE]
@@ -16,14 +17,18 @@ Commands::
       fresh results files against the committed references
   screenshots HTML_DIR OUT_DIR [--width PX] [--chromium PATH]
       every page rendered with headless Chromium
-  grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR [--workers N] [--scheduler ADDR]
-      one run of a chapter notebook per point of the parameter grid (papermill), each with its own results
-      file; DIR (new or empty) gets the executed notebooks, results/ and grid.csv (parameters, method
-      statistics, claim verdicts).  DIR is claimed before the first run (a marker file grid.incomplete,
-      created atomically, removed after grid.csv): a second grid on DIR stops with one line, and a grid stopped
-      by an error or Ctrl-C leaves the marker saying DIR is incomplete.  Needs papermill.
-      (--workers N local worker processes, default the cores of this machine, 1 in this process; or
-      --scheduler tcp://HOST:PORT or $NAVLIB_SCHEDULER for a dask cluster).
+  grid NOTEBOOK --param NAME=V1,V2 [--param ...] --out DIR
+       [--workers N] [--scheduler ADDR]
+      one run of a chapter notebook per point of the parameter grid
+      (papermill), each with its own results file; DIR (new or empty) gets
+      the executed notebooks, results/ and grid.csv (parameters, method
+      statistics, claim verdicts).  DIR is claimed before the first run (a
+      marker file grid.incomplete, created atomically, removed after
+      grid.csv): a second grid on DIR stops with one line, and a grid stopped
+      by an error or Ctrl-C leaves the marker saying DIR is incomplete.
+      --workers N: local worker processes (default the cores of this machine;
+      1 in this process); --scheduler tcp://HOST:PORT or $NAVLIB_SCHEDULER:
+      a dask cluster.
 
 Bad input is one line ``navbook COMMAND: error: ...`` and status 2, Ctrl-C one line and status 130 (the
 conventions of ``navlib``'s command line, :func:`navlib.cli.run_command`); ``--debug`` shows tracebacks.
