@@ -13,7 +13,7 @@ from navlib.sensors import accelerometer as acc
 from navlib.sensors import ins
 from navlib.studies import accelerometer as accel_study
 from navlib.studies import celestial
-from navlib.workbench import diagnose as dg
+from navlib.workbench import bootstrap
 
 SS = np.random.SeedSequence
 
@@ -126,7 +126,8 @@ def test_paper_d_and_e_seeds_are_the_old_ones():
 def test_the_workbench_bootstrap_stream_is_the_old_one():
     for seed in (0, 5):
         assert same_stream(
-            seeding.child(seed, dg._BOOTSTRAP_KEY), SS(seed, spawn_key=(dg._BOOTSTRAP_KEY,))
+            seeding.child(seed, bootstrap.BOOTSTRAP_KEY),
+            SS(seed, spawn_key=(bootstrap.BOOTSTRAP_KEY,)),
         )
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg.lapack import dpotrf, dtrtri
 
 
 def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
@@ -25,3 +26,33 @@ def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
             Q[:, r] = v / left
             r += 1
     return np.ascontiguousarray(Q[:, :r])
+
+
+def lower_solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``L^-1 b`` for stacked lower-triangular ``L`` (B, k, k) and ``b`` (B, k) or (B, k, r)."""
+    if not L.shape[1]:
+        return np.zeros(b.shape)
+    return np.linalg.solve(L, b[..., None])[..., 0] if b.ndim == 2 else np.linalg.solve(L, b)
+
+
+def cholesky_solve(G: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For stacked ``G`` (B, k, k) positive definite and ``b`` (B, k): the Cholesky factors ``L`` and
+    ``z = L^-1 b`` (``|z|^2 = b' G^-1 b``); ``LinAlgError`` if a ``G`` is not numerically positive definite."""
+    L = np.linalg.cholesky(G) if G.shape[1] else G
+    return L, lower_solve(L, b)
+
+
+def inverse_factor(G: np.ndarray) -> np.ndarray:
+    """``T`` with ``T G T' = I`` on the range of ``G`` (``|T h|^2 = h' G^+ h``): the inverse of the Cholesky
+    factor, or for a numerically singular ``G`` the eigenvectors over the roots of the eigenvalues above
+    ``1e-12`` of the largest."""
+    if not G.shape[0]:
+        return np.zeros((0, 0))
+    L, info = dpotrf(G, lower=1, clean=1)
+    if info == 0:
+        Ti, info = dtrtri(L, lower=1)
+        if info == 0:
+            return Ti
+    w, V = np.linalg.eigh(G)
+    keep = w > 1e-12 * max(w[-1], 1e-300)
+    return (V[:, keep] / np.sqrt(w[keep])).T

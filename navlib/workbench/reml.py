@@ -78,7 +78,7 @@ class _Prepared:
     ``C_gij = sum_(t in g) z_(t-i) z_(t-j)'`` (``i, j <= min(g, P)``).  Here those of ``Q``, as the sums
     ``Gq_s = C_gij + C_gji`` (``C_gii`` when ``i = j``) over the unordered pairs ``s = (g, i <= j)``; ``Q``
     need not be orthonormal for them (the bootstrap's tests use them for any columns:
-    :class:`navlib.workbench.diagnose._Family`)."""
+    :class:`navlib.workbench.bootstrap.Family`)."""
 
     def __init__(self, Q: np.ndarray, series, max_order: int):
         Zq = np.asarray(Q, float)[series.order]

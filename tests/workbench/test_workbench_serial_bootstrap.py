@@ -5,7 +5,9 @@ by the diagnoses of one loop without changing a number."""
 import numpy as np
 import pytest
 
+from navlib.workbench import bootstrap
 from navlib.workbench import diagnose as dg
+from navlib.workbench import ftests
 from navlib.workbench import serial
 from navlib.workbench.fit import fit_model
 from navlib.workbench.magnetometer import simulate_hand_turned
@@ -36,7 +38,7 @@ def test_the_bootstrap_tests_from_inner_products_are_the_diagnosis_tests(family_
     diagnosis's own tests under the same noise model: each candidate's GLS F test (``_gls_of``) and each
     structure shape's (``_shape_tests``), on whitened columns."""
     fit, fits, ser = family_case
-    fam = dg._Family(fit, fits, ser, 3)
+    fam = bootstrap.Family(fit, fits, ser, 3)
     assert fam.gram
     nm = serial.NoiseModel(kappa, ser, fit.n)
     E = serial.colour(
@@ -54,13 +56,13 @@ def test_the_bootstrap_tests_from_inner_products_are_the_diagnosis_tests(family_
     E = E[rows]
     shapes = [np.asarray(X0, float)[rows] for _, X0, _ in fit.spec.structure(fit)]
     for b in range(E.shape[1]):
-        e0, Q0 = dg._gls_of(E[:, b], J0, nm)
-        ps = [p for _, p, _ in dg._shape_tests(e0, Q0, shapes, nm, fit.n)]
+        e0, Q0 = ftests.gls_of(E[:, b], J0, nm)
+        ps = [p for _, p, _ in ftests.shape_tests(e0, Q0, shapes, nm, fit.n)]
         for f1 in fits.values():
-            e1, Q1 = dg._gls_of(E[:, b], f1.jacobian[rows], nm)
+            e1, Q1 = ftests.gls_of(E[:, b], f1.jacobian[rows], nm)
             e1 = e1 - Q1 @ (Q1.T @ e1)  # (the GLS residual already is)
             ps.append(
-                dg._f_test(
+                ftests.f_test(
                     float(e0 @ e0), float(e1 @ e1), f1.n_params - fit.n_params, f1.n - f1.n_params
                 )[0]
             )
@@ -78,11 +80,11 @@ def test_the_diagnoses_of_a_loop_share_the_bootstrap_and_its_numbers():
     fit = sc.refit(fit)
     assert sc.noise.correlated
     first = dg.diagnose(fit, screen=sc)
-    assert len(dg._REESTIMATES) == 1
-    memo = next(iter(dg._REESTIMATES.values()))
+    assert len(bootstrap.REESTIMATES) == 1
+    memo = next(iter(bootstrap.REESTIMATES.values()))
     second = dg.diagnose(fit.add("hard_iron"), screen=sc)
-    assert next(iter(dg._REESTIMATES.values())) is memo
-    dg._REESTIMATES.clear()
+    assert next(iter(bootstrap.REESTIMATES.values())) is memo
+    bootstrap.REESTIMATES.clear()
     again = dg.diagnose(fit.add("hard_iron"), screen=sc)
     assert first.calibration.method == "parametric bootstrap"
     assert second.calibration == again.calibration
@@ -92,7 +94,7 @@ def test_all_replicates_at_once_equal_one_noise_model_at_a_time(family_case):
     """``_min_p_many`` (each column whitened with its own coefficients, the Gram blocks factored together)
     against ``_min_p`` column by column; ``whiten_each`` against ``whiten`` and ``whiten_transpose``."""
     fit, fits, ser = family_case
-    fam = dg._Family(fit, fits, ser, 3)
+    fam = bootstrap.Family(fit, fits, ser, 3)
     kappas = [(0.5, 0.3, 0.2), (0.9, -0.4, 0.1), (0.1, 0.0, -0.3), (0.5, 0.3, 0.2)]
     models = [serial.NoiseModel(k, ser, fit.n) for k in kappas]
     E = serial.colour(
