@@ -157,17 +157,18 @@ class Family:
     the model's Jacobian and of each candidate's -- the tests see only their column spaces -- and the
     structure shapes) and ``e`` a residual vector, ``H = F' R^-1 F``, ``h = F' R^-1 e`` and ``e' R^-1 e``.
     For AR noise on segments ``H`` is a weighted sum of ``F``'s lagged cross-products, computed once
-    (:class:`navlib.workbench.reml._Prepared`), and ``h = F' W' (W e)``
+    (``navlib.workbench.reml._Prepared``), and ``h = F' W' (W e)``
     (:func:`navlib.workbench.serial.whiten_transpose`), so no replicate whitens ``F``.  Then, with ``T0``
     the inverse Cholesky factor of the Jacobian's block ``H_00`` and ``z0 = T0 h_0``::
 
-        RSS_0 = e' R^-1 e - |z0|^2,   RSS_1 = e' R^-1 e - |T1 h_1|^2           (candidates)
-        X' (I - P_0) X = D^-1 H_ss D^-1 - B' B,   B = T0 H_0s D^-1              (shapes: D their norms)
+        RSS_0 = e' R^-1 e - |z0|^2,   RSS_1 = e' R^-1 e - |T1 h_1|^2      (candidates)
+        X' (I - P_0) X = D^-1 H_ss D^-1 - B' B,   B = T0 H_0s D^-1    (shapes, D: norms)
 
     the shape's unspanned directions the eigenvectors of the latter above ``SPANNED^2`` (as in
-    :func:`navlib.workbench.ftests.shape_bases`) and its drop ``|u' e_0|^2`` from ``X' (I - P_0) e = D^-1 h_s - B' z0``.  A series
+    :func:`navlib.workbench.ftests.shape_bases`) and its drop ``|u' e_0|^2`` from
+    ``X' (I - P_0) e = D^-1 h_s - B' z0``.  A series
     with a :class:`navlib.workbench.serial.Projection` is whitened by its filter: there each noise model
-    whitens the columns (all in one call) and the tests run on them (:meth:`_min_p_whitened`)."""
+    whitens the columns (all in one call) and the tests run on them (``_min_p_whitened``)."""
 
     def __init__(self, fit: Fit, fits: dict, series, order: int):
         self.n = fit.n
