@@ -526,6 +526,19 @@ def across_text(record: Mapping) -> str:
     return "; ".join(parts)
 
 
+def verdict_counts_text(record: Mapping) -> str:
+    """ "13 rows: 5 reproduced, 7 cannot be judged, 1 no difference" from a record's ``across`` summary:
+    how the verdict is spread over the entry's rows (the primary and its sensitivity), in the order of
+    :data:`navlib.verdicts.VERDICTS`; empty for an entry without rows."""
+    a = record.get("across") or {}
+    n = int(a.get("rows") or 0)
+    if n == 0:
+        return ""
+    counts = a.get("verdicts") or {}
+    parts = [f"{counts[k]} {k}" for k in verdicts.VERDICTS if counts.get(k)]
+    return f"{n} row{'s' if n != 1 else ''}: " + ", ".join(parts)
+
+
 def _with_margin(r: dict, e: Entry) -> dict:
     """A row record judged again with the entry's equivalence margin (:func:`navlib.verdicts.decide`):
     only a row whose interval lies within the margin changes, to *no difference*."""
@@ -763,4 +776,5 @@ __all__ = [
     "parse_register",
     "registers",
     "tally",
+    "verdict_counts_text",
 ]

@@ -71,6 +71,35 @@ def test_register_prose_types_in_none_of_our_results(name):
     assert not found, found
 
 
+#: A verdict in words ("reproduced", "cannot be judged", "no difference", "flips"): the evaluator derives
+#: every verdict, and the chapter shows how it moves across the rows (``across``) from the results.
+OUR_VERDICT = re.compile(
+    r"\breproduc|\bcannot be judged\b|\bno difference\b|\bflips?\b|\bverdicts?\b", re.IGNORECASE
+)
+
+
+@pytest.mark.parametrize("name", sorted({n for ns in claims.REGISTERS.values() for n in ns}))
+def test_register_prose_states_no_verdict(name):
+    """The register names the dimensions a verdict is shown across and why a reading is primary; a verdict
+    typed there goes stale when a row moves (A06's said "cannot be judged at the default noise" where the
+    rows said "not reproduced")."""
+    text = (ROOT / "data" / f"claims_{name}.csv").read_text(encoding="utf-8")
+    found = [
+        (r["id"], col, m.group(0))
+        for r in csv.DictReader(io.StringIO(text))
+        for col in ("why_primary", "sensitivity", "needs", "margin_why")
+        for m in OUR_VERDICT.finditer(r.get(col) or "")
+    ]
+    assert not found, found
+
+
+def test_the_verdict_pattern_finds_a_typed_in_verdict():
+    assert OUR_VERDICT.search("Reproduced in all five readings")
+    assert OUR_VERDICT.search("on C1-C5 some rows flip to cannot be judged")
+    assert OUR_VERDICT.search("so either verdict checks our simulator")
+    assert not OUR_VERDICT.search("the reading x the LS model; the drawn compasses C1-C5")
+
+
 def test_the_interval_pattern_finds_a_typed_in_result():
     assert OUR_INTERVAL.search("the ratio 26.2 [19.0, 32.7] x straddles 31.6x")
     assert OUR_INTERVAL.search("a median 7.8 [3.1, 14.0]x")
@@ -308,3 +337,24 @@ def test_every_register_entry_is_in_the_results_file_and_the_chapters_opening(ch
             f"{chapter}: register entry {e.id} ({e.claim}) is not in the chapter's opening"
         )
     assert len(ids) == len(set(ids))
+
+
+def test_verdict_counts_text_spreads_the_rows_verdicts():
+    rec = {
+        "across": {
+            "rows": 4,
+            "same": 2,
+            "verdicts": {
+                "reproduced": 2,
+                "not reproduced": 0,
+                "cannot be judged": 1,
+                "no difference": 1,
+            },
+        }
+    }
+    assert claims.verdict_counts_text(rec) == (
+        "4 rows: 2 reproduced, 1 cannot be judged, 1 no difference"
+    )
+    one = {"across": {"rows": 1, "same": 1, "verdicts": {"not reproduced": 1}}}
+    assert claims.verdict_counts_text(one) == "1 row: 1 not reproduced"
+    assert claims.verdict_counts_text({"across": {"rows": 0, "same": 0, "verdicts": {}}}) == ""

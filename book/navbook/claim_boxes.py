@@ -235,7 +235,11 @@ def _claim_fold(r: Mapping[str, Any]) -> str:
             f"{html.escape(r['why_primary'])}</p>"
         )
     if r.get("dimensions"):
-        head += f"<p>Shown across: {html.escape(r['dimensions'])}.</p>"
+        head += f"<p>Shown across: {html.escape(r['dimensions'].rstrip('.'))}.</p>"
+    counts = registry.verdict_counts_text(r) if r.get("row_claim") else ""
+    if counts:
+        head += f"<p>Verdicts over its {html.escape(counts)}"
+        head += f" ({html.escape(registry.across_text(r))}).</p>"
     if r.get("status") != "judged" or not r.get("row_claim"):
         return head + f"<p>{html.escape(r.get('why') or '')}</p>"
     rows = [{**r, "claim": r["row_claim"]}] + list(r["sensitivity"])
