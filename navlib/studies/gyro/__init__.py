@@ -27,6 +27,8 @@ Which module holds what, in the order they import each other (each imports only 
 - :mod:`~navlib.studies.gyro.cold_state` -- the cold start: Table 4 by leave-one-out, Table 5 and Fig 4 in
   simulation;
 - :mod:`~navlib.studies.gyro.thermal_worlds` -- the cold-state protocol in simulated thermal worlds;
+- :mod:`~navlib.studies.gyro.bp_compare` -- the hot net against MATLAB's BP network by leave-one-out over
+  Table 2 (``bp_leave_one_out``) and its claims (``bp_claims``, register entry C12);
 - :mod:`~navlib.studies.gyro.claims` -- the claims and their verdicts, the verdict table, the methods' headline
   statistics.
 
@@ -89,6 +91,7 @@ from .parameters import (
     ColdDtColumn,
     ColdNetSettings,
     ColdStudySettings,
+    BpSettings,
     GoalKind,
     HotNetSettings,
     InputUnit,
@@ -173,6 +176,7 @@ from .thermal_worlds import (
     cold_thermal_summary,
     thermal_worlds_table,
 )
+from .bp_compare import BP_READINGS, BpLoo, bp_claims, bp_leave_one_out
 from .claims import (
     claims,
     cold_world_claims,

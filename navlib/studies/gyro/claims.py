@@ -4,7 +4,8 @@
 - :func:`claims`: every claim, one :class:`navlib.claims.Claim` per reading, judged by the book's one rule
   (:mod:`navlib.verdicts`); it gathers :func:`reading_claims` (the hot-state readings and the stored claims),
   :func:`cold_world_claims` (per simulated thermal world) and :func:`register_claims` (the register's claims
-  that rest on the printed tables alone);
+  that rest on the printed tables alone) and :func:`~navlib.studies.gyro.bp_compare.bp_claims` (C12, the RBF
+  against a BP network);
 - :func:`methods_summary`: the identification methods' headline statistics for the chapter's results file.
 """
 
@@ -18,6 +19,7 @@ from navlib.claims import Claim, method_stats
 from navlib.data.gyro_tables import load_cold_test, load_hot_test, load_hot_train
 from navlib.methods.rbf import leave_one_out
 
+from .bp_compare import bp_claims
 from .cold_state import COLD_METHODS, cold_leave_one_out, table4_hot_net, table5_simulation
 from .hot_state import (
     HOT_LOO_METHODS,
@@ -371,6 +373,7 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     out.extend(reading_claims(params))
     out.extend(cold_world_claims(params))
     out.extend(register_claims(params))
+    out.extend(bp_claims(params))
     return out
 
 

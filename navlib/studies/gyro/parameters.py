@@ -304,14 +304,47 @@ class ColdStudySettings:
 
 
 @dataclass(frozen=True)
+class BpSettings:
+    """The BP network set against the hot net (register entry C12, "RBF is better than a BP network"):
+    MATLAB's ``feedforwardnet(n_hidden)`` trained by ``train`` (tansig hidden layer, ``mapminmax``,
+    Nguyen-Widrow initialisation, ``trainlm`` with its defaults; :func:`navlib.methods.bpnet.train_matlab_bp_many`).
+
+    ``n_hidden``: the primary size, 10, ``feedforwardnet``'s default ``hiddenSizes`` (paper C names no BP
+    network, so a MATLAB user who names no size gets this); ``sizes``: the sizes of the sensitivity rows;
+    ``n_inits``: initialisations per leave-one-out fold; ``n_inits_converged``: initialisations per fold of
+    the reading trained to convergence (``min_grad`` 0: up to 1,000 epochs each, hence fewer)."""
+
+    n_hidden: int = 10
+    sizes: tuple = tuple(range(2, 11))
+    n_inits: int = 20
+    n_inits_converged: int = 5
+
+    def __post_init__(self):
+        check_param("bp_hidden", self.n_hidden, lo=1, hi=50, integer=True)
+        if not self.sizes or not all(
+            isinstance(m, int) and 1 <= m <= 50 and not isinstance(m, bool) for m in self.sizes
+        ):
+            raise InputError(
+                f"parameter bp_sizes={self.sizes!r}: whole numbers of hidden neurons 1-50"
+            )
+        if len(set(self.sizes)) != len(self.sizes):
+            raise InputError(f"parameter bp_sizes={self.sizes!r}: each size once")
+        # the interquartile range over initialisations needs a few of them
+        check_param("n_bp_inits", self.n_inits, lo=4, hi=1000, integer=True)
+        check_param("n_bp_inits_converged", self.n_inits_converged, lo=4, hi=1000, integer=True)
+
+
+@dataclass(frozen=True)
 class StudyParams:
     """Everything the gyro chapter can vary; nested settings of the hot net, the cold net, the
-    simulations and the cold-start thermal worlds (:class:`ColdStudySettings`).  The site is paper C's (``navlib.sensors.ins.LOCAL_LATITUDE_DEG``)."""
+    simulations, the cold-start thermal worlds (:class:`ColdStudySettings`) and the BP network of the
+    comparison C12 (:class:`BpSettings`, not in the notebook's parameters cell).  The site is paper C's (``navlib.sensors.ins.LOCAL_LATITUDE_DEG``)."""
 
     hot: HotNetSettings = field(default_factory=HotNetSettings)
     cold: ColdNetSettings = field(default_factory=ColdNetSettings)
     sim: SimulationSettings = field(default_factory=SimulationSettings)
     thermal: ColdStudySettings = field(default_factory=ColdStudySettings)
+    bp: BpSettings = field(default_factory=BpSettings)
 
     def __post_init__(self):
         for name, cls in (
@@ -319,6 +352,7 @@ class StudyParams:
             ("cold", ColdNetSettings),
             ("sim", SimulationSettings),
             ("thermal", ColdStudySettings),
+            ("bp", BpSettings),
         ):
             if not isinstance(getattr(self, name), cls):
                 raise InputError(f"parameter {name}: must be a {cls.__name__}")
@@ -406,9 +440,17 @@ _EXPERIMENTS = (
     "table5_drifts",
     "rounding",
     "bootstrap",
+    "bp_inits",
 )
 #: The bootstrap intervals over rows of the real tables, one seed each (:func:`bootstrap_seed`).
-BOOTSTRAPS = ("loo_arcmin", "loo_deg", "table4_range", "table4_cold_vs_hot", "nonlinear")
+BOOTSTRAPS = (
+    "loo_arcmin",
+    "loo_deg",
+    "table4_range",
+    "table4_cold_vs_hot",
+    "nonlinear",
+    "rbf_vs_bp",
+)
 
 
 def _experiment_children(seed: int, experiment: str, n: int) -> list[np.random.SeedSequence]:
@@ -424,9 +466,9 @@ def _experiment_children(seed: int, experiment: str, n: int) -> list[np.random.S
 def experiment_seeds(seed: int, experiment: str, n: int) -> list[int]:
     """``n`` integer seeds for one random experiment of the chapter.
 
-    ``numpy.random.SeedSequence(seed).spawn(8)[k].spawn(n)``, ``k`` the experiment's place in
+    ``numpy.random.SeedSequence(seed).spawn(9)[k].spawn(n)``, ``k`` the experiment's place in
     ``("fig1", "hot_reference", "cold_training", "fig3", "table5", "table5_drifts", "rounding",
-    "bootstrap")`` (a child's seed depends only on its place, so adding an experiment at the end changes no
+    "bootstrap", "bp_inits")`` (a child's seed depends only on its place, so adding an experiment at the end changes no
     other); each child gives one 32-bit integer (``generate_state(1)``), passed to
     :func:`navlib.sensors.ins.simulated_tests`.
 

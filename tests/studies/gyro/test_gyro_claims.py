@@ -20,8 +20,9 @@ CLAIMS = gyro.StudyParams(
     thermal=gyro.ColdStudySettings(n_draws=7, batch_size=7, worlds=gyro.THERMAL_WORLDS[:2]),
 )
 #: the first claims, those of the hot-state readings and stored claims, 3 per thermal world, and the
-#: register entries judged on the printed tables (C10 2, C11 2, C15 3, C13 3)
-N_CLAIMS = 16 + 14 + 3 * 2 + 10
+#: register entries judged on the printed tables (C10 2, C11 2, C15 3, C13 3), and C12's RBF against BP
+#: (9 sizes, the validation stop, convergence, the spread over initialisations)
+N_CLAIMS = 16 + 14 + 3 * 2 + 10 + 12
 SMALL = gyro.StudyParams(
     thermal=gyro.ColdStudySettings(n_draws=7, batch_size=3, worlds=gyro.THERMAL_WORLDS[:2])
 )

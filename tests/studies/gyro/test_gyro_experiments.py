@@ -23,7 +23,7 @@ CLAIMS = gyro.StudyParams(
 )
 #: the first claims, those of the hot-state readings and stored claims, 3 per thermal world, and the
 #: register entries judged on the printed tables (C10 2, C11 2, C15 3, C13 3)
-N_CLAIMS = 16 + 14 + 3 * 2 + 10
+N_CLAIMS = 16 + 14 + 3 * 2 + 10 + 12
 SMALL = gyro.StudyParams(
     thermal=gyro.ColdStudySettings(n_draws=7, batch_size=3, worlds=gyro.THERMAL_WORLDS[:2])
 )
