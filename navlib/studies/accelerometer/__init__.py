@@ -44,6 +44,10 @@ The modules, each importing only those listed before it:
 - :mod:`~navlib.studies.accelerometer.batch_spread` -- unit B over the batch spreads and the spread the
   paper's 9.3 ug needs;
 - :mod:`~navlib.studies.accelerometer.tables` -- Table 2 and the other tables the chapter shows;
+- :mod:`~navlib.studies.accelerometer.indices` -- "every index greatly reduced": Table 2's indices paired
+  over the seeds, the worst case of the conjunction;
+- :mod:`~navlib.studies.accelerometer.second_order` -- "K2 and Kip negligible": the second-order terms of
+  the tumbles' Fourier fits (true or false by construction of our simulator);
 - :mod:`~navlib.studies.accelerometer.claims` -- the claims and the verdict grid.
 
 Every name the chapter and the tests use is re-exported here: ``from navlib.studies import accelerometer as
@@ -93,6 +97,8 @@ from .tables import (
     tuner_table,
     unit_b_table,
 )
+from .indices import INDICES, SINGLE_MODELS, index_by_seed, index_cases, index_claims, index_table  # noqa: F401
+from .second_order import second_order, second_order_by_seed, second_order_claims  # noqa: F401
 from .claims import (
     claims,
     drift_claims,

@@ -193,7 +193,8 @@ def run_study(
 # ----------------------------------------------------------------------------------------- metrics
 def metrics(err_mg, target_mg) -> dict:
     """Paper D's five indices (its eq 16 is lost in the OCR; our reading): ME = max ``|e|``, AE = mean e
-    (signed), MAXE = max ``|e/Nc|``, MARE = mean ``|e/Nc|``, RMSE = sqrt(mean e^2); e = model - target, in mg."""
+    (signed), MAXE = max ``|e/Nc|``, MARE = mean ``|e/Nc|``, RMSE = sqrt(mean e^2); and the residual range
+    ``max e - min e`` (section 5.2: "the residual range ... is the smallest"); e = model - target, in mg."""
     e = np.asarray(err_mg, float)
     t = np.asarray(target_mg, float)
     rel = np.abs(e / t)
@@ -203,6 +204,7 @@ def metrics(err_mg, target_mg) -> dict:
         "MAXE": float(np.max(rel)),
         "MARE": float(np.mean(rel)),
         "RMSE_mg": float(np.sqrt(np.mean(e**2))),
+        "range_mg": float(np.max(e) - np.min(e)),
     }
 
 

@@ -27,6 +27,7 @@ def test_metrics():
     assert m["ME_mg"] == 2.0 and m["AE_mg"] == 0.0
     assert m["MAXE"] == pytest.approx(0.2) and m["MARE"] == pytest.approx((0.1 + 0.1 + 0.2) / 3)
     assert m["RMSE_mg"] == pytest.approx(np.sqrt(2.0))
+    assert m["range_mg"] == 3.0  # largest minus smallest residual, signs kept: 1 - (-2)
 
 
 def test_split_is_by_whole_temperatures():
