@@ -59,6 +59,7 @@ from ...methods.compass_methods import (
     method_id,
     unit_cost,
 )
+
 # document B and the real compass: sub-namespaces
 from . import elm_iterations, elm_patent, real  # noqa: F401
 from .parameters import (

@@ -71,9 +71,9 @@ def iteration_study(
 ) -> pd.DataFrame:
     """Iterations to the training goal of the runs in :data:`RUNS`, one row per (run, seed):
     ``iterations`` (counted as the module docstring says; at the cap when not reached), ``cap``,
-    ``reached``, ``prune_tol`` (NaN for the I-ELM), ``train_rms_deg`` and ``test_rms_deg`` (sweep 2) at the stop, ``n_nodes``,
-    ``prune_stages`` (ELM solves followed by a prune; 0 for the I-ELM) and ``min_abs_beta`` (the
-    smallest output weight of the final net, normalised units).  Every seed is a task of
+    ``reached``, ``prune_tol`` (NaN for the I-ELM), ``train_rms_deg`` and ``test_rms_deg`` (sweep 2)
+    at the stop, ``n_nodes``, ``prune_stages`` (ELM solves followed by a prune; 0 for the I-ELM) and
+    ``min_abs_beta`` (the smallest output weight of the final net, normalised units).  Every seed is a task of
     :mod:`navlib.engine` (``workers``, ``scheduler``; the numbers do not depend on them)."""
     parts = engine.run(
         _iteration_seed,
