@@ -6,6 +6,7 @@
 - :mod:`navlib.methods.bpnet` -- the 1-M-1 BP network, MATLAB's default BP and their trainers (A);
 - :mod:`navlib.methods.lm` -- MATLAB's ``trainlm`` (batched) and ``dividerand`` with its validation stop;
 - :mod:`navlib.methods.elm` -- extreme learning machine and the patent's incremental back-tuned ELM (B);
+- :mod:`navlib.methods.ielm` -- Huang's point-incremental ELM (I-ELM), the baseline of the patent's iterations claim (B);
 - :mod:`navlib.methods.preprocess` -- the patent's median filter and field-gravity screen (B);
 - :mod:`navlib.methods.rbf` -- MATLAB-compatible ``newrb``/``newrbe`` RBF networks (C);
 - :mod:`navlib.methods.scaling` -- explicit min-max scaling (also MATLAB's ``mapminmax``);

@@ -88,6 +88,8 @@ class MethodParams:
     elm_max_nodes: int = 30  # incremental ELM: cap on the hidden-node count
     elm_goal_deg: float = 0.1  # incremental ELM: stop when the training RMS error (deg) is <= this
     elm_max_iter: int = 200  # incremental ELM: the patent's k (ELM and tuning stages together)
+    #: incremental ELM: prune nodes with max |beta_j| <= this after each ELM solve (the library default)
+    elm_prune_tol: float = IncrementalELMParams.prune_tol
     ls_tol_deg: float = (
         1e-6  # 8-position LS: the reading used for a position lies within this of it
     )
@@ -105,6 +107,7 @@ class MethodParams:
         check_param("elm_max_nodes", self.elm_max_nodes, lo=1, integer=True)
         check_param("elm_goal_deg", self.elm_goal_deg, lo=0)
         check_param("elm_max_iter", self.elm_max_iter, lo=1, integer=True)
+        check_param("elm_prune_tol", self.elm_prune_tol, lo=0)
         check_param("ls_tol_deg", self.ls_tol_deg, lo=0, hi=22.5)
 
     @property
@@ -123,6 +126,7 @@ class MethodParams:
             max_nodes=self.elm_max_nodes,
             loss_goal=(self.elm_goal_deg / float(target_span_deg)) ** 2,
             max_iter=self.elm_max_iter,
+            prune_tol=self.elm_prune_tol,
             weight_range=self.elm_range,
             bias_range=self.elm_range,
         )

@@ -4,7 +4,8 @@ real compass.
 
 Paper A's study and the pieces both studies share are read here as one namespace (``compass.seed_study``,
 ``compass.claims``, ``compass.Sweeps``, ...); document B and the real compass are sub-namespaces
-(``compass.elm_patent.claims``, ``compass.real.real_claims``).  Which module holds what:
+(``compass.elm_patent.claims``, ``compass.elm_iterations.iteration_study``,
+``compass.real.real_claims``).  Which module holds what:
 
 - :mod:`navlib.studies.compass.parameters` -- the methods' settings (``StudyParams``), the method lists and
   constants of the studies, the robustness study's draw rule, and ``params_from_notebook`` (the notebook's
@@ -18,6 +19,8 @@ Paper A's study and the pieces both studies share are read here as one namespace
 - :mod:`navlib.studies.compass.robustness` -- paper A's claims on drawn compasses;
 - :mod:`navlib.studies.compass.elm_patent` -- document B: node count, data preparation and glitches, small
   samples, and its claims;
+- :mod:`navlib.studies.compass.elm_iterations` -- document B's iterations: the back-tuned ELM against
+  Huang's point-incremental ELM, and with its pruning off;
 - :mod:`navlib.studies.compass.real` -- both documents' methods and claims on BROAD's real level sweeps.
 
 The methods themselves (ids, labels, readings, settings) are registered in
@@ -56,7 +59,9 @@ from ...methods.compass_methods import (
     method_id,
     unit_cost,
 )
-from . import elm_patent, real  # noqa: F401  (document B and the real compass: sub-namespaces)
+
+# document B and the real compass: sub-namespaces
+from . import elm_iterations, elm_patent, real  # noqa: F401
 from .parameters import (
     BASE_READINGS,
     BOX_BOUNDS,

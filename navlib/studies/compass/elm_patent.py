@@ -25,6 +25,7 @@ from ...methods.scaling import MinMax
 from ...methods.seeding import generators
 from ...sensors.compass import heading_from_field
 from ...sensors.planar import fit_planar_model
+from .elm_iterations import iteration_claims
 from .parameters import StudyParams
 from .sweeps import TRAINING_ONLY, Sweeps, ls_assumption, paired_seed_difference, per_seed, rms_deg
 
@@ -492,6 +493,7 @@ def claims(
     params: StudyParams,
     big_hidden: int,
     bp_rows=("bp_matlab", "ade_bp_hybrid_trainlm"),
+    iterations: pd.DataFrame | None = None,
 ) -> list[Claim]:
     """Document B's claims (reading ``'document B'``), each judged by the one rule of
     :mod:`navlib.verdicts` on a paired difference over the same seeds (boundary 0, holds above):
@@ -513,7 +515,10 @@ def claims(
     - small samples: on the smallest training set of ``small`` (:func:`small_sample_study`), the
       overfitting gap (test - training RMS) of the over-sized net minus the back-tuned ELM's, paired by
       seed, once per trainer of the net (MATLAB's ``trainlm`` from Nguyen-Widrow weights, Adam from small
-      weights), since the patent does not say which.
+      weights), since the patent does not say which;
+    - iterations (``iterations``, from :func:`navlib.studies.compass.elm_iterations.iteration_study`):
+      against Huang's point-incremental ELM and with pruning off
+      (:func:`navlib.studies.compass.elm_iterations.iteration_claims`).
 
     The intervals cover training randomness on fixed simulated sweeps, not sensor-noise draws."""
     r = "document B"
@@ -716,4 +721,6 @@ def claims(
                 key=key,
             )
         )
+    if iterations is not None:
+        out += iteration_claims(iterations, params)
     return out
