@@ -479,6 +479,21 @@ def entries(chapter: str) -> tuple[Entry, ...]:
     return tuple(e for name in registers(chapter) for e in load_register(name))
 
 
+def row_margin(claim_text: str) -> float | None:
+    """The equivalence margin of the register entry whose ``rows`` list ``claim_text`` (a results row's
+    ``claim``), over every register; None when no entry (or entries with different margins) lists it.
+    :func:`evaluate` judges a row with its entry's margin; prose glued from the row itself
+    (``navbook.glue.glue_claims``) uses this so the two cannot disagree."""
+    margins = {
+        e.margin
+        for names in REGISTERS.values()
+        for name in names
+        for e in load_register(name)
+        if claim_text in e.rows
+    }
+    return margins.pop() if len(margins) == 1 else None
+
+
 def _across(primary: Mapping, others: list[Mapping], worlds: list[Mapping] | None) -> dict:
     """How the primary verdict moves: across the other rows (readings, noise levels, splits) and across
     drawn worlds (records ``{"compass"|"world", "claim", "reading", "verdict"}`` of the primary row)."""
@@ -775,6 +790,7 @@ __all__ = [
     "method_stats",
     "parse_register",
     "registers",
+    "row_margin",
     "tally",
     "verdict_counts_text",
 ]

@@ -3,11 +3,13 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Iterable
 
 import pandas as pd
 
+from navlib import claims as registry
 from navlib.claims import Claim
 from navlib.formatting import fmt
 
@@ -64,6 +66,10 @@ def glue_claims(claims: Iterable[Claim]) -> None:
     for c in claims:
         if not c.key:
             continue
+        if c.margin is None and c.estimate is not None:
+            # the register entry's equivalence margin, as navlib.claims.evaluate judges the row
+            m = registry.row_margin(c.claim)
+            c = c if m is None else replace(c, margin=m)
         glue_text(c.key, c.verdict)
         detail = f"{c.verdict}: ours {c.interval_text}, boundary {c.boundary_text}"
         glue_text(f"{c.key}_detail", detail + (f" ({c.reason})" if c.reason else ""))

@@ -362,3 +362,29 @@ def test_showed_summarises_each_claim_over_its_readings():
     assert "The book's own claims" in s._repr_html_()
     with pytest.raises(InputError, match="claim record"):
         report.showed([{"claim": "x"}])
+
+
+def test_glue_claims_judges_a_row_with_its_register_entrys_margin(monkeypatch):
+    """A04's rows carry the register's 0.01 deg margin: an interval within it is glued as the results
+    file records it (no difference), not as the margin-free row would say (reproduced)."""
+    from navlib import claims as registry
+
+    row = "BP beats 8-position LS [planar 5 par.]"
+    assert registry.row_margin(row) == 0.01
+    assert registry.row_margin("a row no register lists") is None
+    glued = {}
+    monkeypatch.setattr(glue, "_glue", lambda name, obj: glued.__setitem__(name, obj))
+    e = verdicts.Estimate(0.004, 0.0009, 0.0082, "paired difference", 20)
+    c = report.Claim(
+        row,
+        "p",
+        statistic="rms LS - rms BP, deg",
+        estimate=e,
+        boundary=0.0,
+        holds_when="above",
+        unit="deg",
+        key="k",
+    )
+    assert c.verdict == "reproduced"
+    report.glue_claims([c])
+    assert glued["k"] == "no difference"
