@@ -3,7 +3,7 @@ and ELM under every reading of its training, document B's ELM patent, and both d
 real compass.
 
 Paper A's study and the pieces both studies share are read here as one namespace (``compass.seed_study``,
-``compass.claims``, ``compass.Sweeps``, ...); document B and the real compass are sub-namespaces
+``compass.claims``, ``compass.Sweeps``, ...); document B, the real compass and the hidden-node count are sub-namespaces
 (``compass.elm_patent.claims``, ``compass.elm_iterations.iteration_study``,
 ``compass.real.real_claims``).  Which module holds what:
 
@@ -17,6 +17,8 @@ Paper A's study and the pieces both studies share are read here as one namespace
 - :mod:`navlib.studies.compass.tables` -- the runs shaped for display and for the results file;
 - :mod:`navlib.studies.compass.turntable_claims` -- paper A's claims and the verdict tables;
 - :mod:`navlib.studies.compass.robustness` -- paper A's claims on drawn compasses;
+- :mod:`navlib.studies.compass.hidden_nodes` -- paper A's hidden-node count (MATLAB's BP against M) and its
+  claims;
 - :mod:`navlib.studies.compass.elm_patent` -- document B: node count, data preparation and glitches, small
   samples, and its claims;
 - :mod:`navlib.studies.compass.elm_iterations` -- document B's iterations: the back-tuned ELM against
@@ -60,8 +62,8 @@ from ...methods.compass_methods import (
     unit_cost,
 )
 
-# document B and the real compass: sub-namespaces
-from . import elm_iterations, elm_patent, real  # noqa: F401
+# document B, the real compass and the hidden-node count: sub-namespaces
+from . import elm_iterations, elm_patent, hidden_nodes, real  # noqa: F401
 from .parameters import (
     BASE_READINGS,
     BOX_BOUNDS,
