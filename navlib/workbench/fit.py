@@ -199,6 +199,20 @@ def fit_model(
     return fit
 
 
+@one_blas_thread
+def refit_rows(fit: Fit, data: pd.DataFrame) -> Fit:
+    """``fit``'s model on ``data`` (other rows of the same measurements, e.g. without outliers), started from
+    ``fit``'s parameters: by the system's ``refit`` hook where it has one and it converges (the same minimum
+    to the optimiser's tolerance, without the several starts of a full fit), else :func:`fit_model` from
+    ``fit``'s parameters and the linearised start."""
+    if fit.spec.refit is not None:
+        out = fit.spec.refit(fit, data)
+        if out is not None:
+            out.available = fit.available
+            return out
+    return fit_model(fit.spec, data, fit.effects, start=fit.params, user_effects=fit.user_effects)
+
+
 def compare(*fits: Fit) -> pd.DataFrame:
     """Before/after table: one row per fit with RMS, residual range and held-out RMS."""
     return pd.DataFrame([f.summary() for f in fits]).set_index("model")
@@ -241,14 +255,19 @@ def user_design(effects, data: pd.DataFrame, shape) -> np.ndarray:
 
 
 def best_least_squares(model_minus_obs, starts, lo, hi, jac="2-point", tr_solver=None):
-    """``scipy.optimize.least_squares`` (trust-region reflective) from each start; the lowest cost wins.
+    """``scipy.optimize.least_squares`` (trust-region reflective) from each distinct start; the lowest cost
+    wins (a start equal to an earlier one is not solved again: scipy's solver is deterministic).
     ``jac``: a function returning d(model)/d(x), or scipy's finite differences; ``tr_solver``: scipy's
     (default: ``"exact"`` up to 6 parameters, ``"lsmr"`` above)."""
     best = None
     finite = np.isfinite(lo) & np.isfinite(hi)
     margin = np.where(finite, 1e-9 * (np.abs(np.where(finite, hi - lo, 0.0)) + 1), 0.0)
+    done: list[np.ndarray] = []
     for x0 in starts:
         x0 = np.clip(np.asarray(x0, float), lo + margin, hi - margin)
+        if any(np.array_equal(x0, d) for d in done):  # the same start gives the same solution
+            continue
+        done.append(x0)
         sol = least_squares(
             model_minus_obs,
             x0,

@@ -65,7 +65,7 @@ from scipy import special
 
 from ..errors import InputError
 from .effects import testable
-from .fit import MEASURED, Fit, fit_model, measured_columns, residuals_on
+from .fit import MEASURED, Fit, fit_model, measured_columns, refit_rows, residuals_on
 from .linalg import orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
@@ -150,10 +150,11 @@ class Screening:
         return sorted({o.row for o in self.outliers})
 
     def refit(self, fit: Fit) -> Fit:
-        """``fit``'s model on the rows kept (``fit`` itself when no row was set aside)."""
+        """``fit``'s model on the rows kept (``fit`` itself when no row was set aside), from ``fit``'s
+        parameters (:func:`navlib.workbench.fit.refit_rows`)."""
         if len(self.kept) == self.n_rows:
             return fit
-        return fit_model(fit.spec, self.data, fit.effects, user_effects=fit.user_effects)
+        return refit_rows(fit, self.data)
 
     def outlier_line(self, unit: str) -> str:
         """One line for a report: the rows set aside (empty when none)."""
@@ -453,13 +454,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         if np.array_equal(nxt, aside) or nxt.all():
             break
         aside = nxt
-        rich = fit_model(
-            fit.spec,
-            data.iloc[np.flatnonzero(~aside)],
-            rich.effects,
-            start=rich.params,
-            user_effects=fit.user_effects,
-        )
+        rich = refit_rows(rich, data.iloc[np.flatnonzero(~aside)])
     else:
         r, z, flagged = judge(rich, aside)
     bad = np.flatnonzero(aside | flagged.any(axis=1))
