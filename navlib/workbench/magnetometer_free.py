@@ -649,7 +649,8 @@ def warm_refit(fit: Fit, data: pd.DataFrame) -> Fit | None:
     t_c = float(data["temperature_c"].mean()) if "temperature_c" in data else 0.0
     kern = kernel_of(data, names, t_c)
     x0 = np.array([fit.params[q] for q in names], float)
-    if "temperature" in fit.effects and "hard_iron" in fit.effects:  # the same offsets about the new temperature centre
+    # the same offsets about the new temperature centre
+    if "temperature" in fit.effects and "hard_iron" in fit.effects:
         old = fit.model.get("temperature_centre_c", t_c)
         for j, h in enumerate(("hard_x_ut", "hard_y_ut", "hard_z_ut")):
             x0[names.index(h)] += fit.params[f"temp_{'xyz'[j]}_ut_c"] * (t_c - old)

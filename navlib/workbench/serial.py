@@ -607,14 +607,46 @@ def estimate(
     or more, optimise that order only, from these partial autocorrelations; ``cross``: the residual's
     cross-products with ``prepared`` (``_Prepared.cross``), computed for many residual vectors at once
     (:func:`select_many`)."""
+    return _estimate(
+        residuals,
+        regressors,
+        series,
+        max_order,
+        order=order,
+        interval=interval,
+        basis=basis,
+        prepared=prepared,
+        start_at=start_at,
+        cross=cross,
+    )[0]
+
+
+def _estimate(
+    residuals: np.ndarray,
+    regressors: np.ndarray,
+    series: Series | None,
+    max_order: int = MAX_ORDER,
+    *,
+    order: int | None = None,
+    interval: bool = True,
+    basis: np.ndarray | None = None,
+    prepared: _Prepared | None = None,
+    start_at: tuple | None = None,
+    cross: tuple | None = None,
+) -> tuple:
+    """:func:`estimate`, and the likelihood it maximised, the lowest ``atanh kappa_1`` it allowed and the
+    maximum (for :func:`_interval` later; None, 0 and NaN when nothing was estimated)."""
     r = np.asarray(residuals, float)
     if series is None:
-        return NoiseModel((), None, len(r))
+        return NoiseModel((), None, len(r)), None, 0.0, float("nan")
     inc = series.order
     Q = basis_on(regressors, series, len(r)) if basis is None else basis
     if len(inc) - Q.shape[1] < MIN_SAMPLES:
-        return NoiseModel(
-            (), series, len(r), note="too few samples to estimate a serial correlation"
+        return (
+            NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation"),
+            None,
+            0.0,
+            float("nan"),
         )
     if order is not None:
         max_order = int(order)
@@ -684,31 +716,41 @@ def estimate(
             break  # forward selection: stop at the first order that
         best, aic_best = (kappa, ll), aic  # does not lower the AIC
     kappa, ll = best
-    bounds = ()
-    if kappa and interval:
-        drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
-        lim = np.arctanh(KAPPA_MAX)
-        a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
-
-        def gap(a):
-            return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
-
-        ends = []
-        for edge in (min(low, a0), lim):
-            if a0 == edge or gap(edge) <= 0:
-                ends.append(float(np.tanh(edge)))
-            else:
-                ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
-        bounds = tuple(ends)
-    return NoiseModel(
-        tuple(kappa),
-        series,
-        len(r),
-        tuple(logliks),
-        bounds=bounds,
-        ml=loglik.ml(kappa),
-        regressors=Q.shape[1],
+    bounds = _interval(loglik, kappa, ll, low) if kappa and interval else ()
+    return (
+        NoiseModel(
+            tuple(kappa),
+            series,
+            len(r),
+            tuple(logliks),
+            bounds=bounds,
+            ml=loglik.ml(kappa),
+            regressors=Q.shape[1],
+        ),
+        loglik,
+        low,
+        ll,
     )
+
+
+def _interval(loglik, kappa: tuple, ll: float, low: float) -> tuple:
+    """The profile-likelihood interval of ``kappa_1`` (level :data:`KAPPA_LEVEL`) of the estimate ``kappa``
+    (log likelihood ``ll``) with the other partial autocorrelations held; ``low`` the lowest ``atanh
+    kappa_1`` allowed."""
+    drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
+    lim = np.arctanh(KAPPA_MAX)
+    a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
+
+    def gap(a):
+        return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
+
+    ends = []
+    for edge in (min(low, a0), lim):
+        if a0 == edge or gap(edge) <= 0:
+            ends.append(float(np.tanh(edge)))
+        else:
+            ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
+    return tuple(ends)
 
 
 def select(
@@ -736,39 +778,45 @@ def select(
     if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
     cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
-    mb = estimate(
+    mb, *lb = _estimate(
         residuals,
         base,
         series,
         order=order,
-        interval=interval,
+        interval=False,
         basis=qb,
         prepared=pb,
         start_at=start_at,
         cross=cross[0],
     )
+
+    def chosen(m, fitted, around):
+        # the interval of the set chosen only (the other's would be thrown away)
+        loglik, low, ll = fitted
+        if interval and m.kappa and loglik is not None:
+            m = replace(m, bounds=_interval(loglik, m.kappa, ll, low))
+        return replace(m, around=around)
+
     if extra is None or not np.size(extra) or series is None:
-        return replace(mb, around="model")
-    me = estimate(
+        return chosen(mb, lb, "model")
+    me, *le = _estimate(
         residuals,
         None if qe is not None else np.column_stack([base, extra]),
         series,
         order=order,
-        interval=interval,
+        interval=False,
         basis=qe,
         prepared=pe,
         start_at=start_at,
         cross=cross[1],
     )
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
-        return replace(me, around="model and structure shapes")
+        return chosen(me, le, "model and structure shapes")
     n = len(series.order)
     better = criterion(me.ml, me.regressors + me.order, n) < criterion(
         mb.ml, mb.regressors + mb.order, n
     )
-    return (
-        replace(me, around="model and structure shapes") if better else replace(mb, around="model")
-    )
+    return chosen(me, le, "model and structure shapes") if better else chosen(mb, lb, "model")
 
 
 def select_many(
