@@ -164,10 +164,11 @@ class System:
         acceleration; :mod:`navlib.workbench.free_breakdown`), and one sentence reading it.  None: no
         breakdown.
     refit : callable or None
-        ``refit(fit, data) -> Fit or None``: ``fit``'s model on ``data`` (rows of the same recording, e.g.
-        without the screen's outliers) started from ``fit``'s parameters, a cheap path to the minimum
-        ``fit(data, ...)`` finds (the reference-free magnetometer: Gauss-Newton steps with the analytic
-        Jacobian); None when it cannot (the caller then fits in full).  None: always fitted in full.
+        ``refit(fit, data, effects) -> Fit or None``: the model ``effects`` (``fit``'s, or ``fit``'s with more
+        effects) on ``data`` (rows of the same recording, e.g. without the screen's outliers) started from
+        ``fit``'s parameters, a cheap path to the minimum ``fit(data, effects, fit.params)`` finds (the
+        reference-free magnetometer: Gauss-Newton steps with the analytic Jacobian); None when it cannot
+        (the caller then fits in full).  None: always fitted in full.
     columns : tuple of Column
         The file schema ``load`` reads (:class:`navlib.data.tables.Column`: name, unit, required, limits,
         meaning); :func:`columns_table` derives the system's data dictionary from it.

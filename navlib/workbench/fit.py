@@ -200,17 +200,18 @@ def fit_model(
 
 
 @one_blas_thread
-def refit_rows(fit: Fit, data: pd.DataFrame) -> Fit:
-    """``fit``'s model on ``data`` (other rows of the same measurements, e.g. without outliers), started from
-    ``fit``'s parameters: by the system's ``refit`` hook where it has one and it converges (the same minimum
-    to the optimiser's tolerance, without the several starts of a full fit), else :func:`fit_model` from
-    ``fit``'s parameters and the linearised start."""
+def refit_rows(fit: Fit, data: pd.DataFrame, effects=None) -> Fit:
+    """``fit``'s model (or the model ``effects``) on ``data`` (rows of the same measurements, e.g. without
+    outliers), started from ``fit``'s parameters: by the system's ``refit`` hook where it has one and it
+    converges (the same minimum to the optimiser's tolerance, without the several starts of a full fit),
+    else :func:`fit_model` from ``fit``'s parameters and the linearised start."""
+    effects = tuple(fit.effects if effects is None else effects)
     if fit.spec.refit is not None:
-        out = fit.spec.refit(fit, data)
+        out = fit.spec.refit(fit, data, effects)
         if out is not None:
             out.available = fit.available
             return out
-    return fit_model(fit.spec, data, fit.effects, start=fit.params, user_effects=fit.user_effects)
+    return fit_model(fit.spec, data, effects, start=fit.params, user_effects=fit.user_effects)
 
 
 def compare(*fits: Fit) -> pd.DataFrame:

@@ -632,25 +632,32 @@ def gauss_newton(kern: FreeKernel, x0: np.ndarray, steps: int = WARM_STEPS):
     return None
 
 
-def warm_refit(fit: Fit, data: pd.DataFrame) -> Fit | None:
-    """The system's ``refit`` hook: ``fit``'s model on ``data`` (other rows of the same recording, e.g.
-    without the screen's outliers) by :func:`gauss_newton` from ``fit``'s parameters -- the minimum the full
-    fit (:func:`_fit_free` from several starts) finds when the rows change little, in a few p x p solves.
-    None for a model with user effects or when the steps do not converge (the caller then fits in full)."""
-    if any(e not in FREE_EFFECTS for e in fit.effects):
+def warm_refit(fit: Fit, data: pd.DataFrame, effects=None) -> Fit | None:
+    """The system's ``refit`` hook: ``fit``'s model (or the catalogue's ``effects``, parameters ``fit`` lacks
+    starting at zero) on ``data`` (rows of the same recording, e.g. without the screen's outliers) by
+    :func:`gauss_newton` from ``fit``'s parameters -- the minimum the full fit (:func:`_fit_free` from
+    several starts) finds when the data or the model change little, in a few p x p solves.  None for a
+    model with user effects or when the steps do not converge (the caller then fits in full)."""
+    effects = tuple(fit.effects if effects is None else effects)
+    if any(e not in FREE_EFFECTS for e in effects):
         return None
     if not all(c in data for c in DERIVED[: 1 + has_acc(data)]):
         data = with_invariants(data)
-    names = list(fit.params)
-    k = 2 if has_acc(data) else 1
+    acc = has_acc(data)
+    names = (
+        ["field_ut"]
+        + (["field_down_ut"] if acc else [])
+        + [p for e in effects for p in FREE_EFFECTS[e].params]
+    )
+    k = 2 if acc else 1
     if len(data) * k < len(names) + 1:
         raise InputError(f"{len(data)} rows cannot determine {len(names)} model parameters")
     check_orientations(data, "magnetometer data", max(MIN_ORIENTATIONS, len(names)))
     t_c = float(data["temperature_c"].mean()) if "temperature_c" in data else 0.0
     kern = kernel_of(data, names, t_c)
-    x0 = np.array([fit.params[q] for q in names], float)
+    x0 = np.array([fit.params.get(q, 0.0) for q in names], float)
     # the same offsets about the new temperature centre
-    if "temperature" in fit.effects and "hard_iron" in fit.effects:
+    if "temperature" in fit.effects and "hard_iron" in effects:
         old = fit.model.get("temperature_centre_c", t_c)
         for j, h in enumerate(("hard_x_ut", "hard_y_ut", "hard_z_ut")):
             x0[names.index(h)] += fit.params[f"temp_{'xyz'[j]}_ut_c"] * (t_c - old)
@@ -658,8 +665,8 @@ def warm_refit(fit: Fit, data: pd.DataFrame) -> Fit | None:
     if sol is None:
         return None
     x, J = sol
-    effects = tuple(FREE_EFFECTS[e] for e in fit.effects)
-    return _free_fit(data, effects, dict(zip(names, map(float, x))), J, t_c)
+    chosen = tuple(FREE_EFFECTS[e] for e in effects)
+    return _free_fit(data, chosen, dict(zip(names, map(float, x))), J, t_c)
 
 
 def _per_column(x: np.ndarray, k: int, cols=None) -> np.ndarray:

@@ -65,7 +65,7 @@ from scipy import special
 
 from ..errors import InputError
 from .effects import testable
-from .fit import MEASURED, Fit, fit_model, measured_columns, refit_rows, residuals_on
+from .fit import MEASURED, Fit, measured_columns, refit_rows, residuals_on
 from .linalg import orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
@@ -260,7 +260,7 @@ def _richest(fit: Fit) -> list[tuple[str, ...]]:
 def _fit_rich(fit: Fit, frame: pd.DataFrame, models) -> Fit | None:
     for m in models:
         try:
-            f = fit_model(fit.spec, frame, m, start=fit.params, user_effects=fit.user_effects)
+            f = refit_rows(fit, frame, m)
         except InputError:
             continue
         if f.n - f.n_params >= MIN_DOF:
