@@ -364,7 +364,8 @@ def _directions(frame: pd.DataFrame) -> np.ndarray:
 
 def orientation_cells(frame: pd.DataFrame) -> int:
     """Distinct 30-deg cells of the raw field's direction (each component of the unit vector x 2, rounded)."""
-    return len({tuple(v) for v in np.round(_directions(frame) * 2).astype(int)})
+    cell = np.round(_directions(frame) * 2).astype(np.int64) + 2  # each component in 0..4
+    return int(np.unique(cell @ np.array([25, 5, 1])).size)
 
 
 def orientation_spread(frame: pd.DataFrame) -> float:
@@ -555,12 +556,20 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         jac="2-point" if users else kern.jacobian,
         tr_solver=None if users else "exact",
     )
-    return _free_fit(data, effects, dict(zip(names, map(float, sol.x))), sol.jac, t_c)
+    return _free_fit(
+        data,
+        effects,
+        dict(zip(names, map(float, sol.x))),
+        sol.jac,
+        t_c,
+        None if users else kern.residuals(sol.x),
+    )
 
 
-def _free_fit(data: pd.DataFrame, effects, params: dict, jac, t_c: float) -> Fit:
+def _free_fit(data: pd.DataFrame, effects, params: dict, jac, t_c: float, misfit=None) -> Fit:
     """The :class:`~navlib.workbench.fit.Fit` of the parameters ``params`` found on ``data`` (``jac``: the
-    invariants' Jacobian d(model - measured)/dx there, ``t_c`` the temperature centre)."""
+    invariants' Jacobian d(model - measured)/dx there, ``t_c`` the temperature centre; ``misfit``: the
+    invariants' residuals there, (n, k), if already computed -- without user effects only)."""
     users = tuple(e for e in effects if e.contribution is not None)
     k = 2 if has_acc(data) else 1
 
@@ -571,13 +580,14 @@ def _free_fit(data: pd.DataFrame, effects, params: dict, jac, t_c: float) -> Fit
         return frame[list(DERIVED[:k])].to_numpy(float) - r
 
     obs = data[list(DERIVED[:k])].to_numpy(float)
+    model = predict(data) if misfit is None or users else obs - misfit  # predict's numbers
     # residual = measured - model = -(model - measured): the invariants' residual with the sign of a misfit
     return Fit(
         SYSTEM,
         tuple(e.name for e in effects),
         params,
         data,
-        (obs - predict(data)).ravel(),
+        (obs - model).ravel(),
         -np.asarray(jac),
         predict,
         {"temperature_centre_c": t_c},
@@ -666,7 +676,7 @@ def warm_refit(fit: Fit, data: pd.DataFrame, effects=None) -> Fit | None:
         return None
     x, J = sol
     chosen = tuple(FREE_EFFECTS[e] for e in effects)
-    return _free_fit(data, chosen, dict(zip(names, map(float, x))), J, t_c)
+    return _free_fit(data, chosen, dict(zip(names, map(float, x))), J, t_c, kern.residuals(x))
 
 
 def _per_column(x: np.ndarray, k: int, cols=None) -> np.ndarray:
