@@ -64,7 +64,7 @@ def residuals_on(fit: "Fit", frame: pd.DataFrame) -> np.ndarray:
     ``frame``, shape (rows, axes): also on rows the fit did not use."""
     cols, wrapped = MEASURED[fit.system]
     model = np.asarray(fit.predict(frame), float).reshape(len(frame), -1)
-    r = frame[list(cols[: model.shape[1]])].to_numpy(float) - model
+    r = np.column_stack([frame[c].to_numpy(float) for c in cols[: model.shape[1]]]) - model
     return wrap_deg(r) if wrapped else r
 
 

@@ -80,12 +80,17 @@ def propagation(kappa: float, clock: np.ndarray) -> np.ndarray:
     return phi
 
 
-def gains(kappa: float, clock: np.ndarray, d: np.ndarray) -> Gains:
+def nugget_of(d: np.ndarray) -> float:
+    """The measurement nugget of directions ``d`` (:data:`NUGGET` times the mean ``|d_i|^2``)."""
+    return NUGGET * float(np.mean(np.sum(d * d, axis=1))) if len(d) else 0.0
+
+
+def gains(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float | None = None) -> Gains:
     """The :class:`Gains` of AR(1) axis noise of lag-1 correlation ``kappa`` seen along directions ``d``
-    ((n, 3)) at times ``clock`` (in time order)."""
+    ((n, 3)) at times ``clock`` (in time order); ``nugget``: :func:`nugget_of` ``d``, if already known."""
     d = np.ascontiguousarray(d, float)
     phi = propagation(kappa, clock)
-    nugget = NUGGET * float(np.mean(np.sum(d * d, axis=1))) if len(d) else 0.0
+    nugget = nugget_of(d) if nugget is None else nugget
     gain, sd = _gains(phi, d, nugget)
     return Gains(phi, d, gain, sd)
 

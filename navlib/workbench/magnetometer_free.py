@@ -313,6 +313,12 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
     )
 
 
+def columns_of(frame: pd.DataFrame, cols) -> np.ndarray:
+    """``frame[list(cols)].to_numpy(float)``, column by column (the same numbers; on a frame of selected
+    rows pandas' multi-column take costs several times more, and the fits read these columns often)."""
+    return np.column_stack([frame[c].to_numpy(float) for c in cols])
+
+
 def has_acc(frame: pd.DataFrame) -> bool:
     return all(c in frame for c in ACC)
 
@@ -358,26 +364,35 @@ def with_invariants(frame: pd.DataFrame) -> pd.DataFrame:
 
 def _directions(frame: pd.DataFrame) -> np.ndarray:
     """The raw field's unit directions, one row per sample."""
-    m = frame[list(MAG)].to_numpy(float)
+    m = columns_of(frame, MAG)
     return m / np.maximum(np.linalg.norm(m, axis=1, keepdims=True), 1e-300)
+
+
+def _cells(u: np.ndarray) -> int:
+    cell = np.round(u * 2).astype(np.int64) + 2  # each component in 0..4
+    return int(np.unique(cell @ np.array([25, 5, 1])).size)
+
+
+def _spread(u: np.ndarray) -> float:
+    return float(np.linalg.eigvalsh(np.cov(u.T))[0])
 
 
 def orientation_cells(frame: pd.DataFrame) -> int:
     """Distinct 30-deg cells of the raw field's direction (each component of the unit vector x 2, rounded)."""
-    cell = np.round(_directions(frame) * 2).astype(np.int64) + 2  # each component in 0..4
-    return int(np.unique(cell @ np.array([25, 5, 1])).size)
+    return _cells(_directions(frame))
 
 
 def orientation_spread(frame: pd.DataFrame) -> float:
     """Smallest eigenvalue of the second moment of the field's unit directions (about their mean)."""
-    return float(np.linalg.eigvalsh(np.cov(_directions(frame).T))[0])
+    return _spread(_directions(frame))
 
 
 def check_orientations(frame: pd.DataFrame, name: str, needed: int = MIN_ORIENTATIONS) -> None:
     """Refuse data whose field directions cannot separate the model's parameters, naming each limit that
     failed with its value: at least ``needed`` distinct 30-deg cells of the field's direction, and a
     smallest spread (:func:`orientation_spread`) of at least :data:`MIN_SPREAD`."""
-    cells, spread = orientation_cells(frame), orientation_spread(frame)
+    u = _directions(frame)
+    cells, spread = _cells(u), _spread(u)
     failed = []
     if cells < needed:
         failed.append(
@@ -494,9 +509,9 @@ def invariant_residuals(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> 
 
 def kernel_of(frame: pd.DataFrame, names, t_c: float = 0.0) -> FreeKernel:
     """The frame's arrays in a :class:`navlib.workbench.free_kernel.FreeKernel` for the parameters ``names``."""
-    a = frame[list(ACC)].to_numpy(float) if has_acc(frame) else None
+    a = columns_of(frame, ACC) if has_acc(frame) else None
     dt = frame["temperature_c"].to_numpy(float) - t_c if "temperature_c" in frame else None
-    return FreeKernel(names, frame[list(MAG)].to_numpy(float), a, dt)
+    return FreeKernel(names, columns_of(frame, MAG), a, dt)
 
 
 def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
@@ -530,7 +545,7 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         return r - user_columns(users, dict(zip(names, x)), data, shape) if users else r
 
     # start 2 (linearised): a sphere fit |m|^2 = 2 m.b + c for the centre (if hard iron is in the model)
-    m = data[list(MAG)].to_numpy(float)
+    m = columns_of(data, MAG)
     x2 = dict.fromkeys(names, 0.0)
     if "hard_iron" in cat:
         X = np.column_stack([2 * m, np.ones(len(m))])
@@ -577,9 +592,9 @@ def _free_fit(data: pd.DataFrame, effects, params: dict, jac, t_c: float, misfit
         r = invariant_residuals(params, frame, t_c) - user_columns(
             users, params, frame, (len(frame), k)
         ).reshape(len(frame), k)
-        return frame[list(DERIVED[:k])].to_numpy(float) - r
+        return columns_of(frame, DERIVED[:k]) - r
 
-    obs = data[list(DERIVED[:k])].to_numpy(float)
+    obs = columns_of(data, DERIVED[:k])
     model = predict(data) if misfit is None or users else obs - misfit  # predict's numbers
     # residual = measured - model = -(model - measured): the invariants' residual with the sign of a misfit
     return Fit(
@@ -718,7 +733,7 @@ def free_structure(fit: Fit) -> list[tuple[str, np.ndarray, float]]:
             [(cell == i).astype(float) - np.mean(cell == i) for i in np.unique(cell)[1:]]
         )
         out.append(("field changing in time (per invariant)", _per_column(X, k), 2.0))
-    m = d[list(MAG)].to_numpy(float)
+    m = columns_of(d, MAG)
     u = m / np.linalg.norm(m, axis=1, keepdims=True)
     H = _cubic_harmonics(u)
     out.append(
@@ -744,7 +759,7 @@ def noise_directions(fit: Fit) -> np.ndarray:
     uh = u / np.linalg.norm(u, axis=1, keepdims=True)
     cols = [uh @ M]
     if has_acc(d):
-        a = d[list(ACC)].to_numpy(float)
+        a = columns_of(d, ACC)
         R = Rotation.from_rotvec(
             np.radians([p["mis_x_deg"], p["mis_y_deg"], p["mis_z_deg"]])
         ).as_matrix()

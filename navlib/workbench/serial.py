@@ -238,18 +238,20 @@ def _projected_gains(kappa, series: Series) -> innovations.Gains:
     inputs = _INPUTS.get(id(series))
     if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
         pr = series.projection
+        d = np.ascontiguousarray(pr.directions[series.order], float)
         inputs = (
             series,
             pr.clock[series.order],
-            np.ascontiguousarray(pr.directions[series.order], float),
+            d,
             regular_clock(series),
+            innovations.nugget_of(d),
         )
         _INPUTS.clear()
         _INPUTS[id(series)] = inputs
-    _, clock, d, regular = inputs
+    _, clock, d, regular, nugget = inputs
     if k < 0 and not regular:
         raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
-    g = innovations.gains(k, clock, d)
+    g = innovations.gains(k, clock, d, nugget)
     if len(_GAINS) >= _KEEP_GAINS:
         _GAINS.pop(next(iter(_GAINS)))
     _GAINS[key] = (series, g)
