@@ -180,10 +180,10 @@ class FreeKernel:
         return 0.0 if i is None else float(x[i])
 
     def _matrix(self, x) -> np.ndarray:
-        M = np.eye(3)
-        for q, dk in _DK.items():
-            M = M + self._get(x, q) * dk
-        return M
+        """``M = I + K`` (module docstring)."""
+        sx, sy = self._get(x, "scale_x"), self._get(x, "scale_y")
+        xy, xz, yz = self._get(x, "soft_xy"), self._get(x, "soft_xz"), self._get(x, "soft_yz")
+        return np.array([[1.0 + sx, xy, xz], [xy, 1.0 + sy, yz], [xz, yz, 1.0 - sx - sy]])
 
     def _parts(self, x):
         M = self._matrix(x)

@@ -226,15 +226,9 @@ def regular_clock(series: Series) -> bool:
     return bool(np.allclose(c, np.round(c), atol=1e-6))
 
 
-def _projected_gains(kappa, series: Series) -> innovations.Gains:
-    """The Kalman filter of the projected model (module docstring; :mod:`navlib.workbench.innovations`)
-    over the observations of ``series``, in series order (time-major), AR(1): ``kappa[0]``; the last few
-    are kept (a likelihood's optimiser and a bootstrap come back to the same ones)."""
-    k = float(kappa[0])
-    key = (id(series), k)
-    hit = _GAINS.get(key)
-    if hit is not None and hit[0] is series:
-        return hit[1]
+def _projected_inputs(series: Series, k: float) -> tuple:
+    """The filter's inputs for a projected ``series``: the clock and directions in series order and the
+    nugget (computed once per series); ValueError for a negative ``k`` on an irregular clock."""
     inputs = _INPUTS.get(id(series))
     if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
         pr = series.projection
@@ -251,6 +245,19 @@ def _projected_gains(kappa, series: Series) -> innovations.Gains:
     _, clock, d, regular, nugget = inputs
     if k < 0 and not regular:
         raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
+    return clock, d, nugget
+
+
+def _projected_gains(kappa, series: Series) -> innovations.Gains:
+    """The Kalman filter of the projected model (module docstring; :mod:`navlib.workbench.innovations`)
+    over the observations of ``series``, in series order (time-major), AR(1): ``kappa[0]``; the last few
+    are kept (a likelihood's optimiser and a bootstrap come back to the same ones)."""
+    k = float(kappa[0])
+    key = (id(series), k)
+    hit = _GAINS.get(key)
+    if hit is not None and hit[0] is series:
+        return hit[1]
+    clock, d, nugget = _projected_inputs(series, k)
     g = innovations.gains(k, clock, d, nugget)
     if len(_GAINS) >= _KEEP_GAINS:
         _GAINS.pop(next(iter(_GAINS)))
@@ -501,8 +508,10 @@ class _ProjectedLik:
         self.Z = np.column_stack([np.asarray(Q, float), np.asarray(r, float)])[
             series.order
         ]  # [Q, r]
+        self.Z = np.ascontiguousarray(self.Z)
         self.series = series
         self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
+        self._last = (None, None)
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -515,13 +524,17 @@ class _ProjectedLik:
     def _parts(self, kappa):
         if len(kappa) > 1:
             raise ValueError("the projected noise model is of order 0 or 1")
+        key = tuple(float(k) for k in kappa)
+        if self._last[0] == key:  # the plain likelihood at the REML estimate: the same parts
+            return self._last[1]
         if len(kappa):
-            g = _projected_gains(kappa, self.series)
-            w = innovations.whiten_columns(g, self.Z)
-            logdet_r = g.logdet
+            # the filter and the whitening in one pass (the gains themselves are not needed here)
+            clock, d, nugget = _projected_inputs(self.series, key[0])
+            w, logdet_r = innovations.whiten_direct(key[0], clock, d, nugget, self.Z)
         else:
             w, logdet_r = self.Z, 0.0
         rss, logdet_g = _rss_g(w.T @ w, self.k)
+        self._last = (key, (rss, logdet_r, logdet_g))
         return rss, logdet_r, logdet_g
 
 

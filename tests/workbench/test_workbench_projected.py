@@ -121,6 +121,23 @@ def test_the_compiled_kernels_equal_their_python_reference():
         )
 
 
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_one_pass_filter_is_the_gains_and_the_whitening(case):
+    """The likelihood's one-pass filter (issue 34: no gains kept) gives the numbers of the gains and the
+    whitening computed apart, bit for bit, and its Python reference the same to rounding."""
+    kappa, times, axes, drop = CASES[case]
+    ser, n_obs = _projected(times, axes, seed=len(case) + 2, drop=drop)
+    pr = ser.projection
+    clock, d = pr.clock[ser.order], np.ascontiguousarray(pr.directions[ser.order])
+    x = np.random.default_rng(8).standard_normal((len(clock), 4))
+    g = inn.gains(kappa, clock, d)
+    w, logdet = inn.whiten_direct(kappa, clock, d, inn.nugget_of(d), x)
+    assert np.array_equal(w, inn.whiten_columns(g, x)) and logdet == g.logdet
+    w_py, sd_py = inn._filter_whiten.py_func(g.phi, d, inn.nugget_of(d), x)
+    assert np.allclose(w, w_py, rtol=1e-12, atol=1e-13)
+    assert np.allclose(g.sd, sd_py, rtol=1e-13, atol=0)
+
+
 def test_a_projected_series_is_time_major():
     """Rows in time order, each row's observations together; segments start where the rows' did; leaving
     observations out keeps the time order; a series out of time order is refused by the filter."""
