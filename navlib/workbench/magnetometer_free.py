@@ -562,6 +562,15 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         x2.update(zip([p for e in users for p in e.params], beta))
     x2v = np.array([x2[n] for n in names])
     x1v = np.array([(start or {}).get(n, x2[n]) for n in names])
+    if not users and np.array_equal(x1v, x2v):
+        # one start: Gauss-Newton from it (the steps scipy's trust region would take, without its
+        # per-step SVD); scipy where it does not converge
+        gn = gauss_newton(kern, x2v)
+        if gn is not None:
+            x, J = gn
+            return _free_fit(
+                data, effects, dict(zip(names, map(float, x))), J, t_c, kern.residuals(x)
+            )
     inf = np.full(len(names), np.inf)
     sol = best_least_squares(
         resid,
