@@ -9,10 +9,19 @@ from scipy.linalg.lapack import dpotrf, dtrtri
 def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
     """An orthonormal basis of the column space of ``X``: columns are scaled to unit norm and a column is
     dropped when less than ``rtol`` of it is left after removing the previous ones."""
+    return orth_basis_split(X, X.shape[1], rtol)[0]
+
+
+def orth_basis_split(X: np.ndarray, split: int, rtol: float = 1e-7) -> tuple[np.ndarray, int]:
+    """:func:`orth_basis` of ``X`` and how many of its columns come from ``X``'s first ``split`` columns:
+    ``Q[:, :r]`` is ``orth_basis(X[:, :split])`` bit for bit (the columns are taken in order)."""
     n, k = X.shape
     Q = np.zeros((n, k), order="F")  # columns contiguous: Q[:, :r] is one block
     r = 0
+    r_split = 0
     for j in range(k):
+        if j == split:
+            r_split = r
         v = X[:, j].astype(float)
         norm = np.linalg.norm(v)
         if norm == 0:
@@ -25,7 +34,9 @@ def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
         if left > rtol:
             Q[:, r] = v / left
             r += 1
-    return np.ascontiguousarray(Q[:, :r])
+    if split >= k:
+        r_split = r
+    return np.ascontiguousarray(Q[:, :r]), r_split
 
 
 def lower_solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:

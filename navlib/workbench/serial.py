@@ -82,7 +82,7 @@ from scipy.linalg.lapack import dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
-from .linalg import orth_basis
+from .linalg import orth_basis, orth_basis_split
 from .reml import _Prepared, _Restricted, levinson  # noqa: F401  (re-exported: serial's names)
 
 #: A time step more than this many times the median step starts a new segment.
@@ -585,6 +585,22 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
     return Q
 
 
+def basis_pair(
+    base: np.ndarray, extra: np.ndarray, series: Series, n_obs: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`basis_on` of ``base`` and of ``[base, extra]`` in one orthogonalisation: the second's first
+    columns are the first (:func:`navlib.workbench.linalg.orth_basis_split`; the same numbers)."""
+    inc = series.order
+    B = np.asarray(base, float).reshape(n_obs, -1)
+    X = np.column_stack([B, np.asarray(extra, float).reshape(n_obs, -1)])
+    Qi, r = orth_basis_split(X[inc], B.shape[1])
+    Qe = np.zeros((n_obs, Qi.shape[1]))
+    Qe[inc] = Qi
+    Qb = np.zeros((n_obs, r))
+    Qb[inc] = Qi[:, :r]
+    return Qb, Qe
+
+
 def _objective(loglik) -> tuple:
     """What :func:`estimate` minimises over ``a = atanh(kappa)`` (L-BFGS-B): ``fun`` and ``jac`` for
     ``scipy.optimize.minimize``.  With an analytic gradient (:meth:`_Restricted.value_and_gradient`),
@@ -793,6 +809,8 @@ def select(
     if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
     cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
+    if bases is None and series is not None and extra is not None and np.size(extra):
+        qb, qe = basis_pair(base, extra, series, len(np.asarray(residuals)))
     mb, *lb = _estimate(
         residuals,
         base,
@@ -890,12 +908,10 @@ def select_bases(
 ) -> Bases:
     """The :class:`Bases` of :func:`select`'s regressors on ``series``; with ``order``, also their
     likelihood parts for that AR order."""
-    qb = basis_on(base, series, n_obs)
-    qe = (
-        basis_on(np.column_stack([base, extra]), series, n_obs)
-        if extra is not None and np.size(extra)
-        else None
-    )
+    if extra is not None and np.size(extra):
+        qb, qe = basis_pair(base, extra, series, n_obs)
+    else:
+        qb, qe = basis_on(base, series, n_obs), None
     if order is None or series.projection is not None:
         return Bases(qb, qe)
     P = max(int(order), 1)

@@ -521,3 +521,18 @@ def test_select_gives_the_chosen_sets_own_estimate_and_interval(structure):
     assert m.kappa == own.kappa and m.bounds == own.bounds and len(m.bounds) == 2
     assert m.bounds[0] < m.kappa[0] < m.bounds[1]
     assert serial.select(y, J, S, ser, interval=False).bounds == ()
+
+
+def test_the_two_bases_of_select_come_from_one_orthogonalisation():
+    """basis_pair: the model's basis and the basis with the structure shapes from one Gram-Schmidt pass,
+    number for number what basis_on gives each (a dependent column dropped in both)."""
+    rng = np.random.default_rng(1)
+    n = 300
+    ser = serial.series_of(_frame(n), n, "magnetometer").without(rng.random(n) < 0.05)
+    B = rng.normal(size=(n, 5))
+    B[:, 4] = B[:, 0] - 2 * B[:, 1]
+    E = rng.normal(size=(n, 7))
+    qb, qe = serial.basis_pair(B, E, ser, n)
+    assert qb.shape == (n, 4) and qe.shape == (n, 11)
+    assert np.array_equal(qb, serial.basis_on(B, ser, n))
+    assert np.array_equal(qe, serial.basis_on(np.column_stack([B, E]), ser, n))
