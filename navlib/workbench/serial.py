@@ -78,7 +78,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 from scipy import special
-from scipy.linalg.lapack import dtrtrs
+from scipy.linalg.lapack import dpotrf, dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
@@ -533,7 +533,7 @@ class _ProjectedLik:
             w, logdet_r = innovations.whiten_direct(key[0], clock, d, nugget, self.Z)
         else:
             w, logdet_r = self.Z, 0.0
-        rss, logdet_g = _rss_g(w.T @ w, self.k)
+        rss, logdet_g = _rss_g_cholesky(w.T @ w, self.k)
         self._last = (key, (rss, logdet_r, logdet_g))
         return rss, logdet_r, logdet_g
 
@@ -546,6 +546,20 @@ def _rss_g(M: np.ndarray, k: int) -> tuple[float, float]:
     ev, U = np.linalg.eigh(M[:k, :k])
     ev = np.maximum(ev, 1e-300)
     return float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev)), float(np.sum(np.log(ev)))
+
+
+def _rss_g_cholesky(M: np.ndarray, k: int) -> tuple[float, float]:
+    """:func:`_rss_g` by the Cholesky factor of the whole Gram matrix (a tenth of the eigendecomposition's
+    time): with ``M = L L'``, ``L[k, k]^2`` is the Schur complement of the regressors' block -- the RSS after
+    them -- and ``log det`` of that block ``2 sum log L[i, i]``, ``i < k`` (equal to rounding).  Where ``M`` is
+    not numerically positive definite (an RSS at round-off), :func:`_rss_g`."""
+    if not k:
+        return _rss_g(M, k)
+    L, info = dpotrf(M, lower=1, clean=0)
+    if info != 0:
+        return _rss_g(M, k)
+    d = np.diag(L)
+    return float(d[k] * d[k]), 2.0 * float(np.sum(np.log(d[:k])))
 
 
 def _restricted_loglik(kappa, r: np.ndarray, Q: np.ndarray, series: Series) -> float:

@@ -192,3 +192,21 @@ def test_whitening_and_the_likelihood_of_50000_observations_stay_linear_in_memor
     res = json.loads(out.stdout.strip().splitlines()[-1])
     assert res["kib"] < 200 * 1024, res
     assert res["order"] == 1 and res["lag1"] == pytest.approx(0.9, abs=0.02)
+
+
+def test_the_likelihoods_cholesky_parts_are_the_eigendecompositions():
+    """The RSS after the regressors and their log det from the Cholesky factor of the bordered Gram matrix
+    (the projected likelihood's, issue 34) equal the eigendecomposition's; a Gram matrix that is not
+    positive definite (the residual inside the regressors' span) falls back to it."""
+    rng = np.random.default_rng(9)
+    w = rng.standard_normal((400, 8))
+    M = w.T @ w
+    for k in (0, 1, 7):
+        rss, lg = serial._rss_g_cholesky(M[: k + 1, : k + 1], k)
+        ref = serial._rss_g(M[: k + 1, : k + 1], k)
+        assert rss == pytest.approx(ref[0], rel=1e-12) and lg == pytest.approx(ref[1], rel=1e-12)
+    w[:, -1] = w[:, :3] @ np.array([1.0, -2.0, 0.5])  # r in the span: RSS 0, not positive definite
+    M = w.T @ w
+    rss, lg = serial._rss_g_cholesky(M, 7)
+    ref = serial._rss_g(M, 7)
+    assert abs(rss) <= 1e-9 * M[-1, -1] and lg == pytest.approx(ref[1], rel=1e-12)
