@@ -66,7 +66,7 @@ from scipy import special
 from ..errors import InputError
 from .effects import testable
 from .fit import MEASURED, Fit, measured_columns, refit_rows, residuals_on
-from .linalg import orth_basis
+from .linalg import leverage, orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
@@ -419,15 +419,14 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
             # the shapes fitted to the residual clipped at Z_NOISE robust standard deviations (one Huber
             # step), so that a spike is not smeared over its time cell
             S = shapes_all[obs]
-            q = orth_basis(np.column_stack([rich.jacobian, S]))
+            lev = leverage(np.column_stack([rich.jacobian, S]))
             rk = r[kept]
             med = np.median(rk, axis=0)
             half = Z_NOISE * np.maximum(MAD_SD * np.median(np.abs(rk - med), axis=0), floor)
             coef = np.linalg.lstsq(S, np.clip(rk, med - half, med + half).ravel(), rcond=1e-10)[0]
             r = r - (shapes_all @ coef).reshape(n, axes)
         else:
-            q = orth_basis(rich.jacobian)
-        lev = np.sum(q**2, axis=1)
+            lev = leverage(rich.jacobian)
         h = np.zeros((n, axes))
         h[kept] = np.clip(lev, 0.0, 0.99).reshape(len(kept), axes)
         u = r / np.sqrt(1.0 - h)

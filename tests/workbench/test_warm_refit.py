@@ -195,3 +195,19 @@ def test_a_single_start_fit_by_gauss_newton_is_scipys(monkeypatch, seed):
     assert list(gn.params) == list(ref.params)
     assert _in_std(ref, gn) < 0.01 and gn.rss <= ref.rss * (1 + 1e-9)
     np.testing.assert_allclose(gn.residuals, ref.residuals, atol=1e-3)
+
+
+def test_leverage_by_cholesky_is_the_gram_schmidt_basis():
+    """The screen's leverages from the Cholesky factor of the scaled Gram matrix are the row sums of
+    squares of the Gram-Schmidt basis, also with columns of very different scales; with a dependent column
+    (dropped by Gram-Schmidt) the basis is used."""
+    from navlib.workbench.linalg import leverage, orth_basis
+
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(500, 12)) * 10.0 ** rng.integers(-3, 3, 12)
+    for Y in (X, np.column_stack([X, X[:, 1] * 2 - X[:, 3]]), X[:, :0]):
+        q = orth_basis(Y) if Y.shape[1] else np.zeros((len(Y), 0))
+        h = leverage(Y)
+        assert h.shape == (len(Y),)
+        np.testing.assert_allclose(h, np.sum(q**2, axis=1), rtol=0, atol=1e-12)
+    assert leverage(X).sum() == pytest.approx(12.0)
