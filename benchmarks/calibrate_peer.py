@@ -21,8 +21,10 @@ screen's refits became warm-started Gauss-Newton (the same session, the old code
 - 17 BROAD recordings of 1,500-2,100 rows (fitted on 70 %): navlib 0.044-0.16 s per fit, median
   0.06-0.07 s (was 0.11-0.78 s, median 0.20 s; 2026-12-03: median 0.26 s, and 1 s before the analytic
   Jacobian), the peer 0.5 ms-0.5 s, median 4.1-4.5 ms (its LM fit takes 0.4-0.5 s on four magnet trials):
-  16-18 x, median over files (was 48 x in the same session, 65 x on 2026-12-03).  The issue measured
-  magcc's own LM fit at 13-29 ms per file: against that navlib is 2-5 x.
+  16-18 x, median over files (was 48 x in the same session, 65 x on 2026-12-03).  navlib's time includes
+  reading the file (:func:`~navlib.workbench.magnetometer_free.load_free`, as the CLI does: about 12 ms
+  on 1,400 rows, most of it the cell-by-cell validation), the peer's starts from the array in memory.
+  The issue measured magcc's own LM fit at 13-29 ms per file: against that navlib is 2-5 x.
 
 The issue's target, within 5 x of the peer's LM fit on 1,000 rows, is not met.  What costs the rest, on
 the 1,000 simulated rows (27 ms, cProfile): the noise model 15-18 ms -- REML of the AR(1) noise on the
