@@ -163,6 +163,12 @@ class System:
         by the factors the system knows (the reference-free magnetometer: time, turn rate, orientation,
         acceleration; :mod:`navlib.workbench.free_breakdown`), and one sentence reading it.  None: no
         breakdown.
+    refit : callable or None
+        ``refit(fit, data, effects) -> Fit or None``: the model ``effects`` (``fit``'s, or ``fit``'s with more
+        effects) on ``data`` (rows of the same recording, e.g. without the screen's outliers) started from
+        ``fit``'s parameters, a cheap path to the minimum ``fit(data, effects, fit.params)`` finds (the
+        reference-free magnetometer: Gauss-Newton steps with the analytic Jacobian); None when it cannot
+        (the caller then fits in full).  None: always fitted in full.
     columns : tuple of Column
         The file schema ``load`` reads (:class:`navlib.data.tables.Column`: name, unit, required, limits,
         meaning); :func:`columns_table` derives the system's data dictionary from it.
@@ -179,6 +185,7 @@ class System:
     final_check: Callable | None = None
     columns: tuple = ()
     remaining: Callable | None = None
+    refit: Callable | None = None
 
 
 #: Every system, by name (filled by the system modules as they are imported; the package imports them all).

@@ -16,11 +16,17 @@ with ``du/db_j = -M e_j``, ``du/dk_j = -(T - T_c) M e_j`` and ``du/dK = dK v``. 
 (zero where ``c`` is clipped).  The misalignment angles' columns differentiate the rotation matrix by central differences
 (step 1e-4 deg).
 Rows are interleaved as the fit's residual vector is: ``[e_0, e_1]`` of row 0, then of row 1, and so on.
+
+The residuals and the Jacobian are computed row by row in one compiled loop (:func:`_invariants`, numba;
+a fit evaluates them tens of times, and the numpy formulation spent most of its time allocating (n, 3)
+temporaries); :meth:`FreeKernel.reference_residuals` and :meth:`FreeKernel.reference_jacobian` are the
+numpy formulation the tests compare it with (equal to rounding).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 CLIP = 0.99
 # d K / d parameter, the trace-free symmetric part of the correction
@@ -48,6 +54,90 @@ def rotation_deg(rotvec_deg) -> np.ndarray:
     return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
 
 
+# column kinds of the compiled kernel
+_K_DK, _K_HARD, _K_TEMP, _K_FIELD, _K_DOWN, _K_MIS, _K_NONE = range(7)
+_DK_STACK = np.stack(list(_DK.values()))
+
+
+@njit(error_model="numpy", cache=True)
+def _invariants(m, ahat, dt, M, o, kt, R, F, D, kinds, which, dks, dRs, want_jac):
+    """The residuals (n, k) and, with ``want_jac``, the Jacobian (n k, p) of the module docstring, row by
+    row; ``ahat`` (n, 3) or (0, 3) without an accelerometer, ``dt`` (n,) or (0,); column ``j`` of the
+    Jacobian is of kind ``kinds[j]`` (``_K_*``) and index ``which[j]`` (into ``dks``, the axes, ``dRs``)."""
+    n = m.shape[0]
+    acc = ahat.shape[0] > 0
+    has_dt = dt.shape[0] > 0
+    k = 2 if acc else 1
+    p = kinds.shape[0]
+    res = np.empty((n, k))
+    J = np.zeros((n * k if want_jac else 0, p))
+    raw = D / max(F, 1e-9)
+    c = min(max(raw, -0.99), 0.99)
+    s = np.sqrt(1.0 - c * c)
+    free = abs(raw) < 0.99 and F > 1e-9
+    v = np.empty(3)
+    u = np.empty(3)
+    at = np.empty(3)
+    du = np.empty(3)
+    for i in range(n):
+        for a in range(3):
+            v[a] = m[i, a] - o[a]
+            if has_dt:
+                v[a] -= dt[i] * kt[a]
+        for a in range(3):
+            u[a] = v[0] * M[0, a] + v[1] * M[1, a] + v[2] * M[2, a]
+        r = np.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
+        e0 = r - F
+        res[i, 0] = e0
+        g = 0.0
+        if acc:
+            for a in range(3):
+                at[a] = ahat[i, 0] * R[0, a] + ahat[i, 1] * R[1, a] + ahat[i, 2] * R[2, a]
+            g = at[0] * u[0] + at[1] * u[1] + at[2] * u[2] - D
+            res[i, 1] = (g - c * e0) / s
+        if not want_jac:
+            continue
+        de1_dc = -e0 / s + (g - c * e0) * c / s**3
+        for j in range(p):
+            kind = kinds[j]
+            w = which[j]
+            moves_u = True
+            if kind == _K_DK:
+                for a in range(3):
+                    du[a] = v[0] * dks[w, 0, a] + v[1] * dks[w, 1, a] + v[2] * dks[w, 2, a]
+            elif kind == _K_HARD:
+                for a in range(3):
+                    du[a] = -M[w, a]
+            elif kind == _K_TEMP:
+                for a in range(3):
+                    du[a] = -(dt[i] if has_dt else 0.0) * M[w, a]
+            else:
+                moves_u = False
+            if moves_u:
+                j0 = (u[0] * du[0] + u[1] * du[1] + u[2] * du[2]) / r
+                J[i * k, j] = j0
+                if acc:
+                    jg = at[0] * du[0] + at[1] * du[1] + at[2] * du[2]
+                    J[i * k + 1, j] = (jg - c * j0) / s
+            elif kind == _K_FIELD:
+                J[i * k, j] = -1.0
+                if acc:
+                    J[i * k + 1, j] = c / s + (de1_dc * (-D / (F * F)) if free else 0.0)
+            elif kind == _K_DOWN:
+                if acc:
+                    J[i * k + 1, j] = -1.0 / s + (de1_dc / F if free else 0.0)
+            elif kind == _K_MIS and acc:
+                t = 0.0
+                for a in range(3):
+                    t += (
+                        ahat[i, 0] * dRs[w, 0, a]
+                        + ahat[i, 1] * dRs[w, 1, a]
+                        + ahat[i, 2] * dRs[w, 2, a]
+                    ) * u[a]
+                J[i * k + 1, j] = t / s
+    return res, J
+
+
 class FreeKernel:
     """The invariants of one data set for the parameter vector ``x`` named ``names``.
 
@@ -62,15 +152,41 @@ class FreeKernel:
         self.ahat = None if a is None else a / np.linalg.norm(a, axis=1, keepdims=True)
         self.dt = None if dt is None else np.asarray(dt, float)
         self.k = 1 if a is None else 2
+        # the compiled loop's inputs: contiguous arrays, empty where absent, and each column's kind
+        self.m = np.ascontiguousarray(self.m)
+        self._ahat = np.zeros((0, 3)) if self.ahat is None else np.ascontiguousarray(self.ahat)
+        self._dt = np.zeros(0) if self.dt is None else np.ascontiguousarray(self.dt)
+        kinds, which = [], []
+        for q in self.names:
+            if q in _DK:
+                kinds.append(_K_DK), which.append(list(_DK).index(q))
+            elif q in _HARD:
+                kinds.append(_K_HARD), which.append(_HARD.index(q))
+            elif q in _TEMP:
+                kinds.append(_K_TEMP), which.append(_TEMP.index(q))
+            elif q == "field_ut":
+                kinds.append(_K_FIELD), which.append(0)
+            elif q == "field_down_ut":
+                kinds.append(_K_DOWN), which.append(0)
+            elif q in _MIS:
+                kinds.append(_K_MIS), which.append(_MIS.index(q))
+            else:
+                kinds.append(_K_NONE), which.append(0)
+        self._kinds = np.array(kinds, np.int64)
+        self._which = np.array(which, np.int64)
 
     def _get(self, x, q: str) -> float:
         i = self.index.get(q)
         return 0.0 if i is None else float(x[i])
 
+    def _matrix(self, x) -> np.ndarray:
+        """``M = I + K`` (module docstring)."""
+        sx, sy = self._get(x, "scale_x"), self._get(x, "scale_y")
+        xy, xz, yz = self._get(x, "soft_xy"), self._get(x, "soft_xz"), self._get(x, "soft_yz")
+        return np.array([[1.0 + sx, xy, xz], [xy, 1.0 + sy, yz], [xz, yz, 1.0 - sx - sy]])
+
     def _parts(self, x):
-        M = np.eye(3)
-        for q, dk in _DK.items():
-            M = M + self._get(x, q) * dk
+        M = self._matrix(x)
         o = np.array([self._get(x, q) for q in _HARD])
         v = self.m - o
         kt = np.array([self._get(x, q) for q in _TEMP])
@@ -82,8 +198,47 @@ class FreeKernel:
     def _rotation(self, x) -> np.ndarray:
         return rotation_deg([self._get(x, q) for q in _MIS])
 
+    def _compiled(self, x, want_jac: bool):
+        M = self._matrix(x)
+        o = np.array([self._get(x, q) for q in _HARD])
+        kt = np.array([self._get(x, q) for q in _TEMP])
+        R = self._rotation(x)
+        dRs = np.zeros((3, 3, 3))
+        if want_jac and self.ahat is not None:
+            mis = [self._get(x, q) for q in _MIS]
+            for j, q in enumerate(_MIS):
+                if q in self.index:
+                    up, dn = list(mis), list(mis)
+                    up[j] += MIS_STEP_DEG
+                    dn[j] -= MIS_STEP_DEG
+                    dRs[j] = (rotation_deg(up) - rotation_deg(dn)) / (2 * MIS_STEP_DEG)
+        return _invariants(
+            self.m,
+            self._ahat,
+            self._dt,
+            M,
+            o,
+            kt,
+            R,
+            self._get(x, "field_ut"),
+            self._get(x, "field_down_ut"),
+            self._kinds,
+            self._which,
+            _DK_STACK,
+            dRs,
+            want_jac,
+        )
+
     def residuals(self, x) -> np.ndarray:
         """(n, k): the invariants' misfit (module docstring)."""
+        return self._compiled(x, False)[0]
+
+    def jacobian(self, x) -> np.ndarray:
+        """(n k, p): d(residuals().ravel())/dx (module docstring)."""
+        return self._compiled(x, True)[1]
+
+    def reference_residuals(self, x) -> np.ndarray:
+        """:meth:`residuals` in numpy (the reference the compiled loop is tested against)."""
         _, _, u = self._parts(x)
         r = np.sqrt(np.einsum("ij,ij->i", u, u))
         e0 = r - self._get(x, "field_ut")
@@ -94,8 +249,8 @@ class FreeKernel:
         c = float(np.clip(D / max(F, 1e-9), -CLIP, CLIP))
         return np.column_stack([e0, (g - c * e0) / np.sqrt(1.0 - c * c)])
 
-    def jacobian(self, x) -> np.ndarray:
-        """(n k, p): d(residuals().ravel())/dx (module docstring)."""
+    def reference_jacobian(self, x) -> np.ndarray:
+        """:meth:`jacobian` in numpy (the reference the compiled loop is tested against)."""
         M, v, u = self._parts(x)
         n, p = len(u), len(self.names)
         r = np.sqrt(np.einsum("ij,ij->i", u, u))

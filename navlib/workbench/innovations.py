@@ -80,12 +80,17 @@ def propagation(kappa: float, clock: np.ndarray) -> np.ndarray:
     return phi
 
 
-def gains(kappa: float, clock: np.ndarray, d: np.ndarray) -> Gains:
+def nugget_of(d: np.ndarray) -> float:
+    """The measurement nugget of directions ``d`` (:data:`NUGGET` times the mean ``|d_i|^2``)."""
+    return NUGGET * float(np.mean(np.sum(d * d, axis=1))) if len(d) else 0.0
+
+
+def gains(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float | None = None) -> Gains:
     """The :class:`Gains` of AR(1) axis noise of lag-1 correlation ``kappa`` seen along directions ``d``
-    ((n, 3)) at times ``clock`` (in time order)."""
+    ((n, 3)) at times ``clock`` (in time order); ``nugget``: :func:`nugget_of` ``d``, if already known."""
     d = np.ascontiguousarray(d, float)
     phi = propagation(kappa, clock)
-    nugget = NUGGET * float(np.mean(np.sum(d * d, axis=1))) if len(d) else 0.0
+    nugget = nugget_of(d) if nugget is None else nugget
     gain, sd = _gains(phi, d, nugget)
     return Gains(phi, d, gain, sd)
 
@@ -160,6 +165,55 @@ def _colour(phi, d, gain, sd, u):
             a[1, b] = a1 + k1 * e
             a[2, b] = a2 + k2 * e
     return out
+
+
+@njit(error_model="numpy", cache=True)
+def _filter_whiten(phi, d, nugget, x):
+    """:func:`_gains` and :func:`_whiten` in one pass (the same operations in the same order: the same
+    numbers), for a likelihood that needs the whitened columns and ``sqrt(S_i)`` but not the gains."""
+    n, B = x.shape
+    out = np.empty((n, B))
+    sd = np.empty(n)
+    a = np.zeros((3, B))
+    P = np.eye(3)
+    pd = np.empty(3)
+    k = np.empty(3)
+    for i in range(n):
+        f = phi[i]
+        f2 = f * f
+        for r in range(3):
+            for c in range(3):
+                P[r, c] *= f2
+            P[r, r] += 1.0 - f2
+        d0, d1, d2 = d[i, 0], d[i, 1], d[i, 2]
+        for r in range(3):
+            pd[r] = P[r, 0] * d0 + P[r, 1] * d1 + P[r, 2] * d2
+        S = d0 * pd[0] + d1 * pd[1] + d2 * pd[2] + nugget
+        for r in range(3):
+            k[r] = pd[r] / S
+        for r in range(3):
+            for c in range(3):
+                P[r, c] -= pd[r] * pd[c] / S
+        s = np.sqrt(S)
+        sd[i] = s
+        for b in range(B):
+            a0 = f * a[0, b]
+            a1 = f * a[1, b]
+            a2 = f * a[2, b]
+            e = x[i, b] - (d0 * a0 + d1 * a1 + d2 * a2)
+            out[i, b] = e / s
+            a[0, b] = a0 + k[0] * e
+            a[1, b] = a1 + k[1] * e
+            a[2, b] = a2 + k[2] * e
+    return out, sd
+
+
+def whiten_direct(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float, x: np.ndarray):
+    """``(L^-1 x, log det R)`` for ``x`` (n, B) in filter order without keeping the gains
+    (:func:`_filter_whiten`): what a likelihood evaluated at many ``kappa`` needs."""
+    phi = propagation(kappa, clock)
+    out, sd = _filter_whiten(phi, d, nugget, np.ascontiguousarray(x, float))
+    return out, 2.0 * float(np.sum(np.log(sd)))
 
 
 def _columns(kernel, g: Gains, x: np.ndarray) -> np.ndarray:

@@ -65,8 +65,8 @@ from scipy import special
 
 from ..errors import InputError
 from .effects import testable
-from .fit import MEASURED, Fit, fit_model, measured_columns, residuals_on
-from .linalg import orth_basis
+from .fit import MEASURED, Fit, measured_columns, refit_rows, residuals_on
+from .linalg import leverage, orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
@@ -150,10 +150,11 @@ class Screening:
         return sorted({o.row for o in self.outliers})
 
     def refit(self, fit: Fit) -> Fit:
-        """``fit``'s model on the rows kept (``fit`` itself when no row was set aside)."""
+        """``fit``'s model on the rows kept (``fit`` itself when no row was set aside), from ``fit``'s
+        parameters (:func:`navlib.workbench.fit.refit_rows`)."""
         if len(self.kept) == self.n_rows:
             return fit
-        return fit_model(fit.spec, self.data, fit.effects, user_effects=fit.user_effects)
+        return refit_rows(fit, self.data)
 
     def outlier_line(self, unit: str) -> str:
         """One line for a report: the rows set aside (empty when none)."""
@@ -234,9 +235,15 @@ def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str) -> np.ndarray
         ok[ok] &= seg[idx[ok]] == seg[ok]
         near[ok, col] = x[idx[ok]]
         col += 1
-    has = ~np.all(np.isnan(near), axis=1)
+    missing = np.isnan(near)
+    has = ~np.all(missing, axis=1)
     ref = np.full(m, np.nan)
-    ref[has] = np.nanmedian(near[has], axis=1)
+    full = ~np.any(
+        missing, axis=1
+    )  # inside a segment: a plain median (nanmedian's cost is in the edges)
+    ref[full] = np.median(near[full], axis=1)
+    edge = has & ~full
+    ref[edge] = np.nanmedian(near[edge], axis=1)
     gap = x - ref
     out = np.empty(n * k)
     out[ser.order] = gap
@@ -259,7 +266,7 @@ def _richest(fit: Fit) -> list[tuple[str, ...]]:
 def _fit_rich(fit: Fit, frame: pd.DataFrame, models) -> Fit | None:
     for m in models:
         try:
-            f = fit_model(fit.spec, frame, m, start=fit.params, user_effects=fit.user_effects)
+            f = refit_rows(fit, frame, m)
         except InputError:
             continue
         if f.n - f.n_params >= MIN_DOF:
@@ -418,15 +425,14 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
             # the shapes fitted to the residual clipped at Z_NOISE robust standard deviations (one Huber
             # step), so that a spike is not smeared over its time cell
             S = shapes_all[obs]
-            q = orth_basis(np.column_stack([rich.jacobian, S]))
+            lev = leverage(np.column_stack([rich.jacobian, S]))
             rk = r[kept]
             med = np.median(rk, axis=0)
             half = Z_NOISE * np.maximum(MAD_SD * np.median(np.abs(rk - med), axis=0), floor)
             coef = np.linalg.lstsq(S, np.clip(rk, med - half, med + half).ravel(), rcond=1e-10)[0]
             r = r - (shapes_all @ coef).reshape(n, axes)
         else:
-            q = orth_basis(rich.jacobian)
-        lev = np.sum(q**2, axis=1)
+            lev = leverage(rich.jacobian)
         h = np.zeros((n, axes))
         h[kept] = np.clip(lev, 0.0, 0.99).reshape(len(kept), axes)
         u = r / np.sqrt(1.0 - h)
@@ -453,13 +459,7 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         if np.array_equal(nxt, aside) or nxt.all():
             break
         aside = nxt
-        rich = fit_model(
-            fit.spec,
-            data.iloc[np.flatnonzero(~aside)],
-            rich.effects,
-            start=rich.params,
-            user_effects=fit.user_effects,
-        )
+        rich = refit_rows(rich, data.iloc[np.flatnonzero(~aside)])
     else:
         r, z, flagged = judge(rich, aside)
     bad = np.flatnonzero(aside | flagged.any(axis=1))

@@ -78,11 +78,11 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 from scipy import special
-from scipy.linalg.lapack import dtrtrs
+from scipy.linalg.lapack import dpotrf, dtrtrs
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
-from .linalg import orth_basis
+from .linalg import orth_basis, orth_basis_split
 from .reml import _Prepared, _Restricted, levinson  # noqa: F401  (re-exported: serial's names)
 
 #: A time step more than this many times the median step starts a new segment.
@@ -226,6 +226,28 @@ def regular_clock(series: Series) -> bool:
     return bool(np.allclose(c, np.round(c), atol=1e-6))
 
 
+def _projected_inputs(series: Series, k: float) -> tuple:
+    """The filter's inputs for a projected ``series``: the clock and directions in series order and the
+    nugget (computed once per series); ValueError for a negative ``k`` on an irregular clock."""
+    inputs = _INPUTS.get(id(series))
+    if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
+        pr = series.projection
+        d = np.ascontiguousarray(pr.directions[series.order], float)
+        inputs = (
+            series,
+            pr.clock[series.order],
+            d,
+            regular_clock(series),
+            innovations.nugget_of(d),
+        )
+        _INPUTS.clear()
+        _INPUTS[id(series)] = inputs
+    _, clock, d, regular, nugget = inputs
+    if k < 0 and not regular:
+        raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
+    return clock, d, nugget
+
+
 def _projected_gains(kappa, series: Series) -> innovations.Gains:
     """The Kalman filter of the projected model (module docstring; :mod:`navlib.workbench.innovations`)
     over the observations of ``series``, in series order (time-major), AR(1): ``kappa[0]``; the last few
@@ -235,21 +257,8 @@ def _projected_gains(kappa, series: Series) -> innovations.Gains:
     hit = _GAINS.get(key)
     if hit is not None and hit[0] is series:
         return hit[1]
-    inputs = _INPUTS.get(id(series))
-    if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
-        pr = series.projection
-        inputs = (
-            series,
-            pr.clock[series.order],
-            np.ascontiguousarray(pr.directions[series.order], float),
-            regular_clock(series),
-        )
-        _INPUTS.clear()
-        _INPUTS[id(series)] = inputs
-    _, clock, d, regular = inputs
-    if k < 0 and not regular:
-        raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
-    g = innovations.gains(k, clock, d)
+    clock, d, nugget = _projected_inputs(series, k)
+    g = innovations.gains(k, clock, d, nugget)
     if len(_GAINS) >= _KEEP_GAINS:
         _GAINS.pop(next(iter(_GAINS)))
     _GAINS[key] = (series, g)
@@ -499,8 +508,10 @@ class _ProjectedLik:
         self.Z = np.column_stack([np.asarray(Q, float), np.asarray(r, float)])[
             series.order
         ]  # [Q, r]
+        self.Z = np.ascontiguousarray(self.Z)
         self.series = series
         self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
+        self._last = (None, None)
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -513,13 +524,17 @@ class _ProjectedLik:
     def _parts(self, kappa):
         if len(kappa) > 1:
             raise ValueError("the projected noise model is of order 0 or 1")
+        key = tuple(float(k) for k in kappa)
+        if self._last[0] == key:  # the plain likelihood at the REML estimate: the same parts
+            return self._last[1]
         if len(kappa):
-            g = _projected_gains(kappa, self.series)
-            w = innovations.whiten_columns(g, self.Z)
-            logdet_r = g.logdet
+            # the filter and the whitening in one pass (the gains themselves are not needed here)
+            clock, d, nugget = _projected_inputs(self.series, key[0])
+            w, logdet_r = innovations.whiten_direct(key[0], clock, d, nugget, self.Z)
         else:
             w, logdet_r = self.Z, 0.0
-        rss, logdet_g = _rss_g(w.T @ w, self.k)
+        rss, logdet_g = _rss_g_cholesky(w.T @ w, self.k)
+        self._last = (key, (rss, logdet_r, logdet_g))
         return rss, logdet_r, logdet_g
 
 
@@ -531,6 +546,20 @@ def _rss_g(M: np.ndarray, k: int) -> tuple[float, float]:
     ev, U = np.linalg.eigh(M[:k, :k])
     ev = np.maximum(ev, 1e-300)
     return float(M[k, k] - np.sum((U.T @ M[:k, k]) ** 2 / ev)), float(np.sum(np.log(ev)))
+
+
+def _rss_g_cholesky(M: np.ndarray, k: int) -> tuple[float, float]:
+    """:func:`_rss_g` by the Cholesky factor of the whole Gram matrix (a tenth of the eigendecomposition's
+    time): with ``M = L L'``, ``L[k, k]^2`` is the Schur complement of the regressors' block -- the RSS after
+    them -- and ``log det`` of that block ``2 sum log L[i, i]``, ``i < k`` (equal to rounding).  Where ``M`` is
+    not numerically positive definite (an RSS at round-off), :func:`_rss_g`."""
+    if not k:
+        return _rss_g(M, k)
+    L, info = dpotrf(M, lower=1, clean=0)
+    if info != 0:
+        return _rss_g(M, k)
+    d = np.diag(L)
+    return float(d[k] * d[k]), 2.0 * float(np.sum(np.log(d[:k])))
 
 
 def _restricted_loglik(kappa, r: np.ndarray, Q: np.ndarray, series: Series) -> float:
@@ -570,6 +599,22 @@ def basis_on(regressors: np.ndarray | None, series: Series, n_obs: int) -> np.nd
     return Q
 
 
+def basis_pair(
+    base: np.ndarray, extra: np.ndarray, series: Series, n_obs: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`basis_on` of ``base`` and of ``[base, extra]`` in one orthogonalisation: the second's first
+    columns are the first (:func:`navlib.workbench.linalg.orth_basis_split`; the same numbers)."""
+    inc = series.order
+    B = np.asarray(base, float).reshape(n_obs, -1)
+    X = np.column_stack([B, np.asarray(extra, float).reshape(n_obs, -1)])
+    Qi, r = orth_basis_split(X[inc], B.shape[1])
+    Qe = np.zeros((n_obs, Qi.shape[1]))
+    Qe[inc] = Qi
+    Qb = np.zeros((n_obs, r))
+    Qb[inc] = Qi[:, :r]
+    return Qb, Qe
+
+
 def _objective(loglik) -> tuple:
     """What :func:`estimate` minimises over ``a = atanh(kappa)`` (L-BFGS-B): ``fun`` and ``jac`` for
     ``scipy.optimize.minimize``.  With an analytic gradient (:meth:`_Restricted.value_and_gradient`),
@@ -607,14 +652,46 @@ def estimate(
     or more, optimise that order only, from these partial autocorrelations; ``cross``: the residual's
     cross-products with ``prepared`` (``_Prepared.cross``), computed for many residual vectors at once
     (:func:`select_many`)."""
+    return _estimate(
+        residuals,
+        regressors,
+        series,
+        max_order,
+        order=order,
+        interval=interval,
+        basis=basis,
+        prepared=prepared,
+        start_at=start_at,
+        cross=cross,
+    )[0]
+
+
+def _estimate(
+    residuals: np.ndarray,
+    regressors: np.ndarray,
+    series: Series | None,
+    max_order: int = MAX_ORDER,
+    *,
+    order: int | None = None,
+    interval: bool = True,
+    basis: np.ndarray | None = None,
+    prepared: _Prepared | None = None,
+    start_at: tuple | None = None,
+    cross: tuple | None = None,
+) -> tuple:
+    """:func:`estimate`, and the likelihood it maximised, the lowest ``atanh kappa_1`` it allowed and the
+    maximum (for :func:`_interval` later; None, 0 and NaN when nothing was estimated)."""
     r = np.asarray(residuals, float)
     if series is None:
-        return NoiseModel((), None, len(r))
+        return NoiseModel((), None, len(r)), None, 0.0, float("nan")
     inc = series.order
     Q = basis_on(regressors, series, len(r)) if basis is None else basis
     if len(inc) - Q.shape[1] < MIN_SAMPLES:
-        return NoiseModel(
-            (), series, len(r), note="too few samples to estimate a serial correlation"
+        return (
+            NoiseModel((), series, len(r), note="too few samples to estimate a serial correlation"),
+            None,
+            0.0,
+            float("nan"),
         )
     if order is not None:
         max_order = int(order)
@@ -684,31 +761,41 @@ def estimate(
             break  # forward selection: stop at the first order that
         best, aic_best = (kappa, ll), aic  # does not lower the AIC
     kappa, ll = best
-    bounds = ()
-    if kappa and interval:
-        drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
-        lim = np.arctanh(KAPPA_MAX)
-        a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
-
-        def gap(a):
-            return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
-
-        ends = []
-        for edge in (min(low, a0), lim):
-            if a0 == edge or gap(edge) <= 0:
-                ends.append(float(np.tanh(edge)))
-            else:
-                ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
-        bounds = tuple(ends)
-    return NoiseModel(
-        tuple(kappa),
-        series,
-        len(r),
-        tuple(logliks),
-        bounds=bounds,
-        ml=loglik.ml(kappa),
-        regressors=Q.shape[1],
+    bounds = _interval(loglik, kappa, ll, low) if kappa and interval else ()
+    return (
+        NoiseModel(
+            tuple(kappa),
+            series,
+            len(r),
+            tuple(logliks),
+            bounds=bounds,
+            ml=loglik.ml(kappa),
+            regressors=Q.shape[1],
+        ),
+        loglik,
+        low,
+        ll,
     )
+
+
+def _interval(loglik, kappa: tuple, ll: float, low: float) -> tuple:
+    """The profile-likelihood interval of ``kappa_1`` (level :data:`KAPPA_LEVEL`) of the estimate ``kappa``
+    (log likelihood ``ll``) with the other partial autocorrelations held; ``low`` the lowest ``atanh
+    kappa_1`` allowed."""
+    drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
+    lim = np.arctanh(KAPPA_MAX)
+    a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
+
+    def gap(a):
+        return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
+
+    ends = []
+    for edge in (min(low, a0), lim):
+        if a0 == edge or gap(edge) <= 0:
+            ends.append(float(np.tanh(edge)))
+        else:
+            ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
+    return tuple(ends)
 
 
 def select(
@@ -736,39 +823,47 @@ def select(
     if already computed (a bootstrap re-estimates on many residual vectors); ``cross``: the residual's
     cross-products with each set's likelihood parts (:func:`estimate`, :func:`select_many`)."""
     qb, qe, pb, pe = bases if bases is not None else Bases(None, None)
-    mb = estimate(
+    if bases is None and series is not None and extra is not None and np.size(extra):
+        qb, qe = basis_pair(base, extra, series, len(np.asarray(residuals)))
+    mb, *lb = _estimate(
         residuals,
         base,
         series,
         order=order,
-        interval=interval,
+        interval=False,
         basis=qb,
         prepared=pb,
         start_at=start_at,
         cross=cross[0],
     )
+
+    def chosen(m, fitted, around):
+        # the interval of the set chosen only (the other's would be thrown away)
+        loglik, low, ll = fitted
+        if interval and m.kappa and loglik is not None:
+            m = replace(m, bounds=_interval(loglik, m.kappa, ll, low))
+        return replace(m, around=around)
+
     if extra is None or not np.size(extra) or series is None:
-        return replace(mb, around="model")
-    me = estimate(
+        return chosen(mb, lb, "model")
+    me, *le = _estimate(
         residuals,
         None if qe is not None else np.column_stack([base, extra]),
         series,
         order=order,
-        interval=interval,
+        interval=False,
         basis=qe,
         prepared=pe,
         start_at=start_at,
         cross=cross[1],
     )
     if not np.isfinite(mb.ml) or not np.isfinite(me.ml):
-        return replace(me, around="model and structure shapes")
+        return chosen(me, le, "model and structure shapes")
     n = len(series.order)
     better = criterion(me.ml, me.regressors + me.order, n) < criterion(
         mb.ml, mb.regressors + mb.order, n
     )
-    return (
-        replace(me, around="model and structure shapes") if better else replace(mb, around="model")
-    )
+    return chosen(me, le, "model and structure shapes") if better else chosen(mb, lb, "model")
 
 
 def select_many(
@@ -827,12 +922,10 @@ def select_bases(
 ) -> Bases:
     """The :class:`Bases` of :func:`select`'s regressors on ``series``; with ``order``, also their
     likelihood parts for that AR order."""
-    qb = basis_on(base, series, n_obs)
-    qe = (
-        basis_on(np.column_stack([base, extra]), series, n_obs)
-        if extra is not None and np.size(extra)
-        else None
-    )
+    if extra is not None and np.size(extra):
+        qb, qe = basis_pair(base, extra, series, n_obs)
+    else:
+        qb, qe = basis_on(base, series, n_obs), None
     if order is None or series.projection is not None:
         return Bases(qb, qe)
     P = max(int(order), 1)

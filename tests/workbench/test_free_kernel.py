@@ -99,3 +99,30 @@ def test_residuals_follow_the_definition():
 )
 def test_rotation_deg_is_scipys(v):
     assert np.allclose(rotation_deg(v), Rotation.from_rotvec(np.radians(v)).as_matrix(), atol=1e-14)
+
+
+@pytest.mark.parametrize("acc", [True, False])
+@pytest.mark.parametrize("temp", [True, False])
+@pytest.mark.parametrize(
+    "names",
+    [
+        ALL,
+        ["field_ut", "field_down_ut", "hard_x_ut", "hard_y_ut", "hard_z_ut", "soft_xz"],
+        ["field_ut", "field_down_ut", "scale_x", "mis_z_deg", "temp_y_ut_c", "my_user_q"],
+    ],
+)
+def test_compiled_loop_equals_the_numpy_reference(acc, temp, names):
+    """The compiled residuals and Jacobian (numba) are the numpy formulation's, to rounding; a parameter the
+    kernel does not know (a user effect's) has a zero column."""
+    names = [q for q in names if acc or (q != "field_down_ut" and not q.startswith("mis"))]
+    m, a, dt = _data(seed=3, n=200)
+    k = FreeKernel(names, m, a if acc else None, dt if temp else None)
+    x = np.array([X.get(q, 0.7) for q in names], float)
+    r, rr = k.residuals(x), k.reference_residuals(x)
+    assert r.shape == rr.shape
+    np.testing.assert_allclose(r, rr, rtol=1e-12, atol=1e-11)
+    J, Jr = k.jacobian(x), k.reference_jacobian(x)
+    assert J.shape == Jr.shape
+    np.testing.assert_allclose(J, Jr, rtol=1e-12, atol=1e-12 * np.abs(Jr).max())
+    if "my_user_q" in names:
+        assert not J[:, names.index("my_user_q")].any()

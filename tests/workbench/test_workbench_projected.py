@@ -121,6 +121,23 @@ def test_the_compiled_kernels_equal_their_python_reference():
         )
 
 
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_one_pass_filter_is_the_gains_and_the_whitening(case):
+    """The likelihood's one-pass filter (issue 34: no gains kept) gives the numbers of the gains and the
+    whitening computed apart, bit for bit, and its Python reference the same to rounding."""
+    kappa, times, axes, drop = CASES[case]
+    ser, n_obs = _projected(times, axes, seed=len(case) + 2, drop=drop)
+    pr = ser.projection
+    clock, d = pr.clock[ser.order], np.ascontiguousarray(pr.directions[ser.order])
+    x = np.random.default_rng(8).standard_normal((len(clock), 4))
+    g = inn.gains(kappa, clock, d)
+    w, logdet = inn.whiten_direct(kappa, clock, d, inn.nugget_of(d), x)
+    assert np.array_equal(w, inn.whiten_columns(g, x)) and logdet == g.logdet
+    w_py, sd_py = inn._filter_whiten.py_func(g.phi, d, inn.nugget_of(d), x)
+    assert np.allclose(w, w_py, rtol=1e-12, atol=1e-13)
+    assert np.allclose(g.sd, sd_py, rtol=1e-13, atol=0)
+
+
 def test_a_projected_series_is_time_major():
     """Rows in time order, each row's observations together; segments start where the rows' did; leaving
     observations out keeps the time order; a series out of time order is refused by the filter."""
@@ -175,3 +192,21 @@ def test_whitening_and_the_likelihood_of_50000_observations_stay_linear_in_memor
     res = json.loads(out.stdout.strip().splitlines()[-1])
     assert res["kib"] < 200 * 1024, res
     assert res["order"] == 1 and res["lag1"] == pytest.approx(0.9, abs=0.02)
+
+
+def test_the_likelihoods_cholesky_parts_are_the_eigendecompositions():
+    """The RSS after the regressors and their log det from the Cholesky factor of the bordered Gram matrix
+    (the projected likelihood's, issue 34) equal the eigendecomposition's; a Gram matrix that is not
+    positive definite (the residual inside the regressors' span) falls back to it."""
+    rng = np.random.default_rng(9)
+    w = rng.standard_normal((400, 8))
+    M = w.T @ w
+    for k in (0, 1, 7):
+        rss, lg = serial._rss_g_cholesky(M[: k + 1, : k + 1], k)
+        ref = serial._rss_g(M[: k + 1, : k + 1], k)
+        assert rss == pytest.approx(ref[0], rel=1e-12) and lg == pytest.approx(ref[1], rel=1e-12)
+    w[:, -1] = w[:, :3] @ np.array([1.0, -2.0, 0.5])  # r in the span: RSS 0, not positive definite
+    M = w.T @ w
+    rss, lg = serial._rss_g_cholesky(M, 7)
+    ref = serial._rss_g(M, 7)
+    assert abs(rss) <= 1e-9 * M[-1, -1] and lg == pytest.approx(ref[1], rel=1e-12)

@@ -500,3 +500,39 @@ def test_the_vectorised_ar1_likelihoods_equal_the_fast_ones_and_pick_the_same_co
     for b in range(4):
         one = serial.select(E[:, b], X, S, ser, order=1, interval=False)
         assert many[b] == pytest.approx(one.lag1, abs=0.01)
+
+
+@pytest.mark.parametrize("structure", [False, True])
+def test_select_gives_the_chosen_sets_own_estimate_and_interval(structure):
+    """select computes the profile interval of kappa_1 for the chosen set of regressors only: the model it
+    returns is, number for number, that set's own estimate with its interval (issue 34: no work thrown
+    away)."""
+    n = 240
+    ser = serial.series_of(_frame(n), n, "magnetometer")
+    J = np.column_stack([np.ones(n), np.linspace(-1, 1, n)])
+    k = np.arange(n)
+    S = np.column_stack([np.cos(2 * np.pi * 3 * k / 120), np.sin(2 * np.pi * 3 * k / 120)])
+    y = serial.ar1_noise(np.random.default_rng(3), n, 1.0, 0.6)
+    if structure:
+        y = y + 3.0 * np.sin(2 * np.pi * 3 * k / 120)
+    m = serial.select(y, J, S, ser)
+    assert m.around == ("model and structure shapes" if structure else "model")
+    own = serial.estimate(y, np.column_stack([J, S]) if structure else J, ser)
+    assert m.kappa == own.kappa and m.bounds == own.bounds and len(m.bounds) == 2
+    assert m.bounds[0] < m.kappa[0] < m.bounds[1]
+    assert serial.select(y, J, S, ser, interval=False).bounds == ()
+
+
+def test_the_two_bases_of_select_come_from_one_orthogonalisation():
+    """basis_pair: the model's basis and the basis with the structure shapes from one Gram-Schmidt pass,
+    number for number what basis_on gives each (a dependent column dropped in both)."""
+    rng = np.random.default_rng(1)
+    n = 300
+    ser = serial.series_of(_frame(n), n, "magnetometer").without(rng.random(n) < 0.05)
+    B = rng.normal(size=(n, 5))
+    B[:, 4] = B[:, 0] - 2 * B[:, 1]
+    E = rng.normal(size=(n, 7))
+    qb, qe = serial.basis_pair(B, E, ser, n)
+    assert qb.shape == (n, 4) and qe.shape == (n, 11)
+    assert np.array_equal(qb, serial.basis_on(B, ser, n))
+    assert np.array_equal(qe, serial.basis_on(np.column_stack([B, E]), ser, n))
