@@ -544,7 +544,7 @@ def across_text(record: Mapping) -> str:
 def verdict_counts_text(record: Mapping) -> str:
     """ "13 rows: 5 reproduced, 7 cannot be judged, 1 no difference" from a record's ``across`` summary:
     how the verdict is spread over the entry's rows (the primary and its sensitivity), in the order of
-    :data:`navlib.verdicts.VERDICTS`; empty for an entry without rows."""
+    ``navlib.verdicts.VERDICTS``; empty for an entry without rows."""
     a = record.get("across") or {}
     n = int(a.get("rows") or 0)
     if n == 0:

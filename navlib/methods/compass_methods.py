@@ -88,7 +88,7 @@ class MethodParams:
     elm_max_nodes: int = 30  # incremental ELM: cap on the hidden-node count
     elm_goal_deg: float = 0.1  # incremental ELM: stop when the training RMS error (deg) is <= this
     elm_max_iter: int = 200  # incremental ELM: the patent's k (ELM and tuning stages together)
-    #: incremental ELM: prune nodes with max |beta_j| <= this after each ELM solve (the library default)
+    #: incremental ELM: prune nodes with max ``|beta_j|`` <= this after each ELM solve (the library default)
     elm_prune_tol: float = IncrementalELMParams.prune_tol
     ls_tol_deg: float = (
         1e-6  # 8-position LS: the reading used for a position lies within this of it

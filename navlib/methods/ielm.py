@@ -5,10 +5,10 @@ random hidden nodes", IEEE Trans. Neural Networks 17 (2006) 879-892, Sec. III (a
 network ``y = sum_j beta_j g(x w_j + b_j)`` (one hidden layer, no output bias, as
 :class:`navlib.methods.elm.ELMModel`) grows by one random hidden node per iteration, and only the new
 node's output weight is fitted, to the current residual; the earlier nodes and output weights stay frozen.
-With the residual ``e_0 = T`` and, at iteration L, the new node's output column ``h_L = g(X w_L + b_L)``,
+With the residual ``e_0 = T`` and, at iteration L, the new node's output column ``h_L = g(X w_L + b_L)``::
 
-    beta_L = <e_{L-1}, h_L> / <h_L, h_L>        (per output column: the 1-D least-squares fit of the
-                                                 residual on h_L, Huang et al. eq. (8))
+    beta_L = <e_{L-1}, h_L> / <h_L, h_L>    (per output column: the 1-D least-squares fit
+                                             of the residual on h_L, Huang et al. eq. (8))
     e_L    = e_{L-1} - h_L beta_L,
 
 so ``||e_L|| <= ||e_{L-1}||`` (the fit of one column can only lower the residual; Huang et al. Lemma 1)

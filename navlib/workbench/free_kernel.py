@@ -17,7 +17,7 @@ with ``du/db_j = -M e_j``, ``du/dk_j = -(T - T_c) M e_j`` and ``du/dK = dK v``. 
 (step 1e-4 deg).
 Rows are interleaved as the fit's residual vector is: ``[e_0, e_1]`` of row 0, then of row 1, and so on.
 
-The residuals and the Jacobian are computed row by row in one compiled loop (:func:`_invariants`, numba;
+The residuals and the Jacobian are computed row by row in one compiled loop (``_invariants``, numba;
 a fit evaluates them tens of times, and the numpy formulation spent most of its time allocating (n, 3)
 temporaries); :meth:`FreeKernel.reference_residuals` and :meth:`FreeKernel.reference_jacobian` are the
 numpy formulation the tests compare it with (equal to rounding).

@@ -210,7 +210,7 @@ def _filter_whiten(phi, d, nugget, x):
 
 def whiten_direct(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float, x: np.ndarray):
     """``(L^-1 x, log det R)`` for ``x`` (n, B) in filter order without keeping the gains
-    (:func:`_filter_whiten`): what a likelihood evaluated at many ``kappa`` needs."""
+    (``_filter_whiten``): what a likelihood evaluated at many ``kappa`` needs."""
     phi = propagation(kappa, clock)
     out, sd = _filter_whiten(phi, d, nugget, np.ascontiguousarray(x, float))
     return out, 2.0 * float(np.sum(np.log(sd)))

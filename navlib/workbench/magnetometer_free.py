@@ -637,7 +637,7 @@ def gauss_newton(kern: FreeKernel, x0: np.ndarray, steps: int = WARM_STEPS):
     curvature in ``D / F``) Gauss-Newton converges linearly, each step a fraction ``rho`` of the last in
     about the same direction; then the step is first tried extrapolated to the limit of that geometric
     series, ``dx / (1 - rho)`` (Aitken), and kept if it lowers the sum.  Returns ``(x, J)`` (J the Jacobian
-    at ``x``), or None when it has not converged in ``steps`` steps (:data:`WARM_TOL`) or the normal
+    at ``x``), or None when it has not converged in ``steps`` steps (``WARM_TOL``) or the normal
     equations are singular."""
     x = np.asarray(x0, float).copy()
     r = kern.residuals(x).ravel()
@@ -693,7 +693,7 @@ def gauss_newton(kern: FreeKernel, x0: np.ndarray, steps: int = WARM_STEPS):
 def warm_refit(fit: Fit, data: pd.DataFrame, effects=None) -> Fit | None:
     """The system's ``refit`` hook: ``fit``'s model (or the catalogue's ``effects``, parameters ``fit`` lacks
     starting at zero) on ``data`` (rows of the same recording, e.g. without the screen's outliers) by
-    :func:`gauss_newton` from ``fit``'s parameters -- the minimum the full fit (:func:`_fit_free` from
+    :func:`gauss_newton` from ``fit``'s parameters -- the minimum the full fit (``_fit_free`` from
     several starts) finds when the data or the model change little, in a few p x p solves.  None for a
     model with user effects or when the steps do not converge (the caller then fits in full)."""
     effects = tuple(fit.effects if effects is None else effects)

@@ -53,7 +53,7 @@ def second_order(df: pd.DataFrame) -> dict:
 
 
 def second_order_by_seed(params: PaperDParams, seeds) -> pd.DataFrame:
-    """:func:`second_order` of unit A's tumble per seed (its noise :func:`sim_seed` ``(seed, "noise_a")``, the
+    """:func:`second_order` of unit A's tumble per seed (its noise ``sim_seed(seed, "noise_a")``, the
     chapter's data), one row per seed."""
     rows = []
     for s in seeds:

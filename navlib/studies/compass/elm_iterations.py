@@ -51,9 +51,9 @@ def iteration_cap(params: StudyParams) -> int:
 
 
 def prune_tolerances(params: StudyParams, span_deg: float) -> dict[str, float]:
-    """The back-tuned runs' pruning tolerances (max |beta_j| of a pruned node, normalised output units):
+    """The back-tuned runs' pruning tolerances (max ``|beta_j|`` of a pruned node, normalised output units):
     the chapter's (``elm_prune_tol``), none (0: only exact zeros), and the goal's, ``elm_goal_deg`` /
-    ``span_deg``: since |g| <= 1, the largest tolerance at which one pruned node moves the output by no
+    ``span_deg``: since ``|g| <= 1``, the largest tolerance at which one pruned node moves the output by no
     more than the training goal."""
     return {
         BT: float(params.elm_prune_tol),
@@ -69,7 +69,7 @@ def iteration_study(
     workers: int = 1,
     scheduler: str | None = None,
 ) -> pd.DataFrame:
-    """Iterations to the training goal of the runs in :data:`RUNS`, one row per (run, seed):
+    """Iterations to the training goal of the runs in ``RUNS``, one row per (run, seed):
     ``iterations`` (counted as the module docstring says; at the cap when not reached), ``cap``,
     ``reached``, ``prune_tol`` (NaN for the I-ELM), ``train_rms_deg`` and ``test_rms_deg`` (sweep 2)
     at the stop, ``n_nodes``, ``prune_stages`` (ELM solves followed by a prune; 0 for the I-ELM) and

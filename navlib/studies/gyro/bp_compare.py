@@ -12,9 +12,9 @@ target (the drift, deg/h).
   initialisations, for every size of :class:`~navlib.studies.gyro.parameters.BpSettings` and three training
   readings (:data:`BP_READINGS`);
 - :func:`bp_claims`: C12's rows.  Per held-out row the BP net's error is the median over the initialisations
-  of ``|true - predicted|`` (what a typical single training gives, not an ensemble); the statistic is
+  of ``|true - predicted|`` (what a typical single training gives, not an ensemble); the statistic is::
 
-      RMS_i(e_RBF,i) - RMS_i(median_k |e_BP,ik|)                                              (eq. c12)
+      RMS_i(e_RBF,i) - RMS_i(median_k |e_BP,ik|)                  (eq. c12)
 
   over the same rows, with a percentile bootstrap over the rows (paired); the claim holds below 0.  The
   local-optimum row sets the RBF's spread over initialisations (zero: ``newrb`` is deterministic) against the
