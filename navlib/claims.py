@@ -26,7 +26,7 @@ import csv
 import functools
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -494,6 +494,15 @@ def row_margin(claim_text: str) -> float | None:
     return margins.pop() if len(margins) == 1 else None
 
 
+def with_register_margin(c: Claim) -> Claim:
+    """``c`` judged with its register entry's equivalence margin (:func:`row_margin`), as
+    :func:`evaluate` judges its row; ``c`` itself when it has a margin, no statistic or no entry with one."""
+    if c.margin is not None or c.estimate is None:
+        return c
+    m = row_margin(c.claim)
+    return c if m is None else replace(c, margin=m)
+
+
 def _across(primary: Mapping, others: list[Mapping], worlds: list[Mapping] | None) -> dict:
     """How the primary verdict moves: across the other rows (readings, noise levels, splits) and across
     drawn worlds (records ``{"compass"|"world", "claim", "reading", "verdict"}`` of the primary row)."""
@@ -793,4 +802,5 @@ __all__ = [
     "row_margin",
     "tally",
     "verdict_counts_text",
+    "with_register_margin",
 ]

@@ -40,6 +40,22 @@ def _glance_frame(claims: list[Claim]) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=GLANCE_COLUMNS)
 
 
+def claim_table(claims: Iterable[Claim], extra: tuple[str, ...] = ()) -> pd.DataFrame:
+    """One row per claim: its words, the fields named in ``extra`` (e.g. ``"reading"``, ``"source"``),
+    ours with its 95 % interval, the boundary and the verdict, judged with the register entry's
+    equivalence margin as the results file judges it (:func:`navlib.claims.with_register_margin`)."""
+    rows = []
+    for c in map(registry.with_register_margin, claims):
+        row = {"claim": c.claim} | {f: getattr(c, f) for f in extra}
+        row |= {
+            "ours: value [95 % interval]": c.interval_text,
+            "boundary": c.boundary_text,
+            "verdict": c.verdict,
+        }
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
 def tally_of(v: list[str]) -> str:
     """ "k of n reproduced, m not reproduced, j cannot be judged" (", e no difference" where a claim's
     equivalence margin decided it) for a list of verdict names."""

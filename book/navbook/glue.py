@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, Iterable
 
@@ -66,10 +65,7 @@ def glue_claims(claims: Iterable[Claim]) -> None:
     for c in claims:
         if not c.key:
             continue
-        if c.margin is None and c.estimate is not None:
-            # the register entry's equivalence margin, as navlib.claims.evaluate judges the row
-            m = registry.row_margin(c.claim)
-            c = c if m is None else replace(c, margin=m)
+        c = registry.with_register_margin(c)  # as navlib.claims.evaluate judges the row
         glue_text(c.key, c.verdict)
         detail = f"{c.verdict}: ours {c.interval_text}, boundary {c.boundary_text}"
         glue_text(f"{c.key}_detail", detail + (f" ({c.reason})" if c.reason else ""))

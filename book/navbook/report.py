@@ -48,7 +48,7 @@ from navlib.plotstyle import legend_below, legend_right, panel_grid, panels, sta
 from .claim_boxes import ANSWER_COLUMNS, GLANCE_COLUMNS, GLANCE_OPEN_ROWS, ON_REAL  # noqa: F401
 from .claim_boxes import READING_WORDS, VERDICTS_HREF, Answer, Glance, Showed, glance, showed  # noqa: F401
 from .claim_boxes import headline_sentence, reading_label, record_label, register_records  # noqa: F401
-from .claim_boxes import tally, tally_of  # noqa: F401
+from .claim_boxes import claim_table, tally, tally_of  # noqa: F401
 from .glue import glue_claims, glue_figure, glue_number, glue_png, glue_table, glue_text  # noqa: F401
 from .results import METHOD_KEYS, RESULTS_ENV, claims_summary, results_dir, write_results  # noqa: F401
 from .results import read_result, read_results  # noqa: F401

@@ -388,3 +388,22 @@ def test_glue_claims_judges_a_row_with_its_register_entrys_margin(monkeypatch):
     assert c.verdict == "reproduced"
     report.glue_claims([c])
     assert glued["k"] == "no difference"
+
+
+def test_claim_table_shows_each_claim_with_its_register_margin():
+    row = "BP beats 8-position LS [planar 5 par.]"
+    e = verdicts.Estimate(0.004, 0.0009, 0.0082, "paired difference", 20)
+    within = report.Claim(
+        row, "p", statistic="d, deg", estimate=e, boundary=0.0, holds_when="above", unit="deg"
+    )
+    t = report.claim_table([within, _claim((1.5, 2.0))], extra=("reading", "source"))
+    assert list(t.columns) == [
+        "claim",
+        "reading",
+        "source",
+        "ours: value [95 % interval]",
+        "boundary",
+        "verdict",
+    ]
+    assert t.verdict.tolist() == ["no difference", "not reproduced"]
+    assert t["ours: value [95 % interval]"][1] == "1.75 [1.5, 2] deg"
