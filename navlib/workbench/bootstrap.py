@@ -14,12 +14,12 @@ from ..seeding import child
 from .fit import Fit
 from .ftests import SPANNED, f_p, projector, unspanned
 from .linalg import cholesky_solve, inverse_factor, lower_solve, orth_basis
+from .noise_grid import select_ar1_many
 from .reml import _Prepared
 from .screen import Screening
 from .serial import (
     NoiseModel,
     colour,
-    select_ar1_many,
     select_bases,
     select_many,
     whiten,
@@ -140,7 +140,7 @@ def reestimate(E: np.ndarray, bases, noise: NoiseModel, regressors: tuple) -> li
     """Each column's noise model of ``E`` (residual vectors in observation order), chosen as the screen chose
     the data's (:func:`navlib.workbench.serial.select` around ``regressors``, whose orthonormal ``bases`` are
     given; the AR order fixed at the data's).  AR(1): every column's correlation on the grid at once
-    (:func:`navlib.workbench.serial.select_ar1_many`)."""
+    (:func:`navlib.workbench.noise_grid.select_ar1_many`)."""
     if noise.order == 1:
         return [
             NoiseModel((float(k),), noise.series, len(E))

@@ -78,7 +78,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 from scipy import special
-from scipy.linalg.lapack import dpotrf, dtrtrs
+from scipy.linalg.lapack import dpotrf
 from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
@@ -213,7 +213,7 @@ def with_projection(
     return Series(order, pos, series.source, Projection(d, clock))
 
 
-#: Filters of projected series kept (:func:`_projected_gains`).
+#: Filters of projected series kept (:func:`projected_gains`).
 _KEEP_GAINS = 6
 _GAINS: dict = {}
 _INPUTS: dict = {}
@@ -248,7 +248,7 @@ def _projected_inputs(series: Series, k: float) -> tuple:
     return clock, d, nugget
 
 
-def _projected_gains(kappa, series: Series) -> innovations.Gains:
+def projected_gains(kappa, series: Series) -> innovations.Gains:
     """The Kalman filter of the projected model (module docstring; :mod:`navlib.workbench.innovations`)
     over the observations of ``series``, in series order (time-major), AR(1): ``kappa[0]``; the last few
     are kept (a likelihood's optimiser and a bootstrap come back to the same ones)."""
@@ -290,7 +290,7 @@ def whiten(x: np.ndarray, kappa, series: Series, *, ordered: bool = False) -> np
     if p == 0:
         return xo
     if series.projection is not None:
-        return innovations.whiten_columns(_projected_gains(kappa, series), xo)
+        return innovations.whiten_columns(projected_gains(kappa, series), xo)
     phi, v = levinson(kappa)
     m = len(xo)
     out = xo.copy()
@@ -381,7 +381,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
         out[series.order] = u
         return out
     if series.projection is not None:
-        out[series.order] = innovations.colour_columns(_projected_gains(kappa, series), u)
+        out[series.order] = innovations.colour_columns(projected_gains(kappa, series), u)
         return out
     phi, v = levinson(kappa)
     x = np.empty_like(u)
@@ -932,108 +932,3 @@ def select_bases(
     return Bases(
         qb, qe, _Prepared(qb, series, P), _Prepared(qe, series, P) if qe is not None else None
     )
-
-
-#: The grid of lag-1 correlations on which :func:`ar1_grid` evaluates the likelihoods: uniform in
-#: ``atanh(kappa)`` over ``+-atanh(KAPPA_MAX)`` (spacing 0.025, so 0.005 in ``kappa`` near 0.9).
-AR1_GRID = np.tanh(np.linspace(-np.arctanh(KAPPA_MAX), np.arctanh(KAPPA_MAX), 241))
-
-
-def ar1_grid(
-    E: np.ndarray,
-    basis: np.ndarray,
-    series: Series,
-    grid: np.ndarray = AR1_GRID,
-    prepared: _Prepared | None = None,
-) -> tuple:
-    """REML and plain log likelihoods of AR(1) noise (module docstring) for many residual vectors at once,
-    on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
-    (:func:`basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
-    :class:`_Restricted` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
-    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix.  ``prepared``: the
-    basis's own blocks (:class:`_Prepared` of order 1), when many calls share the basis."""
-    pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
-    Ze = np.asarray(E, float)[series.order]
-    Cqe, Cee = pre.cross(Ze)
-    n, k = pre.n, pre.k
-    reml = np.empty((len(grid), Ze.shape[1]))
-    ml = np.empty_like(reml)
-    for g, phi in enumerate(grid):
-        w, ws, logdet_r = pre.weights((phi,))
-        mee = ws @ Cee
-        if k:
-            L = np.linalg.cholesky((ws @ pre.Gq).reshape(k, k))
-            z = dtrtrs(L, np.tensordot(w, Cqe, axes=1), lower=1)[0]
-            rss = mee - np.einsum("ij,ij->j", z, z)
-            logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-        else:
-            rss, logdet_g = mee, 0.0
-        rss = np.maximum(rss, 1e-300)
-        reml[g] = -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
-        ml[g] = -0.5 * (n * np.log(rss / n) + logdet_r)
-    return reml, ml
-
-
-def select_ar1_many(
-    E: np.ndarray, bases: Bases, series: Series, grid: np.ndarray = AR1_GRID
-) -> np.ndarray:
-    """:func:`select` at AR order 1 for many residual vectors at once (the columns of ``E``), the
-    correlation estimated on :data:`AR1_GRID` (REML maximised over the grid): the chosen lag-1
-    correlation of each vector."""
-    qb, qe = bases.base, bases.extra
-    if series.projection is not None:
-        grid = PROJECTED_GRID if regular_clock(series) else PROJECTED_GRID[PROJECTED_GRID >= 0]
-        parts = projected_grid(E, [q for q in (qb, qe) if q is not None], series, grid)
-        rb, mb = parts[0]
-        re_, me = parts[-1]
-    else:
-        rb, mb = ar1_grid(E, qb, series, grid, bases.prepared_base)
-    ib = np.argmax(rb, axis=0)
-    cols = np.arange(E.shape[1])
-    if qe is None:
-        return grid[ib]
-    if series.projection is None:
-        re_, me = ar1_grid(E, qe, series, grid, bases.prepared_extra)
-    ie = np.argmax(re_, axis=0)
-    n = len(series.order)
-    better = criterion(me[ie, cols], qe.shape[1] + 1, n) < criterion(
-        mb[ib, cols], qb.shape[1] + 1, n
-    )
-    return np.where(better, grid[ie], grid[ib])
-
-
-#: The grid of lag-1 correlations of the projected model's bootstrap re-estimates (:func:`projected_grid`):
-#: every fourth point of :data:`AR1_GRID` (spacing 0.1 in ``atanh(kappa)``, 0.02 in ``kappa`` near 0.9),
-#: since each point costs a pass of the filter over every replicate.
-PROJECTED_GRID = AR1_GRID[::4]
-
-
-def projected_grid(
-    E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID
-) -> list:
-    """:func:`ar1_grid` for a series with a :class:`Projection`: for each regressor basis of ``bases``,
-    ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one filter per grid point, shared."""
-    Ze = np.asarray(E, float)[series.order]
-    Qs = [np.asarray(Q, float)[series.order] for Q in bases]
-    n, B = Ze.shape
-    out = [(np.empty((len(grid), B)), np.empty((len(grid), B))) for _ in Qs]
-    for g, phi in enumerate(grid):
-        gains = _projected_gains((float(phi),), series)
-        logdet_r = gains.logdet
-        we = innovations.whiten_columns(gains, Ze)
-        ee = np.einsum("ij,ij->j", we, we)
-        for (reml, ml), Q in zip(out, Qs):
-            k = Q.shape[1]
-            if k:
-                wq = innovations.whiten_columns(gains, Q)
-                ev, U = np.linalg.eigh(wq.T @ wq)
-                ev = np.maximum(ev, 1e-300)
-                z = (U.T @ (wq.T @ we)) / np.sqrt(ev)[:, None]
-                rss = ee - np.einsum("ij,ij->j", z, z)
-                logdet_g = float(np.sum(np.log(ev)))
-            else:
-                rss, logdet_g = ee, 0.0
-            rss = np.maximum(rss, 1e-300)
-            reml[g] = -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
-            ml[g] = -0.5 * (n * np.log(rss / n) + logdet_r)
-    return out

@@ -74,7 +74,7 @@ def test_the_filter_equals_the_dense_cholesky_factor(case):
     ref = solve_triangular(L, xo, lower=True)
     assert np.max(np.abs(w - ref)) <= 1e-9 * max(1.0, np.max(np.abs(ref)))
     assert np.allclose(serial.whiten(x[:, 2], (kappa,), ser), w[:, 2], rtol=0, atol=1e-12)
-    g = serial._projected_gains((kappa,), ser)
+    g = serial.projected_gains((kappa,), ser)
     assert g.logdet == pytest.approx(2 * np.sum(np.log(np.diag(L))), abs=1e-9)
     u = np.random.default_rng(2).standard_normal((len(ser.order), 3))
     c = serial.colour(u, (kappa,), ser, n_obs)

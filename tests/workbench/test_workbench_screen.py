@@ -13,7 +13,7 @@ from navlib.data.gyro_tables import drift_measurements
 from navlib.errors import InputError
 from navlib.paths import data_path
 from navlib.studies import workbench as wb
-from navlib.workbench import serial
+from navlib.workbench import noise_grid, serial
 from navlib.workbench.diagnose import diagnose
 from navlib.workbench.fit import fit_model, load, simulate
 from navlib.workbench.loop import loop, write_report
@@ -491,12 +491,12 @@ def test_the_vectorised_ar1_likelihoods_equal_the_fast_ones_and_pick_the_same_co
     S = rng.standard_normal((600, 3))
     E = serial.colour(rng.standard_normal((len(ser.order), 4)), (0.8,), ser, 600)
     Q = serial.basis_on(X, ser, 600)
-    reml, ml = serial.ar1_grid(E, Q, ser)
+    reml, ml = noise_grid.ar1_grid(E, Q, ser)
     for g in (5, 120, 230):
         fast = serial._Restricted(E[:, 2], Q, ser, 1)
-        assert reml[g, 2] == pytest.approx(fast((serial.AR1_GRID[g],)), rel=1e-10)
-        assert ml[g, 2] == pytest.approx(fast.ml((serial.AR1_GRID[g],)), rel=1e-10)
-    many = serial.select_ar1_many(E, serial.select_bases(X, S, ser, 600), ser)
+        assert reml[g, 2] == pytest.approx(fast((noise_grid.AR1_GRID[g],)), rel=1e-10)
+        assert ml[g, 2] == pytest.approx(fast.ml((noise_grid.AR1_GRID[g],)), rel=1e-10)
+    many = noise_grid.select_ar1_many(E, serial.select_bases(X, S, ser, 600), ser)
     for b in range(4):
         one = serial.select(E[:, b], X, S, ser, order=1, interval=False)
         assert many[b] == pytest.approx(one.lag1, abs=0.01)
