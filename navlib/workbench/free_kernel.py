@@ -198,20 +198,25 @@ class FreeKernel:
     def _rotation(self, x) -> np.ndarray:
         return rotation_deg([self._get(x, q) for q in _MIS])
 
+    def _rotation_steps(self, x) -> np.ndarray:
+        """(3, 3, 3): the rotation's derivative with respect to each misalignment angle in the model
+        (central difference of :func:`rotation_deg`, step ``MIS_STEP_DEG``; zeros for the others)."""
+        dRs = np.zeros((3, 3, 3))
+        mis = [self._get(x, q) for q in _MIS]
+        for j, q in enumerate(_MIS):
+            if q in self.index:
+                up, dn = list(mis), list(mis)
+                up[j] += MIS_STEP_DEG
+                dn[j] -= MIS_STEP_DEG
+                dRs[j] = (rotation_deg(up) - rotation_deg(dn)) / (2 * MIS_STEP_DEG)
+        return dRs
+
     def _compiled(self, x, want_jac: bool):
         M = self._matrix(x)
         o = np.array([self._get(x, q) for q in _HARD])
         kt = np.array([self._get(x, q) for q in _TEMP])
         R = self._rotation(x)
-        dRs = np.zeros((3, 3, 3))
-        if want_jac and self.ahat is not None:
-            mis = [self._get(x, q) for q in _MIS]
-            for j, q in enumerate(_MIS):
-                if q in self.index:
-                    up, dn = list(mis), list(mis)
-                    up[j] += MIS_STEP_DEG
-                    dn[j] -= MIS_STEP_DEG
-                    dRs[j] = (rotation_deg(up) - rotation_deg(dn)) / (2 * MIS_STEP_DEG)
+        dRs = self._rotation_steps(x) if want_jac and self.ahat is not None else np.zeros((3, 3, 3))
         return _invariants(
             self.m,
             self._ahat,
@@ -289,14 +294,10 @@ class FreeKernel:
             J1[:, self.index["field_ut"]] = c / s + (de1_dc * (-D / F**2) if free else 0.0)
         if "field_down_ut" in self.index:
             J1[:, self.index["field_down_ut"]] = -1.0 / s + (de1_dc / F if free else 0.0)
-        mis = [self._get(x, q) for q in _MIS]
+        dRs = self._rotation_steps(x)
         for j, q in enumerate(_MIS):
             if q in self.index:
-                up, dn = list(mis), list(mis)
-                up[j] += MIS_STEP_DEG
-                dn[j] -= MIS_STEP_DEG
-                dR = (rotation_deg(up) - rotation_deg(dn)) / (2 * MIS_STEP_DEG)
-                J1[:, self.index[q]] = np.einsum("ij,ij->i", self.ahat @ dR, u) / s
+                J1[:, self.index[q]] = np.einsum("ij,ij->i", self.ahat @ dRs[j], u) / s
         J = np.empty((2 * n, p))
         J[0::2], J[1::2] = J0, J1
         return J
