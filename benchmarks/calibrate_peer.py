@@ -53,7 +53,8 @@ from navlib.methods.ellipsoid import lm_ellipsoid
 from navlib.studies.workbench import MAG_DIR, calibration_beside_peer
 from navlib.workbench.calibration import calibrate
 from navlib.workbench.magnetometer import MAG
-from navlib.workbench.magnetometer_free import DERIVED, load_free, simulate_free
+from navlib.workbench.free_simulation import simulate_free
+from navlib.workbench.magnetometer_free import DERIVED, load_free
 
 #: The simulated recording timed beside the peer: hard iron, scale and soft iron, 0.3 uT of noise.
 SIM_TRUTH = {

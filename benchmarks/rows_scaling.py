@@ -1,6 +1,6 @@
 """Cost of ``navlib calibrate magnetometer`` against the number of rows (issue 34): the library call the
 CLI makes (:func:`navlib.workbench.calibration.calibrate`) on simulated hand-held magnetometer recordings
-(:func:`navlib.workbench.magnetometer_free.simulate_free`, 10 Hz, AR(1) noise of lag-1 correlation 0.9, an
+(:func:`navlib.workbench.free_simulation.simulate_free`, 10 Hz, AR(1) noise of lag-1 correlation 0.9, an
 accelerometer, so two invariants per row), each size in a fresh process: wall time of the call, the growth
 of the process's peak resident memory during it, and the exponent ``a`` of ``time ~ rows^a`` fitted by
 least squares on the log-log points.  A warm-up call on a short recording comes first (numba kernels
@@ -30,7 +30,7 @@ TRUTH = {"hard_x_ut": 12.0, "hard_y_ut": -5.0, "hard_z_ut": 3.0, "scale_x": 0.02
 def one(rows: int) -> dict:
     """Time one calibration of ``rows`` rows in this process (after a warm-up)."""
     from navlib.workbench.calibration import calibrate
-    from navlib.workbench.magnetometer_free import simulate_free
+    from navlib.workbench.free_simulation import simulate_free
 
     calibrate(simulate_free(TRUTH, duration_s=300 / RATE_HZ, noise_correlation=0.9, seed=0))
     data = simulate_free(

@@ -20,7 +20,7 @@ import time
 import pandas as pd
 
 from navlib.verdicts import wilson
-from navlib.workbench.magnetometer_free import hidden_effect_study
+from navlib.workbench.free_simulation import hidden_effect_study
 
 
 def main():

@@ -77,7 +77,7 @@ def calibrate(
 
     >>> import numpy as np
     >>> from navlib.workbench.calibration import calibrate
-    >>> from navlib.workbench.magnetometer_free import simulate_free
+    >>> from navlib.workbench.free_simulation import simulate_free
     >>> truth = {"hard_x_ut": 12.0, "hard_y_ut": -5.0, "hard_z_ut": 3.0,
     ...          "scale_x": 0.02, "soft_xy": 0.01}
     >>> cal = calibrate(simulate_free(truth, seed=1))

@@ -26,7 +26,7 @@ import pandas as pd
 
 from .. import verdicts
 from ..errors import InputError, check_param
-from . import accelerometer, magnetometer_free
+from . import accelerometer, free_simulation
 from .effects import get_system
 from .trials import TRIAL_SYSTEMS, hidden_effect_study, out_of_catalogue_study
 
@@ -191,7 +191,7 @@ def rates(
         )
         study["noise"] = study.pop("noise_ug") / 1000.0
     elif system == "magnetometer_free":
-        study = magnetometer_free.hidden_effect_study(
+        study = free_simulation.hidden_effect_study(
             ratios, noises, seeds, none_seeds, workers=workers, scheduler=scheduler
         )
     else:

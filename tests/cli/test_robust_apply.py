@@ -13,6 +13,7 @@ import pytest
 from navlib.cli import main
 from navlib.errors import InputError
 from navlib.workbench import calibration as C
+from navlib.workbench import free_simulation as FS
 from navlib.workbench import magnetometer_free as MF
 
 TRUE = {"hard_x_ut": 6.0, "hard_y_ut": -4.0, "hard_z_ut": 2.5, "scale_x": 0.03, "soft_xy": 0.015}
@@ -22,7 +23,7 @@ TRUE = {"hard_x_ut": 6.0, "hard_y_ut": -4.0, "hard_z_ut": 2.5, "scale_x": 0.03, 
 def files(tmp_path_factory):
     """A simulated recording and its calibration (written by ``navlib calibrate``)."""
     folder = tmp_path_factory.mktemp("apply")
-    data = MF.simulate_free(TRUE, duration_s=20.0, noise_ut=0.3, seed=np.random.SeedSequence(35))
+    data = FS.simulate_free(TRUE, duration_s=20.0, noise_ut=0.3, seed=np.random.SeedSequence(35))
     src = folder / "sim.csv"
     data.drop(columns=list(MF.DERIVED)).to_csv(src, index=False)
     cal = folder / "cal.json"

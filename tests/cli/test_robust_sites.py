@@ -11,6 +11,7 @@ import pytest
 from navlib import cli
 from navlib.errors import InputError
 from navlib.sensors.earth_field import Site, igrf_field
+from navlib.workbench import free_simulation as FS
 from navlib.workbench import magnetometer_free as MF
 
 
@@ -75,7 +76,7 @@ def test_a_negative_latitude_in_both_forms(capsys):
 
 @pytest.fixture(scope="module")
 def sim():
-    return MF.simulate_free(
+    return FS.simulate_free(
         {"hard_x_ut": 5.0, "scale_x": 0.02},
         duration_s=20.0,
         noise_ut=0.3,

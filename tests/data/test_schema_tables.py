@@ -13,7 +13,7 @@ from navlib.paths import data_path
 from navlib.workbench import SYSTEMS, get_system
 from navlib.workbench.effects import columns_table
 from navlib.workbench.magnetometer import simulate_magnetometer
-from navlib.workbench.magnetometer_free import simulate_free
+from navlib.workbench.free_simulation import simulate_free
 
 
 def _valid_frame(system: str) -> pd.DataFrame:

@@ -8,7 +8,8 @@ import pytest
 
 from navlib.workbench import free_breakdown as fb
 from navlib.workbench.loop import loop, write_report
-from navlib.workbench.magnetometer_free import DERIVED, simulate_free
+from navlib.workbench.free_simulation import simulate_free
+from navlib.workbench.magnetometer_free import DERIVED
 
 RNG = np.random.default_rng(5)
 N = 2000

@@ -12,11 +12,11 @@ from navlib.workbench.effects import Effect
 from navlib.workbench.fit import fit_model, refit_rows
 from navlib.workbench.free_kernel import FreeKernel
 from navlib.workbench.local_field import parameter_covariance
+from navlib.workbench.free_simulation import simulate_free
 from navlib.workbench.magnetometer_free import (
     DERIVED,
     SYSTEM,
     gauss_newton,
-    simulate_free,
     warm_refit,
     with_invariants,
 )

@@ -13,6 +13,7 @@ from navlib.cli import main
 from navlib.errors import InputError
 from navlib.sensors.earth_field import Site, igrf_field
 from navlib.workbench import get_system
+from navlib.workbench import free_simulation as FS
 from navlib.workbench import magnetometer_free as MF
 from navlib.workbench.local_field import field_check
 from navlib.workbench.diagnose import diagnose
@@ -34,7 +35,7 @@ NOISE = 0.3
 @pytest.fixture(scope="module")
 def sim():
     """A 30 s hand-turned recording with hard iron and the full ellipsoid, no misalignment/temperature."""
-    return MF.simulate_free(TRUE, duration_s=30.0, noise_ut=NOISE, seed=np.random.SeedSequence(23))
+    return FS.simulate_free(TRUE, duration_s=30.0, noise_ut=NOISE, seed=np.random.SeedSequence(23))
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +61,7 @@ def test_registered_and_fits_the_truth(sim):
 
 
 def _trials(rho, seeds, nulls):
-    st = MF.hidden_effect_study(
+    st = FS.hidden_effect_study(
         ratios=(3.0,),
         noises=(NOISE,),
         seeds=range(seeds),
@@ -98,7 +99,7 @@ def test_noise_model_on_the_sensor_axes_not_on_the_invariants(seed):
     from navlib.workbench.screen import screen
     from navlib.workbench.serial import KAPPA_MAX, select, series_of
 
-    d = MF.simulate_free(
+    d = FS.simulate_free(
         {"hard_x_ut": 5.0},
         duration_s=20.0,
         noise_ut=NOISE,
@@ -232,7 +233,7 @@ def test_calibrate_apply_round_trip_and_uncertainties(sim, sim_file, tmp_path, c
     )
     # the corrected field is the true body field to the noise (no misalignment simulated)
     true_u = (sim[list(MF.MAG)].to_numpy() - b_true) @ A_true.T
-    noise_free = MF.simulate_free(
+    noise_free = FS.simulate_free(
         TRUE, duration_s=30.0, noise_ut=0.0, seed=np.random.SeedSequence(23)
     )
     v = (noise_free[list(MF.MAG)].to_numpy() - b_true) @ A_true.T
@@ -349,7 +350,7 @@ def test_igrf_ships_offline_and_bad_site():
 def test_field_check_flags_an_anomaly_and_not_the_model_field(sim):
     site = Site(52.5, 13.4, 50.0, "2021-01-01")
     model = igrf_field(site)
-    same = MF.simulate_free(
+    same = FS.simulate_free(
         TRUE,
         duration_s=20.0,
         noise_ut=NOISE,
