@@ -34,10 +34,10 @@ def ar1_grid(
 ) -> tuple:
     """REML and plain log likelihoods of AR(1) noise (module docstring) for many residual vectors at once,
     on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
-    (:func:`basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
-    :class:`_Restricted` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
+    (:func:`~navlib.workbench.serial.basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
+    ``serial._Restricted`` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
     blocks are shared, each grid point costs one Cholesky factor of a k x k matrix.  ``prepared``: the
-    basis's own blocks (:class:`_Prepared` of order 1), when many calls share the basis."""
+    basis's own blocks (``reml._Prepared`` of order 1), when many calls share the basis."""
     pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
     Ze = np.asarray(E, float)[series.order]
     Cqe, Cee = pre.cross(Ze)
@@ -97,7 +97,7 @@ PROJECTED_GRID = AR1_GRID[::4]
 def projected_grid(
     E: np.ndarray, bases: list, series: Series, grid: np.ndarray = PROJECTED_GRID
 ) -> list:
-    """:func:`ar1_grid` for a series with a :class:`Projection`: for each regressor basis of ``bases``,
+    """:func:`ar1_grid` for a series with a :class:`~navlib.workbench.serial.Projection`: for each regressor basis of ``bases``,
     ``(reml, ml)`` (len(grid) x B) of the columns of ``E``; one filter per grid point, shared."""
     Ze = np.asarray(E, float)[series.order]
     Qs = [np.asarray(Q, float)[series.order] for Q in bases]
