@@ -37,6 +37,8 @@ The modules, each importing only those listed before it:
   splits;
 - :mod:`~navlib.studies.accelerometer.models` -- the physical baseline, the exact model, the swarm's fitness
   and the grid tuner;
+- :mod:`~navlib.studies.accelerometer.separate` -- the separate bias and scale-factor compensator the
+  integrated model is argued against (D11);
 - :mod:`~navlib.studies.accelerometer.runs` -- one seed fitted by every method, the chapter's batch of runs,
   their errors;
 - :mod:`~navlib.studies.accelerometer.floors` -- the noise floors of the statistics;
@@ -48,7 +50,8 @@ The modules, each importing only those listed before it:
   over the seeds, the worst case of the conjunction;
 - :mod:`~navlib.studies.accelerometer.second_order` -- "K2 and Kip negligible": the second-order terms of
   the tumbles' Fourier fits (true or false by construction of our simulator);
-- :mod:`~navlib.studies.accelerometer.claims` -- the claims and the verdict grid.
+- :mod:`~navlib.studies.accelerometer.claims` -- the claims (integrated against separate models among
+  them) and the verdict grid.
 
 Every name the chapter and the tests use is re-exported here: ``from navlib.studies import accelerometer as
 D; D.run_chapter(...)``.
@@ -57,6 +60,7 @@ D; D.run_chapter(...)``.
 # re-exported: the names the chapter and the tests use (ruff: F401 would call them unused)
 from .parameters import (
     BATCH_SPREADS,
+    K1_MIN_INPUT_G,
     METHODS,
     MIN_SEEDS_FOR_CLAIMS,
     NEARLY_TWO_ORDERS,
@@ -65,6 +69,7 @@ from .parameters import (
     PAPER_FILE,
     SIM_ENTROPY,
     SIM_PARTS,
+    SEPARATE,
     SPLIT_MODES,
     TUNERS,
     PaperDParams,
@@ -73,6 +78,7 @@ from .parameters import (
 )
 from .simulation import random_split, samples, sim_seed, simulate, split, unit_b_coefficients  # noqa: F401
 from .models import PolyCompensator, fit_physical, grid_search, oracle, scm_objective  # noqa: F401
+from .separate import SeparateCompensator, bias_points, fit_separate  # noqa: F401
 from .runs import Chapter, Run, errors_long, metrics, run_chapter, run_seed, run_study  # noqa: F401
 from .floors import max_error_floor_ug, rmse_floor_ug  # noqa: F401
 from .figures import (
@@ -104,6 +110,8 @@ from .claims import (
     drift_claims,
     noise_claims,
     reading_claims,
+    separate_claims,
+    separate_noise_claims,
     tuner_claims,
     two_orders_claims,  # noqa: F401
     unit_b_spread_claims,

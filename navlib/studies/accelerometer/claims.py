@@ -17,8 +17,10 @@ from ...errors import InputError
 from .figures import drift_by_seed
 from .floors import _floors, _test_floor, max_error_floor_ug
 from .parameters import (
+    K1_MIN_INPUT_G,
     METHODS,
     MIN_SEEDS_FOR_CLAIMS,
+    SEPARATE,
     NEARLY_TWO_ORDERS,
     ORDER_OF_MAGNITUDE,
     TUNERS,
@@ -666,3 +668,51 @@ def verdict_grid(claims: list, column: str = "reading", rows: str = "claims") ->
         t = t.rename_axis(columns=None)
         return t.fillna("–").reset_index().rename(columns={"claim": f"claim (by {prefix})"})
     return t.fillna("–").reset_index()  # a claim not judged under that reading among these rows
+
+
+# ------------------------------------------------- D11: the integrated model against separate K0, K1
+def separate_claims(err: pd.DataFrame, params: PaperDParams, reading: str, key: str = "") -> list:
+    """D11 under one reading: the integrated model (``ANFIS``) against the separate ``K0``, ``K1``
+    compensator fitted the same way (:mod:`~navlib.studies.accelerometer.separate`), as the paired
+    difference RMSE separate - RMSE integrated on the test readings over the same seeds (ug, boundary 0,
+    holds above)."""
+    n = err["seed"].nunique()
+    if n < MIN_SEEDS_FOR_CLAIMS:
+        raise InputError(
+            f"parameter seeds: the 95 % intervals of the claims need at least "
+            f"{MIN_SEEDS_FOR_CLAIMS} seeds, got {n}"
+        )
+    t = per_seed(err, (SEPARATE, "ANFIS"), "test")
+    return [
+        Claim(
+            "integrated model beats separate K0, K1 models",
+            "the integrated model reduces the repeated modelling error (no number printed)",
+            reading=reading,
+            statistic="RMSE separate K0, K1 - RMSE integrated, both genfis2 then ANFIS, test "
+            "readings, same seeds, ug",
+            estimate=verdicts.paired_difference(t[SEPARATE], t["ANFIS"]),
+            boundary=0.0,
+            holds_when="above",
+            unit="ug",
+            decided_by=(
+                f"sensor noise {params.experiment.noise_ug:g} ug per reading",
+                "our simulated sensor",
+                f"all three models genfis2 at radius {params.fis_radius:g} (MATLAB's default) "
+                f"then ANFIS ({params.anfis.epochs} epochs)",
+                f"K1 trained on |a| >= {K1_MIN_INPUT_G:g} g (undefined at a = 0)",
+            ),
+            ours=f"{t[SEPARATE].median():.1f} vs {t['ANFIS'].median():.1f} ug",
+            spec="{:.3g}",
+            key=key,
+        )
+    ]
+
+
+def separate_noise_claims(noise_err: pd.DataFrame, params: PaperDParams) -> list:
+    """:func:`separate_claims` on held-out temperatures at every noise level of the noise study (reading
+    ``held-out temperatures, noise <v> ug``)."""
+    out = []
+    for v, e in noise_err.groupby("noise_ug", sort=True):
+        p = replace(params, experiment=replace(params.experiment, noise_ug=float(v)))
+        out += separate_claims(e, p, f"held-out temperatures, noise {v:g} ug")
+    return out

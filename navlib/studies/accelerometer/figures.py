@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ...sensors.accelerometer import T_REF_C, bias_test, simulate_tumble
-from .parameters import METHODS, PaperDParams, _paper_value
+from .parameters import K1_MIN_INPUT_G, METHODS, PaperDParams, _paper_value
 from .runs import Run
 from .simulation import samples, sim_seed
 
@@ -42,7 +42,7 @@ def fig4_scale_factor(
     df: pd.DataFrame,
     params: PaperDParams,
     unit: str = "A",
-    min_input_g: float = 0.25,
+    min_input_g: float = K1_MIN_INPUT_G,
     seed: int = 0,
 ) -> pd.DataFrame:
     """Fig 4: scale factor by the paper's eq 3, ``K1(T, a) = (U(T, a) - K0(T))/a`` with ``K0`` from the

@@ -21,6 +21,12 @@ from ...sensors.accelerometer import AccelCoefficients, TumbleExperiment
 METHODS = ("ANN", "FIS", "ANFIS", "IAFSA-SCM-ANFIS", "physical (poly K0, K1, K2)")
 #: The other tuners of the clustering radii (``PaperDParams.tuners``): plain AFSA and a grid, same budget.
 TUNERS = ("AFSA-SCM-ANFIS", "grid-SCM-ANFIS")
+#: The separate bias and scale-factor compensator the paper's integrated model is argued against (section 2,
+#: register entry D11; :mod:`~navlib.studies.accelerometer.separate`), fitted like ``ANFIS``.
+SEPARATE = "separate K0, K1 (ANFIS)"
+#: Readings with a smaller input than this (g) give no scale-factor point ``(U - K0) / a`` (eq 3 is
+#: undefined at ``a = 0`` and amplifies the noise near it); the value of the chapter's Fig 4.
+K1_MIN_INPUT_G = 0.25
 #: "Nearly two orders of magnitude" better than the single models (section 5.2): two defensible
 #: boundaries on the RMSE ratio, 50x (within a factor 2 of 100) and 10^1.5 = 31.6x (nearer to two
 #: orders than to one on a log scale).

@@ -17,7 +17,8 @@ from ...methods.fish_swarm import minimise
 from ...methods.mlp import train_mlp
 from ...methods.subclust import genfis2
 from .models import _genfis2_capped, fit_physical, grid_search, oracle, scm_objective
-from .parameters import METHODS, TUNERS, PaperDParams
+from .parameters import METHODS, SEPARATE, TUNERS, PaperDParams
+from .separate import fit_separate
 from .simulation import random_split, samples, simulate, split
 
 
@@ -90,6 +91,7 @@ def run_seed(params: PaperDParams, seed: int, df: pd.DataFrame | None = None) ->
     phys = fit_physical(train_df[(a["set"] != "test").to_numpy()], params.poly_degree, ref)
     models["physical (poly K0, K1, K2)"] = phys
     models["oracle"] = oracle(params.coefficients, ref)
+    models[SEPARATE] = fit_separate(a, params)
     for name, m in models.items():
         a[f"pred_{name}"] = m(X)
         if b is not None:
@@ -216,8 +218,8 @@ def errors_long(runs: list[Run]) -> pd.DataFrame:
         parts = [(s, r.a[r.a["set"] == s]) for s in ("train", "check", "test")]
         if r.b is not None:
             parts.append(("unit B", r.b))
-        tuners = [t for t in TUNERS if f"pred_{t}" in r.a.columns]
-        for name in (*METHODS, *tuners, "oracle", "uncompensated"):
+        extra = [t for t in (*TUNERS, SEPARATE) if f"pred_{t}" in r.a.columns]
+        for name in (*METHODS, *extra, "oracle", "uncompensated"):
             for s, g in parts:
                 pred = g["output_mg"] if name == "uncompensated" else g[f"pred_{name}"]
                 m = metrics(pred - g["target_mg"], g["target_mg"])

@@ -200,4 +200,3 @@ def test_register_names_the_rows_the_chapter_writes():
     assert d14.primary_reading == cl14[0].reading
     assert (d14.boundary, d14.holds_when, d14.unit) == (4.0, "below", "ug")
     assert d14.statistic == cl14[0].statistic
-    assert es["D11"].status == "open"
