@@ -162,4 +162,6 @@ def fit_separate(
     ck = use & (s["set"] == "check").to_numpy()
     X1 = np.column_stack([t, a])
     k1 = _fit(X1[tr], k1_target[tr], (X1[ck], k1_target[ck]), radius, params.anfis)
-    return SeparateCompensator(k0, k1, t55, (float(k1_target[tr].min()), float(k1_target[tr].max())))
+    return SeparateCompensator(
+        k0, k1, t55, (float(k1_target[tr].min()), float(k1_target[tr].max()))
+    )

@@ -74,9 +74,7 @@ def _run_frame(split_mode="temperatures", noise_ug=3.0, seed=0):
     p = replace(p, experiment=replace(p.experiment, noise_ug=noise_ug))
     df = D.simulate(p, seed)
     a = D.samples(df, "A", p.experiment.reference_c)
-    a["set"] = (
-        D.split(a, p) if split_mode == "temperatures" else D.random_split(a, p, seed)
-    )
+    a["set"] = D.split(a, p) if split_mode == "temperatures" else D.random_split(a, p, seed)
     return p, a
 
 
@@ -195,7 +193,9 @@ def test_register_entry_d11_names_the_rows_the_chapter_writes():
     from navlib import claims as register
 
     d11 = next(e for e in register.load_register("paper_d") if e.id == "D11")
-    c = D.separate_claims(_err(np.full(8, 5.0)), D.PaperDParams(), "random split of the readings")[0]
+    c = D.separate_claims(_err(np.full(8, 5.0)), D.PaperDParams(), "random split of the readings")[
+        0
+    ]
     assert d11.status == "judged" and d11.rows == (c.claim,) and d11.primary_claim == c.claim
     assert d11.primary_reading == c.reading
     assert (d11.boundary, d11.holds_when, d11.unit, d11.statistic) == (
