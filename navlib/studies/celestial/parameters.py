@@ -266,6 +266,7 @@ NOTEBOOK_DEFAULTS = {
     "sweep_repeats": 4,
     "latency_ms_levels": (10.0, 50.0),
     "smear_levels_arcsec_per_deg_s": (2.0, 5.0, 10.0),
+    "quiet_repeats": 10,
     "seed": 0,
     "n_workers": 2,
     "scheduler": None,

@@ -57,6 +57,7 @@ def test_the_notebooks_defaults_give_the_spec_its_mapping_cell_builds():
         sweep_repeats=p["sweep_repeats"],
         latency_ms_levels=tuple(p["latency_ms_levels"]),
         smear_levels_arcsec_per_deg_s=tuple(p["smear_levels_arcsec_per_deg_s"]),
+        quiet_repeats=p["quiet_repeats"],
         seed=p["seed"],
     )
     assert StudySpec.from_notebook(**p) == expected
