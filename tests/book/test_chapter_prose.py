@@ -20,9 +20,7 @@ DEFINING = re.compile(
 def _markdown(path: Path) -> list[tuple[int, str]]:
     nb = json.loads(path.read_text(encoding="utf-8"))
     return [
-        (i, "".join(c["source"]))
-        for i, c in enumerate(nb["cells"])
-        if c["cell_type"] == "markdown"
+        (i, "".join(c["source"])) for i, c in enumerate(nb["cells"]) if c["cell_type"] == "markdown"
     ]
 
 
