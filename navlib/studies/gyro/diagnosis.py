@@ -5,7 +5,7 @@ C17, Sec. 2.1) and the cold-start diagnosis (C19, C20, C21, Sec. 2.3).
   static base".  Per error source, the largest gap between the full static-base error model and Table 1's
   closed form over the 12 h navigation the paper reads, relative to the model's amplitude there::
 
-      g = max_{0 <= t <= 12 h} |dL_sim(t) - dL_T1(t)| / max_{0 <= t <= 12 h} |dL_sim(t)|    (eq. c17)
+      g = max_t |dL_sim(t) - dL_T1(t)| / max_t |dL_sim(t)|,  0 <= t <= 12 h    (eq. c17)
 
   from the runs of :func:`~navlib.studies.gyro.simulation.table1_vs_simulator` (one run per source, no
   draws: exact); Table 1 in the book's sign convention, its velocity term with ``R w_s`` (the printed
@@ -15,7 +15,7 @@ C17, Sec. 2.1) and the cold-start diagnosis (C19, C20, C21, Sec. 2.3).
 
   * C19, a cold start identified by the hot net is worse than a hot start::
 
-        mean(P_hot net, Table 5) - mean(P_after, Table 3)                             (eq. c19)
+        mean(P_hot net, Table 5) - mean(P_after, Table 3)               (eq. c19)
 
     (72 h position errors, nmi; the two tables' rows are different tests, so each is resampled on its
     own: an unpaired bootstrap); beside it the drift errors, ``mean |true - hot net|`` over Table 4 less
@@ -27,7 +27,7 @@ C17, Sec. 2.1) and the cold-start diagnosis (C19, C20, C21, Sec. 2.3).
     Table 4, the hot net less one temperature-rate term (the chapter's eq. gyro-rate, ``k_R`` by
     :func:`~navlib.studies.gyro.networks.rate_coefficient` on the other five rows)::
 
-        RMS_i(true_i - (h_i - k_R(-i) r_i)) - RMS_i(true_i - h_i)                    (eq. c21)
+        RMS_i(true_i - (h_i - k_R(-i) r_i)) - RMS_i(true_i - h_i)       (eq. c21)
 
     with ``h`` the hot net's output and ``r`` the temperature change (a constant window length scales
     ``k_R`` and cancels), bootstrap over the rows (paired); the claim holds above 0.
@@ -316,7 +316,7 @@ def cold_diagnosis_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 estimate=verdicts.bootstrap([x, e], _corr, seed=s20),
                 boundary=0.0,
                 holds_when="above",
-                unit="-",
+                unit="",  # a correlation has none
                 decided_by=(f"bootstrap over Table 4's {y4.size} rows", net_text[net]),
                 ours=f"r = {_corr(x, e):.2f}",
                 key=key,
