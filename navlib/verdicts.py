@@ -210,11 +210,15 @@ def bootstrap(
     """A statistic of a real table with a percentile bootstrap interval over its rows.
 
     ``data`` is a sequence of equal-length arrays (columns; rows are resampled together when ``paired``),
-    ``statistic(*columns)`` returns a number.  ``seed`` is a ``numpy.random.SeedSequence`` (or an
-    integer entropy) so that the interval is the same in every run."""
+    ``statistic(*columns)`` returns a number.  Unpaired (``paired=False``: independent samples, each
+    resampled on its own, e.g. two tables' rows) the columns may differ in length, and ``n`` counts the
+    rows of all of them.  ``seed`` is a ``numpy.random.SeedSequence`` (or an integer entropy) so that
+    the interval is the same in every run."""
     cols = [np.asarray(c, dtype=float) for c in data]
-    if not cols or any(c.shape[0] != cols[0].shape[0] for c in cols) or cols[0].shape[0] < 2:
-        raise InputError("bootstrap: give at least one column, all of the same length >= 2")
+    if not cols or any(c.shape[0] < 2 for c in cols):
+        raise InputError("bootstrap: give at least one column, each of length >= 2")
+    if paired and any(c.shape[0] != cols[0].shape[0] for c in cols):
+        raise InputError("bootstrap: paired columns must have the same length")
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     from scipy import stats  # noqa: PLC0415  # lazy: as in wilson
 
@@ -230,9 +234,8 @@ def bootstrap(
     )
     value = float(statistic(*cols))
     lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
-    return Estimate(
-        value, min(lo, value), max(hi, value), "bootstrap over rows", int(cols[0].shape[0])
-    )
+    n = int(cols[0].shape[0]) if paired else int(sum(c.shape[0] for c in cols))
+    return Estimate(value, min(lo, value), max(hi, value), "bootstrap over rows", n)
 
 
 def exact(value: float) -> Estimate:

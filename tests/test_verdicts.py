@@ -185,3 +185,15 @@ def test_an_equivalence_margin_gives_the_fourth_outcome():
     with pytest.raises(InputError, match="positive number"):
         verdicts.decide((0, 1), 0.0, "above", margin=0.0)
     assert "no difference" in verdicts.VERDICTS and "no difference" in verdicts.VERDICT_DEFINITIONS
+
+
+def test_unpaired_bootstrap_takes_samples_of_different_sizes():
+    a, b = np.array([1.8, 1.7, 1.3, 1.6]), np.array([0.5, 0.6, 0.6])
+    d = verdicts.bootstrap([a, b], lambda u, v: np.mean(u) - np.mean(v), seed=2, paired=False)
+    # each sample resampled on its own: the interval lies within the extremes of the two
+    assert a.min() - b.max() <= d.lo <= d.value <= d.hi <= a.max() - b.min()
+    assert d.n == a.size + b.size
+    with pytest.raises(InputError, match="same length"):
+        verdicts.bootstrap([a, b], lambda u, v: np.mean(u) - np.mean(v), seed=2)
+    with pytest.raises(InputError, match="length >= 2"):
+        verdicts.bootstrap([a, b[:1]], lambda u, v: 0.0, seed=2, paired=False)

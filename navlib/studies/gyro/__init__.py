@@ -29,6 +29,9 @@ Which module holds what, in the order they import each other (each imports only 
 - :mod:`~navlib.studies.gyro.thermal_worlds` -- the cold-state protocol in simulated thermal worlds;
 - :mod:`~navlib.studies.gyro.bp_compare` -- the hot net against MATLAB's BP network by leave-one-out over
   Table 2 (``bp_leave_one_out``) and its claims (``bp_claims``, register entry C12);
+- :mod:`~navlib.studies.gyro.diagnosis` -- the paper's own reasoning: Table 1 against the error model per
+  source (``table1_gaps``, ``table1_claims``, C17) and the cold-start diagnosis on the printed Tables 3-5
+  (``cold_diagnosis_claims``, C19-C21);
 - :mod:`~navlib.studies.gyro.claims` -- the claims and their verdicts, the verdict table, the methods' headline
   statistics.
 
@@ -177,6 +180,13 @@ from .thermal_worlds import (
     thermal_worlds_table,
 )
 from .bp_compare import BP_READINGS, BpLoo, bp_claims, bp_leave_one_out
+from .diagnosis import (
+    TABLE1_SOURCES,
+    cold_diagnosis_claims,
+    rate_corrected_loo,
+    table1_claims,
+    table1_gaps,
+)
 from .claims import (
     claims,
     cold_world_claims,

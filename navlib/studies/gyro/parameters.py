@@ -450,6 +450,9 @@ BOOTSTRAPS = (
     "table4_cold_vs_hot",
     "nonlinear",
     "rbf_vs_bp",
+    "cold_worse_than_hot",
+    "error_with_temperature_change",
+    "rate_compensation",
 )
 
 
