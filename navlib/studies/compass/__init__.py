@@ -23,6 +23,8 @@ Paper A's study and the pieces both studies share are read here as one namespace
   samples, and its claims;
 - :mod:`navlib.studies.compass.elm_iterations` -- document B's iterations: the back-tuned ELM against
   Huang's point-incremental ELM, and with its pruning off;
+- :mod:`navlib.studies.compass.elm_nodes` -- document B's node-count claims (each added node lowers the
+  training error; the node count's influence) on the chapter's node-count runs;
 - :mod:`navlib.studies.compass.real` -- both documents' methods and claims on BROAD's real level sweeps.
 
 The methods themselves (ids, labels, readings, settings) are registered in
@@ -63,7 +65,7 @@ from ...methods.compass_methods import (
 )
 
 # document B, the real compass and the hidden-node count: sub-namespaces
-from . import elm_iterations, elm_patent, hidden_nodes, real  # noqa: F401
+from . import elm_iterations, elm_nodes, elm_patent, hidden_nodes, real  # noqa: F401
 from .parameters import (
     BASE_READINGS,
     BOX_BOUNDS,

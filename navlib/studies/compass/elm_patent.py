@@ -46,7 +46,12 @@ def node_count_curve(
     - ``ELM``: a plain ELM fitted afresh with n = 1..max_nodes random nodes (seed ``seed``);
     - ``ELM back-tuned``: one run of the patent's incremental scheme per seed, grown to ``max_nodes``
       without the loss goal (so it does not stop early), scored after the back-tuning stage that follows
-      each ELM stage (the history's ``val_loss``, evaluated on the test sweep).
+      each ELM stage (the history's ``val_loss``, evaluated on the test sweep); at a node count reached
+      more than once (a prune stage took nodes away) the last such stage.
+
+    ``prunes`` counts the prune stages of the run up to the row's stage (0 for the plain ELM), so that
+    a step from one node count to the next that spans a prune stage can be told apart
+    (:mod:`navlib.studies.compass.elm_nodes`).
 
     The error is the de-normalised network output minus the true heading without wrapping (the same as
     the wrapped error wherever it is below 180 deg), in both cases computed the same way.  Every seed is a
@@ -67,7 +72,7 @@ def node_count_curve(
     )
     rows = [r for part in parts for r in part]
     return pd.DataFrame(
-        rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg"]
+        rows, columns=["method", "seed", "n_nodes", "train_rms_deg", "test_rms_deg", "prunes"]
     )
 
 
@@ -77,16 +82,31 @@ def _node_count_seed(xn, tn, xv, tv, span, params, seed, max_nodes) -> list[tupl
     for n in range(1, max_nodes + 1):  # the same stream for every n: run `seed`'s generator
         model = fit_elm(xn, tn, params.elm_params(), n_hidden=n, rng=generators([seed])[0])
         rows.append(
-            ("ELM", seed, n, span * np.sqrt(model.loss(xn, tn)), span * np.sqrt(model.loss(xv, tv)))
+            (
+                "ELM",
+                seed,
+                n,
+                span * np.sqrt(model.loss(xn, tn)),
+                span * np.sqrt(model.loss(xv, tv)),
+                0,
+            )
         )
     ip = replace(
         params.incremental_params(span), loss_goal=0.0, max_nodes=max_nodes, max_iter=2 * max_nodes
     )
     _, hist = fit_incremental_elm(xn, tn, ip, rng=generators([seed])[0], x_val=xv, t_val=tv)
+    hist = hist.assign(prunes=(hist.stage == "prune").cumsum())
     tuned = hist[hist.stage == "tune"].groupby("n_nodes").last()
     for n, row in tuned.iterrows():
         rows.append(
-            ("ELM back-tuned", seed, int(n), span * np.sqrt(row.loss), span * np.sqrt(row.val_loss))
+            (
+                "ELM back-tuned",
+                seed,
+                int(n),
+                span * np.sqrt(row.loss),
+                span * np.sqrt(row.val_loss),
+                int(row.prunes),
+            )
         )
     return rows
 
