@@ -208,6 +208,84 @@ def _filter_whiten(phi, d, nugget, x):
     return out, sd
 
 
+def clock_steps(clock: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The clock's steps ``t_i - t_(i-1)`` (``0`` first) and whether each is an odd number of whole steps
+    (a negative ``kappa``'s sign: :func:`propagation`), for :func:`whiten_steps`: computed once per series
+    for a likelihood evaluated at many ``kappa``."""
+    clock = np.asarray(clock, float)
+    dt = np.diff(clock, prepend=clock[0] if len(clock) else 0.0)
+    if np.any(dt < 0):
+        raise ValueError(
+            "a projected series must be in time order (serial.with_projection orders it)"
+        )
+    return dt, np.round(dt) % 2 == 1
+
+
+@njit(error_model="numpy", cache=True)
+def _filter_whiten_steps(kappa, dt, odd, d, nugget, x):
+    """:func:`propagation` and :func:`_filter_whiten` in one compiled pass: ``phi_i`` from ``kappa`` and the
+    steps ``dt`` (``odd``: an odd number of whole steps) as :func:`propagation` computes it, ``|kappa|^dt``
+    evaluated once per run of equal steps (1 at a step of 0), then the filter and the whitening."""
+    n, B = x.shape
+    out = np.empty((n, B))
+    sd = np.empty(n)
+    a = np.zeros((3, B))
+    P = np.eye(3)
+    pd = np.empty(3)
+    k = np.empty(3)
+    ak = abs(kappa)
+    last_dt = 0.0
+    last_phi = 1.0
+    for i in range(n):
+        t = dt[i]
+        if t == 0.0:
+            f = 1.0
+        else:
+            if t != last_dt:
+                last_phi = ak**t
+                last_dt = t
+            f = last_phi
+            if kappa < 0 and odd[i]:
+                f = -f
+        f2 = f * f
+        for r in range(3):
+            for c in range(3):
+                P[r, c] *= f2
+            P[r, r] += 1.0 - f2
+        d0, d1, d2 = d[i, 0], d[i, 1], d[i, 2]
+        for r in range(3):
+            pd[r] = P[r, 0] * d0 + P[r, 1] * d1 + P[r, 2] * d2
+        S = d0 * pd[0] + d1 * pd[1] + d2 * pd[2] + nugget
+        for r in range(3):
+            k[r] = pd[r] / S
+        for r in range(3):
+            for c in range(3):
+                P[r, c] -= pd[r] * pd[c] / S
+        s = np.sqrt(S)
+        sd[i] = s
+        for b in range(B):
+            a0 = f * a[0, b]
+            a1 = f * a[1, b]
+            a2 = f * a[2, b]
+            e = x[i, b] - (d0 * a0 + d1 * a1 + d2 * a2)
+            out[i, b] = e / s
+            a[0, b] = a0 + k[0] * e
+            a[1, b] = a1 + k[1] * e
+            a[2, b] = a2 + k[2] * e
+    return out, sd
+
+
+def whiten_steps(
+    kappa: float, steps: tuple, d: np.ndarray, nugget: float, x: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """:func:`whiten_direct` from the clock's :func:`clock_steps` ``steps`` (computed once), the
+    propagation inside the compiled pass: ``(L^-1 x, log det R)`` for ``x`` (n, B), C-contiguous, in
+    filter order."""
+    dt, odd = steps
+    out, sd = _filter_whiten_steps(float(kappa), dt, odd, d, nugget, x)
+    return out, 2.0 * float(np.sum(np.log(sd)))
+
+
 def whiten_direct(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float, x: np.ndarray):
     """``(L^-1 x, log det R)`` for ``x`` (n, B) in filter order without keeping the gains
     (``_filter_whiten``): what a likelihood evaluated at many ``kappa`` needs."""

@@ -226,26 +226,30 @@ def regular_clock(series: Series) -> bool:
     return bool(np.allclose(c, np.round(c), atol=1e-6))
 
 
-def _projected_inputs(series: Series, k: float) -> tuple:
+def _projected_inputs(series: Series, k: float, steps: bool = False) -> tuple:
     """The filter's inputs for a projected ``series``: the clock and directions in series order and the
-    nugget (computed once per series); ValueError for a negative ``k`` on an irregular clock."""
+    nugget (computed once per series); with ``steps``, the clock's
+    :func:`~navlib.workbench.innovations.clock_steps` instead of the clock.  ValueError for a negative
+    ``k`` on an irregular clock."""
     inputs = _INPUTS.get(id(series))
     if inputs is None or inputs[0] is not series:  # the clock and directions in series order, once
         pr = series.projection
         d = np.ascontiguousarray(pr.directions[series.order], float)
+        clock = pr.clock[series.order]
         inputs = (
             series,
-            pr.clock[series.order],
+            clock,
             d,
             regular_clock(series),
             innovations.nugget_of(d),
+            innovations.clock_steps(clock),
         )
         _INPUTS.clear()
         _INPUTS[id(series)] = inputs
-    _, clock, d, regular, nugget = inputs
+    _, clock, d, regular, nugget, clock_steps = inputs
     if k < 0 and not regular:
         raise ValueError("a negative correlation needs a regular clock (whole sampling steps)")
-    return clock, d, nugget
+    return (clock_steps if steps else clock), d, nugget
 
 
 def projected_gains(kappa, series: Series) -> innovations.Gains:
@@ -511,7 +515,7 @@ class _ProjectedLik:
         self.Z = np.ascontiguousarray(self.Z)
         self.series = series
         self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
-        self._last = (None, None)
+        self._seen: dict = {}  # kappa -> parts: the optimiser and the interval come back to points
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -525,16 +529,17 @@ class _ProjectedLik:
         if len(kappa) > 1:
             raise ValueError("the projected noise model is of order 0 or 1")
         key = tuple(float(k) for k in kappa)
-        if self._last[0] == key:  # the plain likelihood at the REML estimate: the same parts
-            return self._last[1]
+        hit = self._seen.get(key)
+        if hit is not None:  # e.g. the plain likelihood at the REML estimate, an interval's ends
+            return hit
         if len(kappa):
-            # the filter and the whitening in one pass (the gains themselves are not needed here)
-            clock, d, nugget = _projected_inputs(self.series, key[0])
-            w, logdet_r = innovations.whiten_direct(key[0], clock, d, nugget, self.Z)
+            # the propagation, the filter and the whitening in one compiled pass (no gains kept)
+            steps, d, nugget = _projected_inputs(self.series, key[0], steps=True)
+            w, logdet_r = innovations.whiten_steps(key[0], steps, d, nugget, self.Z)
         else:
             w, logdet_r = self.Z, 0.0
         rss, logdet_g = _rss_g_cholesky(w.T @ w, self.k)
-        self._last = (key, (rss, logdet_r, logdet_g))
+        self._seen[key] = (rss, logdet_r, logdet_g)
         return rss, logdet_r, logdet_g
 
 

@@ -138,6 +138,29 @@ def test_the_one_pass_filter_is_the_gains_and_the_whitening(case):
     assert np.allclose(g.sd, sd_py, rtol=1e-13, atol=0)
 
 
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_filter_with_its_propagation_compiled_equals_the_numpy_reference(case):
+    """The likelihood's compiled pass with the propagation inside (``whiten_steps``, issue 34) against
+    its numpy reference: ``propagation`` and the Python reference of the one-pass filter; the compiled
+    kernel and its own Python self agree too.  A clock out of time order is refused."""
+    kappa, times, axes, drop = CASES[case]
+    ser, n_obs = _projected(times, axes, seed=len(case) + 5, drop=drop)
+    pr = ser.projection
+    clock, d = pr.clock[ser.order], np.ascontiguousarray(pr.directions[ser.order])
+    x = np.random.default_rng(9).standard_normal((len(clock), 5))
+    nugget = inn.nugget_of(d)
+    steps = inn.clock_steps(clock)
+    w, logdet = inn.whiten_steps(kappa, steps, d, nugget, x)
+    w_ref, sd_ref = inn._filter_whiten.py_func(inn.propagation(kappa, clock), d, nugget, x)
+    assert np.allclose(w, w_ref, rtol=1e-12, atol=1e-13)
+    assert logdet == pytest.approx(2.0 * np.sum(np.log(sd_ref)), rel=1e-13, abs=1e-12)
+    w_py, sd_py = inn._filter_whiten_steps.py_func(kappa, *steps, d, nugget, x)
+    assert np.allclose(w, w_py, rtol=1e-12, atol=1e-13)
+    assert np.allclose(sd_py, sd_ref, rtol=1e-13, atol=0)
+    with pytest.raises(ValueError, match="time order"):
+        inn.clock_steps(np.array([0.0, 2.0, 1.0]))
+
+
 def test_a_projected_series_is_time_major():
     """Rows in time order, each row's observations together; segments start where the rows' did; leaving
     observations out keeps the time order; a series out of time order is refused by the filter."""
