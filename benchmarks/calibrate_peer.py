@@ -41,6 +41,7 @@ than gravity); the peer made it worse on 11 and failed on 2 (the same as before 
 
 from __future__ import annotations
 
+import argparse
 import sys
 import tempfile
 import time
@@ -93,7 +94,17 @@ def simulated(rows: int = 1000, repeats: int = 9) -> tuple[float, float]:
 
 
 def main(argv: list[str]) -> int:
-    files = [Path(a) for a in argv] or None
+    ap = argparse.ArgumentParser(
+        description="navlib calibrate beside a dedicated Levenberg-Marquardt ellipsoid fit (issue 34)"
+    )
+    ap.add_argument(
+        "files",
+        nargs="*",
+        type=Path,
+        metavar="FILE",
+        help="recordings (navlib's free-magnetometer CSV); default: the BROAD 3d trials",
+    )
+    files = ap.parse_args(argv).files or None
     warm_up()
     ours, peer = simulated()
     print(
