@@ -199,12 +199,16 @@ def spread_difference(errors, n_bases: int = len(BASES), random_from: int | None
         Spread over centre choices less spread over bases, deg/h.
     """
     e = np.asarray(errors, float)
-    rms = np.sqrt(np.mean(e * e, axis=0))
-    cut = e.shape[1] if random_from is None else random_from
-    centres = np.r_[rms[0], rms[n_bases:cut]]
+    return _spread_difference_rms(np.sqrt(np.mean(e * e, axis=0)), n_bases, random_from)
+
+
+def _spread_difference_rms(rms, n_bases, random_from) -> float:
+    cut = rms.size if random_from is None else random_from
+    centres = list(rms[n_bases:cut]) + [rms[0]]
     if random_from is not None:
-        centres = np.r_[centres, np.median(rms[random_from:])]
-    return float(np.ptp(centres) - np.ptp(rms[:n_bases]))
+        centres.append(np.median(rms[random_from:]))
+    b = rms[:n_bases]
+    return float(max(centres) - min(centres) - (b.max() - b.min()))
 
 
 @lru_cache(maxsize=4)
@@ -212,9 +216,11 @@ def _c14_runs(params: StudyParams) -> dict:
     h = params.hot
     readings = {
         "primary": h,
-        "deg": HotNetSettings(spread=h.spread, goal=h.goal, goal_kind=h.goal_kind, input_unit="deg"),
-        "rms": HotNetSettings(
-            spread=h.spread, goal=h.goal**2, goal_kind=h.goal_kind, input_unit=h.input_unit
+        "deg": HotNetSettings(
+            spread=h.spread, goal=h.goal, goal_kind=h.goal_kind, input_unit="deg"
+        ),
+        "rss": HotNetSettings(
+            spread=h.spread, goal=h.goal**2, goal_kind="sse", input_unit=h.input_unit
         ),
     }
     seeds = _experiment_children(params.sim.seed, "centre_subsets", len(readings))
@@ -253,10 +259,10 @@ def centre_claims(params: StudyParams = StudyParams()) -> list[Claim]:
             "the same with the input in deg",
         ),
         (
-            "gyro_centres_rms_goal",
-            runs["rms"],
+            "gyro_centres_rss_goal",
+            runs["rss"],
             True,
-            "the same with the goal read as an RMS (more neurons)",
+            "the same with the goal read as a root-sum-square (more neurons)",
         ),
         (
             "gyro_centres_no_random",
@@ -267,9 +273,10 @@ def centre_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     ):
         e = run.matrix(include_random=with_random)
         rf = nb + 1 if with_random else None
+        e2 = e * e
 
-        def stat(idx, e=e, rf=rf):
-            return spread_difference(e[np.asarray(idx, int)], nb, rf)
+        def stat(idx, e2=e2, rf=rf):
+            return _spread_difference_rms(np.sqrt(e2[np.asarray(idx, int)].mean(axis=0)), nb, rf)
 
         rows = np.arange(e.shape[0])
         rms = np.sqrt(np.mean(e * e, axis=0))
@@ -277,7 +284,7 @@ def centre_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         if with_random:
             cen += f", random median {np.median(rms[nb + 1 :]):.5f}"
         unit = "deg" if key.endswith("_deg") else h.input_unit
-        goal = "RMS" if key.endswith("rms_goal") else h.goal_kind.upper()
+        goal = "RSS" if key.endswith("rss_goal") else h.goal_kind.upper()
         out.append(
             Claim(
                 CLAIM_C14,
@@ -296,11 +303,9 @@ def centre_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                     "evenly spaced quantiles; random subsets: the median RMS of "
                     f"{run.random.shape[1]} draws",
                 ),
-                ours=f"centres: {cen}; bases: "
-                + ", ".join(f"{rms[j]:.5f}" for j in range(nb)),
+                ours=f"centres: {cen}; bases: " + ", ".join(f"{rms[j]:.5f}" for j in range(nb)),
                 key=key,
                 spec="{:.5f}",
-                data="real",
             )
         )
     return out
@@ -444,7 +449,6 @@ def latitude_share_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 ours=f"{est.value:.1f} % over {est.n} tests",
                 key=key,
                 spec="{:.1f}",
-                data=data,
             )
         )
     return out
@@ -536,7 +540,9 @@ def rotation_responses(
     )  # (n+1, C, 2)
     ne = np.moveaxis(ne, 0, -1)  # (C, 2, n+1)
     return RotationResponses(
-        axial=ne[-1], horizontal=ne[:-1].reshape(n_ph, 4, 2, n + 1), t_h=np.arange(n + 1) * step_s / 3600
+        axial=ne[-1],
+        horizontal=ne[:-1].reshape(n_ph, 4, 2, n + 1),
+        t_h=np.arange(n + 1) * step_s / 3600,
     )
 
 
@@ -695,24 +701,3 @@ def mechanism_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     """C14, C16 and C18's rows (:func:`centre_claims`, :func:`latitude_share_claims`,
     :func:`rotation_claims`)."""
     return centre_claims(params) + latitude_share_claims(params) + rotation_claims(params)
-
-
-__all__ = [
-    "CLAIM_C14",
-    "CLAIM_C16",
-    "CLAIM_C18",
-    "CentreBasisErrors",
-    "HORIZONTAL_SOURCES",
-    "RotationResponses",
-    "centre_basis_errors",
-    "centre_claims",
-    "equal_harm_accel_ug",
-    "kmeans_centres",
-    "latitude_share",
-    "latitude_share_claims",
-    "mechanism_claims",
-    "rotation_claims",
-    "rotation_responses",
-    "rotation_shares",
-    "spread_difference",
-]
