@@ -32,6 +32,9 @@ Which module holds what, in the order they import each other (each imports only 
 - :mod:`~navlib.studies.gyro.diagnosis` -- the paper's own reasoning: Table 1 against the error model per
   source (``table1_gaps``, ``table1_claims``, C17) and the cold-start diagnosis on the printed Tables 3-5
   (``cold_diagnosis_claims``, C19-C21);
+- :mod:`~navlib.studies.gyro.mechanisms` -- why the method should work: centres against basis functions on
+  Table 2 (``centre_claims``, C14), the axial drift's share of the measured 12 h latitude error
+  (``latitude_share_claims``, C16) and of the 72 h position error with rotation on (``rotation_claims``, C18);
 - :mod:`~navlib.studies.gyro.claims` -- the claims and their verdicts, the verdict table, the methods' headline
   statistics.
 
@@ -186,6 +189,12 @@ from .diagnosis import (
     rate_corrected_loo,
     table1_claims,
     table1_gaps,
+)
+from .mechanisms import (
+    centre_claims,
+    latitude_share_claims,
+    mechanism_claims,
+    rotation_claims,
 )
 from .claims import (
     claims,

@@ -441,6 +441,8 @@ _EXPERIMENTS = (
     "rounding",
     "bootstrap",
     "bp_inits",
+    "centre_subsets",
+    "rotation_share",
 )
 #: The bootstrap intervals over rows of the real tables, one seed each (:func:`bootstrap_seed`).
 BOOTSTRAPS = (
@@ -453,6 +455,8 @@ BOOTSTRAPS = (
     "cold_worse_than_hot",
     "error_with_temperature_change",
     "rate_compensation",
+    "centres_vs_basis",
+    "latitude_share",
 )
 
 
@@ -469,9 +473,9 @@ def _experiment_children(seed: int, experiment: str, n: int) -> list[np.random.S
 def experiment_seeds(seed: int, experiment: str, n: int) -> list[int]:
     """``n`` integer seeds for one random experiment of the chapter.
 
-    ``numpy.random.SeedSequence(seed).spawn(9)[k].spawn(n)``, ``k`` the experiment's place in
+    ``numpy.random.SeedSequence(seed).spawn(11)[k].spawn(n)``, ``k`` the experiment's place in
     ``("fig1", "hot_reference", "cold_training", "fig3", "table5", "table5_drifts", "rounding",
-    "bootstrap", "bp_inits")`` (a child's seed depends only on its place, so adding an experiment at the end changes no
+    "bootstrap", "bp_inits", "centre_subsets", "rotation_share")`` (a child's seed depends only on its place, so adding an experiment at the end changes no
     other); each child gives one 32-bit integer (``generate_state(1)``), passed to
     :func:`navlib.sensors.ins.simulated_tests`.
 
