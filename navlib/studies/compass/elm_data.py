@@ -136,7 +136,7 @@ def interpolation_study(
     sw: Sweeps, params: StudyParams = StudyParams(), seeds=range(20)
 ) -> pd.DataFrame:
     """:func:`interpolation_run` for every reading of :func:`interpolation_readings` and seed, on the
-    chapter's target (:attr:`StudyParams.target`).  In this process: each run is one solve and one SVD
+    chapter's target (``params.target``).  In this process: each run is one solve and one SVD
     of at most 121 x 121 (milliseconds)."""
     rows = []
     for n, wr in interpolation_readings(sw, params):
