@@ -252,6 +252,7 @@ NORMALISED, RAW_FAIR, RAW_SAME = (
     "raw, input weights scaled to the input span",
     "raw, the normalised run's node draw",
 )
+#: The runs of :func:`normalisation_study`, in display order.
 NORMALISATION_RUNS = (NORMALISED, RAW_FAIR, RAW_SAME)
 _IDENTITY = MinMax(lo=np.zeros(1), hi=np.ones(1))
 
@@ -404,6 +405,7 @@ def normalisation_claims(runs: pd.DataFrame, params: StudyParams = StudyParams()
 # ------------------------------------------------------------------------------------------- B19
 #: B19's goals: multiples of the physical model's test RMS on the full sweep (primary first).
 GOAL_FACTORS = (2.0, 4.0)
+#: The back-tuned ELM's method label in the small-sample runs.
 ELM_LABEL = "ELM back-tuned"
 
 
