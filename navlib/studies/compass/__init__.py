@@ -25,6 +25,8 @@ Paper A's study and the pieces both studies share are read here as one namespace
   Huang's point-incremental ELM, and with its pruning off;
 - :mod:`navlib.studies.compass.elm_nodes` -- document B's node-count claims (each added node lowers the
   training error; the node count's influence) on the chapter's node-count runs;
+- :mod:`navlib.studies.compass.elm_data` -- document B's claims about its data: zero error on N samples,
+  min-max normalisation, the sample size deep learning needs;
 - :mod:`navlib.studies.compass.real` -- both documents' methods and claims on BROAD's real level sweeps.
 
 The methods themselves (ids, labels, readings, settings) are registered in
@@ -65,7 +67,7 @@ from ...methods.compass_methods import (
 )
 
 # document B, the real compass and the hidden-node count: sub-namespaces
-from . import elm_iterations, elm_nodes, elm_patent, hidden_nodes, real  # noqa: F401
+from . import elm_data, elm_iterations, elm_nodes, elm_patent, hidden_nodes, real  # noqa: F401
 from .parameters import (
     BASE_READINGS,
     BOX_BOUNDS,
