@@ -516,10 +516,13 @@ class _ProjectedLik:
         self.series = series
         self.n, self.k = self.Z.shape[0], self.Z.shape[1] - 1
         self._seen: dict = {}  # kappa -> parts: the optimiser and the interval come back to points
+        self.values: dict = {}  # kappa -> the REML log likelihood: the interval's first brackets
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
-        return -0.5 * ((self.n - self.k) * np.log(max(rss, 1e-300)) + logdet_r + logdet_g)
+        value = -0.5 * ((self.n - self.k) * np.log(max(rss, 1e-300)) + logdet_r + logdet_g)
+        self.values[tuple(float(k) for k in kappa)] = value
+        return value
 
     def ml(self, kappa) -> float:
         rss, logdet_r, _ = self._parts(kappa)
@@ -783,23 +786,62 @@ def _estimate(
     )
 
 
+#: Tolerance on ``atanh kappa_1`` of the profile-likelihood interval's ends (:func:`_interval`).
+INTERVAL_XTOL = 1e-6
+
+
 def _interval(loglik, kappa: tuple, ll: float, low: float) -> tuple:
     """The profile-likelihood interval of ``kappa_1`` (level :data:`KAPPA_LEVEL`) of the estimate ``kappa``
     (log likelihood ``ll``) with the other partial autocorrelations held; ``low`` the lowest ``atanh
-    kappa_1`` allowed."""
+    kappa_1`` allowed.
+
+    Each end is the root of ``gap(a) = ll - l(a) - chi2_1(level) / 2`` between the estimate ``a0`` and the
+    bound (the bound itself when ``gap`` there is not positive), found by Brent's method in
+    ``u = (a - a0)^2``, where a quadratic log likelihood makes ``gap`` linear (the first secant step is then
+    exact), to :data:`INTERVAL_XTOL` in ``a``; it starts from the tightest bracket among the points the
+    estimate already evaluated (a likelihood's ``values``, where it keeps them), else from the estimate and
+    the bound."""
     drop = special.gammaincinv(0.5, KAPPA_LEVEL)  # chi2.ppf(KAPPA_LEVEL, 1) / 2
     lim = np.arctanh(KAPPA_MAX)
     a0 = float(np.arctanh(np.clip(kappa[0], -KAPPA_MAX, KAPPA_MAX)))
+    rest = tuple(kappa[1:])
 
     def gap(a):
-        return ll - loglik((np.tanh(a),) + tuple(kappa[1:])) - drop
+        return ll - loglik((np.tanh(a),) + rest) - drop
 
+    # the points evaluated already (the estimate's optimiser), as (a, gap)
+    known = [
+        (float(np.arctanh(k[0])), ll - v - drop)
+        for k, v in getattr(loglik, "values", {}).items()
+        if len(k) == len(kappa) and k[1:] == rest and abs(k[0]) < 1.0
+    ]
     ends = []
     for edge in (min(low, a0), lim):
-        if a0 == edge or gap(edge) <= 0:
+        g_edge = None if a0 == edge else gap(edge)
+        if g_edge is None or g_edge <= 0:
             ends.append(float(np.tanh(edge)))
-        else:
-            ends.append(float(np.tanh(brentq(gap, min(a0, edge), max(a0, edge), xtol=1e-4))))
+            continue
+        s = 1.0 if edge > a0 else -1.0
+        side = [(a, g) for a, g in known if 0 < s * (a - a0) < s * (edge - a0)]
+        inside = [p for p in side if p[1] <= 0]
+        outside = [p for p in side if p[1] > 0]
+        a_in, g_in = max(inside, key=lambda p: s * p[0]) if inside else (a0, gap(a0))
+        a_out, g_out = min(outside, key=lambda p: s * p[0]) if outside else (edge, g_edge)
+        if s * (a_out - a_in) <= 0:  # not one crossing: from the estimate and the bound
+            (a_in, g_in), (a_out, g_out) = (a0, gap(a0)), (edge, g_edge)
+        u_in, u_out = (a_in - a0) ** 2, (a_out - a0) ** 2
+
+        def gap_u(u, u_in=u_in, u_out=u_out, g_in=g_in, g_out=g_out, s=s):
+            if u == u_in:
+                return g_in
+            if u == u_out:
+                return g_out
+            return gap(a0 + s * np.sqrt(u))
+
+        # du = 2 |a - a0| da: the tolerance in u of INTERVAL_XTOL in a
+        xtol = 2.0 * INTERVAL_XTOL * max(np.sqrt(u_in), 1e-3)
+        u = brentq(gap_u, u_in, u_out, xtol=xtol)
+        ends.append(float(np.tanh(a0 + s * np.sqrt(u))))
     return tuple(ends)
 
 
