@@ -4,6 +4,9 @@ navigation, with its tables, figures and claims (notebook ``notebooks/celestial.
 - :mod:`navlib.studies.celestial.parameters` -- the study's settings ``StudySpec`` (with
   ``StudySpec.from_notebook`` for the notebook's parameters cell, ``NOTEBOOK_DEFAULTS``), the cases, methods
   and phases it scores, paper E's BP network ``bp_params`` and the seed of every draw ``seed_of``;
+- :mod:`navlib.studies.celestial.step` -- the running BPKF's network step at one filter epoch (45 raw gains
+  or 6 QR features and one forward pass), its paired timings ``step_timings`` and operation count
+  ``step_flops``;
 - :mod:`navlib.studies.celestial.simulation` -- the experiment: ``simulate`` flies the runs, filters them
   and trains the networks (every repeat, the scale-factor sweep, the blind effects, the ``trainlm``
   timings) and returns a ``StudyData``;
@@ -14,7 +17,7 @@ navigation, with its tables, figures and claims (notebook ``notebooks/celestial.
 - :mod:`navlib.studies.celestial.claims` -- the claims under the one verdict rule (``claims``), the sweep's
   verdicts per level and the results file's extra numbers.
 
-The modules import one way: parameters <- simulation <- scores <- tables <- claims.  Every public name is
+The modules import one way: parameters, step <- simulation <- scores <- tables <- claims.  Every public name is
 also here: ``from navlib.studies import celestial``, then ``celestial.simulate(spec)``.
 """
 
@@ -33,6 +36,7 @@ from .parameters import (
     bp_params,
     seed_of,
 )
+from .step import STEP_READINGS, StepNet, step, step_flops, step_timings  # noqa: F401
 from .simulation import StudyData, quiet_repeats_flown, simulate  # noqa: F401
 from .scores import per_run, phase_per_run, sweep_per_run  # noqa: F401
 from .tables import (
@@ -49,6 +53,8 @@ from .tables import (
     named_effect,
     overall,
     paper_numbers,
+    step_time,
+    step_timing_pairs,
     sweep_table,
     time_ratio,
     timing_pairs,

@@ -21,6 +21,7 @@ CASES = {  # case -> (simulation kind, feature set)
     "sturn_qr6_rate": ("s_turns", "qr6_rate"),
     "sturn_raw45": ("s_turns", "raw45"),
     "level_resid3": ("level", "residual3"),
+    "level_qr6_rate": ("level", "qr6_rate"),
 }
 CASE_LABEL = {
     "level_raw45": "level, 45 raw gains (Fig 3, Table 2)",
@@ -29,6 +30,7 @@ CASE_LABEL = {
     "sturn_qr6_rate": "S-turns, 6 QR + 3 rates (Figs 8-9, Table 5)",
     "sturn_raw45": "S-turns, 45 raw gains (ours)",
     "level_resid3": "level, 3 filter residuals (rejected by the paper)",
+    "level_qr6_rate": "level, 6 QR + 3 rates (ours, Sec. 2.2)",
 }
 
 #: The two halves of a held-out S-turn run's scored epochs, split at the median absolute body yaw rate of the run.

@@ -12,7 +12,9 @@ at each filter epoch; the BPKF attitude is the KF attitude minus the network's o
 on the training runs, scored on the test runs; ``same run``: trained and scored on each test run alone (what a
 single-run study may have done: the network is scored on the data it was trained on).  Accuracy: RMS over
 the run after ``settle_s`` per Euler angle (arcsec).  Training time: ``n_timings`` paired repetitions, the
-45-input and the 6-input net timed in the same repetition on the same training set.  The innovation test
+45-input and the 6-input net timed in the same repetition on the same training set; the running filter's
+network step (features of the epoch's gain and one forward pass, :mod:`~navlib.studies.celestial.step`)
+with 45 and 6 inputs in as many paired repetitions.  The innovation test
 runs on each run alone (train and test runs), so how often it names an effect is a rate over runs.
 
 Beyond the paper's tables: the paper's "average time of one training" as MATLAB trains, a whole
@@ -48,6 +50,7 @@ from ...methods.mlp import train_mlp
 from ...seeding import sequence
 from ...sensors.strapdown import InitialError, strapdown
 from ...sensors.trajectory import generate
+from .step import StepNet, step_timings
 from .parameters import (
     AXES,
     CASES,
@@ -98,6 +101,9 @@ class StudyData:
         None  # level_ppm, repeat, run, method, phase, axis, rms_arcsec (held-out
     )
     #                                        S-turn runs, turning and steady epochs apart; KF and BPKF 6 QR)
+    step_timing: pd.DataFrame | None = (
+        None  # timing, reading, n_in, seconds_per_epoch (the network step, level repeat 0)
+    )
 
 
 def _rms(err, mask):
@@ -395,7 +401,18 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
         return {"sweep": _sweep(spec, rep, *kind), "secs": {"sweep": time.perf_counter() - t0}}
     out = {
         k: []
-        for k in ("score", "trace", "time", "glr", "glr_run", "corr", "timing", "diag", "phase")
+        for k in (
+            "score",
+            "trace",
+            "time",
+            "glr",
+            "glr_run",
+            "corr",
+            "timing",
+            "diag",
+            "phase",
+            "step",
+        )
     }
     out["yaw"] = None
     secs = {"simulate_filter": 0.0, "train": 0.0, "timing": 0.0}
@@ -463,12 +480,14 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     secs["simulate_filter"] += time.perf_counter() - t0
     t0 = time.perf_counter()
     net_seed = seed_of(spec, rep, "network")
+    held_nets = {}
     for case, (ck, feats) in CASES.items():
         if ck != kind:
             continue
         x_tr, x_te = km.gain_features(f_train, feats), km.gain_features(f_test, feats)
         mspec = bp_params(km.N_INPUTS[feats], spec.n_hidden, spec.epochs)
         net = train_mlp(x_tr, f_train.att_err_arcsec, mspec, seed=net_seed)
+        held_nets[case] = net
         bp = f_test.att_err_arcsec - net.predict(x_te)
         _score_rows(score_rows, rep, case, "held-out", "BPKF", bp, mask)
         if case == "sturn_qr6" and own_plain:
@@ -496,6 +515,15 @@ def _repeat(spec: StudySpec, rep: int, kind: str) -> dict:
     if rep == 0 and kind == "level":
         t0 = time.perf_counter()
         out["timing"] = _paired_timings(spec, f_train)
+        # the network step of the running BPKF on test run 0, with the held-out nets
+        out["step"] = step_timings(
+            f_test.kf["K"][0, :, : km.N_BASE, :],
+            {
+                45: StepNet.from_mlp(held_nets["level_raw45"]),
+                6: StepNet.from_mlp(held_nets["level_qr6"]),
+            },
+            spec.n_timings,
+        )
         secs["timing"] += time.perf_counter() - t0
     out["secs"] = secs
     return out
@@ -510,7 +538,8 @@ def simulate(
     trained on the training runs (held-out) and on each test run alone (same run); for the S-turns also the
     augmented 18-state KF (gyro scale-factor states); the innovation GLR test of the 15-state KF pooled
     over the training runs and on each run alone; in the first repeat of the level flight the paired
-    training-time repetitions.  Every (repeat, simulation) is a task of :mod:`navlib.engine` (``workers``
+    training-time repetitions and the paired timings of the running filter's network step with 45 and 6
+    inputs (:func:`~navlib.studies.celestial.step.step_timings`, on test run 0 with the held-out nets).  Every (repeat, simulation) is a task of :mod:`navlib.engine` (``workers``
     local processes, or the cluster at ``scheduler``; the one with the timings starts first); the draws of
     each come from :func:`~navlib.studies.celestial.parameters.seed_of`, so the numbers (not the timings) do not
     depend on where they ran."""
@@ -518,7 +547,7 @@ def simulate(
     cost = [
         (3.0 if kind == "s_turns" else 2.0)
         + (
-            2.0 * spec.n_timings * spec.timing_epochs / spec.epochs
+            2.0 * spec.n_timings * spec.timing_epochs / spec.epochs + 0.05 * spec.n_timings
             if rep == 0 and kind == "level"
             else 0.0
         )
@@ -625,6 +654,7 @@ def simulate(
         sweep,
         diagnosis,
         phases,
+        pd.DataFrame(rows("step")),
     )
 
 

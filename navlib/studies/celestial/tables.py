@@ -15,6 +15,7 @@ from ...errors import InputError
 from ...methods import kalman as km
 from ...paths import data_path
 from .parameters import CASE_LABEL, CASES, SWEEP_METHODS, StudySpec
+from .step import STEP_READINGS, step_flops
 from .scores import _paired, _smear, sweep_per_run
 from .simulation import StudyData
 
@@ -143,6 +144,51 @@ def lm_timing_pairs(
         raise InputError("no trainlm timings (lm_timings = 0)")
     w = data.lm_timing.pivot(index="timing", columns="n_in", values="seconds").sort_index()
     return w[n_in].to_numpy(), w[base].to_numpy()
+
+
+def step_timing_pairs(data: StudyData, reading: str = "epoch") -> tuple[np.ndarray, np.ndarray]:
+    """Time per filter epoch (s) of the running BPKF's network step with the 45 raw gains and with the 6
+    QR features, paired by timing repetition; ``reading``: ``"epoch"`` (one epoch at a time, as the
+    running filter does it) or ``"batch"`` (vectorised over a run's epochs)."""
+    if reading not in STEP_READINGS:
+        raise InputError(
+            f"parameter reading={reading!r}: must be one of {', '.join(STEP_READINGS)}"
+        )
+    t = data.step_timing
+    if t is None or t.empty:
+        raise InputError("no timings of the network step (n_timings = 0)")
+    w = (
+        t[t["reading"] == reading]
+        .pivot(index="timing", columns="n_in", values="seconds_per_epoch")
+        .sort_index()
+    )
+    return w[45].to_numpy(), w[6].to_numpy()
+
+
+def step_time(data: StudyData) -> pd.DataFrame:
+    """The running BPKF's network step per filter epoch (features of the epoch's gain and one forward
+    pass, :mod:`~navlib.studies.celestial.step`) with the 45 raw gains and with the 6 QR features: per
+    reading (one epoch at a time, vectorised over a run) the median, 10th and 90th percentile over the
+    paired timing repetitions (this machine, microseconds), the operation count of the step
+    (:func:`~navlib.studies.celestial.step.step_flops`), and the median paired ratio 45 / 6."""
+    rows = []
+    labels = {"epoch": "one epoch at a time", "batch": "vectorised over a run"}
+    for reading in STEP_READINGS:
+        a, b = step_timing_pairs(data, reading)
+        for n_in, v in ((45, a), (6, b)):
+            us = 1e6 * v
+            rows.append(
+                {
+                    "step": labels[reading],
+                    "inputs": n_in,
+                    "ours_median_us": float(np.median(us)),
+                    "ours_p10_us": float(np.quantile(us, 0.1)),
+                    "ours_p90_us": float(np.quantile(us, 0.9)),
+                    "flops": step_flops(n_in, data.spec.n_hidden),
+                    "ratio_45_to_6": float(np.median(a / b)),
+                }
+            )
+    return pd.DataFrame(rows)
 
 
 def trainlm_time(data: StudyData) -> pd.DataFrame:

@@ -26,6 +26,7 @@ from navlib.sensors.trajectory import (
     gravity,
     radii,
 )
+from navlib import claims as claims_mod
 from navlib import verdicts
 from navlib.studies import celestial
 from navlib.studies.celestial import StudySpec
@@ -409,6 +410,8 @@ def fake_data(
     loop_quiet=None,
     loop_own=None,
     turn_factor=1.5,
+    step_ratio=0.5,
+    norates_diff=0.0,
 ):
     """A StudyData with hand-made per-run scores whose claims have known answers.  KF per-run errors vary
     from run to run; BPKF = factor x KF on the same run (``bp_factor`` per case and mode), 6 QR = qr_factor x
@@ -423,7 +426,10 @@ def fake_data(
     (``blind_left``, test runs); ``quiet_flagged`` its flags with nothing missing; the decision rule's answers
     per run with the time offset (``loop_blind``), the rate-proportional error (``loop_smear``), nothing
     missing (``loop_quiet``) and the study's scale factor (``loop_own``); the held-out S-turn error while
-    turning = ``turn_factor`` x the error steady on the same run (KF and 6 QR, every level)."""
+    turning = ``turn_factor`` x the error steady on the same run (KF and 6 QR, every level); the network step
+    of the running filter with 45 inputs ``step_ratio`` x that with 6 (both readings); in level flight the
+    6 QR + 3 rates BPKF's RMS over the three angles = the 6 QR one's - ``norates_diff`` (+- 1 % of it) on
+    every run."""
     spec = StudySpec(
         n_repeats=n_repeats,
         n_test_runs=n_runs,
@@ -440,6 +446,9 @@ def fake_data(
         **(bp_factor or {}),
     }
     rng = np.random.default_rng(0)
+    rng9 = np.random.default_rng(
+        9
+    )  # the level 6 QR + 3 rates rows: the other draws stay as they were
     rows = []
     runs = [(r, i) for r in range(n_repeats) for i in range(n_runs)]
     kf = {(r, i): 1.0 + 3.0 * rng.random(3) for r, i in runs}
@@ -467,14 +476,15 @@ def fake_data(
             for k, v in kf.items()
         }
         add("level_raw45", mode, "BPKF", raw)
-        add(
-            "level_qr6",
-            mode,
-            "BPKF",
+        lq6 = (
             {k: v * bp_factor[("level_qr6", mode)] for k, v in kf.items()}
             if mode == "same run"
-            else {k: v * qr_factor for k, v in raw.items()},
+            else {k: v * qr_factor for k, v in raw.items()}
         )
+        add("level_qr6", mode, "BPKF", lq6)
+        rms6 = {k: float(np.sqrt(np.mean(v**2))) for k, v in lq6.items()}
+        d = {k: norates_diff * (1 + 0.01 * (rng9.random() - 0.5)) for k in lq6}
+        add("level_qr6_rate", mode, "BPKF", {k: v * (1 - d[k] / rms6[k]) for k, v in lq6.items()})
         q6 = {k: v * (0.8 + 0.1 * rng.random()) for k, v in kf.items()}
         add("sturn_qr6", mode, "BPKF", q6)
         add("sturn_raw45", mode, "BPKF", {k: v * raw45_factor for k, v in q6.items()})
@@ -651,6 +661,14 @@ def fake_data(
         for phase, f in (("turning", turn_factor), ("steady", 1.0))
         for a, ax in enumerate(celestial.AXES)
     ]
+    step = pd.DataFrame(
+        [
+            {"timing": j, "reading": rd, "n_in": n, "seconds_per_epoch": t}
+            for j in range(n_t)
+            for rd in celestial.STEP_READINGS
+            for n, t in ((45, 1e-5 * (1 + j / n_t) * step_ratio), (6, 1e-5 * (1 + j / n_t)))
+        ]
+    )
     empty = pd.DataFrame()
     return celestial.StudyData(
         spec,
@@ -667,6 +685,7 @@ def fake_data(
         pd.DataFrame(sw),
         pd.DataFrame(diag),
         pd.DataFrame(ph),
+        step.sample(frac=1.0, random_state=2).reset_index(drop=True),  # rows out of order
     )
 
 
@@ -852,10 +871,16 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
         (6, 45)
     ]
     assert len(data.timings) == 2 * spec.n_timings
+    # the running filter's network step: both inputs and both readings in every repetition
+    st = data.step_timing
+    assert len(st) == 2 * 2 * spec.n_timings and (st["seconds_per_epoch"] > 0).all()
+    assert set(st.groupby(["timing", "reading"])["n_in"].apply(frozenset)) == {frozenset({6, 45})}
+    assert len(celestial.per_run(data, "level_qr6_rate", "held-out", "BPKF")) == n
     assert len(data.glr_runs) == 2 * spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
     c = by_key(data)
     assert c["cel_imp6_same"].estimate.n == n and c["cel_imp6_held"].estimate.n == n
     assert c["cel_time"].estimate.n == spec.n_timings
+    assert c["cel_step"].estimate.n == spec.n_timings and c["cel_norates_held"].estimate.n == n
     assert c["cel_innov"].estimate.n == spec.n_repeats * (spec.n_train_runs + spec.n_test_runs)
     assert len(data.lm_timing) == 3 * spec.lm_timings and set(data.lm_timing["n_in"]) == {45, 6, 9}
     d = data.diagnosis
@@ -913,7 +938,14 @@ def test_a_tiny_study_pairs_held_out_and_same_run_readings_over_every_test_run()
 def test_the_timing_claim_is_stored_as_volatile_and_the_others_are_not():
     data = fake_data(t45_over_t6=2.0)
     cl = celestial.claims(data)
-    assert [c.key for c in cl if c.volatile] == ["cel_time_lm", "cel_time"]
+    assert [c.key for c in cl if c.volatile] == [
+        "cel_time_lm",
+        "cel_time",
+        "cel_step",
+        "cel_step_batch",
+        "cel_train_faster_lm",
+        "cel_train_faster",
+    ]
     t = {c.key: c for c in cl}["cel_time"]
     assert t.verdict == "not reproduced" and t.record()["volatile"] is True
     extra = celestial.results_extra(data)
@@ -1252,3 +1284,158 @@ def test_runs_along_several_paths_are_each_run_flown_alone():
     assert not np.allclose(both.att_true[0], both.att_true[1])
     with pytest.raises(InputError, match="traj"):
         strapdown(trs, [1, 2, 3])
+
+
+# ------------------------------------------------------------------------------ E11 and E12 (efficiency, rates)
+def _two_nets(hidden="logsig"):
+    """A 45-input and a 6-input net trained briefly on one filtered level run's gains, and that run."""
+    spec = StudySpec(duration_s=20.0, n_train_runs=1, n_test_runs=1)
+    from navlib.studies.celestial.simulation import _runs
+
+    train, _, _ = _runs(spec, "level", 0)
+    f = km.run_filter(train, spec.filter)
+    nets = {}
+    for feats, n in (("raw45", 45), ("qr6", 6)):
+        p = MLPParams(
+            n_in=n,
+            n_hidden=10,
+            n_out=3,
+            hidden=hidden,
+            trainer="adam",
+            epochs=3,
+            scaling="standardize",
+            init="torch",
+        )
+        nets[n] = train_mlp(km.gain_features(f, feats), f.att_err_arcsec, p, seed=1)
+    return f, nets
+
+
+def test_the_network_step_is_the_bpkf_correction_epoch_by_epoch_and_at_once():
+    f, nets = _two_nets()
+    K = f.kf["K"][0, :, : km.N_BASE, :]
+    for feats, n in (("raw45", 45), ("qr6", 6)):
+        want = nets[n].predict(km.gain_features(f, feats)[0])
+        sn = celestial.StepNet.from_mlp(nets[n])
+        assert celestial.step(K, sn) == pytest.approx(want, rel=1e-12, abs=1e-12)
+        one = np.array([celestial.step(K[k], sn) for k in range(5)])
+        assert one == pytest.approx(want[:5], rel=1e-12, abs=1e-12)
+    # a broken step: the 6-input net fed R without the sign fix differs where a diagonal entry is negative
+    r = np.linalg.qr(K, mode="r")
+    assert (np.diagonal(r, axis1=-2, axis2=-1) < 0).any()
+    sn6 = celestial.StepNet.from_mlp(nets[6])
+    iu = np.triu_indices(3)
+    raw_r = r[..., iu[0], iu[1]]
+    wrong = 1 / (1 + np.exp(-(((raw_r - sn6.x_offset) / sn6.x_scale) @ sn6.W1.T + sn6.b1)))
+    wrong = (wrong @ sn6.W2.T + sn6.b2) * sn6.y_scale + sn6.y_offset
+    assert not np.allclose(wrong, celestial.step(K, sn6))
+
+
+def test_the_network_step_refuses_other_nets():
+    f, nets = _two_nets(hidden="tansig")
+    with pytest.raises(InputError, match="logsig"):
+        celestial.StepNet.from_mlp(nets[6])
+    f, nets = _two_nets()
+    sn = {n: celestial.StepNet.from_mlp(v) for n, v in nets.items()}
+    K = f.kf["K"][0, :, : km.N_BASE, :]
+    with pytest.raises(InputError, match="the 45-input net has 6 inputs"):
+        celestial.step_timings(K, {45: sn[6], 6: sn[45]}, 2)
+    with pytest.raises(InputError, match="shape"):
+        celestial.step_timings(K[:, :12], sn, 2)
+    with pytest.raises(InputError, match="45 and 6"):
+        celestial.step_timings(K, {45: sn[45]}, 2)
+
+
+def test_step_timings_are_paired_and_alternate():
+    f, nets = _two_nets()
+    sn = {n: celestial.StepNet.from_mlp(v) for n, v in nets.items()}
+    rows = pd.DataFrame(celestial.step_timings(f.kf["K"][0, :, : km.N_BASE, :], sn, 3, n_epochs=20))
+    assert len(rows) == 3 * 2 * 2 and (rows["seconds_per_epoch"] > 0).all()
+    for j, grp in rows.groupby("timing"):
+        first = grp[grp["reading"] == "epoch"]["n_in"].tolist()
+        assert first == ([45, 6] if j % 2 == 0 else [6, 45])
+
+
+def test_step_flops_count_the_householder_qr_and_the_forward_pass():
+    # 45 inputs: scaling 90, hidden layer 900, logsig 30, output 60, scaling back 6
+    assert celestial.step_flops(45) == 90 + 900 + 30 + 60 + 6
+    # 6 inputs: Householder QR of the 15x3 gain, R only: 2 * 3^2 * (15 - 1) = 252
+    assert celestial.step_flops(6) == 252 + 12 + 120 + 30 + 60 + 6
+    assert celestial.step_flops(6, n_states=18) == 2 * 9 * 17 + 12 + 120 + 30 + 60 + 6
+    with pytest.raises(InputError, match="45 or 6"):
+        celestial.step_flops(9)
+
+
+@pytest.mark.parametrize("ratio, verdict", [(2.0, "reproduced"), (0.5, "not reproduced")])
+def test_network_step_claim_is_the_paired_time_ratio_against_one(ratio, verdict):
+    data = fake_data(step_ratio=ratio)
+    c = by_key(data)
+    for k in ("cel_step", "cel_step_batch"):
+        assert c[k].estimate.rule == "paired ratio" and c[k].estimate.n == 12
+        assert c[k].estimate.value == pytest.approx(ratio) and c[k].boundary == 1.0
+        assert c[k].holds_when == "above" and c[k].volatile and c[k].verdict == verdict
+    f = c["cel_step_flops"]
+    assert f.estimate.rule == "exact" and not f.volatile
+    assert f.estimate.value == pytest.approx(celestial.step_flops(45) / celestial.step_flops(6))
+    tab = celestial.step_time(data).set_index(["step", "inputs"])
+    assert tab["ratio_45_to_6"].to_numpy() == pytest.approx(ratio)
+    assert tab.loc[("one epoch at a time", 45), "flops"] == celestial.step_flops(45)
+
+
+def test_network_step_claim_without_timings_cannot_be_judged():
+    from dataclasses import replace
+
+    data = replace(fake_data(), step_timing=pd.DataFrame())
+    c = by_key(data)["cel_step"]
+    assert c.estimate is None and c.verdict == "cannot be judged" and "no timings" in c.reason
+
+
+@pytest.mark.parametrize("lm_ratio, verdict", [(12.0, "reproduced"), (0.5, "not reproduced")])
+def test_training_readings_of_e11_are_e03s_timings_against_one(lm_ratio, verdict):
+    c = by_key(fake_data(lm_ratio=lm_ratio, t45_over_t6=lm_ratio))
+    for k, base in (("cel_train_faster_lm", "cel_time_lm"), ("cel_train_faster", "cel_time")):
+        assert c[k].estimate == c[base].estimate and c[k].boundary == 1.0
+        assert c[k].verdict == verdict
+
+
+@pytest.mark.parametrize(
+    "diff, verdict",
+    [(0.0, "no difference"), (-0.5, "reproduced"), (0.5, "not reproduced")],
+)
+def test_dropping_the_rates_claim_is_the_paired_difference_with_the_registers_margin(diff, verdict):
+    c = by_key(fake_data(n_repeats=4, norates_diff=diff))
+    margin = {e.id: e.margin for e in claims_mod.load_register("paper_e")}["E12"]
+    for k in ("cel_norates_held", "cel_norates_same"):
+        assert c[k].estimate.rule == "paired difference" and c[k].estimate.n == 16
+        assert c[k].estimate.value == pytest.approx(diff, abs=0.01)
+        assert c[k].boundary == 0 and c[k].holds_when == "below" and c[k].margin == margin
+        assert c[k].verdict == verdict
+        assert any("by construction" in d for d in c[k].decided_by)
+
+
+def test_the_register_names_the_rows_e11_and_e12_write():
+    cl = celestial.claims(fake_data(n_repeats=4))
+    entries = {e.id: e for e in claims_mod.load_register("paper_e")}
+    for eid, keys in (
+        (
+            "E11",
+            {
+                "cel_step",
+                "cel_step_batch",
+                "cel_step_flops",
+                "cel_train_faster_lm",
+                "cel_train_faster",
+            },
+        ),
+        ("E12", {"cel_norates_held", "cel_norates_same"}),
+    ):
+        e = entries[eid]
+        mine = [c for c in cl if c.key in keys]
+        assert e.status == "judged" and {c.claim for c in mine} == set(e.rows)
+        assert [c.key for c in cl if c.claim in e.rows] == [c.key for c in mine]
+        prim = [c for c in mine if c.claim == e.primary_claim and c.reading == e.primary_reading]
+        assert len(prim) == 1
+    recs = {r["id"]: r for r in claims_mod.evaluate("celestial", [c.record() for c in cl])}
+    assert recs["E11"]["key"] == "cel_step" and len(recs["E11"]["sensitivity"]) == 4
+    assert (
+        recs["E12"]["key"] == "cel_norates_held" and recs["E12"]["margin"] == entries["E12"].margin
+    )
