@@ -786,7 +786,7 @@ def _estimate(
     )
 
 
-#: Tolerance on ``atanh kappa_1`` of the profile-likelihood interval's ends (:func:`_interval`).
+#: Tolerance on ``atanh kappa_1`` of the profile-likelihood interval's ends (``_interval``).
 INTERVAL_XTOL = 1e-6
 
 

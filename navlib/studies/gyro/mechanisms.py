@@ -18,7 +18,8 @@ model: C14 (Sec. 1), C16 (Sec. 2.1) and C18 (introduction, abstract).
   the axial drift".  On the measured hot tests (Table 2), the latitude error's part due to the axial drift
   through Table 1's own 12 h gain ``k = (cos L / W)(1 - cos 12 W)``, against the rest::
 
-      S = 100 sum_i (k eps_i)^2 / (sum_i (k eps_i)^2 + sum_i (dL_i - k eps_i)^2)      (eq. c16)
+      S = 100 sum_i (k eps_i)^2 / (sum_i (k eps_i)^2 + sum_i (dL_i - k eps_i)^2)
+                                                                       (eq. c16)
 
   ``dL_i`` the printed 12 h latitude less the printed local latitude, ``eps_i`` the printed "true" drift;
   bootstrap over the rows; the claim holds above 50 %.  The simulated hot tests give the same share, but
@@ -67,6 +68,7 @@ CLAIM_C16 = "after 4 h alignment the 12 h latitude error is mainly due to the ax
 CLAIM_C18 = "a single-axis rotation INS's accuracy is set by the axial gyro drift"
 #: C16's and C18's boundary: "mainly" is more than half.
 MAINLY_PCT = 50.0
+#: C14's basis functions at newrb's centres: the Gaussian and C13's others.
 BASES = ("gaussian", *BASIS_FUNCTIONS)
 
 
