@@ -19,6 +19,10 @@ Paper A's study and the pieces both studies share are read here as one namespace
 - :mod:`navlib.studies.compass.robustness` -- paper A's claims on drawn compasses;
 - :mod:`navlib.studies.compass.hidden_nodes` -- paper A's hidden-node count (MATLAB's BP against M) and its
   claims;
+- :mod:`navlib.studies.compass.initial_weights` -- paper A's "ADE overcomes the difficulty of choosing BP's
+  initial weights" on the seed study's runs: runs far from the floor and the spread over seeds;
+- :mod:`navlib.studies.compass.ellipse` -- paper A's "the ellipse-hypothesis model's accuracy is limited"
+  against ADE-BP (by construction on our simulator; real sweeps decide);
 - :mod:`navlib.studies.compass.elm_patent` -- document B: node count, data preparation and glitches, small
   samples, and its claims;
 - :mod:`navlib.studies.compass.elm_iterations` -- document B's iterations: the back-tuned ELM against
@@ -67,7 +71,16 @@ from ...methods.compass_methods import (
 )
 
 # document B, the real compass and the hidden-node count: sub-namespaces
-from . import elm_data, elm_iterations, elm_nodes, elm_patent, hidden_nodes, real  # noqa: F401
+from . import (  # noqa: F401
+    ellipse,
+    elm_data,
+    elm_iterations,
+    elm_nodes,
+    elm_patent,
+    hidden_nodes,
+    initial_weights,
+    real,
+)
 from .parameters import (
     BASE_READINGS,
     BOX_BOUNDS,
