@@ -8,7 +8,7 @@ field traces an ellipse, ``m_xy = A r(psi) + c``.  In the heading domain that is
 method fitted to every training reading.  The statistic is the paired difference of test RMS over the same
 seeds::
 
-    RMS(ellipse) - RMS(ADE-BP)        (holds above 0: the ellipse model is the less accurate)
+    RMS(ellipse) - RMS(ADE-BP)        (holds above 0: the ellipse is the less accurate)
 
 On our simulator that model *is* the compass (every simulated error source is affine in ``r``), so the
 ellipse fit reaches the noise floor by construction and cannot lose: the simulated row is judged *by
