@@ -167,47 +167,6 @@ def _colour(phi, d, gain, sd, u):
     return out
 
 
-@njit(error_model="numpy", cache=True)
-def _filter_whiten(phi, d, nugget, x):
-    """:func:`_gains` and :func:`_whiten` in one pass (the same operations in the same order: the same
-    numbers), for a likelihood that needs the whitened columns and ``sqrt(S_i)`` but not the gains."""
-    n, B = x.shape
-    out = np.empty((n, B))
-    sd = np.empty(n)
-    a = np.zeros((3, B))
-    P = np.eye(3)
-    pd = np.empty(3)
-    k = np.empty(3)
-    for i in range(n):
-        f = phi[i]
-        f2 = f * f
-        for r in range(3):
-            for c in range(3):
-                P[r, c] *= f2
-            P[r, r] += 1.0 - f2
-        d0, d1, d2 = d[i, 0], d[i, 1], d[i, 2]
-        for r in range(3):
-            pd[r] = P[r, 0] * d0 + P[r, 1] * d1 + P[r, 2] * d2
-        S = d0 * pd[0] + d1 * pd[1] + d2 * pd[2] + nugget
-        for r in range(3):
-            k[r] = pd[r] / S
-        for r in range(3):
-            for c in range(3):
-                P[r, c] -= pd[r] * pd[c] / S
-        s = np.sqrt(S)
-        sd[i] = s
-        for b in range(B):
-            a0 = f * a[0, b]
-            a1 = f * a[1, b]
-            a2 = f * a[2, b]
-            e = x[i, b] - (d0 * a0 + d1 * a1 + d2 * a2)
-            out[i, b] = e / s
-            a[0, b] = a0 + k[0] * e
-            a[1, b] = a1 + k[1] * e
-            a[2, b] = a2 + k[2] * e
-    return out, sd
-
-
 def clock_steps(clock: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The clock's steps ``t_i - t_(i-1)`` (``0`` first) and whether each is an odd number of whole steps
     (a negative ``kappa``'s sign: :func:`propagation`), for :func:`whiten_steps`: computed once per series
@@ -223,7 +182,7 @@ def clock_steps(clock: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 @njit(error_model="numpy", cache=True)
 def _filter_whiten_steps(kappa, dt, odd, d, nugget, x):
-    """:func:`propagation` and :func:`_filter_whiten` in one compiled pass: ``phi_i`` from ``kappa`` and the
+    """:func:`propagation`, :func:`_gains` and :func:`_whiten` in one compiled pass: ``phi_i`` from ``kappa`` and the
     steps ``dt`` (``odd``: an odd number of whole steps) as :func:`propagation` computes it, ``|kappa|^dt``
     evaluated once per run of equal steps (1 at a step of 0), then the filter and the whitening."""
     n, B = x.shape
@@ -288,10 +247,8 @@ def whiten_steps(
 
 def whiten_direct(kappa: float, clock: np.ndarray, d: np.ndarray, nugget: float, x: np.ndarray):
     """``(L^-1 x, log det R)`` for ``x`` (n, B) in filter order without keeping the gains
-    (``_filter_whiten``): what a likelihood evaluated at many ``kappa`` needs."""
-    phi = propagation(kappa, clock)
-    out, sd = _filter_whiten(phi, d, nugget, np.ascontiguousarray(x, float))
-    return out, 2.0 * float(np.sum(np.log(sd)))
+    (:func:`whiten_steps` from the clock): what a likelihood evaluated at many ``kappa`` needs."""
+    return whiten_steps(kappa, clock_steps(clock), d, nugget, np.ascontiguousarray(x, float))
 
 
 def _columns(kernel, g: Gains, x: np.ndarray) -> np.ndarray:

@@ -133,7 +133,8 @@ def test_the_one_pass_filter_is_the_gains_and_the_whitening(case):
     g = inn.gains(kappa, clock, d)
     w, logdet = inn.whiten_direct(kappa, clock, d, inn.nugget_of(d), x)
     assert np.array_equal(w, inn.whiten_columns(g, x)) and logdet == g.logdet
-    w_py, sd_py = inn._filter_whiten.py_func(g.phi, d, inn.nugget_of(d), x)
+    steps = inn.clock_steps(clock)
+    w_py, sd_py = inn._filter_whiten_steps.py_func(kappa, *steps, d, inn.nugget_of(d), x)
     assert np.allclose(w, w_py, rtol=1e-12, atol=1e-13)
     assert np.allclose(g.sd, sd_py, rtol=1e-13, atol=0)
 
@@ -141,8 +142,8 @@ def test_the_one_pass_filter_is_the_gains_and_the_whitening(case):
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_filter_with_its_propagation_compiled_equals_the_numpy_reference(case):
     """The likelihood's compiled pass with the propagation inside (``whiten_steps``, issue 34) against
-    its numpy reference: ``propagation`` and the Python reference of the one-pass filter; the compiled
-    kernel and its own Python self agree too.  A clock out of time order is refused."""
+    its reference computed apart: ``propagation`` in numpy, the gains, and the Python reference of the
+    whitening; the compiled kernel and its own Python self agree too.  A clock out of time order is refused."""
     kappa, times, axes, drop = CASES[case]
     ser, n_obs = _projected(times, axes, seed=len(case) + 5, drop=drop)
     pr = ser.projection
@@ -151,7 +152,10 @@ def test_the_filter_with_its_propagation_compiled_equals_the_numpy_reference(cas
     nugget = inn.nugget_of(d)
     steps = inn.clock_steps(clock)
     w, logdet = inn.whiten_steps(kappa, steps, d, nugget, x)
-    w_ref, sd_ref = inn._filter_whiten.py_func(inn.propagation(kappa, clock), d, nugget, x)
+    g = inn.gains(
+        kappa, clock, d, nugget
+    )  # the numpy propagation, the gains and the whitening apart
+    w_ref, sd_ref = inn._whiten.py_func(g.phi, d, g.gain, g.sd, x), g.sd
     assert np.allclose(w, w_ref, rtol=1e-12, atol=1e-13)
     assert logdet == pytest.approx(2.0 * np.sum(np.log(sd_ref)), rel=1e-13, abs=1e-12)
     w_py, sd_py = inn._filter_whiten_steps.py_func(kappa, *steps, d, nugget, x)
