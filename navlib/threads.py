@@ -7,7 +7,7 @@ with the default threads against 0.6-0.9 s with one).  The command line sets the
 numpy loads (``navlib.__main__``); a library call cannot, because numpy is already loaded.  So the entry
 points (:func:`navlib.workbench.fit.fit_model`, :func:`~navlib.workbench.diagnose.diagnose`,
 :func:`~navlib.workbench.loop.loop`, :func:`~navlib.workbench.calibration.calibrate`) run under
-``threadpoolctl.threadpool_limits`` with one BLAS thread (:func:`one_blas_thread`).
+a ``threadpoolctl`` limit of one BLAS thread (:func:`one_blas_thread`).
 
 A caller who set a thread count in the environment (``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS``,
 ``MKL_NUM_THREADS``) keeps it: the limit applies only where none is set.  Calls nested inside one entry point
@@ -20,7 +20,7 @@ import contextvars
 import functools
 import os
 
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from . import ONE_THREAD
 
@@ -29,6 +29,16 @@ THREAD_VARIABLES = tuple(
     k for k in ONE_THREAD if k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 )
 _INSIDE = contextvars.ContextVar("navlib_one_blas_thread", default=False)
+#: The process's thread pools, found once, at the first limited call (``threadpoolctl.threadpool_limits``
+#: looks for them at every call: about 1 ms, a twentieth of a calibration of 1,000 rows).  numpy's and
+#: scipy's BLAS are loaded with navlib; a BLAS library loaded after the first call is not limited.
+_CONTROLLER: list = []
+
+
+def _controller() -> ThreadpoolController:
+    if not _CONTROLLER:
+        _CONTROLLER.append(ThreadpoolController())
+    return _CONTROLLER[0]
 
 
 def caller_chose_threads() -> bool:
@@ -46,7 +56,7 @@ def one_blas_thread(func):
             return func(*args, **kwargs)
         token = _INSIDE.set(True)
         try:
-            with threadpool_limits(limits=1, user_api="blas"):
+            with _controller().limit(limits=1, user_api="blas"):
                 return func(*args, **kwargs)
         finally:
             _INSIDE.reset(token)

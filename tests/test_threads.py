@@ -32,13 +32,19 @@ def test_the_limit_applies_inside_and_is_lifted_after(no_thread_variables):
         seen = threads.one_blas_thread(blas_threads)()
         assert seen == {1}
         assert blas_threads() == outside
+        assert threads.one_blas_thread(blas_threads)() == {1}  # the controller kept, again
+        assert blas_threads() == outside
 
 
 def test_a_thread_count_the_caller_chose_is_kept(monkeypatch):
     calls = []
-    monkeypatch.setattr(
-        threads, "threadpool_limits", lambda **kw: calls.append(kw) or contextlib.nullcontext()
-    )
+
+    class Controller:
+        def limit(self, **kw):
+            calls.append(kw)
+            return contextlib.nullcontext()
+
+    monkeypatch.setattr(threads, "_controller", Controller)
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")
     assert threads.one_blas_thread(lambda: 7)() == 7
     assert calls == []

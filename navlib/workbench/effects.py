@@ -314,7 +314,12 @@ def column_problem(effect: Effect, data: pd.DataFrame) -> tuple[str, str] | None
     for col in effect.columns:
         if col not in data:
             return f"no column '{col}'", f"the column '{col}', which the data do not have"
-        values = pd.to_numeric(data[col], errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+        column = data[col]
+        values = (
+            column.to_numpy(dtype=float)  # already numbers: the same values, without the conversion
+            if column.dtype == np.float64
+            else pd.to_numeric(column, errors="coerce").to_numpy(dtype=float, na_value=np.nan)
+        )
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             cell = show(data[col].iloc[bad[0]])

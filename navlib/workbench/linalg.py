@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dpotrf, dtrtri, dtrtrs
+from scipy.linalg.lapack import dpotrf, dpotrs, dtrtri, dtrtrs
 
 
 def orth_basis(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
@@ -62,6 +62,24 @@ def leverage(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
             return np.einsum("ij,ij->j", Z, Z)
     q = orth_basis(X, rtol)
     return np.einsum("ij,ij->i", q, q)
+
+
+def least_squares_coef(X: np.ndarray, y: np.ndarray, rcond: float = 1e-10) -> np.ndarray:
+    """``argmin_c |X c - y|``: from the Cholesky factor of the column-scaled Gram matrix (the normal
+    equations; a fifth of an SVD's time on thousands of rows) where every column keeps more than
+    :data:`LEVERAGE_CHOL_MIN` of its norm after the previous ones (the Gram matrix's condition number below
+    about 1e6, so the coefficients are exact to about 1e-10 relative), else ``numpy.linalg.lstsq`` with
+    ``rcond`` (the minimum-norm solution of a rank-deficient ``X``)."""
+    n, k = X.shape
+    norms = np.sqrt(np.einsum("ij,ij->j", X, X))
+    if k and np.all(norms > 0):
+        Xs = X / norms
+        L, info = dpotrf(Xs.T @ Xs, lower=1, clean=1)
+        if info == 0 and np.min(np.diag(L)) > LEVERAGE_CHOL_MIN:
+            c, info = dpotrs(L, Xs.T @ y, lower=1)
+            if info == 0:
+                return c / norms
+    return np.linalg.lstsq(X, y, rcond=rcond)[0]
 
 
 def lower_solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -308,8 +308,16 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
 
 
 def columns_of(frame: pd.DataFrame, cols) -> np.ndarray:
-    """``frame[list(cols)].to_numpy(float)``, column by column (the same numbers; on a frame of selected
-    rows pandas' multi-column take costs several times more, and the fits read these columns often)."""
+    """``frame[list(cols)].to_numpy(float)``, column by column (the same numbers; pandas' multi-column take
+    costs forty times more, and the fits read these columns often).  Each column's values are read
+    straight from the frame's block where pandas offers it (``DataFrame._get_column_array``, a tenth of a
+    ``frame[c]``); else, and for repeated column names, through ``frame[c]``."""
+    get = getattr(frame, "_get_column_array", None)
+    if get is not None and frame.columns.is_unique:
+        loc = (
+            frame.columns.get_loc
+        )  # a hash lookup per name (KeyError for a missing one, as frame[c])
+        return np.column_stack([np.asarray(get(loc(c)), float) for c in cols])
     return np.column_stack([frame[c].to_numpy(float) for c in cols])
 
 
@@ -330,7 +338,7 @@ def accelerometer_motion(frame: pd.DataFrame) -> str | None:
     else None (no accelerometer, or a still or slowly turned one)."""
     if not has_acc(frame):
         return None
-    g = np.linalg.norm(frame[list(ACC)].to_numpy(float), axis=1)
+    g = np.linalg.norm(columns_of(frame, ACC), axis=1)
     dev = np.abs(g - np.median(g))
     p95 = float(np.percentile(dev, 95))
     if p95 <= ACC_STILL_TOL_MS2:
@@ -364,7 +372,10 @@ def _directions(frame: pd.DataFrame) -> np.ndarray:
 
 def _cells(u: np.ndarray) -> int:
     cell = np.round(u * 2).astype(np.int64) + 2  # each component in 0..4
-    return int(np.unique(cell @ np.array([25, 5, 1])).size)
+    ids = cell @ np.array([25, 5, 1])  # 0..124 for unit vectors
+    if ids.size and ids.min() >= 0:
+        return int(np.count_nonzero(np.bincount(ids)))  # the distinct ids without sorting them
+    return int(np.unique(ids).size)
 
 
 def _spread(u: np.ndarray) -> float:
@@ -489,9 +500,7 @@ def offset(params: dict, frame: pd.DataFrame, t_c: float) -> np.ndarray:
 
 def corrected(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
     """The corrected field ``u = M (m - b - k (T - T_c))``, (n, 3) uT, in the magnetometer's axes."""
-    return (frame[list(MAG)].to_numpy(float) - offset(params, frame, t_c)) @ correction_matrix(
-        params
-    ).T
+    return (columns_of(frame, MAG) - offset(params, frame, t_c)) @ correction_matrix(params).T
 
 
 def invariant_residuals(params: dict, frame: pd.DataFrame, t_c: float = 0.0) -> np.ndarray:
@@ -545,13 +554,13 @@ def _fit_free(data: pd.DataFrame, effects: tuple[Effect, ...], start) -> Fit:
         X = np.column_stack([2 * m, np.ones(len(m))])
         sol = np.linalg.lstsq(X, np.sum(m * m, axis=1), rcond=None)[0]
         x2.update(hard_x_ut=sol[0], hard_y_ut=sol[1], hard_z_ut=sol[2])
-    r0 = invariant_residuals(x2, data, t_c)
+    r0 = kern.residuals(np.array([x2[q] for q in names], float))  # invariant_residuals(x2, ...)
     x2["field_ut"] = float(np.mean(r0[:, 0]))
     if acc:
         x2["field_down_ut"] = float(np.mean(r0[:, 1]))
     if users:
         U = user_design(users, data, shape)
-        r0 = invariant_residuals(x2, data, t_c).ravel()
+        r0 = kern.residuals(np.array([x2[q] for q in names], float)).ravel()
         beta = np.linalg.lstsq(U, -r0, rcond=None)[0]
         x2.update(zip([p for e in users for p in e.params], beta))
     x2v = np.array([x2[n] for n in names])

@@ -61,12 +61,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
+from numba import njit
 from scipy import special
 
 from ..errors import InputError
 from .effects import testable
 from .fit import MEASURED, Fit, measured_columns, refit_rows, residuals_on
-from .linalg import leverage, orth_basis
+from .linalg import least_squares_coef, leverage, orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
 #: Lowest robust ``|z|`` that flags an outlier: a Gaussian sample beyond 6 standard deviations has probability
@@ -199,7 +200,12 @@ def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
     """RMS of the measured values of ``frame`` (:data:`navlib.workbench.fit.MEASURED`; for a system
     without an entry, of the model's prediction plus the residual)."""
     if fit.system in MEASURED:
-        v = frame[[c for c in MEASURED[fit.system][0] if c in frame]].to_numpy(float)
+        cols = [c for c in MEASURED[fit.system][0] if c in frame]
+        v = (
+            np.column_stack([frame[c].to_numpy(float) for c in cols])
+            if cols
+            else np.zeros((len(frame), 0))
+        )
     else:
         v = np.asarray(fit.predict(frame), float).ravel() + fit.residuals
     return float(np.sqrt(np.mean(v**2)))
@@ -215,21 +221,61 @@ def _robust_z(u: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
     return (u - med) / s
 
 
-def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str) -> np.ndarray | None:
+def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str, ser=False) -> np.ndarray | None:
     """``u_t`` minus the median of its neighbours within ``ISOLATION`` samples in time (same segment; NaN
     where a segment has a single sample), or None if the data are not a time series
-    (:func:`navlib.workbench.serial.series_of`).  The median (a Hampel filter's reference, Pearson 2002,
-    *IEEE Trans. Control Syst. Technol.* 10:55) keeps a spike from making its neighbours look like spikes."""
+    (:func:`navlib.workbench.serial.series_of`; ``ser``: that series, if already made).  The median (a
+    Hampel filter's reference, Pearson 2002, *IEEE Trans. Control Syst. Technol.* 10:55) keeps a spike
+    from making its neighbours look like spikes."""
     n, k = u.shape
-    ser = series_of(data, n * k, system)
+    if ser is False:
+        ser = series_of(data, n * k, system)
     if ser is None:
         return None
     x = u.ravel()[ser.order]
     seg = np.cumsum(ser.pos == 0)
+    gap = x - _neighbour_median(x, seg, ISOLATION)
+    out = np.empty(n * k)
+    out[ser.order] = gap
+    return out.reshape(n, k)
+
+
+@njit(error_model="numpy", cache=True)
+def _neighbour_median(x, seg, width):  # pragma: no cover (compiled; tested against its numpy self)
+    """For each sample of ``x``, the median of the samples within ``width`` of it in the same segment
+    (``seg``), itself excluded (NaN where there are none): ``np.median`` / ``np.nanmedian`` of those
+    values, to the bit (the middle one, or the mean of the middle two)."""
     m = len(x)
-    near = np.full((m, 2 * ISOLATION), np.nan)
+    out = np.empty(m)
+    near = np.empty(2 * width)
+    for i in range(m):
+        c = 0
+        for off in range(-width, width + 1):
+            j = i + off
+            if off == 0 or j < 0 or j >= m or seg[j] != seg[i] or np.isnan(x[j]):
+                continue
+            v = x[j]
+            p = c  # insertion sort: at most 2 * width values
+            while p > 0 and near[p - 1] > v:
+                near[p] = near[p - 1]
+                p -= 1
+            near[p] = v
+            c += 1
+        if c == 0:
+            out[i] = np.nan
+        elif c % 2:
+            out[i] = near[c // 2]
+        else:
+            out[i] = (near[c // 2 - 1] + near[c // 2]) / 2.0
+    return out
+
+
+def _neighbour_median_numpy(x: np.ndarray, seg: np.ndarray, width: int) -> np.ndarray:
+    """The reference of ``_neighbour_median`` (numpy: the neighbours side by side, a median per row)."""
+    m = len(x)
+    near = np.full((m, 2 * width), np.nan)
     col = 0
-    for off in [o for o in range(-ISOLATION, ISOLATION + 1) if o]:
+    for off in [o for o in range(-width, width + 1) if o]:
         idx = np.arange(m) + off
         ok = (idx >= 0) & (idx < m)
         ok[ok] &= seg[idx[ok]] == seg[ok]
@@ -238,16 +284,11 @@ def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str) -> np.ndarray
     missing = np.isnan(near)
     has = ~np.all(missing, axis=1)
     ref = np.full(m, np.nan)
-    full = ~np.any(
-        missing, axis=1
-    )  # inside a segment: a plain median (nanmedian's cost is in the edges)
+    full = ~np.any(missing, axis=1)
     ref[full] = np.median(near[full], axis=1)
     edge = has & ~full
     ref[edge] = np.nanmedian(near[edge], axis=1)
-    gap = x - ref
-    out = np.empty(n * k)
-    out[ser.order] = gap
-    return out.reshape(n, k)
+    return ref
 
 
 def _richest(fit: Fit) -> list[tuple[str, ...]]:
@@ -299,14 +340,18 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
     elif fit.system not in MEASURED:
         note = f"not run: system '{fit.system}' names no measured columns"
     zk = None
+    # the time series of the data's observations (the screen's rounds and the noise model share it)
+    ser_all = series_of(data, rich.n, rich.system) if rich is not None else None
+    shapes_all = None  # the structure shapes on every row (they read the data only)
     if rich is not None and outliers and fit.system in MEASURED and rich.rms > floor:
-        rich, kept, found, zk = _screen_rows(fit, data, rich, c, floor)
+        shapes_all = _shapes_on(rich, data)
+        rich, kept, found, zk = _screen_rows(fit, data, rich, c, floor, ser_all, shapes_all)
     if rich is not None and len(kept) < n:
         data = data.iloc[kept]
     noise = NoiseModel(n_obs=fit.n)
     regressors = None
     if serial and rich is not None and rich.rms > floor:
-        ser = series_of(rich.data, rich.n, rich.system)
+        ser = ser_all if rich.data is fit.data else series_of(rich.data, rich.n, rich.system)
         if (
             ser is not None and rich.spec.noise_directions is not None
         ):  # residuals see axis-wise noise
@@ -314,8 +359,12 @@ def screen(fit: Fit, *, outliers: bool = True, serial: bool = True) -> Screening
         if ser is not None:
             if zk is not None:  # the noise model describes the bulk of the data
                 ser = ser.without(np.abs(zk.ravel()) > Z_NOISE)
-            shapes = [np.asarray(X, float) for _, X, _ in rich.spec.structure(rich)]
-            regressors = (rich.jacobian, np.column_stack(shapes) if shapes else None)
+            if shapes_all is not None and len(rich.data) == n:  # no row set aside: the same shapes
+                S = shapes_all if shapes_all.shape[1] else None
+            else:
+                shapes = [np.asarray(X, float) for _, X, _ in rich.spec.structure(rich)]
+                S = np.column_stack(shapes) if shapes else None
+            regressors = (rich.jacobian, S)
             noise = select(rich.residuals, *regressors, ser)
     return Screening(
         data,
@@ -340,12 +389,15 @@ def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
     return np.column_stack(cols) if cols else np.zeros((len(frame) * (rich.n // len(rich.data)), 0))
 
 
-def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system: str) -> np.ndarray:
+def _isolated(
+    size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system: str, ser=False
+) -> np.ndarray:
     """In a time series, the rows whose largest robust ``|z|`` (``size``) no other row within ``ISOLATION``
     samples of their segment comes near: none there exceeds ``max(c, size / DOMINANCE)``.  A run of large
     residuals is an event, left to the structure tests; the lesser residuals a huge spike causes around it
     in a fit it distorts do not hide the spike."""
-    ser = series_of(data, len(data) * axes, system)
+    if ser is False:  # else the series, if already made
+        ser = series_of(data, len(data) * axes, system)
     if ser is None:
         return np.ones(len(data), bool)
     n = len(data)
@@ -402,15 +454,21 @@ def _deletion_z(fit: Fit, data: pd.DataFrame, rich: Fit, floor: float) -> np.nda
     return z
 
 
-def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float):
+def _screen_rows(
+    fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float, ser=False, shapes_all=None
+):
     """The iteration of the module docstring; returns the richest fit on the rows kept, their positions
-    and the outliers."""
+    and the outliers.  ``ser``: the series of ``data``'s observations, ``shapes_all`` the structure shapes
+    on them (:func:`_shapes_on`), if already made."""
     n = len(data)
     axes = rich.n // n
     cols = measured_columns(fit.system, axes)
     aside = np.zeros(n, bool)
     limit = max(1, int(math.floor(MAX_OUTLIER_SHARE * n)))
-    shapes_all = _shapes_on(rich, data)
+    if shapes_all is None:
+        shapes_all = _shapes_on(rich, data)
+    if ser is False:  # the same for every round
+        ser = series_of(data, n * axes, fit.system)
     dof = rich.n - rich.n_params
     if n <= SMALL_TABLE or dof - shapes_all.shape[1] < max(MIN_DOF, dof / 2):
         shapes_all = shapes_all[:, :0]  # too few rows to take the structure out as well
@@ -424,12 +482,12 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         if shapes_all.shape[1]:
             # the shapes fitted to the residual clipped at Z_NOISE robust standard deviations (one Huber
             # step), so that a spike is not smeared over its time cell
-            S = shapes_all[obs]
+            S = shapes_all if len(kept) == n else shapes_all[obs]  # every row: no copy
             lev = leverage(np.column_stack([rich.jacobian, S]))
             rk = r[kept]
             med = np.median(rk, axis=0)
             half = Z_NOISE * np.maximum(MAD_SD * np.median(np.abs(rk - med), axis=0), floor)
-            coef = np.linalg.lstsq(S, np.clip(rk, med - half, med + half).ravel(), rcond=1e-10)[0]
+            coef = least_squares_coef(S, np.clip(rk, med - half, med + half).ravel())
             r = r - (shapes_all @ coef).reshape(n, axes)
         else:
             lev = leverage(rich.jacobian)
@@ -438,11 +496,11 @@ def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float
         u = r / np.sqrt(1.0 - h)
         z = _robust_z(u, kept, floor)
         flagged = np.abs(z) > c
-        gap = _neighbour_gap(u, data, fit.system)
+        gap = _neighbour_gap(u, data, fit.system, ser)
         if gap is not None:
             zg = _robust_z(gap, kept, floor)
             flagged &= np.isnan(zg) | (np.abs(zg) > c)
-            flagged &= _isolated(np.abs(z).max(axis=1), c, data, axes, fit.system)[:, None]
+            flagged &= _isolated(np.abs(z).max(axis=1), c, data, axes, fit.system, ser)[:, None]
         return r_model, z, flagged
 
     for k in range(MAX_ROUNDS):

@@ -223,7 +223,8 @@ def regular_clock(series: Series) -> bool:
     """Whether a projected series is sampled on whole steps (then a negative lag-1 correlation is an AR(1)
     process; on an irregular clock only ``kappa >= 0``, ``kappa^|dt|``, is a valid correlation)."""
     c = series.projection.clock
-    return bool(np.allclose(c, np.round(c), atol=1e-6))
+    r = np.round(c)
+    return bool(np.all(np.abs(c - r) <= 1e-6 + 1e-5 * np.abs(r)))  # np.allclose's test, in one pass
 
 
 def _projected_inputs(series: Series, k: float, steps: bool = False) -> tuple:
@@ -796,7 +797,8 @@ def _interval(loglik, kappa: tuple, ll: float, low: float) -> tuple:
     kappa_1`` allowed.
 
     Each end is the root of ``gap(a) = ll - l(a) - chi2_1(level) / 2`` between the estimate ``a0`` and the
-    bound (the bound itself when ``gap`` there is not positive), found by Brent's method in
+    bound (the bound itself when ``gap`` there is not positive; the bound is not evaluated where a point
+    the estimate evaluated on that side already has a positive ``gap``), found by Brent's method in
     ``u = (a - a0)^2``, where a quadratic log likelihood makes ``gap`` linear (the first secant step is then
     exact), to :data:`INTERVAL_XTOL` in ``a``; it starts from the tightest bracket among the points the
     estimate already evaluated (a likelihood's ``values``, where it keeps them), else from the estimate and
@@ -817,17 +819,22 @@ def _interval(loglik, kappa: tuple, ll: float, low: float) -> tuple:
     ]
     ends = []
     for edge in (min(low, a0), lim):
-        g_edge = None if a0 == edge else gap(edge)
-        if g_edge is None or g_edge <= 0:
-            ends.append(float(np.tanh(edge)))
-            continue
         s = 1.0 if edge > a0 else -1.0
         side = [(a, g) for a, g in known if 0 < s * (a - a0) < s * (edge - a0)]
         inside = [p for p in side if p[1] <= 0]
         outside = [p for p in side if p[1] > 0]
+        # the bound is evaluated only where no point already evaluated on this side is beyond the drop
+        g_edge = None if a0 == edge or outside else gap(edge)
+        if a0 == edge or (g_edge is not None and g_edge <= 0):
+            ends.append(float(np.tanh(edge)))
+            continue
         a_in, g_in = max(inside, key=lambda p: s * p[0]) if inside else (a0, gap(a0))
         a_out, g_out = min(outside, key=lambda p: s * p[0]) if outside else (edge, g_edge)
         if s * (a_out - a_in) <= 0:  # not one crossing: from the estimate and the bound
+            g_edge = gap(edge) if g_edge is None else g_edge
+            if g_edge <= 0:
+                ends.append(float(np.tanh(edge)))
+                continue
             (a_in, g_in), (a_out, g_out) = (a0, gap(a0)), (edge, g_edge)
         u_in, u_out = (a_in - a0) ** 2, (a_out - a0) ** 2
 

@@ -1,0 +1,111 @@
+"""The calibration's faster paths (issue 34) against their references: the compiled neighbour median
+against numpy's median, and the profile interval that does not evaluate a bound beyond a point the
+estimate evaluated."""
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import minimize_scalar
+
+from navlib.workbench import serial
+from navlib.workbench.screen import _neighbour_median, _neighbour_median_numpy
+
+
+def test_the_compiled_neighbour_median_is_numpys_median():
+    rng = np.random.default_rng(2)
+    for t in range(300):
+        m = int(rng.integers(1, 50))
+        x = rng.normal(size=m) * 10.0 ** rng.uniform(-3, 3)
+        if t % 3 == 0:
+            x[rng.random(m) < 0.2] = np.nan
+        seg = np.cumsum(rng.random(m) < 0.2)
+        for width in (1, 2, 3):
+            got = _neighbour_median(x, seg, width)
+            assert np.array_equal(got, _neighbour_median_numpy(x, seg, width), equal_nan=True)
+
+
+def _projected_ar1(kappa, rows=1500, seed=3):
+    """Residuals of two observations per row, the projections of a 3-axis AR(1) noise of lag-1
+    correlation ``kappa`` along turning unit directions, on a regular clock."""
+    rng = np.random.default_rng(seed)
+    t = 0.1 * np.arange(rows)
+    noise = np.zeros((rows, 3))
+    e = rng.normal(size=(rows, 3))
+    noise[0] = e[0]
+    for i in range(1, rows):
+        noise[i] = kappa * noise[i - 1] + np.sqrt(1 - kappa**2) * e[i]
+    ang = np.cumsum(rng.normal(0.05, 0.02, size=(rows, 2)), axis=0)
+    d = np.stack(
+        [
+            np.column_stack([np.cos(ang[:, j]), np.sin(ang[:, j]), 0.3 * np.ones(rows)])
+            for j in (0, 1)
+        ],
+        axis=1,
+    ).reshape(2 * rows, 3)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    x = np.einsum("ij,ij->i", d, np.repeat(noise, 2, axis=0))
+    data = pd.DataFrame({"time_s": t})
+    ser = serial.with_projection(serial.series_of(data, 2 * rows, "magnetometer"), data, d)
+    return x, ser
+
+
+class _Counting:
+    """A likelihood that counts where it is evaluated (and keeps ``values`` as the real ones do)."""
+
+    def __init__(self, lik, keep=True):
+        self.lik, self.calls, self.keep = lik, [], keep
+        self.values = {}
+
+    def __call__(self, kappa):
+        self.calls.append(float(kappa[0]))
+        v = self.lik(kappa)
+        if self.keep:
+            self.values[tuple(float(k) for k in kappa)] = v
+        return v
+
+
+def test_the_interval_does_not_evaluate_a_bound_beyond_an_evaluated_point():
+    x, ser = _projected_ar1(0.6, rows=400)
+    counted = _Counting(serial._ProjectedLik(x, np.zeros((len(x), 0)), ser))
+    lim = np.arctanh(serial.KAPPA_MAX)
+    sol = minimize_scalar(
+        lambda a: -counted((np.tanh(a),)), bounds=(-lim, lim), method="bounded"
+    )  # from the whole range: points beyond the drop on both sides
+    kappa, ll = (float(np.tanh(sol.x)),), -float(sol.fun)
+    counted.calls.clear()
+    ends = serial._interval(counted, kappa, ll, -lim)
+    assert not any(abs(c) >= serial.KAPPA_MAX - 1e-12 for c in counted.calls)
+    # the same ends as from the estimate and the bounds alone (no evaluated points known)
+    blind = _Counting(serial._ProjectedLik(x, np.zeros((len(x), 0)), ser), keep=False)
+    ref = serial._interval(blind, kappa, ll, -lim)
+    assert any(abs(c) >= serial.KAPPA_MAX - 1e-12 for c in blind.calls)
+    np.testing.assert_allclose(np.arctanh(ends), np.arctanh(ref), atol=3 * serial.INTERVAL_XTOL)
+    assert ends[0] < kappa[0] < ends[1]
+
+
+def test_the_orientation_cells_are_the_distinct_cell_ids():
+    """_cells counts the distinct 30-deg cells by a bincount where the ids are small non-negative
+    integers (unit vectors), by np.unique otherwise: the same count as np.unique always."""
+    from navlib.workbench.magnetometer_free import _cells
+
+    rng = np.random.default_rng(4)
+    for t in range(200):
+        u = rng.normal(size=(int(rng.integers(1, 300)), 3))
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        if t % 4 == 0:
+            u *= 3.0  # not unit: ids outside 0..124, some negative
+        ids = (np.round(u * 2).astype(np.int64) + 2) @ np.array([25, 5, 1])
+        assert _cells(u) == np.unique(ids).size
+
+
+def test_least_squares_by_the_normal_equations_is_lstsq():
+    """Well-conditioned columns of very different scales: the Cholesky route's coefficients are lstsq's
+    to 1e-9; a dependent column: lstsq's minimum-norm solution itself."""
+    from navlib.workbench.linalg import least_squares_coef
+
+    rng = np.random.default_rng(5)
+    X = rng.normal(size=(1500, 20)) * 10.0 ** rng.uniform(-3, 3, 20)
+    y = rng.normal(size=1500)
+    ref = np.linalg.lstsq(X, y, rcond=1e-10)[0]
+    np.testing.assert_allclose(least_squares_coef(X, y), ref, rtol=1e-9)
+    X[:, 7] = 2.0 * X[:, 3] - X[:, 1]
+    assert np.array_equal(least_squares_coef(X, y), np.linalg.lstsq(X, y, rcond=1e-10)[0])
