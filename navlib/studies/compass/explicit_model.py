@@ -84,8 +84,9 @@ class CrossAxis:
     def apply(self, mag_xy_ut: np.ndarray) -> np.ndarray:
         """The bridges' readings ``(n, 2)`` (uT) of the sensor-frame field ``mag_xy_ut`` ``(n, 2)``::
 
-        m_x' = m_x H_0 / (H_0 + m_y),      m_y' = m_y H_0 / (H_0 - m_x)
-        """
+            m_x' = m_x H_0 / (H_0 + m_y),      m_y' = m_y H_0 / (H_0 - m_x)
+
+        A field component of half ``H_0`` or more is refused (the small-angle model fails there)."""
         m = np.asarray(mag_xy_ut, dtype=float)
         if m.ndim != 2 or m.shape[1] != 2:
             raise InputError("cross-axis effect: the field must be an (n, 2) array of x, y (uT)")
