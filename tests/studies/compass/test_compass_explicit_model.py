@@ -150,3 +150,91 @@ def test_the_study_fits_both_models_on_the_same_sweep_and_pairs_the_seeds():
     model = fit_planar_model(sw.t_train, np.mod(sw.m_train, 360.0))
     rms = np.sqrt(np.mean(wrap_deg(model.correct(np.mod(sw.m_test, 360.0)) - sw.t_test) ** 2))
     assert e[0] == pytest.approx(rms, rel=1e-9)
+
+
+# ------------------------------------------------------------------ real sweeps: inside the coverage
+def test_covered_marks_readings_between_close_training_headings_across_north():
+    train = np.r_[np.arange(0.0, 100.0, 3.0), np.arange(200.0, 360.0, 3.0)]  # a gap 99..200
+    got = em.covered(train, [50.0, 150.0, 358.5, 1.0, 99.5, 201.0])
+    assert got.tolist() == [True, False, True, True, False, True]
+    assert em.covered([350.0, 5.0], [358.0, 180.0], gap_deg=15.0).tolist() == [True, False]
+    assert em.covered([350.0, 5.0], [358.0], gap_deg=14.0).tolist() == [False]
+
+
+@pytest.mark.parametrize(
+    "args,match",
+    [(([0.0, 10.0], [5.0], 0.0), "gap_deg"), (([0.0], [5.0]), "2 training headings")],
+)
+def test_covered_refuses_broken_input(args, match):
+    with pytest.raises(InputError, match=match):
+        em.covered(*args)
+
+
+def _fake_real(gap_error_deg, inside_elm_deg=0.5, inside_explicit_deg=0.6, seeds=10):
+    """A real-data result over headings every 3 deg with two folds: fold 1 trains on 180..357 without
+    243..297 plus 0..57 and scores 0..177; fold 2 trains on 0..177 and scores 180..357 without 243..297.
+    Fold 1's held-out readings 60..177 lie in a gap of its training headings.  The ELM errs by
+    ``gap_error_deg`` on the uncovered readings, by ``inside_elm_deg`` (plus 0.01 per seed) on the
+    covered ones; the explicit model by ``inside_explicit_deg`` everywhere."""
+    from types import SimpleNamespace
+
+    from navlib.workbench.compare import Fold
+
+    h = np.arange(0.0, 360.0, 3.0)
+    first = np.where(h < 180)[0]
+    second = np.where((h >= 180) & ~((h > 240) & (h < 300)))[0]
+    folds = [
+        Fold(np.r_[second, np.where(h < 60)[0]], first, "sweep 2 + 0..57", "sweep 1"),
+        Fold(first, second, "sweep 1", "sweep 2"),
+    ]
+    n = h.size
+    elm = np.full((seeds, n), inside_elm_deg) + 0.01 * np.arange(seeds)[:, None]
+    phys = np.full((1, n), inside_explicit_deg)
+    inside = np.zeros(n, dtype=bool)
+    for f in folds:
+        inside[f.test] = em.covered(h[f.train], h[f.test])
+    elm[:, ~inside] = gap_error_deg
+    res = SimpleNamespace(
+        frame=pd.DataFrame({"true_heading_deg": h}),
+        folds=folds,
+        methods=["physical", "elm_backtuned"],
+        errors={"physical": phys, "elm_backtuned": elm},
+        stochastic={"physical": False, "elm_backtuned": True},
+    )
+    return SimpleNamespace(results={em.COVERAGE_RECORDING: res}), inside
+
+
+def test_coverage_claims_score_only_the_covered_readings():
+    real, inside = _fake_real(gap_error_deg=10.0)
+    assert 2 <= inside.sum() < inside.size  # some readings in gaps, some covered
+    (c,) = em.coverage_claims(real)
+    assert c.claim == em.EXPLICIT_TEXT and c.data == "real" and c.source == "paper"
+    assert c.reading.startswith(em.EXPLICIT_READING + "; BROAD trial 05")
+    elm = np.array([0.5 + 0.01 * k for k in range(10)])
+    want = verdicts.paired_difference(np.full(10, 0.6), elm)
+    got = (c.estimate.value, c.estimate.lo, c.estimate.hi)
+    assert got == pytest.approx((want.value, want.lo, want.hi), abs=1e-12)
+    assert c.verdict == "reproduced"  # the gap rows' large errors are left out
+    assert f"on {int(inside.sum())} of {inside.size} readings" in c.ours
+    # the ELM worse inside the coverage too: the other branch
+    (w,) = em.coverage_claims(_fake_real(10.0, inside_elm_deg=0.9)[0])
+    assert w.verdict == "not reproduced"
+
+
+def test_coverage_claims_without_the_methods_or_covered_readings():
+    real, _ = _fake_real(10.0)
+    res = real.results[em.COVERAGE_RECORDING]
+    res.methods = ["physical"]
+    assert em.coverage_claims(real) == []
+    res.methods = ["physical", "elm_backtuned"]
+    with pytest.raises(InputError, match="inside the coverage"):
+        em.coverage_claims(real, gap_deg=1.0)  # 3-deg spacing: nothing is covered
+
+
+def test_the_coverage_row_belongs_to_b14s_real_record():
+    sim = em.explicit_model_claims(_runs(0.4, _spread(0.1)))[0]
+    real = sim.__class__(**{**sim.__dict__, "data": "real", "key": ""})
+    (cov,) = em.coverage_claims(_fake_real(10.0)[0])
+    recs = registry.evaluate("compass", [sim.record(), real.record(), cov.record()])
+    (r,) = [r for r in recs if r["id"] == "B14" and r["data"] == "real"]
+    assert [s["reading"] for s in r["sensitivity"]] == [cov.reading]
