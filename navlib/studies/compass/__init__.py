@@ -31,6 +31,9 @@ Paper A's study and the pieces both studies share are read here as one namespace
   training error; the node count's influence) on the chapter's node-count runs;
 - :mod:`navlib.studies.compass.elm_data` -- document B's claims about its data: zero error on N samples,
   min-max normalisation, the sample size deep learning needs;
+- :mod:`navlib.studies.compass.explicit_model` -- document B's "any explicit error model can hardly include
+  all error factors": the ellipse model against the back-tuned ELM on the same training readings, on a
+  simulated compass with the AMR cross-axis effect (real sweeps decide, in ``real``);
 - :mod:`navlib.studies.compass.real` -- both documents' methods and claims on BROAD's real level sweeps.
 
 The methods themselves (ids, labels, readings, settings) are registered in
@@ -77,6 +80,7 @@ from . import (  # noqa: F401
     elm_iterations,
     elm_nodes,
     elm_patent,
+    explicit_model,
     hidden_nodes,
     initial_weights,
     real,

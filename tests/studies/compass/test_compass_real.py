@@ -93,12 +93,12 @@ def test_real_claims_carry_data_real_the_simulated_wording_and_the_primary_readi
     primary = [c for c in cs if "; " not in c.reading]
     assert {c.claim for c in primary} == {
         "the back-tuned ELM improves the uncompensated heading",
-        "the implicit ELM beats the exact physical model",
+        "ELM back-tuned beats the explicit (ellipse) model fitted on its training readings",
         "back-tuning beats a plain ELM of 19 nodes",
     }
     assert all(c.reading == entries[c.claim].primary_reading for c in primary)
     assert all(c.reading.endswith("; BROAD trials 2, 3, 5, 7") for c in cs if c not in primary)
-    phys = next(c for c in primary if "physical" in c.claim)
+    phys = next(c for c in primary if "explicit" in c.claim)
     runs = cr.runs_frame(real.results["trial05"])
     want = verdicts.paired_difference(
         runs[runs.method == "physical"].rms_deg.repeat(6).to_numpy(),
@@ -109,8 +109,12 @@ def test_real_claims_carry_data_real_the_simulated_wording_and_the_primary_readi
     recs = [
         r for r in registry.evaluate("compass", [c.record() for c in cs]) if r["data"] == "real"
     ]
-    assert {r["id"] for r in recs} == {"B01", "B08", "B09"}
-    assert all(r["primary_reading"] == "document B" and r["row_claim"] for r in recs)
+    assert {r["id"] for r in recs} == {"B01", "B14", "B09"}  # B08's real row is B14's
+    by_id = {e.id: e for e in registry.entries("compass")}
+    assert all(
+        r["primary_reading"] == by_id[r["id"]].primary_reading and r["row_claim"] for r in recs
+    )
+    assert next(r for r in recs if r["id"] == "B14")["source"] == "paper"
 
 
 @needs_data
