@@ -163,6 +163,31 @@ def explicit_model_study(
     )
 
 
+def _explicit_claim(
+    runs: pd.DataFrame, *, reading, statistic, decided_by, key, data="simulated", on=""
+):
+    """B14's row from ``runs`` (method, seed, rms_deg): test RMS of the explicit model minus that of the
+    back-tuned ELM, paired by seed, boundary 0, holds above; ``on``: where the RMS was taken, for ``ours``."""
+    est, short = verdicts.attempt(paired_rms_difference, runs, EXPLICIT_ID, IMPLICIT_ID)
+    e, b = per_seed(runs, EXPLICIT_ID), per_seed(runs, IMPLICIT_ID)
+    return Claim(
+        EXPLICIT_TEXT,
+        PAPER_TEXT,
+        reading=reading,
+        source="paper",
+        data=data,
+        statistic=statistic,
+        estimate=est,
+        boundary=0.0,
+        holds_when="above",
+        unit="deg",
+        decided_by=decided_by,
+        why=short,
+        ours=f"{b.median():.3f} vs {e.median():.3f} deg rms{on}",
+        key=key,
+    )
+
+
 def explicit_model_claims(runs: pd.DataFrame, cross: CrossAxis = CrossAxis()) -> list[Claim]:
     """B14 on the simulated compass with the AMR cross-axis effect, from :func:`explicit_model_study`'s
     ``runs``: test RMS(ellipse model) - test RMS(back-tuned ELM), paired by seed, boundary 0, holds above
@@ -171,20 +196,12 @@ def explicit_model_claims(runs: pd.DataFrame, cross: CrossAxis = CrossAxis()) ->
     missing = [m for m in (EXPLICIT_ID, IMPLICIT_ID) if m not in set(runs.method)]
     if missing:
         raise InputError(f"explicit_model_claims: the runs lack method(s) {', '.join(missing)}")
-    est, short = verdicts.attempt(paired_rms_difference, runs, EXPLICIT_ID, IMPLICIT_ID)
-    e, b = per_seed(runs, EXPLICIT_ID), per_seed(runs, IMPLICIT_ID)
     return [
-        Claim(
-            EXPLICIT_TEXT,
-            PAPER_TEXT,
+        _explicit_claim(
+            runs,
             reading=EXPLICIT_READING,
-            source="paper",
             statistic="test RMS ellipse (planar hard/soft-iron) model - test RMS ELM back-tuned, "
             "both fitted on sweep 1, paired by seed, deg",
-            estimate=est,
-            boundary=0.0,
-            holds_when="above",
-            unit="deg",
             decided_by=(
                 f"our simulated compass plus the AMR cross-axis effect (H_0 = {cross.h0_ut:g} uT, "
                 "one set state), an error source outside the ellipse model",
@@ -192,8 +209,6 @@ def explicit_model_claims(runs: pd.DataFrame, cross: CrossAxis = CrossAxis()) ->
                 "the ELM trained on the same readings at the chapter's a-priori settings",
                 TRAINING_ONLY,
             ),
-            why=short,
-            ours=f"{b.median():.3f} vs {e.median():.3f} deg rms",
             key="b_explicit_cross_axis",
         )
     ]
@@ -241,31 +256,21 @@ def coverage_claims(real, gap_deg: float = COVERAGE_GAP_DEG) -> list[Claim]:
             for k, run in zip(seeds, e)
         ]
     runs = pd.DataFrame(rows)
-    est, short = verdicts.attempt(paired_rms_difference, runs, EXPLICIT_ID, IMPLICIT_ID)
-    e, b = per_seed(runs, EXPLICIT_ID), per_seed(runs, IMPLICIT_ID)
     return [
-        Claim(
-            EXPLICIT_TEXT,
-            PAPER_TEXT,
+        _explicit_claim(
+            runs,
             reading=f"{EXPLICIT_READING}; BROAD trial 05, scored inside the training coverage",
-            source="paper",
             data="real",
             statistic="held-out RMS physical model - held-out RMS ELM back-tuned over the held-out "
             f"readings whose training neighbours lie at most {gap_deg:g} deg apart, paired by seed, deg",
-            estimate=est,
-            boundary=0.0,
-            holds_when="above",
-            unit="deg",
             decided_by=(
                 "BROAD trial 05, real measurements (BROAD, Laidig et al. 2021): one sweep fitted, the "
                 "other scored, both ways; the fits of the real-data section",
                 f"scored on {int(mask.sum())} of {mask.size} held-out readings (inside the coverage)",
                 "the interval covers training randomness (seeds), not another recording of the compass",
             ),
-            why=short,
-            ours=f"{b.median():.3f} vs {e.median():.3f} deg rms on {int(mask.sum())} of "
-            f"{mask.size} readings",
             key="real_b_explicit_covered",
+            on=f" on {int(mask.sum())} of {mask.size} readings",
         )
     ]
 
