@@ -45,6 +45,20 @@ def orth_basis_split(X: np.ndarray, split: int, rtol: float = 1e-7) -> tuple[np.
 LEVERAGE_CHOL_MIN = 1e-3
 
 
+def _scaled_cholesky(X: np.ndarray):
+    """``(X / norms, norms, L)`` with ``L`` the lower Cholesky factor of the column-scaled Gram matrix,
+    where every column keeps more than :data:`LEVERAGE_CHOL_MIN` of its norm after the previous ones; else
+    None (a zero column, no columns, or a Gram matrix too ill conditioned for the normal equations)."""
+    norms = np.sqrt(np.einsum("ij,ij->j", X, X))
+    if not X.shape[1] or not np.all(norms > 0):
+        return None
+    Xs = X / norms
+    L, info = dpotrf(Xs.T @ Xs, lower=1, clean=1)
+    if info != 0 or np.min(np.diag(L)) <= LEVERAGE_CHOL_MIN:
+        return None
+    return Xs, norms, L
+
+
 def leverage(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
     """The leverages ``h_i`` (the diagonal of the hat matrix) of the column space of ``X``: the row sums of
     squares of :func:`orth_basis` ``(X, rtol)``, from the Cholesky factor of the column-scaled Gram matrix
@@ -53,13 +67,11 @@ def leverage(X: np.ndarray, rtol: float = 1e-7) -> np.ndarray:
     n, k = X.shape
     if not k:
         return np.zeros(n)
-    norms = np.sqrt(np.einsum("ij,ij->j", X, X))
-    if np.all(norms > 0):
-        Xs = X / norms
-        L, info = dpotrf(Xs.T @ Xs, lower=1, clean=1)
-        if info == 0 and np.min(np.diag(L)) > LEVERAGE_CHOL_MIN:
-            Z, _ = dtrtrs(L, Xs.T, lower=1)  # L^-1 Xs' (k x n)
-            return np.einsum("ij,ij->j", Z, Z)
+    scaled = _scaled_cholesky(X)
+    if scaled is not None:
+        Xs, _, L = scaled
+        Z, _ = dtrtrs(L, Xs.T, lower=1)  # L^-1 Xs' (k x n)
+        return np.einsum("ij,ij->j", Z, Z)
     q = orth_basis(X, rtol)
     return np.einsum("ij,ij->i", q, q)
 
@@ -70,15 +82,12 @@ def least_squares_coef(X: np.ndarray, y: np.ndarray, rcond: float = 1e-10) -> np
     :data:`LEVERAGE_CHOL_MIN` of its norm after the previous ones (the Gram matrix's condition number below
     about 1e6, so the coefficients are exact to about 1e-10 relative), else ``numpy.linalg.lstsq`` with
     ``rcond`` (the minimum-norm solution of a rank-deficient ``X``)."""
-    n, k = X.shape
-    norms = np.sqrt(np.einsum("ij,ij->j", X, X))
-    if k and np.all(norms > 0):
-        Xs = X / norms
-        L, info = dpotrf(Xs.T @ Xs, lower=1, clean=1)
-        if info == 0 and np.min(np.diag(L)) > LEVERAGE_CHOL_MIN:
-            c, info = dpotrs(L, Xs.T @ y, lower=1)
-            if info == 0:
-                return c / norms
+    scaled = _scaled_cholesky(X)
+    if scaled is not None:
+        Xs, norms, L = scaled
+        c, info = dpotrs(L, Xs.T @ y, lower=1)
+        if info == 0:
+            return c / norms
     return np.linalg.lstsq(X, y, rcond=rcond)[0]
 
 

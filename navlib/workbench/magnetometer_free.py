@@ -72,7 +72,7 @@ from ..errors import InputError
 from ..methods.preprocess import field_gravity_dot
 from ..sensors.earth_field import Site
 from .effects import Effect, System, register_system
-from .fit import MEASURED, Fit, best_least_squares, user_columns, user_design
+from .fit import MEASURED, Fit, best_least_squares, columns_of, user_columns, user_design
 from . import free_breakdown
 from .free_kernel import FreeKernel
 from .local_field import field_check, field_lines
@@ -305,20 +305,6 @@ def site_of(frame: pd.DataFrame, site=None, date: str | None = None, name: str =
     return Site(
         site[0], site[1], site[2] if len(site) > 2 else 0.0, *((date,) if date is not None else ())
     )
-
-
-def columns_of(frame: pd.DataFrame, cols) -> np.ndarray:
-    """``frame[list(cols)].to_numpy(float)``, column by column (the same numbers; pandas' multi-column take
-    costs forty times more, and the fits read these columns often).  Each column's values are read
-    straight from the frame's block where pandas offers it (``DataFrame._get_column_array``, a tenth of a
-    ``frame[c]``); else, and for repeated column names, through ``frame[c]``."""
-    get = getattr(frame, "_get_column_array", None)
-    if get is not None and frame.columns.is_unique:
-        loc = (
-            frame.columns.get_loc
-        )  # a hash lookup per name (KeyError for a missing one, as frame[c])
-        return np.column_stack([np.asarray(get(loc(c)), float) for c in cols])
-    return np.column_stack([frame[c].to_numpy(float) for c in cols])
 
 
 def has_acc(frame: pd.DataFrame) -> bool:

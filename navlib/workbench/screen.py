@@ -66,7 +66,7 @@ from scipy import special
 
 from ..errors import InputError
 from .effects import testable
-from .fit import MEASURED, Fit, measured_columns, refit_rows, residuals_on
+from .fit import MEASURED, Fit, columns_of, measured_columns, refit_rows, residuals_on
 from .linalg import least_squares_coef, leverage, orth_basis
 from .serial import NoiseModel, select, series_of, with_projection
 
@@ -201,11 +201,7 @@ def measurement_scale(fit: Fit, frame: pd.DataFrame) -> float:
     without an entry, of the model's prediction plus the residual)."""
     if fit.system in MEASURED:
         cols = [c for c in MEASURED[fit.system][0] if c in frame]
-        v = (
-            np.column_stack([frame[c].to_numpy(float) for c in cols])
-            if cols
-            else np.zeros((len(frame), 0))
-        )
+        v = columns_of(frame, cols) if cols else np.zeros((len(frame), 0))
     else:
         v = np.asarray(fit.predict(frame), float).ravel() + fit.residuals
     return float(np.sqrt(np.mean(v**2)))
@@ -221,15 +217,13 @@ def _robust_z(u: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
     return (u - med) / s
 
 
-def _neighbour_gap(u: np.ndarray, data: pd.DataFrame, system: str, ser=False) -> np.ndarray | None:
+def _neighbour_gap(u: np.ndarray, ser) -> np.ndarray | None:
     """``u_t`` minus the median of its neighbours within ``ISOLATION`` samples in time (same segment; NaN
-    where a segment has a single sample), or None if the data are not a time series
-    (:func:`navlib.workbench.serial.series_of`; ``ser``: that series, if already made).  The median (a
-    Hampel filter's reference, Pearson 2002, *IEEE Trans. Control Syst. Technol.* 10:55) keeps a spike
-    from making its neighbours look like spikes."""
+    where a segment has a single sample), or None if the data are not a time series (``ser``, the
+    observations' :func:`navlib.workbench.serial.series_of`, is None).  The median (a Hampel filter's
+    reference, Pearson 2002, *IEEE Trans. Control Syst. Technol.* 10:55) keeps a spike from making its
+    neighbours look like spikes."""
     n, k = u.shape
-    if ser is False:
-        ser = series_of(data, n * k, system)
     if ser is None:
         return None
     x = u.ravel()[ser.order]
@@ -389,15 +383,12 @@ def _shapes_on(rich: Fit, frame: pd.DataFrame) -> np.ndarray:
     return np.column_stack(cols) if cols else np.zeros((len(frame) * (rich.n // len(rich.data)), 0))
 
 
-def _isolated(
-    size: np.ndarray, c: float, data: pd.DataFrame, axes: int, system: str, ser=False
-) -> np.ndarray:
-    """In a time series, the rows whose largest robust ``|z|`` (``size``) no other row within ``ISOLATION``
-    samples of their segment comes near: none there exceeds ``max(c, size / DOMINANCE)``.  A run of large
-    residuals is an event, left to the structure tests; the lesser residuals a huge spike causes around it
-    in a fit it distorts do not hide the spike."""
-    if ser is False:  # else the series, if already made
-        ser = series_of(data, len(data) * axes, system)
+def _isolated(size: np.ndarray, c: float, data: pd.DataFrame, axes: int, ser) -> np.ndarray:
+    """In a time series (``ser``, the observations' :func:`navlib.workbench.serial.series_of`; None: not
+    one), the rows whose largest robust ``|z|`` (``size``) no other row within ``ISOLATION`` samples of their
+    segment comes near: none there exceeds ``max(c, size / DOMINANCE)``.  A run of large residuals is an
+    event, left to the structure tests; the lesser residuals a huge spike causes around it in a fit it
+    distorts do not hide the spike."""
     if ser is None:
         return np.ones(len(data), bool)
     n = len(data)
@@ -454,21 +445,15 @@ def _deletion_z(fit: Fit, data: pd.DataFrame, rich: Fit, floor: float) -> np.nda
     return z
 
 
-def _screen_rows(
-    fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float, ser=False, shapes_all=None
-):
+def _screen_rows(fit: Fit, data: pd.DataFrame, rich: Fit, c: float, floor: float, ser, shapes_all):
     """The iteration of the module docstring; returns the richest fit on the rows kept, their positions
-    and the outliers.  ``ser``: the series of ``data``'s observations, ``shapes_all`` the structure shapes
-    on them (:func:`_shapes_on`), if already made."""
+    and the outliers.  ``ser``: the series of ``data``'s observations (:func:`serial.series_of`, None if
+    not a time series), ``shapes_all`` the structure shapes on them (:func:`_shapes_on`)."""
     n = len(data)
     axes = rich.n // n
     cols = measured_columns(fit.system, axes)
     aside = np.zeros(n, bool)
     limit = max(1, int(math.floor(MAX_OUTLIER_SHARE * n)))
-    if shapes_all is None:
-        shapes_all = _shapes_on(rich, data)
-    if ser is False:  # the same for every round
-        ser = series_of(data, n * axes, fit.system)
     dof = rich.n - rich.n_params
     if n <= SMALL_TABLE or dof - shapes_all.shape[1] < max(MIN_DOF, dof / 2):
         shapes_all = shapes_all[:, :0]  # too few rows to take the structure out as well
@@ -496,11 +481,11 @@ def _screen_rows(
         u = r / np.sqrt(1.0 - h)
         z = _robust_z(u, kept, floor)
         flagged = np.abs(z) > c
-        gap = _neighbour_gap(u, data, fit.system, ser)
+        gap = _neighbour_gap(u, ser)
         if gap is not None:
             zg = _robust_z(gap, kept, floor)
             flagged &= np.isnan(zg) | (np.abs(zg) > c)
-            flagged &= _isolated(np.abs(z).max(axis=1), c, data, axes, fit.system, ser)[:, None]
+            flagged &= _isolated(np.abs(z).max(axis=1), c, data, axes, ser)[:, None]
         return r_model, z, flagged
 
     for k in range(MAX_ROUNDS):
