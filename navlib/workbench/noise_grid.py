@@ -14,7 +14,6 @@ instead of maximising :mod:`navlib.workbench.serial`'s likelihood per replicate.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dtrtrs
 
 from . import innovations
 from .reml import _Prepared
@@ -36,28 +35,41 @@ def ar1_grid(
     on a grid of correlations: ``E`` (N_obs x B), ``basis`` the regressors' orthonormal basis
     (:func:`~navlib.workbench.serial.basis_on`).  Returns ``(reml, ml)``, each (len(grid) x B).  The same numbers as
     ``serial._Restricted`` at order 1 (tested), vectorised over the residual vectors: the regressors' Gram
-    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix.  ``prepared``: the
+    blocks are shared, each grid point costs one Cholesky factor of a k x k matrix, all grid points in one
+    batch.  ``prepared``: the
     basis's own blocks (``reml._Prepared`` of order 1), when many calls share the basis."""
     pre = prepared if prepared is not None and prepared.P == 1 else _Prepared(basis, series, 1)
     Ze = np.asarray(E, float)[series.order]
     Cqe, Cee = pre.cross(Ze)
     n, k = pre.n, pre.k
-    reml = np.empty((len(grid), Ze.shape[1]))
-    ml = np.empty_like(reml)
-    for g, phi in enumerate(grid):
-        w, ws, logdet_r = pre.weights((phi,))
-        mee = ws @ Cee
-        if k:
-            L = np.linalg.cholesky((ws @ pre.Gq).reshape(k, k))
-            z = dtrtrs(L, np.tensordot(w, Cqe, axes=1), lower=1)[0]
-            rss = mee - np.einsum("ij,ij->j", z, z)
-            logdet_g = 2.0 * float(np.sum(np.log(np.diag(L))))
-        else:
-            rss, logdet_g = mee, 0.0
-        rss = np.maximum(rss, 1e-300)
-        reml[g] = -0.5 * ((n - k) * np.log(rss) + logdet_r + logdet_g)
-        ml[g] = -0.5 * (n * np.log(rss / n) + logdet_r)
+    w, ws, logdet_r = _ar1_weights(pre, np.asarray(grid, float))
+    mee = ws @ Cee  # (grid, B)
+    if k:
+        L = np.linalg.cholesky((ws @ pre.Gq).reshape(len(grid), k, k))
+        z = np.linalg.solve(L, np.tensordot(w, Cqe, axes=1))  # L^-1 b: (grid, k, B), one C loop
+        rss = mee - np.einsum("gij,gij->gj", z, z)
+        logdet_g = 2.0 * np.sum(np.log(np.diagonal(L, axis1=1, axis2=2)), axis=1)
+    else:
+        rss, logdet_g = mee, np.zeros(len(grid))
+    rss = np.maximum(rss, 1e-300)
+    reml = -0.5 * ((n - k) * np.log(rss) + logdet_r[:, None] + logdet_g[:, None])
+    ml = -0.5 * (n * np.log(rss / n) + logdet_r[:, None])
     return reml, ml
+
+
+def _ar1_weights(pre: _Prepared, grid: np.ndarray) -> tuple:
+    """``_Prepared.weights`` at order 1 (``P = 1``) for every correlation of ``grid`` at once: the
+    ordered and unordered pairs' weights (grid x pairs) and ``log det R`` (grid).  Group 0 is whitened
+    by ``A_0 = (1, 0)``, the bulk by ``A_1 = (1, -kappa) / sqrt(1 - kappa^2)`` (``levinson`` at order 1)."""
+    v1 = 1.0 * (1.0 - grid**2)
+    s1 = 1.0 / np.sqrt(v1)
+    A = np.zeros((len(grid), 4))  # A[g * 2 + i]
+    A[:, 0] = 1.0
+    A[:, 2] = s1
+    A[:, 3] = -grid * s1
+    (oi, oj), (si, sj) = pre._flat
+    logdet_r = pre.count[0] * np.log(1.0) + pre.count[1] * np.log(v1)
+    return A[:, oi] * A[:, oj], A[:, si] * A[:, sj], logdet_r
 
 
 def select_ar1_many(

@@ -14,6 +14,7 @@ argument (a :class:`~navlib.workbench.serial.Series`) is used only through its `
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from scipy.linalg.lapack import dpotrf, dtrtri, dtrtrs
 
 
@@ -30,6 +31,33 @@ def levinson(kappa) -> tuple[np.ndarray, np.ndarray]:
         phi[m, 1:m] = phi[m - 1, 1:m] - kappa[m - 1] * phi[m - 1, m - 1 : 0 : -1]
         v[m] = v[m - 1] * (1.0 - kappa[m - 1] ** 2)
     return phi, v
+
+
+@njit(error_model="numpy", cache=True)
+def ar_colour(u, phi, v, starts):
+    """The AR process on segments from independent unit samples: for rows ``t`` of each segment
+    ``starts[s] .. starts[s + 1] - 1`` (``k = t - starts[s]`` samples into it, order ``m = min(k, p)``)::
+
+        x_t = sum_(j=1..m) phi[m, j] x_(t-j) + sqrt(v[m]) u_t
+
+    with ``phi``, ``v`` from :func:`levinson` (p = ``len(v) - 1``): the first samples of a segment by the
+    Durbin-Levinson coefficients of their own order (exactly the stationary law), the rest by the order-p
+    recursion.  ``u`` is (N, B): every column coloured alike.  Compiled (numba, no fast-math); its
+    ``py_func`` and ``scipy.signal.lfilter`` on the same recursion are its references (tests)."""
+    n, b = u.shape
+    p = len(v) - 1
+    x = np.empty((n, b))
+    for s in range(len(starts) - 1):
+        a0 = starts[s]
+        for t in range(a0, starts[s + 1]):
+            m = min(t - a0, p)
+            sd = np.sqrt(v[m])
+            for c in range(b):
+                acc = sd * u[t, c]
+                for j in range(1, m + 1):
+                    acc += phi[m, j] * x[t - j, c]
+                x[t, c] = acc
+    return x
 
 
 def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

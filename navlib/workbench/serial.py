@@ -83,7 +83,7 @@ from scipy.optimize import brentq, minimize, minimize_scalar
 
 from . import innovations
 from .linalg import orth_basis, orth_basis_split
-from .reml import _Prepared, _Restricted, levinson  # noqa: F401  (re-exported: serial's names)
+from .reml import _Prepared, _Restricted, ar_colour, levinson  # noqa: F401  (re-exported: serial's names)
 
 #: A time step more than this many times the median step starts a new segment.
 GAP_FACTOR = 2.5
@@ -376,9 +376,7 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
     variance on each segment, returned in observation order (``n_obs`` rows; observations outside the
     series are 0).  ``whiten(colour(u)) == u``: the first samples of a segment are built with the
     Durbin-Levinson coefficients of their own order, the rest by the recursion of order p
-    (``scipy.signal.lfilter``, its state carried over from the start-up)."""
-    from scipy.signal import lfilter  # noqa: PLC0415  # lazy: scipy.signal costs 0.3 s at the CLI's start
-
+    (:func:`navlib.workbench.reml.ar_colour`, compiled)."""
     u = np.asarray(u, float)
     p = len(kappa)
     out = np.zeros((n_obs,) + u.shape[1:])
@@ -389,21 +387,9 @@ def colour(u: np.ndarray, kappa, series: Series, n_obs: int) -> np.ndarray:
         out[series.order] = innovations.colour_columns(projected_gains(kappa, series), u)
         return out
     phi, v = levinson(kappa)
-    x = np.empty_like(u)
-    starts = np.flatnonzero(series.pos == 0).tolist() + [len(u)]
-    a = np.r_[1.0, -phi[p, 1 : p + 1]]
-    for a0, b0 in zip(starts[:-1], starts[1:]):
-        head = min(p, b0 - a0)
-        for t in range(head):  # start-up: order t predicts sample t exactly
-            x[a0 + t] = np.sqrt(v[t]) * u[a0 + t]
-            for j in range(1, t + 1):
-                x[a0 + t] += phi[t, j] * x[a0 + t - j]
-        if b0 - a0 > p:
-            # x_t = sum_j phi_pj x_(t-j) + sqrt(v_p) u_t for t >= p; the filter's state holds the start-up
-            past = x[a0 : a0 + p][::-1]  # x_(p-1), ..., x_0
-            # (transposed direct form: z_k = -sum_(m>k) a_m x_(t-1-(m-k-1)))
-            zi = np.array([-np.tensordot(a[k + 1 :], past[: p - k], axes=(0, 0)) for k in range(p)])
-            x[a0 + p : b0], _ = lfilter([1.0], a, np.sqrt(v[p]) * u[a0 + p : b0], axis=0, zi=zi)
+    starts = np.r_[np.flatnonzero(series.pos == 0), len(u)].astype(np.int64)
+    cols = np.ascontiguousarray(u.reshape(len(u), -1))
+    x = ar_colour(cols, phi, v, starts).reshape(u.shape)
     out[series.order] = x
     return out
 

@@ -109,3 +109,63 @@ def test_least_squares_by_the_normal_equations_is_lstsq():
     np.testing.assert_allclose(least_squares_coef(X, y), ref, rtol=1e-9)
     X[:, 7] = 2.0 * X[:, 3] - X[:, 1]
     assert np.array_equal(least_squares_coef(X, y), np.linalg.lstsq(X, y, rcond=1e-10)[0])
+
+
+def _lfilter_colour(u, kappa, starts):
+    """The AR colouring as it was written with ``scipy.signal.lfilter``: start-up by the Durbin-Levinson
+    coefficients of each order, then the order-p recursion with the start-up as the filter's state."""
+    from scipy.signal import lfilter
+
+    phi, v = serial.levinson(kappa)
+    p = len(kappa)
+    x = np.empty_like(u)
+    a = np.r_[1.0, -phi[p, 1 : p + 1]]
+    for a0, b0 in zip(starts[:-1], starts[1:]):
+        for t in range(min(p, b0 - a0)):
+            x[a0 + t] = np.sqrt(v[t]) * u[a0 + t]
+            for j in range(1, t + 1):
+                x[a0 + t] += phi[t, j] * x[a0 + t - j]
+        if b0 - a0 > p:
+            past = x[a0 : a0 + p][::-1]
+            zi = np.array([-np.tensordot(a[k + 1 :], past[: p - k], axes=(0, 0)) for k in range(p)])
+            x[a0 + p : b0], _ = lfilter([1.0], a, np.sqrt(v[p]) * u[a0 + p : b0], axis=0, zi=zi)
+    return x
+
+
+def test_the_compiled_ar_colouring_is_the_lfilter_recursion():
+    rng = np.random.default_rng(5)
+    for kappa in [(0.6,), (0.9, -0.3, 0.2), (-0.5, 0.4)]:
+        u = rng.standard_normal((700, 4))
+        starts = np.array([0, 1, 3, 250, 600, 700], dtype=np.int64)  # segments shorter than p too
+        phi, v = serial.levinson(kappa)
+        got = serial.ar_colour(u, phi, v, starts)
+        assert np.allclose(got, _lfilter_colour(u, kappa, starts), rtol=1e-12, atol=1e-12)
+        assert np.array_equal(got, serial.ar_colour.py_func(u, phi, v, starts))
+    # a wrong coefficient shows: the check can fail
+    bad = serial.ar_colour(u, phi * 1.001, v, starts)
+    assert not np.allclose(bad, _lfilter_colour(u, kappa, starts), rtol=1e-9)
+
+
+def test_noise_band_quantile_is_scipy_stats_chi2():
+    from scipy.stats import chi2
+
+    from navlib.workbench.loop import _chi2_ppf
+
+    for q in (0.025, 0.5, 0.975):
+        for dof in (1, 7, 1997, 250_000):
+            assert _chi2_ppf(q, dof) == chi2.ppf(q, dof)
+
+
+def test_the_grids_order_1_weights_are_the_prepared_weights():
+    from navlib.workbench import noise_grid
+    from navlib.workbench.reml import _Prepared
+
+    rng = np.random.default_rng(8)
+    t = np.cumsum(rng.choice([0.1, 0.1, 0.7], 300))
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 300, "compass")
+    pre = _Prepared(rng.standard_normal((300, 3)), ser, 1)
+    w, ws, logdet = noise_grid._ar1_weights(pre, noise_grid.AR1_GRID)
+    for g in (0, 17, 120, 240):
+        w1, ws1, ld1 = pre.weights((noise_grid.AR1_GRID[g],))
+        assert np.array_equal(w[g], w1) and np.array_equal(ws[g], ws1)
+        assert logdet[g] == ld1
