@@ -94,6 +94,141 @@ def levinson_derivatives(kappa) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.
     return phi, v, dphi, dv
 
 
+@njit(error_model="numpy", cache=True)
+def _restricted_parts(kappa, P, count, oi, oj, si, sj, Gq, Cqr, Crr, k, gradient):
+    """``_Restricted``'s likelihood parts at ``kappa`` in one compiled call: ``(rss, logdet_r, logdet_g)``
+    and, with ``gradient``, their derivatives ``(drss, dlogdet_r, dlogdet_g)`` with respect to each
+    ``kappa_l`` -- the formulas of ``_Prepared.weights`` (with :func:`levinson_derivatives`) and
+    ``_Restricted.value_and_gradient`` (docstrings there), written as loops over the few pairs and
+    regressors.  ``G`` is factored by its own Cholesky loop; a non-positive pivot (``G`` numerically
+    singular) falls back to its eigenvalues, floored at 1e-300, as the numpy code does.  The numpy code
+    is its reference (tests)."""
+    p = kappa.shape[0]
+    phi = np.zeros((p + 1, p + 1))
+    v = np.ones(p + 1)
+    dphi = np.zeros((p, p + 1, p + 1))
+    dv = np.zeros((p, p + 1))
+    for m in range(1, p + 1):
+        km = kappa[m - 1]
+        for j in range(1, m):
+            phi[m, j] = phi[m - 1, j] - km * phi[m - 1, m - j]
+            for q_ in range(p):
+                dphi[q_, m, j] = dphi[q_, m - 1, j] - km * dphi[q_, m - 1, m - j]
+            dphi[m - 1, m, j] -= phi[m - 1, m - j]
+        phi[m, m] = km
+        dphi[m - 1, m, m] = 1.0
+        v[m] = v[m - 1] * (1.0 - km**2)
+        for q_ in range(p):
+            dv[q_, m] = dv[q_, m - 1] * (1.0 - km**2)
+        dv[m - 1, m] -= 2.0 * km * v[m - 1]
+    width = P + 1
+    A = np.zeros(width * width)
+    dA = np.zeros((p, width * width))
+    logdet_r = 0.0
+    dlogdet_r = np.zeros(p)
+    for g in range(width):
+        mg = min(g, p)
+        vm = v[mg]
+        scale = 1.0 / np.sqrt(vm)
+        logdet_r += count[g] * np.log(vm)
+        A[g * width] = scale
+        for i in range(1, p + 1):
+            A[g * width + i] = -phi[mg, i] * scale
+        if gradient:
+            for q_ in range(p):
+                rel = dv[q_, mg] / vm
+                dlogdet_r[q_] += rel * count[g]
+                for i in range(width):
+                    d = -dphi[q_, mg, i] * scale if 1 <= i <= p else 0.0
+                    dA[q_, g * width + i] = d - 0.5 * rel * A[g * width + i]
+    no, ns = oi.shape[0], si.shape[0]
+    w = np.empty(no)
+    ws = np.empty(ns)
+    for o in range(no):
+        w[o] = A[oi[o]] * A[oj[o]]
+    for t in range(ns):
+        ws[t] = A[si[t]] * A[sj[t]]
+    c = 0.0
+    for t in range(ns):
+        c += ws[t] * Crr[t]
+    drss = np.zeros(p)
+    dlogdet_g = np.zeros(p)
+    if gradient:
+        dw = np.empty((p, no))
+        dws = np.empty((p, ns))
+        for q_ in range(p):
+            for o in range(no):
+                dw[q_, o] = dA[q_, oi[o]] * A[oj[o]] + A[oi[o]] * dA[q_, oj[o]]
+            for t in range(ns):
+                dws[q_, t] = dA[q_, si[t]] * A[sj[t]] + A[si[t]] * dA[q_, sj[t]]
+                drss[q_] += dws[q_, t] * Crr[t]
+    if k == 0:
+        return c, logdet_r, 0.0, drss, dlogdet_r, dlogdet_g
+    G = np.dot(ws, Gq).reshape(k, k)  # BLAS, as the numpy code
+    b = np.dot(w, Cqr)
+    L = np.zeros((k, k))
+    ok = True
+    for j in range(k):
+        d = G[j, j]
+        for q in range(j):
+            d -= L[j, q] * L[j, q]
+        if not d > 0.0:
+            ok = False
+            break
+        L[j, j] = np.sqrt(d)
+        for i in range(j + 1, k):
+            e = G[i, j]
+            for q in range(j):
+                e -= L[i, q] * L[j, q]
+            L[i, j] = e / L[j, j]
+    Gi = np.zeros((k, k))
+    logdet_g = 0.0
+    if ok:  # Gi = L'^-1 L^-1 from the inverse of the triangular factor
+        Li = np.zeros((k, k))
+        for j in range(k):
+            Li[j, j] = 1.0 / L[j, j]
+            for i in range(j + 1, k):
+                e = 0.0
+                for q in range(j, i):
+                    e -= L[i, q] * Li[q, j]
+                Li[i, j] = e / L[i, i]
+            logdet_g += 2.0 * np.log(L[j, j])
+        for a in range(k):
+            for bb in range(k):
+                e = 0.0
+                for q in range(max(a, bb), k):
+                    e += Li[q, a] * Li[q, bb]
+                Gi[a, bb] = e
+    else:  # numerically singular: the eigenvalues, floored
+        ev, U = np.linalg.eigh(G)
+        for q in range(k):
+            e = max(ev[q], 1e-300)
+            logdet_g += np.log(e)
+            for a in range(k):
+                for bb in range(k):
+                    Gi[a, bb] += U[a, q] * U[bb, q] / e
+    y = np.dot(Gi, b)
+    rss = c
+    for a in range(k):
+        rss -= b[a] * y[a]
+    if gradient:
+        # y' Gq_s y and tr(G^-1 Gq_s) of every pair in one product (BLAS)
+        M = np.empty((k * k, 2))
+        for a in range(k):
+            for bb in range(k):
+                M[a * k + bb, 0] = y[a] * y[bb]
+                M[a * k + bb, 1] = Gi[a, bb]
+        H = np.dot(Gq, M)
+        cy = np.dot(Cqr, y)
+        for q_ in range(p):
+            for t in range(ns):
+                drss[q_] += dws[q_, t] * H[t, 0]
+                dlogdet_g[q_] += dws[q_, t] * H[t, 1]
+            for o in range(no):
+                drss[q_] -= 2.0 * dw[q_, o] * cy[o]
+    return rss, logdet_r, logdet_g, drss, dlogdet_r, dlogdet_g
+
+
 class _Prepared:
     """The parts of :class:`_Restricted` that depend only on the regressors' basis ``Q`` and the series (not
     on the residual): computed once when many residual vectors share them (a bootstrap).
@@ -131,6 +266,10 @@ class _Prepared:
             (x[:, 0] * (P + 1) + x[:, 1], x[:, 0] * (P + 1) + x[:, 2])
             for x in (self.pairs, self.sym)
         ]
+        #: the same indices as contiguous int64 arrays, for the compiled likelihood
+        self.flat_arrays = tuple(
+            np.ascontiguousarray(a, dtype=np.int64) for pair in self._flat for a in pair
+        )
         Gq = np.empty((len(self.sym), k, k))
         for s, (g, i, j) in enumerate(self.sym):
             c = self.lag_q[g][i].T @ self.lag_q[g][j]
@@ -220,7 +359,7 @@ class _Restricted:
         if cross is None or not usable:
             Cqr, Crr = pre.cross(np.asarray(r, float)[series.order][:, None])
             cross = (Cqr[:, :, 0], Crr[:, 0])
-        self.Cqr, self.Crr = cross
+        self.Cqr, self.Crr = (np.ascontiguousarray(x, dtype=float) for x in cross)
 
     def __call__(self, kappa) -> float:
         rss, logdet_r, logdet_g = self._parts(kappa)
@@ -234,6 +373,29 @@ class _Restricted:
         return -0.5 * (self.n * np.log(max(rss, 1e-300) / self.n) + logdet_r)
 
     def value_and_gradient(self, kappa) -> tuple[float, np.ndarray]:
+        """``l_R`` and its gradient with respect to ``kappa`` (:meth:`_value_and_gradient_numpy`), by the
+        compiled ``_restricted_parts``."""
+        rss, logdet_r, logdet_g, drss, dlogdet_r, dlogdet_g = self._compiled(kappa, True)
+        if rss <= 1e-300:
+            rss, drss = 1e-300, 0.0 * drss
+        value = -0.5 * ((self.n - self.k) * np.log(rss) + logdet_r + logdet_g)
+        return value, -0.5 * ((self.n - self.k) * drss / rss + dlogdet_r + dlogdet_g)
+
+    def _compiled(self, kappa, gradient: bool) -> tuple:
+        pre = self.pre
+        return _restricted_parts(
+            np.asarray(kappa, dtype=float).reshape(-1),
+            pre.P,
+            pre.count,
+            *pre.flat_arrays,
+            pre.Gq,
+            self.Cqr,
+            self.Crr,
+            self.k,
+            gradient,
+        )
+
+    def _value_and_gradient_numpy(self, kappa) -> tuple[float, np.ndarray]:
         """``l_R`` and its gradient with respect to ``kappa``: with ``y = G^-1 b`` and the pair weights'
         derivatives (``_Prepared.weights``)::
 
@@ -273,7 +435,11 @@ class _Restricted:
         return value, -0.5 * ((self.n - self.k) * drss / rss + dlogdet_r + dlogdet_g)
 
     def _parts(self, kappa) -> tuple[float, float, float]:
-        """``(RSS_W, log det R, log det X' R^-1 X)`` at ``kappa``."""
+        """``(RSS_W, log det R, log det X' R^-1 X)`` at ``kappa`` (:meth:`_parts_numpy`, compiled)."""
+        return self._compiled(kappa, False)[:3]
+
+    def _parts_numpy(self, kappa) -> tuple[float, float, float]:
+        """``(RSS_W, log det R, log det X' R^-1 X)`` at ``kappa``: the reference of :meth:`_parts`."""
         w, ws, logdet_r = self.pre.weights(kappa)
         k = self.k
         c = float(ws @ self.Crr)

@@ -3,6 +3,7 @@ against numpy's median, and the profile interval that does not evaluate a bound 
 estimate evaluated."""
 
 import numpy as np
+import pytest
 import pandas as pd
 from scipy.optimize import minimize_scalar
 
@@ -169,3 +170,34 @@ def test_the_grids_order_1_weights_are_the_prepared_weights():
         w1, ws1, ld1 = pre.weights((noise_grid.AR1_GRID[g],))
         assert np.array_equal(w[g], w1) and np.array_equal(ws[g], ws1)
         assert logdet[g] == ld1
+
+
+def test_the_compiled_restricted_likelihood_is_the_numpy_one():
+    """``_Restricted``'s compiled parts against its numpy reference: value, gradient and parts, for
+    regressor counts 0..40, AR orders up to the cache's, and a singular Gram matrix (eigenvalue path)."""
+    from navlib.workbench.reml import _Restricted
+
+    rng = np.random.default_rng(4)
+    t = np.cumsum(rng.choice([0.1, 0.1, 0.1, 0.6], 400))
+    ser = serial.series_of(pd.DataFrame({"time_s": t}), 800, "magnetometer").without(
+        rng.random(800) < 0.03
+    )
+    e = serial.colour(rng.standard_normal(len(ser.order)), (0.7, 0.2), ser, 800)
+    X1 = rng.standard_normal((800, 3))
+    cases = [np.zeros((800, 0))] + [
+        serial.basis_on(rng.standard_normal((800, k)), ser, 800) for k in (1, 4, 40)
+    ]
+    for Q in cases:
+        for P in (1, 3):
+            R = _Restricted(e, Q, ser, P)
+            for p in range(P + 1):
+                kap = np.tanh(rng.normal(size=p))
+                v1, g1 = R.value_and_gradient(kap)
+                v0, g0 = R._value_and_gradient_numpy(kap)
+                assert v1 == pytest.approx(v0, rel=1e-10)
+                assert np.allclose(g1, g0, rtol=1e-8, atol=1e-8 * abs(v0))
+                assert np.allclose(R._parts(kap), R._parts_numpy(kap), rtol=1e-10)
+    # two equal columns: G singular, the eigenvalue path (round-off decides the numbers: finite only)
+    R = _Restricted(e, np.column_stack([X1, X1[:, :1]]), ser, 2)
+    v1, g1 = R.value_and_gradient(np.array([0.5, 0.1]))
+    assert np.isfinite(v1) and np.all(np.isfinite(g1))
