@@ -14,7 +14,9 @@ decide them) or *not checkable* (it says why); a paper's contradictions of itsel
 (:func:`inconsistencies`).
 
 Every results row must belong to exactly one entry: a chapter that writes a row the register does not
-know stops with one line naming both (:class:`navlib.errors.InputError`).  A rerun with other parameters
+know stops with one line naming both (:class:`navlib.errors.InputError`).  The register holds each
+claim's boundary, side and unit once: an entry's primary row that uses others stops the same way, naming
+the entry, the field and both values (:func:`check_primary`).  A rerun with other parameters
 may not run an entry's primary reading (or any of its rows: other parameters, or no real measurements):
 the entry is then kept as *cannot be judged: its primary reading was not run*, with the rows that were
 run as its sensitivity, and the run finishes.
@@ -625,6 +627,49 @@ def data_of(record: Mapping) -> str:
     return record.get("data") or "simulated"
 
 
+def units_of(e: Entry) -> tuple[str, ...]:
+    """The units a row of entry ``e`` may carry: the register's ``unit``, or, where it lists several
+    separated by `` or `` (a worst case chosen over cases in different units, D13's ``ug or %``), any of
+    them."""
+    return tuple(u.strip() for u in e.unit.split(" or ")) if e.unit else ("",)
+
+
+def _disagreement(e: Entry, row: Mapping) -> tuple[str, object, object] | None:
+    """The first of ``boundary``, ``holds_when`` and ``unit`` on which the results row ``row`` disagrees
+    with its register entry ``e`` (field, register's value, row's value), or None.  The boundary agrees
+    within a relative 1e-9::
+
+        |b_row - b_register| <= 1e-9 max(|b_row|, |b_register|)
+
+    A row with neither a statistic nor a boundary (a row that says why it was not run) carries nothing
+    to compare."""
+    if row.get("estimate") is None and row.get("boundary") is None:
+        return None
+    b = row.get("boundary")
+    if (b is None) != (e.boundary is None) or (
+        b is not None and not math.isclose(float(b), e.boundary, rel_tol=1e-9, abs_tol=0.0)
+    ):
+        return "boundary", e.boundary, b
+    if row.get("holds_when") != e.holds_when:
+        return "holds_when", e.holds_when, row.get("holds_when")
+    if (row.get("unit") or "") not in units_of(e):
+        return "unit", e.unit, row.get("unit") or ""
+    return None
+
+
+def check_primary(e: Entry, row: Mapping) -> None:
+    """Refuse a primary row whose boundary, side or unit is not its register entry's: the register holds
+    each claim's boundary once, and the row that judges it must use it.  One line naming the register
+    file, the entry, the field and both values (:class:`navlib.errors.InputError`)."""
+    bad = _disagreement(e, row)
+    if bad is not None:
+        field, want, got = bad
+        raise InputError(
+            f"claims_{e.register}.csv, {e.id}: {field} is {want!r} in the register but "
+            f"{got!r} in its primary row {row.get('claim')!r} ({row.get('reading')})"
+        )
+
+
 def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None) -> dict:
     """The record of a judged entry from its rows ``mine`` (all on one kind of data): the primary row's
     fields, the other rows as ``sensitivity``; "not run" when the primary row (or every row) is missing."""
@@ -656,6 +701,7 @@ def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None
             "across": {"rows": 0, "same": 0, "verdicts": {}},
         }
     p = prim[0]
+    check_primary(e, p)
     others = [{**r, "source": e.origin} for r in mine if r is not p]
     rec = {
         **p,
@@ -790,6 +836,7 @@ __all__ = [
     "REGISTERS",
     "SOURCE_NAMES",
     "across_text",
+    "check_primary",
     "data_of",
     "entries",
     "evaluate",
@@ -801,6 +848,7 @@ __all__ = [
     "registers",
     "row_margin",
     "tally",
+    "units_of",
     "verdict_counts_text",
     "with_register_margin",
 ]
