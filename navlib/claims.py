@@ -629,8 +629,8 @@ def data_of(record: Mapping) -> str:
 
 def units_of(e: Entry) -> tuple[str, ...]:
     """The units a row of entry ``e`` may carry: the register's ``unit``, or, where it lists several
-    separated by `` or `` (a worst case chosen over cases in different units, D13's ``ug or %``), any of
-    them."""
+    joined by the word *or* (a worst case chosen over cases in different units, D13's ``ug or %``),
+    any of them."""
     return tuple(u.strip() for u in e.unit.split(" or ")) if e.unit else ("",)
 
 
