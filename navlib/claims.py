@@ -123,6 +123,49 @@ class Claim:
         if self.key and not self.key.isidentifier():
             raise InputError(f"Claim.key={self.key!r}: use letters, digits and underscores")
 
+    @classmethod
+    def of(cls, entry_id: str, claim: str, paper: str, **fields) -> Claim:
+        """A results row of register entry ``entry_id`` judged against the register's ``boundary``,
+        ``holds_when`` and ``unit`` (the register holds them once; :func:`evaluate` refuses a primary
+        row that uses others).  ``claim`` must be one of the entry's ``rows``; the other fields are
+        :class:`Claim`'s.  A ``boundary``, ``holds_when`` or ``unit`` given as well must agree with the
+        register's (the boundary within a relative 1e-9), else :class:`navlib.errors.InputError`
+        names both; a row judged against another boundary (a margin, another threshold) is built with
+        :class:`Claim` itself.  Where the register lists several units (``ug or %``) the row's
+        ``unit`` must be given, one of them.
+
+        Examples
+        --------
+        >>> row = "the relation is nonlinear: a network beats a straight line"
+        >>> c = Claim.of("C06", row, "nonlinear", statistic="s, deg/h",
+        ...              estimate=verdicts.exact(-1e-5))
+        >>> (c.boundary, c.holds_when, c.unit)
+        (0.0, 'below', 'deg/h')
+        """
+        e = entry(entry_id)
+        if claim not in e.rows:
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: row {claim!r} is not one of its rows "
+                f"{list(e.rows)}"
+            )
+        given = {k: fields[k] for k in ("boundary", "holds_when", "unit") if k in fields}
+        units = units_of(e)
+        if "unit" not in given and len(units) > 1:
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: the register lists the units {e.unit!r}: "
+                f"give the row's unit, one of them"
+            )
+        kw = {"boundary": e.boundary, "holds_when": e.holds_when, "unit": units[0], **fields}
+        bad = _disagreement(e, {"estimate": 0.0, **kw})
+        if bad is not None:
+            field, want, got = bad
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: {field}={got!r} given for row {claim!r} "
+                f"({kw.get('reading', 'as printed')}), the register's is {want!r}: leave it out, or "
+                f"build a row judged against another {field} with Claim"
+            )
+        return cls(claim, paper, **kw)
+
     # -- the rule
     @property
     def interval(self) -> tuple[float, float] | None:
@@ -469,6 +512,23 @@ def load_register(name: str) -> tuple[Entry, ...]:
             return parse_register(fh, fname)
     except FileNotFoundError:
         raise InputError(f"{fname}: no such claims register in navlib's data") from None
+
+
+def entry(entry_id: str) -> Entry:
+    """The register entry ``entry_id`` (ids are unique over every register)."""
+    found = [
+        e
+        for names in REGISTERS.values()
+        for n in names
+        for e in load_register(n)
+        if e.id == entry_id
+    ]
+    if len(found) != 1:
+        raise InputError(
+            f"entry {entry_id!r}: found {len(found)} times in the claims registers "
+            f"(navlib.claims.REGISTERS), expected once"
+        )
+    return found[0]
 
 
 def registers(chapter: str) -> tuple[str, ...]:
@@ -839,6 +899,7 @@ __all__ = [
     "check_primary",
     "data_of",
     "entries",
+    "entry",
     "evaluate",
     "headlines",
     "inconsistencies",

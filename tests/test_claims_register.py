@@ -355,6 +355,67 @@ def test_a_primary_row_without_a_statistic_or_boundary_carries_nothing_to_compar
     assert a1["row_claim"] == "X beats Y" and a1["boundary"] is None
 
 
+@pytest.fixture
+def one_register(monkeypatch):
+    es = _parse(
+        _row(rows="X beats Y ; X beats Y [variant]"),
+        _row(id="A02", headline="", rows="Z", primary_claim="Z", boundary="5e-05", unit="ug or %"),
+    )
+    monkeypatch.setattr(claims, "REGISTERS", {"testch": ("test",)})
+    monkeypatch.setattr(claims, "load_register", lambda name: es)
+    return es
+
+
+def test_claim_of_takes_boundary_side_and_unit_from_the_register(one_register):
+    est = verdicts.exact(1.5)
+    c = claims.Claim.of("A01", "X beats Y", "p", reading="r1", statistic="s", estimate=est)
+    assert (c.boundary, c.holds_when, c.unit, c.verdict) == (0.0, "above", "deg", "reproduced")
+    assert c == claims.Claim(
+        "X beats Y",
+        "p",
+        reading="r1",
+        statistic="s",
+        estimate=est,
+        boundary=0.0,
+        holds_when="above",
+        unit="deg",
+    )
+    # a value given as well must be the register's (the boundary within a relative 1e-9)
+    same = claims.Claim.of(
+        "A02",
+        "Z",
+        "p",
+        reading="r1",
+        statistic="s",
+        estimate=est,
+        boundary=5e-05 * (1 + 1e-12),
+        unit="%",
+    )
+    assert same.unit == "%" and same.boundary == pytest.approx(5e-05)
+    (rec,) = [r for r in claims.evaluate("testch", [c.record(), same.record()]) if r["id"] == "A02"]
+    assert rec["unit"] == "%"
+
+
+@pytest.mark.parametrize(
+    "entry_id, claim, given, match",
+    [
+        ("A01", "X beats Y", {"boundary": 0.5}, "A01: boundary=0.5 given .* the register's is 0.0"),
+        ("A01", "X beats Y", {"boundary": None}, "A01: boundary=None given"),
+        ("A01", "X beats Y", {"holds_when": "below"}, "holds_when='below' given .* is 'above'"),
+        ("A01", "X beats Y", {"unit": "rad"}, "unit='rad' given .* the register's is 'deg'"),
+        ("A02", "Z", {}, "A02: the register lists the units 'ug or %': give the row's unit"),
+        ("A02", "Z", {"unit": "mg"}, "unit='mg' given .* the register's is 'ug or %'"),
+        ("A01", "Z", {}, "A01: row 'Z' is not one of its rows"),
+        ("A09", "X beats Y", {}, "entry 'A09': found 0 times"),
+    ],
+)
+def test_claim_of_refuses_a_value_the_register_does_not_hold(
+    one_register, entry_id, claim, given, match
+):
+    with pytest.raises(InputError, match=match):
+        claims.Claim.of(entry_id, claim, "p", statistic="s", estimate=verdicts.exact(1.0), **given)
+
+
 def _stored_rows(chapter):
     """The results rows a chapter's stored results file was evaluated from: each record's primary row
     (its ``claim`` the row's) and its sensitivity rows."""
