@@ -14,7 +14,9 @@ decide them) or *not checkable* (it says why); a paper's contradictions of itsel
 (:func:`inconsistencies`).
 
 Every results row must belong to exactly one entry: a chapter that writes a row the register does not
-know stops with one line naming both (:class:`navlib.errors.InputError`).  A rerun with other parameters
+know stops with one line naming both (:class:`navlib.errors.InputError`).  The register holds each
+claim's boundary, side and unit once: an entry's primary row that uses others stops the same way, naming
+the entry, the field and both values (:func:`check_primary`).  A rerun with other parameters
 may not run an entry's primary reading (or any of its rows: other parameters, or no real measurements):
 the entry is then kept as *cannot be judged: its primary reading was not run*, with the rows that were
 run as its sensitivity, and the run finishes.
@@ -120,6 +122,49 @@ class Claim:
             raise InputError("Claim.floor: a navlib.verdicts.Floor")
         if self.key and not self.key.isidentifier():
             raise InputError(f"Claim.key={self.key!r}: use letters, digits and underscores")
+
+    @classmethod
+    def of(cls, entry_id: str, claim: str, paper: str, **fields) -> Claim:
+        """A results row of register entry ``entry_id`` judged against the register's ``boundary``,
+        ``holds_when`` and ``unit`` (the register holds them once; :func:`evaluate` refuses a primary
+        row that uses others).  ``claim`` must be one of the entry's ``rows``; the other fields are
+        :class:`Claim`'s.  A ``boundary``, ``holds_when`` or ``unit`` given as well must agree with the
+        register's (the boundary within a relative 1e-9), else :class:`navlib.errors.InputError`
+        names both; a row judged against another boundary (a margin, another threshold) is built with
+        :class:`Claim` itself.  Where the register lists several units (``ug or %``) the row's
+        ``unit`` must be given, one of them.
+
+        Examples
+        --------
+        >>> row = "the relation is nonlinear: a network beats a straight line"
+        >>> c = Claim.of("C06", row, "nonlinear", statistic="s, deg/h",
+        ...              estimate=verdicts.exact(-1e-5))
+        >>> (c.boundary, c.holds_when, c.unit)
+        (0.0, 'below', 'deg/h')
+        """
+        e = entry(entry_id)
+        if claim not in e.rows:
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: row {claim!r} is not one of its rows "
+                f"{list(e.rows)}"
+            )
+        given = {k: fields[k] for k in ("boundary", "holds_when", "unit") if k in fields}
+        units = units_of(e)
+        if "unit" not in given and len(units) > 1:
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: the register lists the units {e.unit!r}: "
+                f"give the row's unit, one of them"
+            )
+        kw = {"boundary": e.boundary, "holds_when": e.holds_when, "unit": units[0], **fields}
+        bad = _disagreement(e, {"estimate": 0.0, **kw})
+        if bad is not None:
+            field, want, got = bad
+            raise InputError(
+                f"claims_{e.register}.csv, {e.id}: {field}={got!r} given for row {claim!r} "
+                f"({kw.get('reading', 'as printed')}), the register's is {want!r}: leave it out, or "
+                f"build a row judged against another {field} with Claim"
+            )
+        return cls(claim, paper, **kw)
 
     # -- the rule
     @property
@@ -469,6 +514,23 @@ def load_register(name: str) -> tuple[Entry, ...]:
         raise InputError(f"{fname}: no such claims register in navlib's data") from None
 
 
+def entry(entry_id: str) -> Entry:
+    """The register entry ``entry_id`` (ids are unique over every register)."""
+    found = [
+        e
+        for names in REGISTERS.values()
+        for n in names
+        for e in load_register(n)
+        if e.id == entry_id
+    ]
+    if len(found) != 1:
+        raise InputError(
+            f"entry {entry_id!r}: found {len(found)} times in the claims registers "
+            f"(navlib.claims.REGISTERS), expected once"
+        )
+    return found[0]
+
+
 def registers(chapter: str) -> tuple[str, ...]:
     """The register names a chapter is judged against (empty for a chapter without one)."""
     return REGISTERS.get(chapter, ())
@@ -625,6 +687,49 @@ def data_of(record: Mapping) -> str:
     return record.get("data") or "simulated"
 
 
+def units_of(e: Entry) -> tuple[str, ...]:
+    """The units a row of entry ``e`` may carry: the register's ``unit``, or, where it lists several
+    joined by the word *or* (a worst case chosen over cases in different units, D13's ``ug or %``),
+    any of them."""
+    return tuple(u.strip() for u in e.unit.split(" or ")) if e.unit else ("",)
+
+
+def _disagreement(e: Entry, row: Mapping) -> tuple[str, object, object] | None:
+    """The first of ``boundary``, ``holds_when`` and ``unit`` on which the results row ``row`` disagrees
+    with its register entry ``e`` (field, register's value, row's value), or None.  The boundary agrees
+    within a relative 1e-9::
+
+        |b_row - b_register| <= 1e-9 max(|b_row|, |b_register|)
+
+    A row with neither a statistic nor a boundary (a row that says why it was not run) carries nothing
+    to compare."""
+    if row.get("estimate") is None and row.get("boundary") is None:
+        return None
+    b = row.get("boundary")
+    if (b is None) != (e.boundary is None) or (
+        b is not None and not math.isclose(float(b), e.boundary, rel_tol=1e-9, abs_tol=0.0)
+    ):
+        return "boundary", e.boundary, b
+    if row.get("holds_when") != e.holds_when:
+        return "holds_when", e.holds_when, row.get("holds_when")
+    if (row.get("unit") or "") not in units_of(e):
+        return "unit", e.unit, row.get("unit") or ""
+    return None
+
+
+def check_primary(e: Entry, row: Mapping) -> None:
+    """Refuse a primary row whose boundary, side or unit is not its register entry's: the register holds
+    each claim's boundary once, and the row that judges it must use it.  One line naming the register
+    file, the entry, the field and both values (:class:`navlib.errors.InputError`)."""
+    bad = _disagreement(e, row)
+    if bad is not None:
+        field, want, got = bad
+        raise InputError(
+            f"claims_{e.register}.csv, {e.id}: {field} is {want!r} in the register but "
+            f"{got!r} in its primary row {row.get('claim')!r} ({row.get('reading')})"
+        )
+
+
 def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None) -> dict:
     """The record of a judged entry from its rows ``mine`` (all on one kind of data): the primary row's
     fields, the other rows as ``sensitivity``; "not run" when the primary row (or every row) is missing."""
@@ -656,6 +761,7 @@ def _judged(e: Entry, mine: list[dict], base: dict, worlds: list[Mapping] | None
             "across": {"rows": 0, "same": 0, "verdicts": {}},
         }
     p = prim[0]
+    check_primary(e, p)
     others = [{**r, "source": e.origin} for r in mine if r is not p]
     rec = {
         **p,
@@ -790,8 +896,10 @@ __all__ = [
     "REGISTERS",
     "SOURCE_NAMES",
     "across_text",
+    "check_primary",
     "data_of",
     "entries",
+    "entry",
     "evaluate",
     "headlines",
     "inconsistencies",
@@ -801,6 +909,7 @@ __all__ = [
     "registers",
     "row_margin",
     "tally",
+    "units_of",
     "verdict_counts_text",
     "with_register_margin",
 ]

@@ -287,6 +287,159 @@ def test_evaluate_refuses_rows_the_register_does_not_know_and_missing_primaries(
     assert register_problems(a4) == []
 
 
+# ------------------------------------------------------------------ the register holds each boundary once
+@pytest.mark.parametrize(
+    "change, field, values",
+    [
+        ({"boundary": 0.5}, "boundary", "0.0 in the register but 0.5"),
+        ({"boundary": 1e-6}, "boundary", "0.0 in the register but 1e-06"),
+        ({"boundary": None}, "boundary", "0.0 in the register but None"),
+        ({"holds_when": "below"}, "holds_when", "'above' in the register but 'below'"),
+        ({"unit": "arcmin"}, "unit", "'deg' in the register but 'arcmin'"),
+        ({"unit": ""}, "unit", "'deg' in the register but ''"),
+    ],
+)
+def test_evaluate_refuses_a_primary_row_off_its_registers_boundary_side_or_unit(
+    reg, change, field, values
+):
+    rows = [dict(_rec("X beats Y", "r1", (1, 2)), **change), _rec("ours", "real", (1, 2))]
+    with pytest.raises(InputError) as err:
+        claims.evaluate("testch", rows)
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert msg.startswith(f"claims_test.csv, A01: {field} is {values} in its primary row")
+    assert "'X beats Y' (r1)" in msg
+
+
+def test_a_primary_row_on_its_registers_boundary_side_and_unit_passes(reg):
+    rows = [
+        _rec("X beats Y", "r1", (1, 2)),
+        # another reading may judge against another boundary (a margin, another threshold)
+        dict(_rec("X beats Y", "r2", (1, 2), boundary=0.5, side="below"), unit="%"),
+        _rec("ours", "real", (1, 2), boundary=1e-13),
+    ]
+    # a boundary of 0 has no relative neighbourhood: any other number disagrees with it
+    with pytest.raises(InputError, match="A04: boundary is 0.0 in the register but 1e-13"):
+        claims.evaluate("testch", rows)
+    rows[2] = _rec("ours", "real", (1, 2))
+    a1 = claims.evaluate("testch", rows)[0]
+    assert a1["verdict"] == "reproduced" and len(a1["sensitivity"]) == 1
+
+
+def test_the_boundary_agrees_within_a_relative_1e_9_and_a_unit_may_be_one_of_several(monkeypatch):
+    es = _parse(_row(boundary="0.0003", unit="ug or %"))
+    monkeypatch.setitem(claims.REGISTERS, "testch", ("test",))
+    monkeypatch.setattr(claims, "load_register", lambda name: es)
+    near = dict(_rec("X beats Y", "r1", (1, 2), boundary=0.0003 * (1 + 1e-12)), unit="%")
+    assert claims.evaluate("testch", [near])[0]["boundary"] == near["boundary"]
+    assert claims.evaluate("testch", [dict(near, unit="ug")])[0]["unit"] == "ug"
+    with pytest.raises(InputError, match="boundary is 0.0003 in the register but 0.0003003"):
+        claims.evaluate("testch", [dict(near, boundary=0.0003003)])
+    with pytest.raises(InputError, match="unit is 'ug or %' in the register but 'ug or %'"):
+        claims.evaluate("testch", [dict(near, unit="ug or %")])
+
+
+def test_a_primary_row_without_a_statistic_or_boundary_carries_nothing_to_compare(reg):
+    not_run = dict(
+        _rec("X beats Y", "r1", (1, 2)),
+        estimate=None,
+        interval=None,
+        boundary=None,
+        holds_when=None,
+        unit="",
+        reproduced=None,
+        verdict="cannot be judged",
+        basis="no statistic",
+    )
+    a1 = claims.evaluate("testch", [not_run, _rec("ours", "real", (1, 2))])[0]
+    assert a1["row_claim"] == "X beats Y" and a1["boundary"] is None
+
+
+@pytest.fixture
+def one_register(monkeypatch):
+    es = _parse(
+        _row(rows="X beats Y ; X beats Y [variant]"),
+        _row(id="A02", headline="", rows="Z", primary_claim="Z", boundary="5e-05", unit="ug or %"),
+    )
+    monkeypatch.setattr(claims, "REGISTERS", {"testch": ("test",)})
+    monkeypatch.setattr(claims, "load_register", lambda name: es)
+    return es
+
+
+def test_claim_of_takes_boundary_side_and_unit_from_the_register(one_register):
+    est = verdicts.exact(1.5)
+    c = claims.Claim.of("A01", "X beats Y", "p", reading="r1", statistic="s", estimate=est)
+    assert (c.boundary, c.holds_when, c.unit, c.verdict) == (0.0, "above", "deg", "reproduced")
+    assert c == claims.Claim(
+        "X beats Y",
+        "p",
+        reading="r1",
+        statistic="s",
+        estimate=est,
+        boundary=0.0,
+        holds_when="above",
+        unit="deg",
+    )
+    # a value given as well must be the register's (the boundary within a relative 1e-9)
+    same = claims.Claim.of(
+        "A02",
+        "Z",
+        "p",
+        reading="r1",
+        statistic="s",
+        estimate=est,
+        boundary=5e-05 * (1 + 1e-12),
+        unit="%",
+    )
+    assert same.unit == "%" and same.boundary == pytest.approx(5e-05)
+    (rec,) = [r for r in claims.evaluate("testch", [c.record(), same.record()]) if r["id"] == "A02"]
+    assert rec["unit"] == "%"
+
+
+@pytest.mark.parametrize(
+    "entry_id, claim, given, match",
+    [
+        ("A01", "X beats Y", {"boundary": 0.5}, "A01: boundary=0.5 given .* the register's is 0.0"),
+        ("A01", "X beats Y", {"boundary": None}, "A01: boundary=None given"),
+        ("A01", "X beats Y", {"holds_when": "below"}, "holds_when='below' given .* is 'above'"),
+        ("A01", "X beats Y", {"unit": "rad"}, "unit='rad' given .* the register's is 'deg'"),
+        ("A02", "Z", {}, "A02: the register lists the units 'ug or %': give the row's unit"),
+        ("A02", "Z", {"unit": "mg"}, "unit='mg' given .* the register's is 'ug or %'"),
+        ("A01", "Z", {}, "A01: row 'Z' is not one of its rows"),
+        ("A09", "X beats Y", {}, "entry 'A09': found 0 times"),
+    ],
+)
+def test_claim_of_refuses_a_value_the_register_does_not_hold(
+    one_register, entry_id, claim, given, match
+):
+    with pytest.raises(InputError, match=match):
+        claims.Claim.of(entry_id, claim, "p", statistic="s", estimate=verdicts.exact(1.0), **given)
+
+
+def _stored_rows(chapter):
+    """The results rows a chapter's stored results file was evaluated from: each record's primary row
+    (its ``claim`` the row's) and its sensitivity rows."""
+    recs = json.loads((ROOT / "notebooks" / "results" / f"{chapter}.json").read_text("utf-8"))
+    rows = []
+    for r in recs["claims"]:
+        if r.get("row_claim") is not None:
+            rows.append({**r, "claim": r["row_claim"]})
+        rows.extend(r.get("sensitivity") or [])
+    return recs["claims"], rows
+
+
+@pytest.mark.parametrize("chapter", sorted(claims.REGISTERS))
+def test_every_stored_primary_row_uses_its_registers_boundary_side_and_unit(chapter):
+    """The stored results, evaluated again against today's registers: a register whose boundary, side or
+    unit drifts from the rows the chapter wrote (or a row that drifts from it) stops here."""
+    stored, rows = _stored_rows(chapter)
+    again = claims.evaluate(chapter, rows)
+    key = ("id", "data", "row_claim", "primary_reading", "boundary", "holds_when", "unit")
+    assert [tuple(r.get(k) for k in key) for r in again] == [
+        tuple(r.get(k) for k in key) for r in stored
+    ]
+
+
 # ------------------------------------------------------------------ every entry is shown by its chapter
 CHAPTERS = sorted(claims.REGISTERS)
 

@@ -194,15 +194,13 @@ def bp_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 "gyro_rbf_vs_bp_converged",
             )
         out.append(
-            Claim(
+            Claim.of(
+                "C12",
                 CLAIM,
                 PAPER,
                 reading=label,
                 statistic=stat,
                 estimate=verdicts.bootstrap([er, typ], lambda a, b: _rms(a) - _rms(b), seed=seed),
-                boundary=0.0,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=(
                     f"leave-one-out over Table 2's {len(er)} rows, {k} initialisations per fold",
                     rbf_text,
@@ -217,7 +215,8 @@ def bp_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     idx = np.arange(len(er), dtype=float)
     per_init = np.sqrt(np.mean(e**2, axis=0))
     out.append(
-        Claim(
+        Claim.of(
+            "C12",
             CLAIM,
             PAPER,
             reading=f"local optima: spread over initialisations, BP 1-{bp.n_hidden}-1, every row trains",
@@ -227,9 +226,6 @@ def bp_claims(params: StudyParams = StudyParams()) -> list[Claim]:
             estimate=verdicts.bootstrap(
                 [idx], lambda i: -_iqr_of_loo_rms(e[i.astype(int)]), seed=seed
             ),
-            boundary=0.0,
-            holds_when="below",
-            unit="deg/h",
             decided_by=(
                 f"leave-one-out over Table 2's {len(er)} rows, {bp.n_inits} initialisations per fold",
                 "any randomly initialised trainer spreads; the size of the spread is the evidence",

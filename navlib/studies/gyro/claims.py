@@ -144,15 +144,13 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
             for i in np.flatnonzero(dec > coarse)
         ]
         out.append(
-            Claim(
+            Claim.of(
+                "C02",
                 f"Table 3's RBF outputs reproduced to the printed {_ordinal(coarse)} decimal",
                 ", ".join(_printed(3, "paper_rbf_drift_deg_h")) + " deg/h",
                 reading=f"input in {unit}, goal as MSE",
                 statistic="largest |our output - printed output| over Table 3's 3 rows, deg/h",
                 estimate=verdicts.exact(diff.max()),
-                boundary=bound_out,
-                holds_when="below",
-                unit="deg/h",
                 floor=verdicts.Floor(
                     moved,
                     f"latitudes printed to {lat_dec} decimals (95th percentile of our output change "
@@ -174,15 +172,13 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
         for reading in ("MSE", "SSE", "RMS"):
             v = var.loc[(unit, reading)]
             out.append(
-                Claim(
+                Claim.of(
+                    "C01",
                     f"accuracy better than {lim:g} deg/h on the 3 hot tests (Table 3)",
                     paper_t3,
                     reading=f"input in {unit}, goal as {reading}",
                     statistic="largest |true - identified drift| over Table 3's 3 rows, deg/h",
                     estimate=verdicts.exact(float(v["max |T3 err| (deg/h)"])),
-                    boundary=lim,
-                    holds_when="below",
-                    unit="deg/h",
                     decided_by=(
                         "rests on Table 3's 3 rows only",
                         "reference: the paper's 72 h-optimal 'true' drift",
@@ -199,15 +195,13 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
         e = _hot_loo_errors(hot)
         beyond = int(np.sum(np.abs(e) > lim))
         out.append(
-            Claim(
+            Claim.of(
+                "C03",
                 f"accuracy better than {lim:g} deg/h (as RMS) under leave-one-out (Table 2)",
                 f"better than {lim:g} deg/h",
                 reading=f"input in {unit}, goal as MSE",
                 statistic="RMS of the leave-one-out error over Table 2's rows (bootstrap over the rows), deg/h",
                 estimate=verdicts.bootstrap([e], _rms, seed=bootstrap_seed(seed, f"loo_{unit}")),
-                boundary=lim,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=(
                     "the accuracy read as an RMS error",
                     f"leave-one-out over Table 2's {len(e)} rows",
@@ -222,16 +216,14 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     goal_nmi = fact("position_goal")
     floor_nmi = float(np.median(f3.runs["best_nmi"]))
     out.append(
-        Claim(
+        Claim.of(
+            "C04",
             f"position error after identification below {goal_nmi:g} nmi/72 h (Table 3, paper Fig 3)",
             ", ".join(f"{x:g}" for x in f3.table["paper after"]) + " nmi",
             reading="our RBF on the measured latitudes",
             statistic=f"median over {len(f3.runs)} simulated runs (Table 3's tests x {s.n_seeds} draws) of the worst "
             f"72 h position error after identification, nmi",
             estimate=verdicts.median_ci(f3.runs["after_nmi"]),
-            boundary=goal_nmi,
-            holds_when="below",
-            unit="nmi",
             floor=verdicts.Floor(
                 floor_nmi,
                 f"simulated residual errors after alignment (1 sigma: tilt {s.tilt_sd_arcsec:g} arcsec, "
@@ -255,16 +247,14 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     ss = bootstrap_seed(seed, "table4_range")
     rms4 = verdicts.bootstrap([e4], _rms, seed=ss)
     out.append(
-        Claim(
+        Claim.of(
+            "C07",
             f"after a cold start the hot net misses by {lo:g}-{hi:g} deg/h (Table 4)",
             f"{lo:g}-{hi:g} deg/h",
             reading="RMS over Table 4's rows",
             statistic=f"distance of the RMS hot-net error outside {lo:g}-{hi:g} deg/h, |RMS - {mid:g}| - {half:g} "
             f"(below 0: inside; bootstrap over Table 4's rows), deg/h",
             estimate=verdicts.bootstrap([e4], lambda e: abs(_rms(e) - mid) - half, seed=ss),
-            boundary=0.0,
-            holds_when="below",
-            unit="deg/h",
             decided_by=(
                 f"bootstrap over Table 4's {len(e4)} rows",
                 "the range read as the RMS error",
@@ -278,7 +268,8 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     ec, eh = cold.rows["err cold net"].to_numpy(), cold.rows["err hot net"].to_numpy()
     t5p = load_cold_test()
     out.append(
-        Claim(
+        Claim.of(
+            "C09",
             "after a cold start the cold-state net beats the hot net",
             f"Table 5: cold {t5p['paper_pos_error_cold_net_nmi_72h'].min():g}-"
             f"{t5p['paper_pos_error_cold_net_nmi_72h'].max():g} vs hot "
@@ -291,9 +282,6 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 lambda a, b: _rms(a) - _rms(b),
                 seed=bootstrap_seed(seed, "table4_cold_vs_hot"),
             ),
-            boundary=0.0,
-            holds_when="below",
-            unit="deg/h",
             decided_by=(
                 f"bootstrap over Table 4's {len(ec)} rows",
                 f"cold net: newrb on {len(ec) - 1} rows per fold, z-scored inputs, SPREAD "
@@ -349,7 +337,8 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
     hl = hot_leave_one_out(params).rows
     er, el = hl["err our RBF"].to_numpy(), hl["err straight line"].to_numpy()
     out.append(
-        Claim(
+        Claim.of(
+            "C06",
             "the relation is nonlinear: a network beats a straight line",
             "nonlinear, hence an RBF network",
             reading=f"input in {params.hot.input_unit}, goal as printed ({params.hot.goal_kind.upper()})",
@@ -358,9 +347,6 @@ def claims(params: StudyParams = StudyParams()) -> list[Claim]:
             estimate=verdicts.bootstrap(
                 [er, el], lambda a, b: _rms(a) - _rms(b), seed=bootstrap_seed(seed, "nonlinear")
             ),
-            boundary=0.0,
-            holds_when="below",
-            unit="deg/h",
             decided_by=(
                 f"leave-one-out over Table 2's {len(er)} rows",
                 "a straight line as the linear model",
@@ -447,7 +433,6 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     t3 = load_hot_test()
     printed = t3["paper_rbf_drift_deg_h"].to_numpy(float)
     coarse = int(printed_decimals(3, "paper_rbf_drift_deg_h").min())
-    bound_out = 0.5 * 10.0**-coarse
     out: list[Claim] = []
     readings = [
         ("arcmin", "MSE", "gaussian"),
@@ -470,15 +455,13 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         rtxt = f"input in {unit}, goal as {reading}, {wtxt}"
         tag = f"{unit}_{reading.lower()}" + ("_gauss" if width == "gaussian" else "")
         out.append(
-            Claim(
+            Claim.of(
+                "C02",
                 f"Table 3's RBF outputs reproduced to the printed {_ordinal(coarse)} decimal",
                 ", ".join(_printed(3, "paper_rbf_drift_deg_h")) + " deg/h",
                 reading=rtxt,
                 statistic="largest |our output - printed output| over Table 3's 3 rows, deg/h",
                 estimate=verdicts.exact(_maxabs(p3 - printed)),
-                boundary=bound_out,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=("rests on Table 3's 3 rows", f"{net.n_neurons} neurons"),
                 ours=", ".join(f"{v:.5f}" for v in p3),
                 key=f"gyro_t3_outputs_{tag}",
@@ -486,15 +469,13 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
             )
         )
         out.append(
-            Claim(
+            Claim.of(
+                "C01",
                 f"accuracy better than {lim:g} deg/h on the 3 hot tests (Table 3)",
                 f"max |err| {_f(_maxabs(t3['paper_error_deg_h']))} deg/h",
                 reading=rtxt,
                 statistic="largest |true - identified drift| over Table 3's 3 rows, deg/h",
                 estimate=verdicts.exact(_maxabs(y3 - p3)),
-                boundary=lim,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=(
                     "rests on Table 3's 3 rows only",
                     "reference: the paper's 72 h-optimal 'true' drift",
@@ -506,7 +487,8 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         )
         e = _hot_loo_errors(hot)
         out.append(
-            Claim(
+            Claim.of(
+                "C03",
                 f"accuracy better than {lim:g} deg/h (as RMS) under leave-one-out (Table 2)",
                 f"better than {lim:g} deg/h",
                 reading=rtxt,
@@ -514,9 +496,6 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 estimate=verdicts.bootstrap(
                     [e], _rms, seed=seeding.child(bootstrap_seed(seed, f"loo_{unit}"), 1, k)
                 ),
-                boundary=lim,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=(
                     "the accuracy read as an RMS error",
                     f"leave-one-out over Table 2's {len(e)} rows",
@@ -531,15 +510,13 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     gain = _unit_position_gain(params)
     paper_req = f"{req:g} deg/h needed for {goal:g} nmi/72 h"
     out.append(
-        Claim(
+        Claim.of(
+            "C05",
             f"{req:g} deg/h is needed for {goal:g} nmi/72 h",
             paper_req,
             reading=f"{req:g} deg/h suffices (drift alone)",
             statistic=f"worst 72 h position error from a residual axial drift of {req:g} deg/h alone, nmi",
             estimate=verdicts.exact(gain * req),
-            boundary=goal,
-            holds_when="below",
-            unit="nmi",
             decided_by=("static-base error model, no other error source",),
             ours=f"{gain:.0f} nmi per deg/h",
             key="gyro_required_suffices",
@@ -569,16 +546,14 @@ def reading_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     wr = _residual_required(params)
     s = params.sim
     out.append(
-        Claim(
+        Claim.of(
+            "C05",
             f"{req:g} deg/h is needed for {goal:g} nmi/72 h",
             paper_req,
             reading=f"{req:g} deg/h suffices, with the simulated residual errors",
             statistic=f"median over {wr.size} simulated hot tests of the worst 72 h error with the compensation off by "
             f"+-{req:g} deg/h (worse sign), nmi",
             estimate=verdicts.median_ci(wr),
-            boundary=goal,
-            holds_when="below",
-            unit="nmi",
             decided_by=(
                 f"simulated residual errors after alignment (1 sigma: tilt {s.tilt_sd_arcsec:g} arcsec, azimuth "
                 f"{s.azimuth_sd_arcsec:g} arcsec, accelerometer bias {s.accel_bias_sd_ug:g} ug, gyro bias "
@@ -676,16 +651,14 @@ def cold_world_claims(
         ):
             c = g[f"{m} RMS (deg/h)"].to_numpy()
             out.append(
-                Claim(
+                Claim.of(
+                    "C09",
                     "after a cold start the cold-state net beats the hot net",
                     paper5,
                     reading=f"simulated thermal world '{w.name}', cold net {how}",
                     statistic=f"median paired difference over {len(g)} draws of the RMS drift error on the 3 Table 5 "
                     f"runs, cold net - hot net, deg/h",
                     estimate=verdicts.paired_difference(c, hot),
-                    boundary=0.0,
-                    holds_when="below",
-                    unit="deg/h",
                     decided_by=common,
                     ours=f"median RMS cold {np.median(c):.5f} vs hot {np.median(hot):.5f}",
                     key=f"gyro_cold_world{k}_{tag}",
@@ -694,16 +667,14 @@ def cold_world_claims(
             )
         pos = gain * hot
         out.append(
-            Claim(
+            Claim.of(
+                "C08",
                 f"after a cold start the hot net leaves {plo:g}-{phi:g} nmi/72 h",
                 f"{plo:g}-{phi:g} nmi",
                 reading=f"simulated thermal world '{w.name}', the hot net's drift error alone",
                 statistic=f"median over {len(g)} draws of |P - {mid:g}| - {half:g}, P the worst 72 h error from the "
                 f"hot net's RMS drift error on the 3 Table 5 runs (below 0: inside the range), nmi",
                 estimate=verdicts.median_ci(np.abs(pos - mid) - half),
-                boundary=0.0,
-                holds_when="below",
-                unit="nmi",
                 decided_by=common
                 + ("position error from the axial drift error alone (no residual errors)",),
                 ours=f"median P {np.median(pos):.2f} nmi",
@@ -769,16 +740,14 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     ):
         d = implied_drift_error(cold_pos, gain, other_nmi)
         out.append(
-            Claim(
+            Claim.of(
+                "C10",
                 f"accuracy better than {lim:g} deg/h in the cold state",
                 f"better than {lim:g} deg/h",
                 reading=reading,
                 statistic="largest residual axial drift implied by Table 5's cold-net 72 h position errors "
                 "(position error / worst 72 h error per deg/h), deg/h",
                 estimate=verdicts.exact(d.max()),
-                boundary=lim,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=common + (extra,),
                 ours="implied "
                 + ", ".join(f"{v:.5f}" for v in d)
@@ -809,16 +778,14 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         rel_other = other_g / float(b["printed (nmi)"].min())
         bound = float(b["printed rounding (relative)"].max())
         out.append(
-            Claim(
+            Claim.of(
+                "C11",
                 f"Table 3's position errors before identification ({before} nmi/72 h)",
                 f"{before} nmi/72 h",
                 reading=reading,
                 statistic="largest |printed - ours| / printed over Table 3's 3 rows, ours the worst 72 h error the "
                 "row's uncompensated true drift leaves alone (ratio)",
                 estimate=verdicts.exact(b["relative gap"].max()),
-                boundary=bound,
-                holds_when="below",
-                unit="ratio",
                 floor=verdicts.Floor(
                     rel_other,
                     f"the other errors of the paper's own hot tests (up to {other_g:.2f} nmi of Table 3's "
@@ -866,15 +833,13 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         ),
     ):
         out.append(
-            Claim(
+            Claim.of(
+                "C15",
                 f"hot-state tests change temperature by less than {dmax:g} C",
                 f"below {dmax:g} C",
                 reading=reading,
                 statistic=f"largest span of the printed temperature range (max - min) over {where}'s rows, C",
                 estimate=verdicts.exact(spans.max()),
-                boundary=dmax,
-                holds_when="below",
-                unit="C",
                 decided_by=(
                     f"{where}'s {spans.size} rows as printed",
                     "the printed range read as the temperature over the alignment (Table 4 prints the "
@@ -887,7 +852,6 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         )
     # C13
     coarse = int(printed_decimals(3, "paper_rbf_drift_deg_h").min())
-    bound_out = 0.5 * 10.0**-coarse
     br = basis_readings(params).set_index("basis")
     others = br.drop(index="gaussian")
     names = ", ".join(others.index)
@@ -930,15 +894,13 @@ def register_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         ),
     ):
         out.append(
-            Claim(
+            Claim.of(
+                "C13",
                 "the choice of basis function matters little",
                 "Phi(.) has little influence on performance",
                 reading=reading,
                 statistic=stat,
                 estimate=verdicts.exact(est),
-                boundary=bound_out,
-                holds_when="below",
-                unit="deg/h",
                 decided_by=(
                     f"input in {params.hot.input_unit}, goal as {params.hot.goal_kind.upper()}",
                     extra,

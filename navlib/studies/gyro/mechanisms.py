@@ -66,8 +66,6 @@ from .simulation import _simulated_hot_tests
 CLAIM_C14 = "the choice of centres matters more than the basis function"
 CLAIM_C16 = "after 4 h alignment the 12 h latitude error is mainly due to the axial drift"
 CLAIM_C18 = "a single-axis rotation INS's accuracy is set by the axial gyro drift"
-#: C16's and C18's boundary: "mainly" is more than half.
-MAINLY_PCT = 50.0
 #: C14's basis functions at newrb's centres: the Gaussian and C13's others.
 BASES = ("gaussian", *BASIS_FUNCTIONS)
 
@@ -288,16 +286,14 @@ def centre_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         unit = "deg" if key.endswith("_deg") else h.input_unit
         goal = "RSS" if key.endswith("rss_goal") else h.goal_kind.upper()
         out.append(
-            Claim(
+            Claim.of(
+                "C14",
                 CLAIM_C14,
                 "centres c_i influence performance more than Phi(.)",
                 reading=reading,
                 statistic="spread (max - min) of the leave-one-out RMS over Table 2 across centre choices "
                 "- its spread across basis functions at newrb's centres (bootstrap over the rows), deg/h",
                 estimate=verdicts.bootstrap([rows], stat, seed=seed),
-                boundary=0.0,
-                holds_when="above",
-                unit="deg/h",
                 decided_by=(
                     f"input in {unit}, goal as {goal}; each fold's newrb fixes the neurons "
                     f"({int(run.neurons.min())}-{int(run.neurons.max())}) and the width",
@@ -429,16 +425,14 @@ def latitude_share_claims(params: StudyParams = StudyParams()) -> list[Claim]:
     for reading, est, key, data, extra in rows:
         sim_row = data == "simulated"
         out.append(
-            Claim(
+            Claim.of(
+                "C16",
                 CLAIM_C16,
                 "12 h latitude error mainly caused by the axial drift",
                 reading=reading,
                 statistic="axial drift's share of the summed squared 12 h latitude errors, Table 1 gain "
                 "times drift against the rest (bootstrap over the tests), %",
                 estimate=est,
-                boundary=MAINLY_PCT,
-                holds_when="above",
-                unit="%",
                 by_construction=sim_row,
                 why=(
                     "in simulation the other sources' part is set by the residual error sizes the book "
@@ -672,7 +666,8 @@ def rotation_claims(params: StudyParams = StudyParams()) -> list[Claim]:
         df = rotation_shares(r, d, acc, N_ROTATION_RUNS, s)
         med = df.median()
         out.append(
-            Claim(
+            Claim.of(
+                "C18",
                 CLAIM_C18,
                 "accuracy mainly determined by the axial gyro drift",
                 reading=reading,
@@ -680,9 +675,6 @@ def rotation_claims(params: StudyParams = StudyParams()) -> list[Claim]:
                 "drift, the horizontal gyros and the accelerometers, each alone, rotation on (median over "
                 "runs), %",
                 estimate=verdicts.median_ci(df["axial share (%)"].to_numpy()),
-                boundary=MAINLY_PCT,
-                holds_when="above",
-                unit="%",
                 decided_by=(
                     "static-base error model (navlib.sensors.ins), zero initial errors, no noise; runs "
                     "draw the rotation phase and the horizontal instruments' signs",

@@ -32,7 +32,7 @@ def test_table1_gaps_by_hand():
     assert row["relative gap"] == pytest.approx(d / np.abs(w["simulator_arcsec"]).max())
     assert row["largest gap (arcsec)"] == pytest.approx(d)
     # the drift term is Table 1's own closed form of the same linear equations: it must overlay
-    assert g.loc["axial gyro drift", "relative gap"] < diagnosis.TABLE1_BOUND
+    assert g.loc["axial gyro drift", "relative gap"] < reg.entry("C17").boundary
 
 
 def test_table1_claims_primary_is_the_worst_of_four():

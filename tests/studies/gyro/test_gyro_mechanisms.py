@@ -136,7 +136,7 @@ def test_rotation_share_needs_the_rotation(kind, verdict):
         "x",
         statistic="share",
         estimate=verdicts.median_ci(df["axial share (%)"].to_numpy()),
-        boundary=mech.MAINLY_PCT,
+        boundary=reg.entry("C18").boundary,
         holds_when="above",
         unit="%",
     )
